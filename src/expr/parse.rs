@@ -1,0 +1,288 @@
+//! A Pratt parser for expressions, with a bound on size and depth so that a
+//! hostile attribute cannot exhaust the stack.
+
+use super::{BinaryOp, Expr, ExprKind, Function};
+use crate::span::Span;
+
+/// Most nodes one expression may have.
+pub const MAX_NODES: usize = 10_000;
+/// Deepest nesting of one expression.
+pub const MAX_DEPTH: usize = 256;
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParseError {
+    /// Malformed syntax; the message says what was expected.
+    Syntax { span: Span, message: String },
+    UnknownFunction { span: Span, name: String },
+    WrongArgumentCount { span: Span, function: Function, given: usize },
+    TooLarge { span: Span },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+enum Token {
+    Number(f64),
+    Ident(String),
+    Op(char),
+    LParen,
+    RParen,
+    Comma,
+}
+
+/// Parses `text`, whose first byte is at absolute offset `base` in the source file.
+pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
+    let tokens = lex(text, base)?;
+    let end = base + text.len();
+    let mut parser = Parser {
+        tokens,
+        pos: 0,
+        nodes: 0,
+        end,
+    };
+    if parser.tokens.is_empty() {
+        return Err(ParseError::Syntax {
+            span: Span::new(base, end),
+            message: "expected a number or an expression, found nothing".into(),
+        });
+    }
+    let expr = parser.expression(0, 0)?;
+    if let Some((token, span)) = parser.tokens.get(parser.pos) {
+        let what = match token {
+            Token::RParen => "an unmatched ')'".to_string(),
+            other => format!("{} after a complete expression", describe(other)),
+        };
+        return Err(ParseError::Syntax {
+            span: *span,
+            message: format!("unexpected {what}"),
+        });
+    }
+    Ok(expr)
+}
+
+fn describe(token: &Token) -> String {
+    match token {
+        Token::Number(v) => format!("number {v}"),
+        Token::Ident(name) => format!("name '{name}'"),
+        Token::Op(c) => format!("'{c}'"),
+        Token::LParen => "'('".into(),
+        Token::RParen => "')'".into(),
+        Token::Comma => "','".into(),
+    }
+}
+
+fn lex(text: &str, base: usize) -> Result<Vec<(Token, Span)>, ParseError> {
+    let bytes = text.as_bytes();
+    let mut tokens = Vec::new();
+    let mut i = 0;
+    while i < bytes.len() {
+        let c = bytes[i];
+        let start = i;
+        match c {
+            b' ' | b'\t' | b'\n' | b'\r' => {
+                i += 1;
+                continue;
+            }
+            b'0'..=b'9' | b'.' => {
+                while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+                    i += 1;
+                }
+                if i < bytes.len() && (bytes[i] == b'e' || bytes[i] == b'E') {
+                    let mut j = i + 1;
+                    if j < bytes.len() && (bytes[j] == b'+' || bytes[j] == b'-') {
+                        j += 1;
+                    }
+                    if j < bytes.len() && bytes[j].is_ascii_digit() {
+                        while j < bytes.len() && bytes[j].is_ascii_digit() {
+                            j += 1;
+                        }
+                        i = j;
+                    }
+                }
+                let literal = &text[start..i];
+                let value: f64 = literal.parse().map_err(|_| ParseError::Syntax {
+                    span: Span::new(base + start, base + i),
+                    message: format!("'{literal}' is not a number"),
+                })?;
+                tokens.push((Token::Number(value), Span::new(base + start, base + i)));
+                continue;
+            }
+            b'+' | b'-' | b'*' | b'/' | b'^' => tokens.push((Token::Op(c as char), Span::new(base + i, base + i + 1))),
+            b'(' => tokens.push((Token::LParen, Span::new(base + i, base + i + 1))),
+            b')' => tokens.push((Token::RParen, Span::new(base + i, base + i + 1))),
+            b',' => tokens.push((Token::Comma, Span::new(base + i, base + i + 1))),
+            c if c.is_ascii_alphabetic() || c == b'_' => {
+                while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                    i += 1;
+                }
+                tokens.push((
+                    Token::Ident(text[start..i].to_string()),
+                    Span::new(base + start, base + i),
+                ));
+                continue;
+            }
+            _ => {
+                let ch = text[i..].chars().next().unwrap_or('?');
+                return Err(ParseError::Syntax {
+                    span: Span::new(base + i, base + i + ch.len_utf8()),
+                    message: format!("unexpected character '{ch}' in an expression"),
+                });
+            }
+        }
+        i += 1;
+    }
+    Ok(tokens)
+}
+
+struct Parser {
+    tokens: Vec<(Token, Span)>,
+    pos: usize,
+    nodes: usize,
+    end: usize,
+}
+
+/// Binding powers: (left, right). `^` is right-associative and binds tighter
+/// than unary minus on its left (-2^2 = -4), as in mathematics.
+fn infix_power(op: char) -> Option<(u8, u8, BinaryOp)> {
+    Some(match op {
+        '+' => (1, 2, BinaryOp::Add),
+        '-' => (1, 2, BinaryOp::Sub),
+        '*' => (3, 4, BinaryOp::Mul),
+        '/' => (3, 4, BinaryOp::Div),
+        '^' => (8, 7, BinaryOp::Pow),
+        _ => return None,
+    })
+}
+const PREFIX_POWER: u8 = 5;
+
+impl Parser {
+    fn peek(&self) -> Option<&(Token, Span)> {
+        self.tokens.get(self.pos)
+    }
+
+    fn end_span(&self) -> Span {
+        Span::new(self.end, self.end)
+    }
+
+    fn node(&mut self, span: Span) -> Result<(), ParseError> {
+        self.nodes += 1;
+        if self.nodes > MAX_NODES {
+            return Err(ParseError::TooLarge { span });
+        }
+        Ok(())
+    }
+
+    fn expression(&mut self, min_power: u8, depth: usize) -> Result<Expr, ParseError> {
+        let mut left = self.prefix(depth)?;
+        while let Some((Token::Op(op), _)) = self.peek() {
+            let Some((lp, rp, bin)) = infix_power(*op) else { break };
+            if lp < min_power {
+                break;
+            }
+            self.pos += 1;
+            let right = self.expression(rp, depth + 1)?;
+            let span = Span::new(left.span.start as usize, right.span.end as usize);
+            self.node(span)?;
+            left = Expr {
+                kind: ExprKind::Binary(bin, Box::new(left), Box::new(right)),
+                span,
+            };
+        }
+        Ok(left)
+    }
+
+    fn prefix(&mut self, depth: usize) -> Result<Expr, ParseError> {
+        let Some((token, span)) = self.peek().cloned() else {
+            return Err(ParseError::Syntax {
+                span: self.end_span(),
+                message: "expected a number, a name or '(' but the expression ends".into(),
+            });
+        };
+        if depth > MAX_DEPTH {
+            return Err(ParseError::TooLarge { span });
+        }
+        self.node(span)?;
+        self.pos += 1;
+        match token {
+            Token::Number(value) => Ok(Expr::number(value, span)),
+            Token::Op('-') => {
+                let inner = self.expression(PREFIX_POWER, depth + 1)?;
+                let span = Span::new(span.start as usize, inner.span.end as usize);
+                Ok(Expr {
+                    kind: ExprKind::Neg(Box::new(inner)),
+                    span,
+                })
+            }
+            Token::Op('+') => self.expression(PREFIX_POWER, depth + 1),
+            Token::LParen => {
+                let inner = self.expression(0, depth + 1)?;
+                self.expect_rparen(span)?;
+                Ok(inner)
+            }
+            Token::Ident(name) => {
+                if matches!(self.peek(), Some((Token::LParen, _))) {
+                    self.pos += 1;
+                    self.call(name, span, depth)
+                } else {
+                    Ok(Expr {
+                        kind: ExprKind::Name(name),
+                        span,
+                    })
+                }
+            }
+            other => Err(ParseError::Syntax {
+                span,
+                message: format!("expected a number, a name or '(', found {}", describe(&other)),
+            }),
+        }
+    }
+
+    fn call(&mut self, name: String, name_span: Span, depth: usize) -> Result<Expr, ParseError> {
+        let Some(function) = Function::lookup(&name) else {
+            return Err(ParseError::UnknownFunction { span: name_span, name });
+        };
+        let mut args = Vec::new();
+        if !matches!(self.peek(), Some((Token::RParen, _))) {
+            loop {
+                args.push(self.expression(0, depth + 1)?);
+                match self.peek() {
+                    Some((Token::Comma, _)) => self.pos += 1,
+                    _ => break,
+                }
+            }
+        }
+        let close = self.expect_rparen(name_span)?;
+        let span = Span::new(name_span.start as usize, close.end as usize);
+        let arity_ok = if function.is_variadic() {
+            args.len() >= 2
+        } else {
+            args.len() == 1
+        };
+        if !arity_ok {
+            return Err(ParseError::WrongArgumentCount {
+                span,
+                function,
+                given: args.len(),
+            });
+        }
+        Ok(Expr {
+            kind: ExprKind::Call(function, args),
+            span,
+        })
+    }
+
+    fn expect_rparen(&mut self, open: Span) -> Result<Span, ParseError> {
+        match self.peek().cloned() {
+            Some((Token::RParen, span)) => {
+                self.pos += 1;
+                Ok(span)
+            }
+            Some((token, span)) => Err(ParseError::Syntax {
+                span,
+                message: format!("expected ')' to close the '(' at byte {}, found {}", open.start, describe(&token)),
+            }),
+            None => Err(ParseError::Syntax {
+                span: self.end_span(),
+                message: "expected ')' but the expression ends".into(),
+            }),
+        }
+    }
+}

@@ -1,0 +1,162 @@
+//! XML syntax: the only module that touches the XML parser. It turns text into an
+//! owned element tree with byte spans on every name and value, refusing DTDs,
+//! over-deep nesting and oversized input before any later stage sees them.
+
+mod tree;
+
+pub use tree::{Attribute, Element};
+
+use crate::diag::{Code, Diagnostic};
+use crate::span::{SourceFile, Span};
+
+/// Resource limits of the front end; each has a command-line option that raises it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Limits {
+    /// Largest accepted input, in bytes (`--max-file-size`).
+    pub max_file_size: usize,
+    /// Deepest accepted element nesting, the root being level 1 (`--max-depth`).
+    pub max_depth: usize,
+    /// Most XML nodes (elements, text, comments) in one document (`--max-nodes`).
+    pub max_nodes: u32,
+}
+
+impl Default for Limits {
+    fn default() -> Limits {
+        Limits {
+            max_file_size: 256 * 1024 * 1024,
+            max_depth: 64,
+            max_nodes: 50_000_000,
+        }
+    }
+}
+
+/// Parses `source` into an owned tree, or says why it cannot.
+pub fn parse(source: &SourceFile, limits: &Limits) -> Result<Element, Diagnostic> {
+    let text = source.text.as_str();
+    if text.len() > limits.max_file_size {
+        return Err(Diagnostic::new(
+            Code::FileTooLarge,
+            None,
+            format!(
+                "the file is {} bytes, over the limit of {} bytes",
+                text.len(),
+                limits.max_file_size
+            ),
+        )
+        .with_help("raise the limit with --max-file-size BYTES"));
+    }
+    // Refuse a DTD before the parser sees it: no entity is ever declared or expanded.
+    if let Some(pos) = find_doctype(text) {
+        return Err(Diagnostic::new(
+            Code::DtdRefused,
+            Span::new(pos, pos + "<!DOCTYPE".len()),
+            "the document has a document type declaration (<!DOCTYPE …>); geomc never reads DTDs or expands their entities",
+        )
+        .with_help("remove the <!DOCTYPE …> block"));
+    }
+    let options = roxmltree::ParsingOptions {
+        allow_dtd: false,
+        nodes_limit: limits.max_nodes,
+        ..roxmltree::ParsingOptions::default()
+    };
+    let document = roxmltree::Document::parse_with_options(text, options)
+        .map_err(|error| xml_error(source, &error, limits))?;
+    let root = document.root_element();
+    check_depth(root, limits)?;
+    Ok(tree::build(root))
+}
+
+fn find_doctype(text: &str) -> Option<usize> {
+    let bytes = text.as_bytes();
+    let needle = b"<!DOCTYPE";
+    bytes
+        .windows(needle.len())
+        .position(|w| w.eq_ignore_ascii_case(needle))
+}
+
+/// Depth check without recursion, so a hostile file cannot overflow the stack.
+fn check_depth(root: roxmltree::Node, limits: &Limits) -> Result<(), Diagnostic> {
+    let mut stack = vec![(root, 1usize)];
+    while let Some((node, depth)) = stack.pop() {
+        if depth > limits.max_depth {
+            let range = node.range();
+            let name_end = range.start + 1 + node.tag_name().name().len();
+            return Err(Diagnostic::new(
+                Code::NestingTooDeep,
+                Span::new(range.start, name_end),
+                format!(
+                    "element <{}> is nested {depth} levels deep, over the limit of {}",
+                    node.tag_name().name(),
+                    limits.max_depth
+                ),
+            )
+            .with_help("flatten the nesting, or raise the limit with --max-depth N"));
+        }
+        stack.extend(node.children().filter(|c| c.is_element()).map(|c| (c, depth + 1)));
+    }
+    Ok(())
+}
+
+fn xml_error(source: &SourceFile, error: &roxmltree::Error, limits: &Limits) -> Diagnostic {
+    use roxmltree::Error as E;
+    match error {
+        E::NodesLimitReached => Diagnostic::new(
+            Code::TooManyNodes,
+            None,
+            format!("the document has more than {} XML nodes", limits.max_nodes),
+        )
+        .with_help("raise the limit with --max-nodes N"),
+        E::DtdDetected => Diagnostic::new(
+            Code::DtdRefused,
+            None,
+            "the document has a document type declaration; geomc never reads DTDs",
+        )
+        .with_help("remove the <!DOCTYPE …> block"),
+        E::UnknownEntityReference(name, _) => Diagnostic::new(
+            Code::XmlSyntax,
+            position_span(source, error.pos()),
+            format!("unknown entity reference '&{name};': geomc knows only XML's five predefined entities"),
+        )
+        .with_help("write the character itself, or one of &lt; &gt; &amp; &quot; &apos;"),
+        _ => {
+            let message = error.to_string();
+            // roxmltree appends " at L:C"; the position goes into the span instead.
+            let message = match message.rfind(" at ") {
+                Some(i) => message[..i].to_string(),
+                None => message,
+            };
+            Diagnostic::new(
+                Code::XmlSyntax,
+                position_span(source, error.pos()),
+                lowercase_first(&message),
+            )
+            .with_help("fix the XML at this position")
+        }
+    }
+}
+
+fn position_span(source: &SourceFile, pos: roxmltree::TextPos) -> Span {
+    let offset = source
+        .lines
+        .offset_of(
+            &source.text,
+            crate::span::LineCol {
+                line: pos.row,
+                column: pos.col,
+            },
+        )
+        .unwrap_or(0);
+    let end = source.text[offset..]
+        .chars()
+        .next()
+        .map_or(offset, |c| offset + c.len_utf8());
+    Span::new(offset, end)
+}
+
+fn lowercase_first(text: &str) -> String {
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(first) => first.to_lowercase().chain(chars).collect(),
+        None => String::new(),
+    }
+}
