@@ -10,3 +10,6 @@ pub mod diag;
 pub mod expr;
 pub mod span;
 pub mod syntax;
+pub mod doc;
+pub mod geom;
+pub mod ir;

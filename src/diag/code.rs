@@ -68,6 +68,8 @@ codes! {
         "The attribute takes one of a fixed set of words (for example a coordinate's name is X, Y or Z). Use one of the values the message lists.";
     ConflictingForms = "E117", Error, "conflicting forms of one element",
         "The element mixes two ways of being given (for example a parallelepiped with both <base_point> and <first_point>, or a centre with both coordinates and a point reference). Keep one form.";
+    OutOfOrder = "E118", Error, "element out of order",
+        "Some elements list their children in a fixed order, as the schema does (for example an ellipse's <center> comes before its two <radius_vertex> elements, a parallelepiped's <base_point> before its three <vertex> elements). Move the element to the place the message names.";
     BadExpression = "E120", Error, "malformed number or expression",
         "A numeric attribute holds a number, a name, or an arithmetic expression over them: + - * / ^, parentheses, unary minus, the functions sqrt sin cos tan asin acos atan exp ln abs min max, and pi. Fix the expression at the position shown.";
     UnknownFunction = "E121", Error, "unknown function",

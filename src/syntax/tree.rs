@@ -77,6 +77,9 @@ fn shell(node: roxmltree::Node) -> Element {
         span: Span::from_range(range),
         attributes: node
             .attributes()
+            // Namespaced attributes (xsi:noNamespaceSchemaLocation) belong to
+            // the XML tooling, not to the format.
+            .filter(|a| a.namespace().is_none())
             .map(|a| Attribute {
                 name: a.name().to_string(),
                 name_span: Span::from_range(a.range_qname()),

@@ -1,0 +1,521 @@
+//! The structure of geomc's XML format, as data: which elements exist where,
+//! their attributes and their children. The structural checker walks it, and a
+//! test compares it with `schema/geomc.xsd` so the two cannot drift apart.
+
+/// What an attribute holds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum AttrKind {
+    /// A number or an expression over parameters and basis coordinates.
+    Expr,
+    /// The name this element defines.
+    Name,
+    /// One reference to a named object (`ref`, `point`, `cs`, `surface`, …).
+    Ref,
+    /// Whitespace-separated references.
+    RefList,
+    /// Free text (a description, a material name).
+    Text,
+    /// One of a fixed set of words.
+    Enum(&'static [&'static str]),
+}
+
+#[derive(Debug, Clone, Copy)]
+pub struct Attr {
+    pub name: &'static str,
+    pub required: bool,
+    pub kind: AttrKind,
+}
+
+/// A child element as it may occur in its parent.
+#[derive(Debug, Clone, Copy)]
+pub struct Child {
+    pub rule: &'static Rule,
+    pub min: u32,
+    /// `None` = unbounded.
+    pub max: Option<u32>,
+}
+
+/// How an element's children are arranged (the XSD particle it maps to).
+#[derive(Debug, Clone, Copy)]
+pub enum Content {
+    /// No children.
+    Empty,
+    /// `xs:all`: each child at most once, in any order.
+    All(&'static [Child]),
+    /// `xs:sequence`: children in this order, each within its counts.
+    Sequence(&'static [Child]),
+    /// `xs:choice minOccurs=min maxOccurs=max` over single elements: any of
+    /// them, in any order, `min..=max` children in all.
+    Choice {
+        options: &'static [&'static Rule],
+        min: u32,
+        max: Option<u32>,
+    },
+    /// `xs:choice` between sequences: exactly one form, each form a sequence.
+    Forms(&'static [&'static [Child]]),
+}
+
+/// One element declaration in one context.
+#[derive(Debug)]
+pub struct Rule {
+    pub name: &'static str,
+    pub attrs: &'static [Attr],
+    /// Any further attribute (`xs:anyAttribute`), as basis coordinate values have.
+    pub any_attrs: bool,
+    pub content: Content,
+}
+
+impl Rule {
+    pub fn attr(&self, name: &str) -> Option<&'static Attr> {
+        self.attrs.iter().find(|a| a.name == name)
+    }
+
+    /// Every child rule this element may contain, in declaration order.
+    pub fn child_rules(&self) -> Vec<&'static Rule> {
+        match self.content {
+            Content::Empty => Vec::new(),
+            Content::All(children) | Content::Sequence(children) => {
+                children.iter().map(|c| c.rule).collect()
+            }
+            Content::Choice { options, .. } => options.to_vec(),
+            Content::Forms(forms) => {
+                let mut out: Vec<&'static Rule> = Vec::new();
+                for child in forms.iter().flat_map(|f| f.iter()) {
+                    if !out.iter().any(|r| r.name == child.rule.name) {
+                        out.push(child.rule);
+                    }
+                }
+                out
+            }
+        }
+    }
+
+    pub fn child_rule(&self, name: &str) -> Option<&'static Rule> {
+        self.child_rules().into_iter().find(|r| r.name == name)
+    }
+}
+
+const fn req(name: &'static str, kind: AttrKind) -> Attr {
+    Attr { name, required: true, kind }
+}
+const fn opt(name: &'static str, kind: AttrKind) -> Attr {
+    Attr { name, required: false, kind }
+}
+const fn one(rule: &'static Rule) -> Child {
+    Child { rule, min: 1, max: Some(1) }
+}
+const fn maybe(rule: &'static Rule) -> Child {
+    Child { rule, min: 0, max: Some(1) }
+}
+const fn exactly(rule: &'static Rule, n: u32) -> Child {
+    Child { rule, min: n, max: Some(n) }
+}
+const fn many(rule: &'static Rule, min: u32) -> Child {
+    Child { rule, min, max: None }
+}
+const fn leaf(name: &'static str, attrs: &'static [Attr]) -> Rule {
+    Rule { name, attrs, any_attrs: false, content: Content::Empty }
+}
+
+use AttrKind::{Expr, Name, Ref, RefList, Text};
+
+// ---- shared leaf shapes ----
+
+/// A point given by coordinates (any of x, y, z) or by reference to a named point.
+const POINT_ATTRS: &[Attr] = &[
+    opt("x", Expr),
+    opt("y", Expr),
+    opt("z", Expr),
+    opt("point", Ref),
+];
+/// A vector (normal, axis, rotation angles, semi-axes): missing components are 0.
+const VECTOR_ATTRS: &[Attr] = &[opt("x", Expr), opt("y", Expr), opt("z", Expr)];
+const VALUE_ATTRS: &[Attr] = &[req("value", Expr)];
+const NAMED: &[Attr] = &[req("name", Name), opt("cs", Ref)];
+
+pub static CENTER: Rule = leaf("center", POINT_ATTRS);
+pub static BASE_POINT: Rule = leaf("base_point", POINT_ATTRS);
+pub static VERTEX_POINT: Rule = leaf("vertex", POINT_ATTRS);
+pub static FIRST_POINT: Rule = leaf("first_point", POINT_ATTRS);
+pub static SECOND_POINT: Rule = leaf("second_point", POINT_ATTRS);
+pub static BOTTOM_CENTER: Rule = leaf("bottom_center", POINT_ATTRS);
+pub static TOP_CENTER: Rule = leaf("top_center", POINT_ATTRS);
+pub static BEGIN_POINT: Rule = leaf("begin_point", POINT_ATTRS);
+pub static END_POINT: Rule = leaf("end_point", POINT_ATTRS);
+pub static RADIUS_VERTEX: Rule = leaf("radius_vertex", POINT_ATTRS);
+pub static ORIGIN: Rule = leaf("origin", POINT_ATTRS);
+pub static APEX: Rule = leaf("apex", POINT_ATTRS);
+pub static NEAR: Rule = leaf("near", POINT_ATTRS);
+
+pub static NORMAL: Rule = leaf("normal", VECTOR_ATTRS);
+pub static AXIS: Rule = leaf("axis", VECTOR_ATTRS);
+pub static ROTATION: Rule = leaf("rotation", VECTOR_ATTRS);
+pub static SEMI_AXES: Rule = leaf("semi_axes", VECTOR_ATTRS);
+
+pub static RADIUS: Rule = leaf("radius", VALUE_ATTRS);
+pub static BOTTOM_RADIUS: Rule = leaf("bottom_radius", VALUE_ATTRS);
+pub static TOP_RADIUS: Rule = leaf("top_radius", VALUE_ATTRS);
+pub static MAJOR_RADIUS: Rule = leaf("major_radius", VALUE_ATTRS);
+pub static MINOR_RADIUS: Rule = leaf("minor_radius", VALUE_ATTRS);
+pub static HALF_ANGLE: Rule = leaf("half_angle", VALUE_ATTRS);
+
+// ---- parameters and basis coordinates ----
+
+pub static PARAMETER: Rule = leaf(
+    "parameter",
+    &[req("name", Name), req("value", Expr), opt("description", Text)],
+);
+pub static PARAMETERS: Rule = Rule {
+    name: "parameters",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Choice { options: &[&PARAMETER], min: 0, max: None },
+};
+/// `<value x1='1' x2='10'/>`: every attribute defines a basis coordinate.
+pub static BASIS_VALUE: Rule = Rule {
+    name: "value",
+    attrs: &[],
+    any_attrs: true,
+    content: Content::Empty,
+};
+pub static COORDINATE: Rule = Rule {
+    name: "coordinate",
+    attrs: &[req("name", AttrKind::Enum(&["X", "Y", "Z"]))],
+    any_attrs: false,
+    content: Content::Sequence(&[many(&BASIS_VALUE, 1)]),
+};
+pub static BASIS_COORDINATE: Rule = Rule {
+    name: "basis_coordinate",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Choice { options: &[&COORDINATE], min: 1, max: None },
+};
+pub static COORDINATE_SYSTEM: Rule = Rule {
+    name: "coordinate_system",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::All(&[maybe(&ORIGIN), maybe(&ROTATION)]),
+};
+
+// ---- paper 000's primitives and the rest of its kernel ----
+
+pub static POINT_VALUE: Rule = leaf("value", VECTOR_ATTRS);
+pub static POINT: Rule = Rule {
+    name: "point",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[many(&POINT_VALUE, 1)]),
+};
+pub static ELLIPSE: Rule = Rule {
+    name: "ellipse",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[one(&CENTER), exactly(&RADIUS_VERTEX, 2)]),
+};
+pub static CIRCLE: Rule = Rule {
+    name: "circle",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::All(&[one(&CENTER), one(&RADIUS)]),
+};
+pub static TRIANGLE: Rule = Rule {
+    name: "triangle",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[exactly(&VERTEX_POINT, 3)]),
+};
+pub static PARALLELOGRAM: Rule = Rule {
+    name: "parallelogram",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[one(&BASE_POINT), exactly(&VERTEX_POINT, 2)]),
+};
+pub static POLY_LINE_SEGMENT: Rule = Rule {
+    name: "line",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Sequence(&[one(&BEGIN_POINT), one(&END_POINT)]),
+};
+pub static POLY_LINE: Rule = Rule {
+    name: "poly_line",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[many(&POLY_LINE_SEGMENT, 1)]),
+};
+pub static TRUNCATED_CONE: Rule = Rule {
+    name: "truncated_cone",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::All(&[
+        one(&BOTTOM_RADIUS),
+        maybe(&TOP_RADIUS),
+        one(&BOTTOM_CENTER),
+        one(&TOP_CENTER),
+    ]),
+};
+pub static PARALLELEPIPED: Rule = Rule {
+    name: "parallelepiped",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Forms(&[
+        &[one(&BASE_POINT), exactly(&VERTEX_POINT, 3)],
+        &[one(&FIRST_POINT), one(&SECOND_POINT)],
+    ]),
+};
+pub static SPHERE: Rule = Rule {
+    name: "sphere",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::All(&[one(&CENTER), one(&RADIUS)]),
+};
+pub static ELLIPSOID: Rule = Rule {
+    name: "ellipsoid",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::All(&[one(&CENTER), one(&SEMI_AXES)]),
+};
+pub static TORUS: Rule = Rule {
+    name: "torus",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::All(&[one(&CENTER), one(&MAJOR_RADIUS), one(&MINOR_RADIUS), maybe(&AXIS)]),
+};
+pub static PLANE: Rule = Rule {
+    name: "plane",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::All(&[one(&BASE_POINT), one(&NORMAL)]),
+};
+
+// ---- transforms and replication ----
+
+pub static SHIFT: Rule = leaf("shift", VECTOR_ATTRS);
+/// Rotation angles in degrees about the x, y, z axes through `center` (default the origin).
+pub static ROTATE: Rule = leaf(
+    "rotate",
+    &[
+        opt("x", Expr),
+        opt("y", Expr),
+        opt("z", Expr),
+        opt("center", Ref),
+    ],
+);
+pub static SCALE: Rule = leaf(
+    "scale",
+    &[opt("x", Expr), opt("y", Expr), opt("z", Expr), opt("factor", Expr)],
+);
+const STEPS: &[&Rule] = &[&SHIFT, &ROTATE, &SCALE];
+pub static TRANSFORM: Rule = Rule {
+    name: "transform",
+    attrs: &[req("name", Name), req("ref", Ref)],
+    any_attrs: false,
+    content: Content::Choice { options: STEPS, min: 1, max: None },
+};
+pub static REPLICATE: Rule = Rule {
+    name: "replicate",
+    attrs: &[req("name", Name), req("ref", Ref), req("count", Expr)],
+    any_attrs: false,
+    content: Content::Choice { options: STEPS, min: 1, max: None },
+};
+
+// ---- explicit topology ----
+
+pub static SURFACE_PLANE: Rule = Rule {
+    name: "plane",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::All(&[one(&BASE_POINT), one(&NORMAL)]),
+};
+pub static SURFACE_SPHERE: Rule = Rule {
+    name: "sphere",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::All(&[one(&CENTER), one(&RADIUS)]),
+};
+pub static SURFACE_CYLINDER: Rule = Rule {
+    name: "cylinder",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::All(&[one(&BASE_POINT), one(&AXIS), one(&RADIUS)]),
+};
+pub static SURFACE_CONE: Rule = Rule {
+    name: "cone",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::All(&[one(&APEX), one(&AXIS), one(&HALF_ANGLE)]),
+};
+/// xx·x² + yy·y² + zz·z² + xy·xy + yz·yz + zx·zx + x·x + y·y + z·z + c = 0.
+pub static SURFACE_QUADRIC: Rule = leaf(
+    "quadric",
+    &[
+        opt("xx", Expr),
+        opt("yy", Expr),
+        opt("zz", Expr),
+        opt("xy", Expr),
+        opt("yz", Expr),
+        opt("zx", Expr),
+        opt("x", Expr),
+        opt("y", Expr),
+        opt("z", Expr),
+        opt("c", Expr),
+    ],
+);
+/// S(x, y, z) = 0 for an expression in the free variables x, y, z.
+pub static SURFACE_IMPLICIT: Rule = leaf("implicit", &[req("equation", Expr)]);
+pub static SURFACE: Rule = Rule {
+    name: "surface",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Forms(&[
+        &[one(&SURFACE_PLANE)],
+        &[one(&SURFACE_SPHERE)],
+        &[one(&SURFACE_CYLINDER)],
+        &[one(&SURFACE_CONE)],
+        &[one(&SURFACE_QUADRIC)],
+        &[one(&SURFACE_IMPLICIT)],
+    ]),
+};
+
+/// The straight segment between an edge's two vertices.
+pub static LINE_STRAIGHT: Rule = leaf("straight", &[]);
+/// A circular arc about `center`, counter-clockwise about `normal` (default +z).
+pub static LINE_CIRCLE_ARC: Rule = Rule {
+    name: "circle_arc",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::All(&[one(&CENTER), maybe(&NORMAL)]),
+};
+/// An elliptic arc: centre and the ends of the two semi-axes, as `ellipse`.
+pub static LINE_ELLIPSE_ARC: Rule = Rule {
+    name: "ellipse_arc",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Sequence(&[one(&CENTER), exactly(&RADIUS_VERTEX, 2)]),
+};
+/// The intersection curve of two surfaces.
+pub static LINE_INTERSECTION: Rule = leaf("intersection", &[req("surfaces", RefList)]);
+pub static LINE: Rule = Rule {
+    name: "line",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Forms(&[
+        &[one(&LINE_STRAIGHT)],
+        &[one(&LINE_CIRCLE_ARC)],
+        &[one(&LINE_ELLIPSE_ARC)],
+        &[one(&LINE_INTERSECTION)],
+    ]),
+};
+
+/// A vertex as the intersection of three surfaces or two lines, found by
+/// Newton's method from the `near` hint.
+pub static VERTEX_INTERSECTION: Rule = Rule {
+    name: "intersection",
+    attrs: &[opt("surfaces", RefList), opt("lines", RefList)],
+    any_attrs: false,
+    content: Content::Sequence(&[one(&NEAR)]),
+};
+pub static VERTEX: Rule = Rule {
+    name: "vertex",
+    attrs: &[
+        req("name", Name),
+        opt("cs", Ref),
+        opt("x", Expr),
+        opt("y", Expr),
+        opt("z", Expr),
+        opt("point", Ref),
+    ],
+    any_attrs: false,
+    content: Content::Sequence(&[maybe(&VERTEX_INTERSECTION)]),
+};
+pub static EDGE: Rule = leaf(
+    "edge",
+    &[
+        req("name", Name),
+        opt("line", Ref),
+        req("begin", Ref),
+        req("end", Ref),
+    ],
+);
+pub static LOOP: Rule = leaf("loop", &[req("edges", RefList)]);
+pub static FACE: Rule = Rule {
+    name: "face",
+    attrs: &[req("name", Name), req("surface", Ref), opt("edges", RefList)],
+    any_attrs: false,
+    content: Content::Sequence(&[many(&LOOP, 0)]),
+};
+
+// ---- subdomains and boundaries ----
+
+pub static SOLID: Rule = leaf("solid", &[req("ref", Ref)]);
+static SOLID_TREE: [&Rule; 4] = [&SOLID, &UNION, &INTERSECTION, &DIFFERENCE];
+pub static UNION: Rule = Rule {
+    name: "union",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Choice { options: &SOLID_TREE, min: 2, max: None },
+};
+pub static INTERSECTION: Rule = Rule {
+    name: "intersection",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Choice { options: &SOLID_TREE, min: 2, max: None },
+};
+/// The first operand minus all the others.
+pub static DIFFERENCE: Rule = Rule {
+    name: "difference",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Choice { options: &SOLID_TREE, min: 2, max: None },
+};
+pub static SUBDOMAIN: Rule = Rule {
+    name: "subdomain",
+    attrs: &[req("name", Name), opt("faces", RefList), opt("material", Text)],
+    any_attrs: false,
+    content: Content::Choice { options: &SOLID_TREE, min: 0, max: Some(1) },
+};
+pub static BOUNDARY: Rule = leaf(
+    "boundary",
+    &[req("name", Name), opt("faces", RefList), opt("edges", RefList)],
+);
+
+// ---- the root ----
+
+pub static GEOMETRY: Rule = Rule {
+    name: "geometry",
+    attrs: &[
+        req("version", AttrKind::Enum(&["1"])),
+        opt("dimension", AttrKind::Enum(&["2", "3"])),
+        opt("name", Text),
+    ],
+    any_attrs: false,
+    content: Content::Choice {
+        options: &[
+            &PARAMETERS,
+            &BASIS_COORDINATE,
+            &COORDINATE_SYSTEM,
+            &POINT,
+            &ELLIPSE,
+            &CIRCLE,
+            &TRIANGLE,
+            &PARALLELOGRAM,
+            &POLY_LINE,
+            &TRUNCATED_CONE,
+            &PARALLELEPIPED,
+            &SPHERE,
+            &ELLIPSOID,
+            &TORUS,
+            &PLANE,
+            &TRANSFORM,
+            &REPLICATE,
+            &SURFACE,
+            &LINE,
+            &VERTEX,
+            &EDGE,
+            &FACE,
+            &SUBDOMAIN,
+            &BOUNDARY,
+        ],
+        min: 0,
+        max: None,
+    },
+};

@@ -1,0 +1,286 @@
+//! The structural check: walks the element tree against the [grammar](super::grammar)
+//! and reports unknown, missing, duplicate and out-of-order elements and attributes,
+//! text where none belongs, and enumeration values outside their set.
+
+use super::grammar::{AttrKind, Child, Content, Rule};
+use crate::diag::{did_you_mean, Code, Diagnostic, Diagnostics};
+use crate::syntax::Element;
+
+/// Checks `root` (and everything below it) against `rule`.
+pub fn check(root: &Element, rule: &'static Rule, diags: &mut Diagnostics) {
+    let mut stack = vec![(root, rule)];
+    while let Some((element, rule)) = stack.pop() {
+        check_attributes(element, rule, diags);
+        for (text, span) in &element.text {
+            diags.push(
+                Diagnostic::new(
+                    Code::UnexpectedText,
+                    *span,
+                    format!("unexpected text '{}' inside <{}>", abbreviate(text), element.name),
+                )
+                .with_help("put data in attributes; use an XML comment <!-- … --> for notes"),
+            );
+        }
+        let known: Vec<&Element> = check_children(element, rule, diags);
+        for child in known.into_iter().rev() {
+            if let Some(child_rule) = rule.child_rule(&child.name) {
+                stack.push((child, child_rule));
+            }
+        }
+    }
+}
+
+fn abbreviate(text: &str) -> String {
+    let mut out: String = text.chars().take(40).collect();
+    if text.chars().count() > 40 {
+        out.push('…');
+    }
+    out
+}
+
+fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
+    for attr in &element.attributes {
+        match rule.attr(&attr.name) {
+            Some(spec) => {
+                if let AttrKind::Enum(values) = spec.kind {
+                    if !values.contains(&attr.value.trim()) {
+                        let listed = values.iter().map(|v| format!("\"{v}\"")).collect::<Vec<_>>().join(", ");
+                        diags.push(
+                            Diagnostic::new(
+                                Code::InvalidValue,
+                                attr.value_span,
+                                format!(
+                                    "{}=\"{}\" on <{}> is not one of {listed}",
+                                    attr.name, attr.value, element.name
+                                ),
+                            )
+                            .with_help(format!("use one of {listed}")),
+                        );
+                    }
+                }
+                if spec.kind == AttrKind::Name && attr.value.trim().is_empty() {
+                    diags.push(Diagnostic::new(
+                        Code::InvalidValue,
+                        attr.value_span,
+                        format!("<{}> has an empty name", element.name),
+                    ).with_help("give the object a name of letters, digits, '_' and '-'"));
+                }
+            }
+            None if rule.any_attrs => {}
+            None => {
+                let names = rule.attrs.iter().map(|a| a.name);
+                let mut d = Diagnostic::new(
+                    Code::UnknownAttribute,
+                    attr.name_span,
+                    format!("unknown attribute '{}' on <{}>", attr.name, element.name),
+                );
+                d.help = Some(match did_you_mean(&attr.name, names) {
+                    Some(best) => format!("did you mean '{best}'?"),
+                    None if rule.attrs.is_empty() => format!("<{}> takes no attributes", element.name),
+                    None => format!(
+                        "<{}> takes {}",
+                        element.name,
+                        rule.attrs.iter().map(|a| a.name).collect::<Vec<_>>().join(", ")
+                    ),
+                });
+                diags.push(d);
+            }
+        }
+    }
+    for spec in rule.attrs.iter().filter(|a| a.required) {
+        if element.attribute(spec.name).is_none() {
+            diags.push(
+                Diagnostic::new(
+                    Code::MissingAttribute,
+                    element.name_span,
+                    format!("<{}> needs the attribute '{}'", element.name, spec.name),
+                )
+                .with_help(format!("add {}=\"…\"", spec.name)),
+            );
+        }
+    }
+}
+
+/// Reports problems with the children and returns the ones whose rules are known.
+fn check_children<'e>(element: &'e Element, rule: &'static Rule, diags: &mut Diagnostics) -> Vec<&'e Element> {
+    let allowed = rule.child_rules();
+    let mut known = Vec::new();
+    for child in &element.children {
+        if allowed.iter().any(|r| r.name == child.name) {
+            known.push(child);
+        } else {
+            let mut d = Diagnostic::new(
+                Code::UnknownElement,
+                child.name_span,
+                format!("unknown element <{}> inside <{}>", child.name, element.name),
+            );
+            d.help = Some(match did_you_mean(&child.name, allowed.iter().map(|r| r.name)) {
+                Some(best) => format!("did you mean <{best}>?"),
+                None if allowed.is_empty() => format!("<{}> has no child elements", element.name),
+                None => format!(
+                    "<{}> may contain {}",
+                    element.name,
+                    allowed.iter().map(|r| format!("<{}>", r.name)).collect::<Vec<_>>().join(", ")
+                ),
+            });
+            diags.push(d);
+        }
+    }
+    match rule.content {
+        Content::Empty => {}
+        Content::All(children) => {
+            for spec in children {
+                check_count(element, &known, spec, diags);
+            }
+        }
+        Content::Sequence(children) => {
+            for spec in children {
+                check_count(element, &known, spec, diags);
+            }
+            check_order(element, &known, children, diags);
+        }
+        Content::Choice { min, max, .. } => {
+            let n = known.len() as u32;
+            if n < min {
+                let options = allowed.iter().map(|r| format!("<{}>", r.name)).collect::<Vec<_>>().join(", ");
+                diags.push(
+                    Diagnostic::new(
+                        Code::MissingElement,
+                        element.name_span,
+                        format!("<{}> needs at least {min} child element{} ({options}), found {n}", element.name, plural(min)),
+                    )
+                    .with_help(format!("add {} of {options}", min - n)),
+                );
+            }
+            if let Some(max) = max {
+                if n > max {
+                    if let Some(extra) = known.get(max as usize) {
+                        diags.push(
+                            Diagnostic::new(
+                                Code::DuplicateElement,
+                                extra.name_span,
+                                format!("<{}> may hold at most {max} child element{}, found {n}", element.name, plural(max)),
+                            )
+                            .with_help("remove the extra elements, or combine them with <union>"),
+                        );
+                    }
+                }
+            }
+        }
+        Content::Forms(forms) => check_forms(element, &known, forms, diags),
+    }
+    known
+}
+
+fn plural(n: u32) -> &'static str {
+    if n == 1 { "" } else { "s" }
+}
+
+fn check_count(element: &Element, known: &[&Element], spec: &Child, diags: &mut Diagnostics) {
+    let found: Vec<&&Element> = known.iter().filter(|c| c.name == spec.rule.name).collect();
+    let n = found.len() as u32;
+    if n < spec.min {
+        let need = if spec.min == 1 { "a".to_string() } else { spec.min.to_string() };
+        diags.push(
+            Diagnostic::new(
+                Code::MissingElement,
+                element.name_span,
+                format!(
+                    "<{}> needs {need} <{}> element{}, found {n}",
+                    element.name,
+                    spec.rule.name,
+                    plural(spec.min)
+                ),
+            )
+            .with_help(format!("add <{} …/> inside <{}>", spec.rule.name, element.name)),
+        );
+    }
+    if let Some(max) = spec.max {
+        if let Some(extra) = found.get(max as usize) {
+            diags.push(
+                Diagnostic::new(
+                    Code::DuplicateElement,
+                    extra.name_span,
+                    format!(
+                        "<{}> may have {} <{}> element{}, found {n}",
+                        element.name,
+                        if max == 1 { "only one".to_string() } else { format!("at most {max}") },
+                        spec.rule.name,
+                        plural(max)
+                    ),
+                )
+                .with_help(format!("remove the extra <{}>", spec.rule.name)),
+            );
+        }
+    }
+}
+
+/// In a sequence, each child must come no earlier than the children before it.
+fn check_order(element: &Element, known: &[&Element], children: &[Child], diags: &mut Diagnostics) {
+    let position = |name: &str| children.iter().position(|c| c.rule.name == name);
+    let mut latest: Option<(usize, &Element)> = None;
+    for child in known {
+        let Some(p) = position(&child.name) else { continue };
+        if let Some((q, previous)) = latest {
+            if p < q {
+                diags.push(
+                    Diagnostic::new(
+                        Code::OutOfOrder,
+                        child.name_span,
+                        format!(
+                            "<{}> must come before <{}> inside <{}>",
+                            child.name, previous.name, element.name
+                        ),
+                    )
+                    .with_help(format!(
+                        "order the children of <{}> as {}",
+                        element.name,
+                        children.iter().map(|c| format!("<{}>", c.rule.name)).collect::<Vec<_>>().join(", ")
+                    )),
+                );
+                continue;
+            }
+        }
+        latest = Some((p, child));
+    }
+}
+
+fn check_forms(element: &Element, known: &[&Element], forms: &[&[Child]], diags: &mut Diagnostics) {
+    let in_form = |form: &[Child], name: &str| form.iter().any(|c| c.rule.name == name);
+    let describe = |form: &[Child]| form.iter().map(|c| format!("<{}>", c.rule.name)).collect::<Vec<_>>().join(" + ");
+    // The form is chosen by the first child; a child of another form conflicts.
+    let Some(first) = known.first() else {
+        let options = forms.iter().map(|f| describe(f)).collect::<Vec<_>>().join(", or ");
+        diags.push(
+            Diagnostic::new(
+                Code::MissingElement,
+                element.name_span,
+                format!("<{}> is empty; it needs {options}", element.name),
+            )
+            .with_help(format!("give <{}> one of its forms", element.name)),
+        );
+        return;
+    };
+    let Some(form) = forms.iter().find(|f| in_form(f, &first.name)) else { return };
+    let mut conflict = false;
+    for child in known.iter().filter(|c| !in_form(form, &c.name)) {
+        conflict = true;
+        diags.push(
+            Diagnostic::new(
+                Code::ConflictingForms,
+                child.name_span,
+                format!(
+                    "<{}> cannot be combined with <{}> in <{}>",
+                    child.name, first.name, element.name
+                ),
+            )
+            .with_help(format!("give <{}> as {} only", element.name, describe(form))),
+        );
+    }
+    if !conflict {
+        for spec in form.iter() {
+            check_count(element, known, spec, diags);
+        }
+        check_order(element, known, form, diags);
+    }
+}

@@ -1,0 +1,204 @@
+//! The model IR: geometry and the topology graph of a resolved domain, in
+//! global coordinates. Plain data with public fields and typed indices; it holds
+//! no spans and no paths (the [`SourceMap`] side table maps entities back to the
+//! XML that made them).
+//!
+//! Rules of the IR:
+//! - every edge's curve runs from its `begin` vertex to its `end` vertex;
+//! - a face's loops are closed chains of oriented edges, counter-clockwise
+//!   seen from the side its normal points to (the surface gradient, negated when
+//!   `reversed`); the first loop is the outer one in planar faces;
+//! - a 3D subdomain lists the faces of its boundary with `outward = true` where
+//!   the face normal points out of the subdomain;
+//! - entities are welded: two solids that share a face share one `Face`.
+
+mod incidence;
+mod fragments;
+mod source_map;
+
+pub use fragments::{derive_fragments, Fragment, Side};
+pub use incidence::{Incidence, IncidenceMatrices};
+pub use source_map::{Origin, SourceMap};
+
+use crate::geom::{Aabb, Curve, Point3, SolidShape, Surface};
+
+macro_rules! id_type {
+    ($($name:ident),*) => {$(
+        #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
+        pub struct $name(pub u32);
+        impl $name {
+            pub fn index(self) -> usize { self.0 as usize }
+        }
+    )*};
+}
+id_type!(VertexId, EdgeId, FaceId, SubdomainId, SolidId);
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+pub enum Dimension {
+    Two,
+    Three,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Vertex {
+    pub name: String,
+    pub position: Point3,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Edge {
+    pub name: String,
+    pub curve: Curve,
+    pub begin: VertexId,
+    pub end: VertexId,
+}
+
+impl Edge {
+    pub fn is_closed(&self) -> bool {
+        self.begin == self.end
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OrientedEdge {
+    pub edge: EdgeId,
+    /// True when the loop runs along the edge from `begin` to `end`.
+    pub forward: bool,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Face {
+    pub name: String,
+    pub surface: Surface,
+    /// The face normal is −∇S when true.
+    pub reversed: bool,
+    pub loops: Vec<Vec<OrientedEdge>>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct OrientedFace {
+    pub face: FaceId,
+    /// True when the face normal points out of the subdomain.
+    pub outward: bool,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum SubdomainCells {
+    /// A 3D subdomain: the faces of its boundary (one or more closed shells).
+    Volume { boundary: Vec<OrientedFace> },
+    /// A 2D subdomain: the planar faces it consists of.
+    Region { faces: Vec<FaceId> },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Subdomain {
+    pub name: String,
+    pub material: Option<String>,
+    pub cells: SubdomainCells,
+    /// The leaf solids of its boolean tree, when it was built from solids
+    /// (used to classify points); empty for explicit face lists.
+    pub solids: Vec<SolidId>,
+}
+
+/// A lowered primitive solid: its shape and the entities of its canonical
+/// boundary representation.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Solid {
+    pub name: String,
+    pub shape: SolidShape,
+    /// Faces with `outward` relative to this solid (edges in 2D: see `edges`).
+    pub faces: Vec<OrientedFace>,
+    pub edges: Vec<EdgeId>,
+    pub vertices: Vec<VertexId>,
+}
+
+/// A set of points (paper 000's `point` with several values), global coordinates.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointSet {
+    pub name: String,
+    pub points: Vec<Point3>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polyline {
+    pub name: String,
+    pub points: Vec<Point3>,
+}
+
+/// A user-named set of faces (3D) or edges (2D) where boundary conditions go.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Boundary {
+    pub name: String,
+    pub faces: Vec<FaceId>,
+    pub edges: Vec<EdgeId>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Model {
+    pub dimension: Dimension,
+    pub vertices: Vec<Vertex>,
+    pub edges: Vec<Edge>,
+    pub faces: Vec<Face>,
+    pub subdomains: Vec<Subdomain>,
+    pub solids: Vec<Solid>,
+    pub boundaries: Vec<Boundary>,
+    pub point_sets: Vec<PointSet>,
+    pub polylines: Vec<Polyline>,
+    /// Parameter values in force, in definition order.
+    pub parameters: Vec<(String, f64)>,
+    /// The absolute geometric tolerance used by the checks (1e-6 of the
+    /// bounding-box diagonal, at least 1e-12).
+    pub tolerance: f64,
+}
+
+impl Model {
+    pub fn empty(dimension: Dimension) -> Model {
+        Model {
+            dimension,
+            vertices: Vec::new(),
+            edges: Vec::new(),
+            faces: Vec::new(),
+            subdomains: Vec::new(),
+            solids: Vec::new(),
+            boundaries: Vec::new(),
+            point_sets: Vec::new(),
+            polylines: Vec::new(),
+            parameters: Vec::new(),
+            tolerance: 1e-12,
+        }
+    }
+
+    pub fn vertex(&self, id: VertexId) -> &Vertex {
+        &self.vertices[id.index()]
+    }
+
+    pub fn edge(&self, id: EdgeId) -> &Edge {
+        &self.edges[id.index()]
+    }
+
+    pub fn face(&self, id: FaceId) -> &Face {
+        &self.faces[id.index()]
+    }
+
+    pub fn subdomain(&self, id: SubdomainId) -> &Subdomain {
+        &self.subdomains[id.index()]
+    }
+
+    /// The bounding box of every vertex, point, polyline and solid.
+    pub fn bbox(&self) -> Aabb {
+        let mut bbox = Aabb::empty();
+        for v in &self.vertices {
+            bbox.include(&v.position);
+        }
+        for p in self.point_sets.iter().flat_map(|s| &s.points) {
+            bbox.include(p);
+        }
+        for p in self.polylines.iter().flat_map(|s| &s.points) {
+            bbox.include(p);
+        }
+        for solid in &self.solids {
+            bbox = bbox.union(&solid.shape.bbox());
+        }
+        bbox
+    }
+}
