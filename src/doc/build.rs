@@ -1,0 +1,538 @@
+//! Element tree → typed [`Document`]. Parses every numeric attribute as an
+//! expression and every reference; reports malformed ones and keeps going.
+//! Structure (missing or unknown elements) is the structural check's job: here
+//! anything missing simply stays `None`.
+
+use super::model::*;
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::expr::{self, ParseError};
+use crate::span::{SourceFile, Span};
+use crate::syntax::{Attribute, Element};
+
+/// Builds the typed document from a structurally checked tree.
+pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Document {
+    let mut b = Builder { source, diags };
+    let mut doc = Document {
+        dimension: match root.attribute("dimension").map(|a| a.value.trim()) {
+            Some("2") => 2,
+            _ => 3,
+        },
+        title: root.attribute("name").map(|a| a.value.clone()),
+        ..Document::default()
+    };
+    for element in &root.children {
+        b.top_level(element, &mut doc);
+    }
+    doc
+}
+
+struct Builder<'a> {
+    source: &'a SourceFile,
+    diags: &'a mut Diagnostics,
+}
+
+impl Builder<'_> {
+    fn top_level(&mut self, e: &Element, doc: &mut Document) {
+        match e.name.as_str() {
+            "parameters" => {
+                for p in e.children_named("parameter") {
+                    if let (Some(name), Some(value)) = (self.name(p), self.number(p, "value")) {
+                        doc.parameters.push(Parameter { name, value });
+                    }
+                }
+            }
+            "basis_coordinate" => {
+                for c in e.children_named("coordinate") {
+                    let axis = match c.attribute("name").map(|a| a.value.trim()) {
+                        Some("X") => Axis::X,
+                        Some("Y") => Axis::Y,
+                        Some("Z") => Axis::Z,
+                        _ => continue,
+                    };
+                    for v in c.children_named("value") {
+                        for attr in &v.attributes {
+                            let value = self.parse_number(attr);
+                            doc.basis.push(BasisCoordinate {
+                                axis,
+                                name: Name {
+                                    text: attr.name.clone(),
+                                    span: attr.name_span,
+                                },
+                                value,
+                            });
+                        }
+                    }
+                }
+            }
+            "coordinate_system" => {
+                if let Some(name) = self.name(e) {
+                    doc.coordinate_systems.push(CoordinateSystem {
+                        name,
+                        parent: self.reference(e, "cs"),
+                        origin: self.point_child(e, "origin"),
+                        rotation: self.vector_child(e, "rotation"),
+                    });
+                }
+            }
+            "subdomain" => {
+                if let Some(name) = self.name(e) {
+                    doc.subdomains.push(SubdomainDef {
+                        name,
+                        material: e.attribute("material").map(|a| a.value.clone()),
+                        faces: self.ref_list(e, "faces"),
+                        tree: e.children.first().and_then(|c| self.solid_tree(c)),
+                        span: e.name_span,
+                    });
+                }
+            }
+            "boundary" => {
+                if let Some(name) = self.name(e) {
+                    doc.boundaries.push(BoundaryDef {
+                        name,
+                        faces: self.ref_list(e, "faces"),
+                        edges: self.ref_list(e, "edges"),
+                        span: e.name_span,
+                    });
+                }
+            }
+            _ => {
+                if let Some(kind) = self.object_kind(e) {
+                    if let Some(name) = self.name(e) {
+                        doc.objects.push(Object {
+                            name,
+                            cs: self.reference(e, "cs"),
+                            kind,
+                            span: e.name_span,
+                        });
+                    }
+                }
+            }
+        }
+    }
+
+    fn object_kind(&mut self, e: &Element) -> Option<ObjectKind> {
+        Some(match e.name.as_str() {
+            "point" => ObjectKind::Point {
+                values: e.children_named("value").map(|v| self.vector(v)).collect(),
+            },
+            "ellipse" => ObjectKind::Ellipse {
+                center: self.point_child(e, "center"),
+                radius_vertices: self.points_named(e, "radius_vertex"),
+            },
+            "circle" => ObjectKind::Circle {
+                center: self.point_child(e, "center"),
+                radius: self.value_child(e, "radius"),
+            },
+            "triangle" => ObjectKind::Triangle {
+                vertices: self.points_named(e, "vertex"),
+            },
+            "parallelogram" => ObjectKind::Parallelogram {
+                base: self.point_child(e, "base_point"),
+                vertices: self.points_named(e, "vertex"),
+            },
+            "poly_line" => ObjectKind::PolyLine {
+                segments: e
+                    .children_named("line")
+                    .map(|l| (self.point_child(l, "begin_point"), self.point_child(l, "end_point")))
+                    .collect(),
+            },
+            "truncated_cone" => ObjectKind::TruncatedCone {
+                bottom_center: self.point_child(e, "bottom_center"),
+                top_center: self.point_child(e, "top_center"),
+                bottom_radius: self.value_child(e, "bottom_radius"),
+                top_radius: self.value_child(e, "top_radius"),
+            },
+            "parallelepiped" => ObjectKind::Parallelepiped(
+                if let Some(base) = self.point_child(e, "base_point") {
+                    Some(ParallelepipedForm::Edges {
+                        base,
+                        vertices: self.points_named(e, "vertex"),
+                    })
+                } else {
+                    match (self.point_child(e, "first_point"), self.point_child(e, "second_point")) {
+                        (Some(first), Some(second)) => Some(ParallelepipedForm::Corners { first, second }),
+                        _ => None,
+                    }
+                },
+            ),
+            "sphere" => ObjectKind::Sphere {
+                center: self.point_child(e, "center"),
+                radius: self.value_child(e, "radius"),
+            },
+            "ellipsoid" => ObjectKind::Ellipsoid {
+                center: self.point_child(e, "center"),
+                semi_axes: self.vector_child(e, "semi_axes"),
+            },
+            "torus" => ObjectKind::Torus {
+                center: self.point_child(e, "center"),
+                major: self.value_child(e, "major_radius"),
+                minor: self.value_child(e, "minor_radius"),
+                axis: self.vector_child(e, "axis"),
+            },
+            "plane" => ObjectKind::Plane {
+                base: self.point_child(e, "base_point"),
+                normal: self.vector_child(e, "normal"),
+            },
+            "transform" => ObjectKind::Transform {
+                target: self.reference(e, "ref"),
+                steps: self.steps(e),
+            },
+            "replicate" => ObjectKind::Replicate {
+                target: self.reference(e, "ref"),
+                count: self.number(e, "count"),
+                steps: self.steps(e),
+            },
+            "surface" => ObjectKind::Surface(e.children.first().and_then(|c| self.surface(c))),
+            "line" => ObjectKind::Line(e.children.first().and_then(|c| self.line(c))),
+            "vertex" => ObjectKind::Vertex(self.vertex(e)),
+            "edge" => ObjectKind::Edge {
+                line: self.reference(e, "line"),
+                begin: self.reference(e, "begin"),
+                end: self.reference(e, "end"),
+            },
+            "face" => {
+                let mut loops = Vec::new();
+                let mut loop_spans = Vec::new();
+                if let Some((refs, span)) = self.ref_list(e, "edges") {
+                    loops.push(refs);
+                    loop_spans.push(span);
+                }
+                for l in e.children_named("loop") {
+                    if let Some((refs, span)) = self.ref_list(l, "edges") {
+                        loops.push(refs);
+                        loop_spans.push(span);
+                    }
+                }
+                ObjectKind::Face {
+                    surface: self.reference(e, "surface"),
+                    loops,
+                    loop_spans,
+                }
+            }
+            _ => return None,
+        })
+    }
+
+    fn steps(&mut self, e: &Element) -> Vec<Step> {
+        let mut steps = Vec::new();
+        for c in &e.children {
+            match c.name.as_str() {
+                "shift" => steps.push(Step::Shift(self.vector(c))),
+                "rotate" => steps.push(Step::Rotate {
+                    angles: self.vector(c),
+                    center: self.reference(c, "center"),
+                }),
+                "scale" => steps.push(Step::Scale {
+                    factors: self.vector(c),
+                    factor: self.number(c, "factor"),
+                }),
+                _ => {}
+            }
+        }
+        steps
+    }
+
+    fn surface(&mut self, c: &Element) -> Option<SurfaceSpec> {
+        Some(match c.name.as_str() {
+            "plane" => SurfaceSpec::Plane {
+                base: self.point_child(c, "base_point"),
+                normal: self.vector_child(c, "normal"),
+            },
+            "sphere" => SurfaceSpec::Sphere {
+                center: self.point_child(c, "center"),
+                radius: self.value_child(c, "radius"),
+            },
+            "cylinder" => SurfaceSpec::Cylinder {
+                base: self.point_child(c, "base_point"),
+                axis: self.vector_child(c, "axis"),
+                radius: self.value_child(c, "radius"),
+            },
+            "cone" => SurfaceSpec::Cone {
+                apex: self.point_child(c, "apex"),
+                axis: self.vector_child(c, "axis"),
+                half_angle: self.value_child(c, "half_angle"),
+            },
+            "quadric" => {
+                const NAMES: [&str; 10] = ["xx", "yy", "zz", "xy", "yz", "zx", "x", "y", "z", "c"];
+                let mut coefficients: [Option<Number>; 10] = Default::default();
+                for (slot, name) in coefficients.iter_mut().zip(NAMES) {
+                    *slot = self.number(c, name);
+                }
+                SurfaceSpec::Quadric {
+                    coefficients,
+                    span: c.name_span,
+                }
+            }
+            "implicit" => SurfaceSpec::Implicit {
+                equation: self.number(c, "equation"),
+            },
+            _ => return None,
+        })
+    }
+
+    fn line(&mut self, c: &Element) -> Option<LineSpec> {
+        Some(match c.name.as_str() {
+            "straight" => LineSpec::Straight,
+            "circle_arc" => LineSpec::CircleArc {
+                center: self.point_child(c, "center"),
+                normal: self.vector_child(c, "normal"),
+            },
+            "ellipse_arc" => LineSpec::EllipseArc {
+                center: self.point_child(c, "center"),
+                radius_vertices: self.points_named(c, "radius_vertex"),
+            },
+            "intersection" => LineSpec::Intersection {
+                surfaces: self.ref_list(c, "surfaces").map(|(r, _)| r).unwrap_or_default(),
+                span: c.name_span,
+            },
+            _ => return None,
+        })
+    }
+
+    fn vertex(&mut self, e: &Element) -> Option<VertexSpec> {
+        if let Some(i) = e.children_named("intersection").next() {
+            let near = self.point_child(i, "near");
+            if let Some((surfaces, _)) = self.ref_list(i, "surfaces") {
+                return Some(VertexSpec::Surfaces {
+                    surfaces,
+                    near,
+                    span: i.name_span,
+                });
+            }
+            if let Some((lines, _)) = self.ref_list(i, "lines") {
+                return Some(VertexSpec::Lines {
+                    lines,
+                    near,
+                    span: i.name_span,
+                });
+            }
+            self.diags.push(
+                Diagnostic::new(
+                    Code::MissingAttribute,
+                    i.name_span,
+                    "<intersection> of a vertex needs surfaces=\"a b c\" or lines=\"a b\"",
+                )
+                .with_help("name three surfaces or two lines whose intersection is the vertex"),
+            );
+            return None;
+        }
+        Some(VertexSpec::Coordinates(self.point(e)))
+    }
+
+    fn solid_tree(&mut self, e: &Element) -> Option<SolidTree> {
+        let operands = |b: &mut Self| -> Vec<SolidTree> {
+            e.children.iter().filter_map(|c| b.solid_tree(c)).collect()
+        };
+        Some(match e.name.as_str() {
+            "solid" => SolidTree::Solid(self.reference(e, "ref")?),
+            "union" => SolidTree::Union(operands(self), e.name_span),
+            "intersection" => SolidTree::Intersection(operands(self), e.name_span),
+            "difference" => SolidTree::Difference(operands(self), e.name_span),
+            _ => return None,
+        })
+    }
+
+    // ---- leaves ----
+
+    fn name(&mut self, e: &Element) -> Option<Name> {
+        e.attribute("name").map(|a| Name {
+            text: a.value.trim().to_string(),
+            span: a.value_span,
+        })
+    }
+
+    fn number(&mut self, e: &Element, attr: &str) -> Option<Number> {
+        e.attribute(attr).map(|a| self.parse_number(a))
+    }
+
+    fn parse_number(&mut self, attr: &Attribute) -> Number {
+        // Offsets into the value map onto the source only when the raw text
+        // equals the value (no entity references); otherwise point at the whole value.
+        let raw = self.source.snippet(attr.value_span);
+        let exact = raw == attr.value;
+        let base = if exact { attr.value_span.start as usize } else { 0 };
+        let fix = |span: Span| if exact { span } else { attr.value_span };
+        match expr::parse(&attr.value, base) {
+            Ok(mut expr) => {
+                if !exact {
+                    relocate(&mut expr, attr.value_span);
+                }
+                Number {
+                    expr: Some(expr),
+                    span: attr.value_span,
+                }
+            }
+            Err(error) => {
+                let d = match error {
+                    ParseError::Syntax { span, message } => Diagnostic::new(
+                        Code::BadExpression,
+                        fix(span),
+                        format!("{}=\"{}\": {message}", attr.name, attr.value),
+                    )
+                    .with_help("write a number like 2.5 or an expression like 2*r + 1"),
+                    ParseError::UnknownFunction { span, name } => {
+                        let names = expr::Function::ALL.iter().map(|(n, _)| *n);
+                        let suggestion = crate::diag::did_you_mean(&name, names)
+                            .map_or(String::new(), |s| format!("did you mean '{s}'? "));
+                        Diagnostic::new(Code::UnknownFunction, fix(span), format!("unknown function '{name}' in {}=\"{}\"", attr.name, attr.value))
+                            .with_help(format!("{suggestion}known functions: sqrt sin cos tan asin acos atan exp ln abs min max"))
+                    }
+                    ParseError::WrongArgumentCount { span, function, given } => Diagnostic::new(
+                        Code::WrongArgumentCount,
+                        fix(span),
+                        format!(
+                            "{}() called with {given} argument{} in {}=\"{}\"",
+                            function.name(),
+                            if given == 1 { "" } else { "s" },
+                            attr.name,
+                            attr.value
+                        ),
+                    )
+                    .with_help(if function.is_variadic() {
+                        format!("{}() takes two or more arguments", function.name())
+                    } else {
+                        format!("{}() takes exactly one argument", function.name())
+                    }),
+                    ParseError::TooLarge { span } => Diagnostic::new(
+                        Code::ExpressionTooLarge,
+                        fix(span),
+                        format!("the expression in {}= exceeds the limit of 10,000 nodes or 256 levels of nesting", attr.name),
+                    )
+                    .with_help("split it into parameters"),
+                };
+                self.diags.push(d);
+                Number {
+                    expr: None,
+                    span: attr.value_span,
+                }
+            }
+        }
+    }
+
+    fn reference(&mut self, e: &Element, attr: &str) -> Option<Ref> {
+        let a = e.attribute(attr)?;
+        Some(parse_ref(a.value.trim(), a.value_span))
+    }
+
+    fn ref_list(&mut self, e: &Element, attr: &str) -> Option<(Vec<Ref>, Span)> {
+        let a = e.attribute(attr)?;
+        let mut refs = Vec::new();
+        let base = a.value_span.start as usize;
+        let exact = self.source.snippet(a.value_span) == a.value;
+        let mut offset = 0;
+        for token in a.value.split(|c: char| c.is_whitespace()) {
+            if !token.is_empty() {
+                let span = if exact { Span::new(base + offset, base + offset + token.len()) } else { a.value_span };
+                refs.push(parse_ref(token, span));
+            }
+            offset += token.len() + 1;
+        }
+        if refs.is_empty() {
+            self.diags.push(
+                Diagnostic::new(
+                    Code::EmptyModel,
+                    a.value_span,
+                    format!("{attr}=\"\" on <{}> lists nothing", e.name),
+                )
+                .with_help(format!("name at least one object in {attr}=\"…\"")),
+            );
+        }
+        Some((refs, a.value_span))
+    }
+
+    fn point(&mut self, e: &Element) -> PointSpec {
+        PointSpec {
+            x: self.number(e, "x"),
+            y: self.number(e, "y"),
+            z: self.number(e, "z"),
+            point: self.reference(e, "point"),
+            tag: e.name.clone(),
+            span: e.name_span,
+        }
+    }
+
+    fn vector(&mut self, e: &Element) -> VectorSpec {
+        VectorSpec {
+            x: self.number(e, "x"),
+            y: self.number(e, "y"),
+            z: self.number(e, "z"),
+            span: e.name_span,
+        }
+    }
+
+    fn point_child(&mut self, e: &Element, name: &str) -> Option<PointSpec> {
+        e.children_named(name).next().map(|c| self.point(c))
+    }
+
+    fn points_named(&mut self, e: &Element, name: &str) -> Vec<PointSpec> {
+        e.children_named(name).map(|c| self.point(c)).collect()
+    }
+
+    fn vector_child(&mut self, e: &Element, name: &str) -> Option<VectorSpec> {
+        e.children_named(name).next().map(|c| self.vector(c))
+    }
+
+    fn value_child(&mut self, e: &Element, name: &str) -> Option<Number> {
+        e.children_named(name).next().and_then(|c| self.number(c, "value"))
+    }
+}
+
+/// `name`, `name[3]` or `name.entity` (the entity part only when the name
+/// before the dot is non-empty).
+pub fn parse_ref(text: &str, span: Span) -> Ref {
+    let mut name = text.to_string();
+    let mut index = None;
+    let mut entity = None;
+    if let Some(dot) = name.rfind('.') {
+        if dot > 0 && dot + 1 < name.len() && !name[dot + 1..].contains(']') {
+            entity = Some(name[dot + 1..].to_string());
+            name.truncate(dot);
+        }
+    }
+    if name.ends_with(']') {
+        if let Some(open) = name.rfind('[') {
+            if let Ok(i) = name[open + 1..name.len() - 1].trim().parse::<usize>() {
+                index = Some(i);
+                name.truncate(open);
+            }
+        }
+    }
+    Ref {
+        name,
+        index,
+        entity,
+        text: text.to_string(),
+        span,
+    }
+}
+
+fn relocate(expr: &mut crate::expr::Expr, span: Span) {
+    use crate::expr::ExprKind;
+    expr.span = span;
+    match &mut expr.kind {
+        ExprKind::Number(_) | ExprKind::Name(_) => {}
+        ExprKind::Neg(inner) => relocate(inner, span),
+        ExprKind::Binary(_, a, b) => {
+            relocate(a, span);
+            relocate(b, span);
+        }
+        ExprKind::Call(_, args) => args.iter_mut().for_each(|a| relocate(a, span)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn references_parse_members_and_entities() {
+        let r = parse_ref("pts[2]", Span::default());
+        assert_eq!((r.name.as_str(), r.index, r.entity), ("pts", Some(2), None));
+        let r = parse_ref("box.xmin", Span::default());
+        assert_eq!((r.name.as_str(), r.entity.as_deref()), ("box", Some("xmin")));
+        let r = parse_ref("row[3].top", Span::default());
+        assert_eq!((r.name.as_str(), r.index, r.entity.as_deref()), ("row", Some(3), Some("top")));
+        let r = parse_ref("point 3D", Span::default());
+        assert_eq!((r.name.as_str(), r.index), ("point 3D", None));
+    }
+}

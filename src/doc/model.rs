@@ -1,0 +1,248 @@
+//! The typed document: one struct per element kind, names still unresolved,
+//! every value with the span it came from. Built by [`super::build`]; parts the
+//! structural check already reported as missing are `None`.
+
+use crate::expr::Expr;
+use crate::span::Span;
+
+/// A name as written, with the span of the attribute value.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Name {
+    pub text: String,
+    pub span: Span,
+}
+
+/// A reference to a named object: `name`, `name[3]` (1-based member), or, in
+/// face and edge lists, `name.entity`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ref {
+    pub name: String,
+    pub index: Option<usize>,
+    pub entity: Option<String>,
+    /// The reference as written.
+    pub text: String,
+    pub span: Span,
+}
+
+/// A numeric attribute: the parsed expression, or `None` if it did not parse
+/// (already reported).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Number {
+    pub expr: Option<Expr>,
+    pub span: Span,
+}
+
+/// A point-valued child element (`center`, `vertex`, …): coordinates, or a
+/// reference to a named point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PointSpec {
+    pub x: Option<Number>,
+    pub y: Option<Number>,
+    pub z: Option<Number>,
+    pub point: Option<Ref>,
+    /// The element's tag, for messages.
+    pub tag: String,
+    /// The element's name in its start tag.
+    pub span: Span,
+}
+
+/// A vector-valued child element (`normal`, `axis`, `rotation`, `semi_axes`, shift …).
+#[derive(Debug, Clone, PartialEq)]
+pub struct VectorSpec {
+    pub x: Option<Number>,
+    pub y: Option<Number>,
+    pub z: Option<Number>,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Parameter {
+    pub name: Name,
+    pub value: Number,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash)]
+pub enum Axis {
+    X,
+    Y,
+    Z,
+}
+
+impl Axis {
+    pub fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+    pub fn letter(self) -> &'static str {
+        match self {
+            Axis::X => "X",
+            Axis::Y => "Y",
+            Axis::Z => "Z",
+        }
+    }
+}
+
+/// One basis coordinate: an attribute of `<coordinate name="X"><value x1=…/>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct BasisCoordinate {
+    pub axis: Axis,
+    pub name: Name,
+    pub value: Number,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct CoordinateSystem {
+    pub name: Name,
+    pub parent: Option<Ref>,
+    pub origin: Option<PointSpec>,
+    pub rotation: Option<VectorSpec>,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum ParallelepipedForm {
+    /// Base point and the ends of the three edges from it.
+    Edges { base: PointSpec, vertices: Vec<PointSpec> },
+    /// Two opposite corners of an axis-aligned box.
+    Corners { first: PointSpec, second: PointSpec },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum Step {
+    Shift(VectorSpec),
+    Rotate { angles: VectorSpec, center: Option<Ref> },
+    Scale { factors: VectorSpec, factor: Option<Number> },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum SurfaceSpec {
+    Plane { base: Option<PointSpec>, normal: Option<VectorSpec> },
+    Sphere { center: Option<PointSpec>, radius: Option<Number> },
+    Cylinder { base: Option<PointSpec>, axis: Option<VectorSpec>, radius: Option<Number> },
+    Cone { apex: Option<PointSpec>, axis: Option<VectorSpec>, half_angle: Option<Number> },
+    /// Coefficients xx yy zz xy yz zx x y z c (absent = 0).
+    Quadric { coefficients: [Option<Number>; 10], span: Span },
+    Implicit { equation: Option<Number> },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum LineSpec {
+    Straight,
+    CircleArc { center: Option<PointSpec>, normal: Option<VectorSpec> },
+    EllipseArc { center: Option<PointSpec>, radius_vertices: Vec<PointSpec> },
+    Intersection { surfaces: Vec<Ref>, span: Span },
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum VertexSpec {
+    Coordinates(PointSpec),
+    Surfaces { surfaces: Vec<Ref>, near: Option<PointSpec>, span: Span },
+    Lines { lines: Vec<Ref>, near: Option<PointSpec>, span: Span },
+}
+
+/// What a named object is.
+#[derive(Debug, Clone, PartialEq)]
+pub enum ObjectKind {
+    Point { values: Vec<VectorSpec> },
+    Ellipse { center: Option<PointSpec>, radius_vertices: Vec<PointSpec> },
+    Circle { center: Option<PointSpec>, radius: Option<Number> },
+    Triangle { vertices: Vec<PointSpec> },
+    Parallelogram { base: Option<PointSpec>, vertices: Vec<PointSpec> },
+    PolyLine { segments: Vec<(Option<PointSpec>, Option<PointSpec>)> },
+    TruncatedCone {
+        bottom_center: Option<PointSpec>,
+        top_center: Option<PointSpec>,
+        bottom_radius: Option<Number>,
+        top_radius: Option<Number>,
+    },
+    Parallelepiped(Option<ParallelepipedForm>),
+    Sphere { center: Option<PointSpec>, radius: Option<Number> },
+    Ellipsoid { center: Option<PointSpec>, semi_axes: Option<VectorSpec> },
+    Torus { center: Option<PointSpec>, major: Option<Number>, minor: Option<Number>, axis: Option<VectorSpec> },
+    Plane { base: Option<PointSpec>, normal: Option<VectorSpec> },
+    Transform { target: Option<Ref>, steps: Vec<Step> },
+    Replicate { target: Option<Ref>, count: Option<Number>, steps: Vec<Step> },
+    Surface(Option<SurfaceSpec>),
+    Line(Option<LineSpec>),
+    Vertex(Option<VertexSpec>),
+    Edge { line: Option<Ref>, begin: Option<Ref>, end: Option<Ref> },
+    /// Loops of edge references; the first is the outer loop.
+    Face { surface: Option<Ref>, loops: Vec<Vec<Ref>>, loop_spans: Vec<Span> },
+}
+
+impl ObjectKind {
+    /// The element name that defines this kind, for messages.
+    pub fn element(&self) -> &'static str {
+        match self {
+            ObjectKind::Point { .. } => "point",
+            ObjectKind::Ellipse { .. } => "ellipse",
+            ObjectKind::Circle { .. } => "circle",
+            ObjectKind::Triangle { .. } => "triangle",
+            ObjectKind::Parallelogram { .. } => "parallelogram",
+            ObjectKind::PolyLine { .. } => "poly_line",
+            ObjectKind::TruncatedCone { .. } => "truncated_cone",
+            ObjectKind::Parallelepiped(_) => "parallelepiped",
+            ObjectKind::Sphere { .. } => "sphere",
+            ObjectKind::Ellipsoid { .. } => "ellipsoid",
+            ObjectKind::Torus { .. } => "torus",
+            ObjectKind::Plane { .. } => "plane",
+            ObjectKind::Transform { .. } => "transform",
+            ObjectKind::Replicate { .. } => "replicate",
+            ObjectKind::Surface(_) => "surface",
+            ObjectKind::Line(_) => "line",
+            ObjectKind::Vertex(_) => "vertex",
+            ObjectKind::Edge { .. } => "edge",
+            ObjectKind::Face { .. } => "face",
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct Object {
+    pub name: Name,
+    pub cs: Option<Ref>,
+    pub kind: ObjectKind,
+    /// The element's name in its start tag.
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub enum SolidTree {
+    Solid(Ref),
+    Union(Vec<SolidTree>, Span),
+    Intersection(Vec<SolidTree>, Span),
+    /// The first operand minus the others.
+    Difference(Vec<SolidTree>, Span),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct SubdomainDef {
+    pub name: Name,
+    pub material: Option<String>,
+    pub faces: Option<(Vec<Ref>, Span)>,
+    pub tree: Option<SolidTree>,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct BoundaryDef {
+    pub name: Name,
+    pub faces: Option<(Vec<Ref>, Span)>,
+    pub edges: Option<(Vec<Ref>, Span)>,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct Document {
+    /// 2 or 3 (the default).
+    pub dimension: u8,
+    pub title: Option<String>,
+    pub parameters: Vec<Parameter>,
+    pub basis: Vec<BasisCoordinate>,
+    pub coordinate_systems: Vec<CoordinateSystem>,
+    pub objects: Vec<Object>,
+    pub subdomains: Vec<SubdomainDef>,
+    pub boundaries: Vec<BoundaryDef>,
+}

@@ -1,0 +1,168 @@
+//! Resolution: parameters and expressions evaluated, names looked up,
+//! coordinate systems and transforms applied — every object of the document
+//! in global coordinates, ready to be lowered into the model IR.
+
+mod frames;
+mod geometry;
+mod names;
+mod objects;
+mod shapes;
+mod values;
+
+pub use geometry::{Geometry, LineCarrier, Link};
+pub use names::{is_plain_name, NameTable};
+pub use values::{Ctx, Values};
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::doc::Document;
+use crate::expr::Expr;
+use crate::span::{SourceFile, Span};
+use std::collections::HashMap;
+
+/// One object of the document after resolution.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ResolvedObject {
+    pub name: String,
+    /// The element's name in its start tag.
+    pub span: Span,
+    /// `None` when the object could not be resolved (already reported).
+    pub geometry: Option<Geometry>,
+}
+
+#[derive(Debug, Clone)]
+pub struct Resolved {
+    pub dimension: u8,
+    /// In document order: `objects[i]` resolves `doc.objects[i]`.
+    pub objects: Vec<ResolvedObject>,
+    pub by_name: HashMap<String, usize>,
+    /// Parameter values in force, in definition order.
+    pub parameters: Vec<(String, f64)>,
+}
+
+impl Resolved {
+    pub fn object(&self, name: &str) -> Option<&ResolvedObject> {
+        self.by_name.get(name).and_then(|&i| self.objects.get(i))
+    }
+}
+
+/// A `--set NAME=VALUE` override, parsed.
+#[derive(Debug, Clone)]
+pub struct Override {
+    pub name: String,
+    pub value: Expr,
+}
+
+/// Parses `NAME=VALUE` from the command line.
+pub fn parse_override(text: &str) -> Result<Override, Diagnostic> {
+    let Some((name, value)) = text.split_once('=') else {
+        return Err(Diagnostic::new(
+            Code::BadOverride,
+            None,
+            format!("--set {text}: expected NAME=VALUE"),
+        )
+        .with_help("write for example --set r=0.8"));
+    };
+    let name = name.trim();
+    if !is_plain_name(name) {
+        return Err(Diagnostic::new(
+            Code::BadOverride,
+            None,
+            format!("--set {text}: '{name}' is not a parameter name"),
+        )
+        .with_help("write for example --set r=0.8"));
+    }
+    match crate::expr::parse(value, 0) {
+        Ok(expr) => Ok(Override { name: name.to_string(), value: expr }),
+        Err(_) => Err(Diagnostic::new(
+            Code::BadOverride,
+            None,
+            format!("--set {text}: '{value}' is not a number or an expression"),
+        )
+        .with_help("write for example --set r=0.8 or --set r=2*h")),
+    }
+}
+
+/// Resolves a typed document. Overrides naming no parameter are reported with E204.
+pub fn resolve(source: &SourceFile, doc: &Document, overrides: &[Override], diags: &mut Diagnostics) -> Resolved {
+    let names = NameTable::build(source, doc, diags);
+    let pairs: Vec<(String, Expr)> = overrides.iter().map(|o| (o.name.clone(), o.value.clone())).collect();
+    let mut values = Values::new(doc, &pairs);
+    for o in overrides {
+        if !values.is_parameter(&o.name) {
+            let candidates = values.parameter_names();
+            let mut d = Diagnostic::new(
+                Code::UnknownParameterOverride,
+                None,
+                format!("--set {}: the file defines no parameter '{}'", o.name, o.name),
+            );
+            d.help = Some(match crate::diag::did_you_mean(&o.name, candidates.iter().copied()) {
+                Some(best) => format!("did you mean --set {best}=…?"),
+                None if candidates.is_empty() => "the file defines no parameters".to_string(),
+                None => format!("parameters: {}", candidates.join(", ")),
+            });
+            diags.push(d);
+        }
+    }
+    for (name, def) in &names.defs {
+        if def.kind != "parameter" && def.kind != "basis coordinate" {
+            values.other_names.insert(name.clone(), def.kind);
+        }
+    }
+    let parameters = values.evaluate_all(diags);
+    check_basis_order(doc, &values, diags);
+    let mut resolver = objects::Resolver::new(doc, &names, values, diags);
+    let objects = resolver.resolve_all();
+    let values = resolver.finish();
+    for (name, span) in values.unused_parameters() {
+        diags.push(
+            Diagnostic::new(Code::UnusedParameter, span, format!("parameter '{name}' is never used"))
+                .with_help("remove it, or use it in an attribute"),
+        );
+    }
+    let by_name = objects
+        .iter()
+        .enumerate()
+        .map(|(i, o)| (o.name.clone(), i))
+        .collect();
+    Resolved {
+        dimension: doc.dimension,
+        objects,
+        by_name,
+        parameters,
+    }
+}
+
+/// Paper 000 supposes basis coordinates ascend with their index (x1 < x2 < …).
+fn check_basis_order(doc: &Document, values: &Values, diags: &mut Diagnostics) {
+    use crate::doc::Axis;
+    for axis in [Axis::X, Axis::Y, Axis::Z] {
+        let known = values.basis_values(axis);
+        let mut indexed: Vec<(u64, &str, f64, Span)> = doc
+            .basis
+            .iter()
+            .filter(|b| b.axis == axis)
+            .filter_map(|b| {
+                let digits: String = b.name.text.chars().rev().take_while(char::is_ascii_digit).collect();
+                let index: u64 = digits.chars().rev().collect::<String>().parse().ok()?;
+                Some((index, b.name.text.as_str(), *known.get(&b.name.text)?, b.name.span))
+            })
+            .collect();
+        indexed.sort_by_key(|&(i, _, _, _)| i);
+        for pair in indexed.windows(2) {
+            let (_, prev_name, prev, _) = pair[0];
+            let (_, name, value, span) = pair[1];
+            if value <= prev {
+                diags.push(
+                    Diagnostic::new(
+                        Code::NotAscending,
+                        span,
+                        format!(
+                            "basis coordinate {name} = {value} is not greater than {prev_name} = {prev}; the values are used as given"
+                        ),
+                    )
+                    .with_help(format!("{} coordinates are expected to ascend with their index", axis.letter())),
+                );
+            }
+        }
+    }
+}

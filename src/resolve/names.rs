@@ -1,0 +1,90 @@
+//! The global name table: every definition's name, its kind and span;
+//! duplicates and names that cannot be referenced everywhere are reported here.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::doc::Document;
+use crate::span::{SourceFile, Span};
+use std::collections::HashMap;
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Definition {
+    pub kind: &'static str,
+    pub span: Span,
+}
+
+#[derive(Debug, Default)]
+pub struct NameTable {
+    pub defs: HashMap<String, Definition>,
+}
+
+impl NameTable {
+    pub fn build(source: &SourceFile, doc: &Document, diags: &mut Diagnostics) -> NameTable {
+        let mut table = NameTable::default();
+        let mut all: Vec<(&str, &'static str, Span)> = Vec::new();
+        all.extend(doc.parameters.iter().map(|p| (p.name.text.as_str(), "parameter", p.name.span)));
+        all.extend(doc.basis.iter().map(|b| (b.name.text.as_str(), "basis coordinate", b.name.span)));
+        all.extend(
+            doc.coordinate_systems
+                .iter()
+                .map(|c| (c.name.text.as_str(), "coordinate system", c.name.span)),
+        );
+        all.extend(doc.objects.iter().map(|o| (o.name.text.as_str(), o.kind.element(), o.name.span)));
+        all.extend(doc.subdomains.iter().map(|s| (s.name.text.as_str(), "subdomain", s.name.span)));
+        all.extend(doc.boundaries.iter().map(|b| (b.name.text.as_str(), "boundary", b.name.span)));
+        all.sort_by_key(|&(_, _, span)| span);
+        for (name, kind, span) in all {
+            if name.is_empty() {
+                continue;
+            }
+            if let Some(first) = table.defs.get(name) {
+                let line = source.line_col(first.span.start as usize).line;
+                diags.push(
+                    Diagnostic::new(
+                        Code::DuplicateName,
+                        span,
+                        format!("the name '{name}' is already used by the {} on line {line}", first.kind),
+                    )
+                    .with_help("names are global across all objects; rename one of them"),
+                );
+                continue;
+            }
+            if !is_plain_name(name) {
+                diags.push(
+                    Diagnostic::new(
+                        Code::NameNotIdentifier,
+                        span,
+                        format!("the name '{name}' contains characters that separate names in lists and expressions"),
+                    )
+                    .with_help(format!(
+                        "it can be referenced only by attributes that take one name; consider '{}'",
+                        plain_version(name)
+                    )),
+                );
+            }
+            table.defs.insert(name.to_string(), Definition { kind, span });
+        }
+        table
+    }
+
+    pub fn kind_of(&self, name: &str) -> Option<&'static str> {
+        self.defs.get(name).map(|d| d.kind)
+    }
+}
+
+/// Letters, digits, '_' and '-', not starting with a digit or '-'.
+pub fn is_plain_name(name: &str) -> bool {
+    let mut chars = name.chars();
+    matches!(chars.next(), Some(c) if c.is_alphabetic() || c == '_')
+        && chars.all(|c| c.is_alphanumeric() || c == '_' || c == '-')
+}
+
+fn plain_version(name: &str) -> String {
+    let mut out: String = name
+        .chars()
+        .map(|c| if c.is_alphanumeric() || c == '-' { c } else { '_' })
+        .collect();
+    if out.starts_with(|c: char| c.is_ascii_digit() || c == '-') {
+        out.insert(0, '_');
+    }
+    out
+}

@@ -1,0 +1,369 @@
+//! The object resolver: looks up references (with cycle detection through
+//! transforms), evaluates points and vectors in their coordinate systems, and
+//! hands each primitive to [`super::shapes`].
+
+use super::frames::{resolve_cs, FrameState};
+use super::geometry::{Geometry, Link};
+use super::names::NameTable;
+use super::values::{Ctx, Values};
+use super::ResolvedObject;
+use crate::diag::{did_you_mean, Code, Diagnostic, Diagnostics};
+use crate::doc::{Axis, CoordinateSystem, Document, Number, Object, PointSpec, Ref, VectorSpec};
+use crate::geom::{Frame, Point3, Vec3};
+use std::collections::HashMap;
+
+#[derive(Debug, Clone, PartialEq)]
+enum State {
+    InProgress,
+    Done(Option<Geometry>),
+}
+
+pub(super) struct Resolver<'a> {
+    pub doc: &'a Document,
+    pub names: &'a NameTable,
+    pub values: Values,
+    pub diags: &'a mut Diagnostics,
+    by_name: HashMap<&'a str, usize>,
+    systems: HashMap<String, &'a CoordinateSystem>,
+    frames: HashMap<String, FrameState>,
+    state: Vec<Option<State>>,
+}
+
+impl<'a> Resolver<'a> {
+    pub fn new(doc: &'a Document, names: &'a NameTable, values: Values, diags: &'a mut Diagnostics) -> Self {
+        let mut by_name = HashMap::new();
+        for (i, o) in doc.objects.iter().enumerate() {
+            by_name.entry(o.name.text.as_str()).or_insert(i);
+        }
+        let mut systems = HashMap::new();
+        for cs in &doc.coordinate_systems {
+            systems.entry(cs.name.text.clone()).or_insert(cs);
+        }
+        Resolver {
+            doc,
+            names,
+            values,
+            diags,
+            by_name,
+            systems,
+            frames: HashMap::new(),
+            state: vec![None; doc.objects.len()],
+        }
+    }
+
+    pub fn finish(self) -> Values {
+        self.values
+    }
+
+    pub fn resolve_all(&mut self) -> Vec<ResolvedObject> {
+        // Coordinate systems first, so unused ones are checked too.
+        let systems: Vec<&CoordinateSystem> = self.doc.coordinate_systems.iter().collect();
+        for cs in systems {
+            let reference = crate::doc::Ref {
+                name: cs.name.text.clone(),
+                index: None,
+                entity: None,
+                text: cs.name.text.clone(),
+                span: cs.name.span,
+            };
+            self.frame_of(&reference);
+        }
+        (0..self.doc.objects.len())
+            .map(|i| {
+                let object = &self.doc.objects[i];
+                let geometry = self.geometry(i);
+                ResolvedObject {
+                    name: object.name.text.clone(),
+                    span: object.span,
+                    geometry,
+                }
+            })
+            .collect()
+    }
+
+    /// The geometry of object `i`, resolved once.
+    pub fn geometry(&mut self, i: usize) -> Option<Geometry> {
+        match &self.state[i] {
+            Some(State::Done(g)) => return g.clone(),
+            Some(State::InProgress) => {
+                let object = &self.doc.objects[i];
+                self.diags.push(
+                    Diagnostic::new(
+                        Code::ReferenceCycle,
+                        object.name.span,
+                        format!("{} '{}' is defined through itself", object.kind.element(), object.name.text),
+                    )
+                    .with_help("a transform or reference chain leads back to this object; break the chain"),
+                );
+                self.state[i] = Some(State::Done(None));
+                return None;
+            }
+            None => {}
+        }
+        self.state[i] = Some(State::InProgress);
+        let object: &'a Object = &self.doc.objects[i];
+        let geometry = self.resolve_object(object);
+        if let Some(State::Done(None)) = self.state[i] {
+            return None;
+        }
+        self.state[i] = Some(State::Done(geometry.clone()));
+        geometry
+    }
+
+    fn resolve_object(&mut self, object: &'a Object) -> Option<Geometry> {
+        let frame = match &object.cs {
+            Some(cs) => self.frame_of(cs)?,
+            None => Frame::identity(),
+        };
+        super::shapes::resolve_kind(self, object, &frame)
+    }
+
+    pub fn frame_of(&mut self, reference: &Ref) -> Option<Frame> {
+        let other_kind = self.names.kind_of(&reference.name);
+        let mut values = std::mem::replace(&mut self.values, Values::new(&Document::default(), &[]));
+        let result = resolve_cs(
+            reference,
+            &self.systems,
+            &mut self.frames,
+            other_kind,
+            &mut |cs, diags| {
+                let zero = Vec3::zeros();
+                let origin = match &cs.origin {
+                    Some(o) => vector3(&mut values, o.x.as_ref(), o.y.as_ref(), o.z.as_ref(), true, diags)?,
+                    None => zero,
+                };
+                let angles = match &cs.rotation {
+                    Some(r) => vector3(&mut values, r.x.as_ref(), r.y.as_ref(), r.z.as_ref(), false, diags)?,
+                    None => zero,
+                };
+                Some((origin, angles))
+            },
+            self.diags,
+        );
+        self.values = values;
+        result
+    }
+
+    // ---- numbers, points, vectors ----
+
+    pub fn number(&mut self, n: &Number) -> Option<f64> {
+        self.values.eval(n, Ctx::Any, self.diags)
+    }
+
+    /// A point in global coordinates. `need3` asks for a warning when a 3D
+    /// model's single point leaves coordinates out.
+    pub fn point(&mut self, spec: &PointSpec, frame: &Frame, need3: bool) -> Option<Point3> {
+        if let Some(reference) = &spec.point {
+            if spec.x.is_some() || spec.y.is_some() || spec.z.is_some() {
+                self.diags.push(
+                    Diagnostic::new(
+                        Code::ConflictingForms,
+                        spec.span,
+                        format!("<{}> gives both coordinates and point=\"{}\"", self.tag(spec), reference.text),
+                    )
+                    .with_help("give either x/y/z or point=, not both"),
+                );
+                return None;
+            }
+            return self.point_reference(reference);
+        }
+        if spec.x.is_none() && spec.y.is_none() && spec.z.is_none() {
+            self.diags.push(
+                Diagnostic::new(
+                    Code::MissingAttribute,
+                    spec.span,
+                    format!("<{}> gives no coordinates", self.tag(spec)),
+                )
+                .with_help("add x=, y= and z= (or point=\"name\")"),
+            );
+            return None;
+        }
+        let local = vector3(&mut self.values, spec.x.as_ref(), spec.y.as_ref(), spec.z.as_ref(), true, self.diags)?;
+        let missing_z = spec.z.is_none() && self.doc.dimension == 3;
+        if need3 && (spec.x.is_none() || spec.y.is_none() || missing_z) {
+            let missing: Vec<&str> = [("x", spec.x.is_none()), ("y", spec.y.is_none()), ("z", missing_z)]
+                .iter()
+                .filter(|(_, m)| *m)
+                .map(|(n, _)| *n)
+                .collect();
+            self.diags.push(
+                Diagnostic::new(
+                    Code::PointValueShape,
+                    spec.span,
+                    format!("<{}> gives no {}; taken as 0", self.tag(spec), missing.join(", ")),
+                )
+                .with_help("give all three coordinates of a 3D point"),
+            );
+        }
+        Some(frame.to_global(&Point3::from(local)))
+    }
+
+    fn tag(&self, spec: &PointSpec) -> String {
+        spec.tag.clone()
+    }
+
+    /// A point given by reference: a point set (member), or a vertex.
+    fn point_reference(&mut self, reference: &Ref) -> Option<Point3> {
+        let i = self.lookup(reference, &["point", "vertex"])?;
+        match self.geometry(i)? {
+            Geometry::Points { points } => match (reference.index, points.len()) {
+                (None, 1) => points.first().copied(),
+                (Some(k), n) if k >= 1 && k <= n => points.get(k - 1).copied(),
+                (None, n) => {
+                    self.diags.push(
+                        Diagnostic::new(
+                            Code::IndexOutOfRange,
+                            reference.span,
+                            format!("point '{}' holds {n} points; say which one", reference.name),
+                        )
+                        .with_help(format!("write {}[1] … {}[{n}]", reference.name, reference.name)),
+                    );
+                    None
+                }
+                (Some(k), n) => {
+                    self.diags.push(
+                        Diagnostic::new(
+                            Code::IndexOutOfRange,
+                            reference.span,
+                            format!("point '{}' has no member {k}: it holds {n} point{}", reference.name, if n == 1 { "" } else { "s" }),
+                        )
+                        .with_help(format!("use an index from 1 to {n}")),
+                    );
+                    None
+                }
+            },
+            Geometry::Vertex(p) => Some(p),
+            _ => None,
+        }
+    }
+
+    pub fn vector(&mut self, spec: &VectorSpec, frame: &Frame) -> Option<Vec3> {
+        let v = vector3(&mut self.values, spec.x.as_ref(), spec.y.as_ref(), spec.z.as_ref(), true, self.diags)?;
+        Some(frame.linear * v)
+    }
+
+    /// A vector of plain numbers (angles, scale factors): basis coordinates not allowed.
+    pub fn numbers3(&mut self, spec: &VectorSpec) -> Option<Vec3> {
+        vector3(&mut self.values, spec.x.as_ref(), spec.y.as_ref(), spec.z.as_ref(), false, self.diags)
+    }
+
+    // ---- references ----
+
+    /// Finds the object a reference names, checking that its element is one of
+    /// `kinds` (element names as in the format; "*" accepts any object).
+    pub fn lookup(&mut self, reference: &Ref, kinds: &[&str]) -> Option<usize> {
+        let Some(&i) = self.by_name.get(reference.name.as_str()) else {
+            let d = match self.names.kind_of(&reference.name) {
+                Some(kind) => Diagnostic::new(
+                    Code::WrongKind,
+                    reference.span,
+                    format!("'{}' is a {kind}, but a {} is expected here", reference.name, kinds.join(" or ")),
+                )
+                .with_help(format!("name a {}", kinds.join(" or "))),
+                None => {
+                    let mut d = Diagnostic::new(
+                        Code::UndefinedName,
+                        reference.span,
+                        format!("undefined name '{}'", reference.name),
+                    );
+                    let candidates = self
+                        .doc
+                        .objects
+                        .iter()
+                        .filter(|o| kinds.contains(&"*") || kinds.contains(&o.kind.element()))
+                        .map(|o| o.name.text.as_str());
+                    d.help = Some(match did_you_mean(&reference.name, candidates) {
+                        Some(best) => format!("did you mean '{best}'?"),
+                        None => format!("define a {} named '{}'", kinds.join(" or "), reference.name),
+                    });
+                    d
+                }
+            };
+            self.diags.push(d);
+            return None;
+        };
+        let element = self.doc.objects[i].kind.element();
+        let transformed = matches!(element, "transform" | "replicate");
+        if !kinds.contains(&"*") && !kinds.contains(&element) && !transformed {
+            self.diags.push(
+                Diagnostic::new(
+                    Code::WrongKind,
+                    reference.span,
+                    format!("'{}' is a {element}, but a {} is expected here", reference.name, kinds.join(" or ")),
+                )
+                .with_help(format!("name a {}", kinds.join(" or "))),
+            );
+            return None;
+        }
+        Some(i)
+    }
+
+    /// Resolves a reference to geometry, picking a replicate's member when indexed.
+    pub fn linked_geometry(&mut self, reference: &Ref, kinds: &[&str]) -> Option<(usize, Geometry)> {
+        let i = self.lookup(reference, kinds)?;
+        let g = self.geometry(i)?;
+        match (g, reference.index) {
+            (Geometry::Group(members), Some(k)) => match members.get(k.wrapping_sub(1)) {
+                Some(m) => Some((i, m.clone())),
+                None => {
+                    self.diags.push(
+                        Diagnostic::new(
+                            Code::IndexOutOfRange,
+                            reference.span,
+                            format!("'{}' has {} members; there is no [{k}]", reference.name, members.len()),
+                        )
+                        .with_help(format!("use an index from 1 to {}", members.len())),
+                    );
+                    None
+                }
+            },
+            (Geometry::Group(members), None) => Some((i, Geometry::Group(members))),
+            (g, None) => Some((i, g)),
+            (g, Some(k)) => {
+                if let Geometry::Points { points } = &g {
+                    if k >= 1 && k <= points.len() {
+                        return Some((i, Geometry::Points { points: vec![points[k - 1]] }));
+                    }
+                }
+                self.diags.push(
+                    Diagnostic::new(
+                        Code::IndexOutOfRange,
+                        reference.span,
+                        format!("'{}' is a single {}; it has no member [{k}]", reference.name, g.kind()),
+                    )
+                    .with_help(format!("write '{}' without an index", reference.name)),
+                );
+                None
+            }
+        }
+    }
+
+    pub fn link(&mut self, reference: &Ref, kinds: &[&str]) -> Option<Link> {
+        let i = self.lookup(reference, kinds)?;
+        Some(Link { object: i, span: reference.span })
+    }
+}
+
+/// Evaluates three optional components (missing = 0). As coordinates, each
+/// may use basis coordinates of its own axis.
+fn vector3(
+    values: &mut Values,
+    x: Option<&Number>,
+    y: Option<&Number>,
+    z: Option<&Number>,
+    coordinates: bool,
+    diags: &mut Diagnostics,
+) -> Option<Vec3> {
+    let mut out = Vec3::zeros();
+    let mut ok = true;
+    for (slot, (n, axis)) in [(x, Axis::X), (y, Axis::Y), (z, Axis::Z)].into_iter().enumerate() {
+        if let Some(n) = n {
+            let ctx = if coordinates { Ctx::Coordinate(axis) } else { Ctx::Any };
+            match values.eval(n, ctx, diags) {
+                Some(v) => out[slot] = v,
+                None => ok = false,
+            }
+        }
+    }
+    ok.then_some(out)
+}

@@ -1,0 +1,281 @@
+//! Parameters and basis coordinates: their values (with `--set` overrides),
+//! evaluated on demand with cycle detection, and the evaluation of every other
+//! numeric attribute against them.
+
+use crate::diag::{did_you_mean, Code, Diagnostic, Diagnostics};
+use crate::doc::{Axis, Document, Number};
+use crate::expr::{self, EvalError, Expr};
+use crate::span::Span;
+use std::collections::{BTreeMap, HashMap, HashSet};
+
+/// Where a number is used: basis coordinates are allowed only as coordinates
+/// of their own axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Ctx {
+    Any,
+    Coordinate(Axis),
+}
+
+#[derive(Debug, Clone)]
+enum Source {
+    Parameter { expr: Option<Expr>, span: Span },
+    Basis { axis: Axis, expr: Option<Expr>, span: Span },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum State {
+    InProgress,
+    Done(Option<f64>),
+}
+
+/// The evaluator of numeric attributes.
+pub struct Values {
+    sources: HashMap<String, Source>,
+    /// Parameter names in definition order.
+    parameter_order: Vec<String>,
+    state: HashMap<String, State>,
+    used: HashSet<String>,
+    /// Names of non-numeric objects, to say "wrong kind" instead of "undefined".
+    pub other_names: HashMap<String, &'static str>,
+    stack: Vec<String>,
+}
+
+impl Values {
+    /// Collects parameters and basis coordinates; `overrides` (from `--set`)
+    /// replace parameter expressions. Duplicate names are reported by the name
+    /// table, so the first definition wins here.
+    pub fn new(doc: &Document, overrides: &[(String, Expr)]) -> Values {
+        let mut sources = HashMap::new();
+        let mut parameter_order = Vec::new();
+        for p in &doc.parameters {
+            if sources.contains_key(&p.name.text) {
+                continue;
+            }
+            parameter_order.push(p.name.text.clone());
+            sources.insert(
+                p.name.text.clone(),
+                Source::Parameter { expr: p.value.expr.clone(), span: p.name.span },
+            );
+        }
+        for b in &doc.basis {
+            sources.entry(b.name.text.clone()).or_insert(Source::Basis {
+                axis: b.axis,
+                expr: b.value.expr.clone(),
+                span: b.name.span,
+            });
+        }
+        for (name, expr) in overrides {
+            if let Some(Source::Parameter { expr: slot, .. }) = sources.get_mut(name) {
+                *slot = Some(expr.clone());
+            }
+        }
+        Values {
+            sources,
+            parameter_order,
+            state: HashMap::new(),
+            used: HashSet::new(),
+            other_names: HashMap::new(),
+            stack: Vec::new(),
+        }
+    }
+
+    pub fn is_parameter(&self, name: &str) -> bool {
+        matches!(self.sources.get(name), Some(Source::Parameter { .. }))
+    }
+
+    pub fn parameter_names(&self) -> Vec<&str> {
+        self.parameter_order.iter().map(String::as_str).collect()
+    }
+
+    /// The value of a numeric attribute, or `None` after reporting why not.
+    pub fn eval(&mut self, number: &Number, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
+        let expr = number.expr.as_ref()?;
+        self.eval_expr(expr, ctx, diags)
+    }
+
+    pub fn eval_opt(&mut self, number: &Option<Number>, ctx: Ctx, diags: &mut Diagnostics) -> Option<Option<f64>> {
+        match number {
+            None => Some(None),
+            Some(n) => self.eval(n, ctx, diags).map(Some),
+        }
+    }
+
+    fn eval_expr(&mut self, expr: &Expr, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
+        let mut failed = false;
+        let result = expr::eval(expr, &mut |name, span| {
+            let value = self.lookup(name, span, ctx, diags);
+            if value.is_none() && name != "pi" {
+                failed = true;
+            }
+            value.or(if name == "pi" { None } else { Some(0.0) })
+        });
+        if failed {
+            return None;
+        }
+        match result {
+            Ok(v) => Some(v),
+            Err(EvalError::Unknown { .. }) => None,
+            Err(EvalError::NonFinite { span, what }) => {
+                diags.push(
+                    Diagnostic::new(Code::NonFiniteValue, span, format!("this expression has no finite value: {what}"))
+                        .with_help("check the values of the parameters it uses"),
+                );
+                None
+            }
+        }
+    }
+
+    fn lookup(&mut self, name: &str, span: Span, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
+        match self.sources.get(name).cloned() {
+            Some(Source::Parameter { .. }) => {
+                self.used.insert(name.to_string());
+                self.value_of(name, diags)
+            }
+            Some(Source::Basis { axis, .. }) => {
+                self.used.insert(name.to_string());
+                match ctx {
+                    Ctx::Coordinate(want) if want == axis => self.value_of(name, diags),
+                    Ctx::Coordinate(want) => {
+                        diags.push(
+                            Diagnostic::new(
+                                Code::WrongAxis,
+                                span,
+                                format!(
+                                    "basis coordinate '{name}' is a {} coordinate but is used for {}",
+                                    axis.letter(),
+                                    want.letter().to_lowercase()
+                                ),
+                            )
+                            .with_help(format!(
+                                "use a basis coordinate listed under <coordinate name=\"{}\">",
+                                want.letter()
+                            )),
+                        );
+                        None
+                    }
+                    Ctx::Any => {
+                        diags.push(
+                            Diagnostic::new(
+                                Code::WrongKind,
+                                span,
+                                format!("basis coordinate '{name}' is used where no coordinate is expected"),
+                            )
+                            .with_help("basis coordinates give x, y or z coordinates; define a <parameter> for other values"),
+                        );
+                        None
+                    }
+                }
+            }
+            None if name == "pi" => None,
+            None => {
+                if let Some(kind) = self.other_names.get(name) {
+                    diags.push(
+                        Diagnostic::new(
+                            Code::WrongKind,
+                            span,
+                            format!("'{name}' is a {kind}, not a number"),
+                        )
+                        .with_help("expressions may use parameters, basis coordinates and pi"),
+                    );
+                } else {
+                    let candidates: Vec<&str> = self.sources.keys().map(String::as_str).collect();
+                    let mut d = Diagnostic::new(Code::UndefinedName, span, format!("undefined name '{name}'"));
+                    d.help = Some(match did_you_mean(name, candidates) {
+                        Some(best) => format!("did you mean '{best}'?"),
+                        None => format!("define it: <parameters><parameter name=\"{name}\" value=\"…\"/></parameters>"),
+                    });
+                    diags.push(d);
+                }
+                None
+            }
+        }
+    }
+
+    /// The value of a parameter or basis coordinate, evaluated once.
+    fn value_of(&mut self, name: &str, diags: &mut Diagnostics) -> Option<f64> {
+        match self.state.get(name) {
+            Some(State::Done(v)) => return *v,
+            Some(State::InProgress) => {
+                let start = self.stack.iter().position(|n| n == name).unwrap_or(0);
+                let mut cycle: Vec<&str> = self.stack[start..].iter().map(String::as_str).collect();
+                cycle.push(name);
+                let span = match self.sources.get(name) {
+                    Some(Source::Parameter { span, .. } | Source::Basis { span, .. }) => Some(*span),
+                    None => None,
+                };
+                diags.push(
+                    Diagnostic::new(
+                        Code::ReferenceCycle,
+                        span,
+                        format!("'{name}' is defined through itself: {}", cycle.join(" → ")),
+                    )
+                    .with_help("give one of these a value that does not depend on the others"),
+                );
+                // Mark every member of the cycle failed so it is reported once.
+                for n in &self.stack[start..] {
+                    self.state.insert(n.clone(), State::Done(None));
+                }
+                return None;
+            }
+            None => {}
+        }
+        let (expr, ctx) = match self.sources.get(name) {
+            Some(Source::Parameter { expr, .. }) => (expr.clone(), Ctx::Any),
+            Some(Source::Basis { axis, expr, .. }) => (expr.clone(), Ctx::Coordinate(*axis)),
+            None => return None,
+        };
+        self.state.insert(name.to_string(), State::InProgress);
+        self.stack.push(name.to_string());
+        let value = expr.and_then(|e| self.eval_expr(&e, ctx, diags));
+        self.stack.pop();
+        if let Some(State::Done(v)) = self.state.get(name) {
+            // A cycle through this name was found and reported while evaluating it.
+            return *v;
+        }
+        self.state.insert(name.to_string(), State::Done(value));
+        value
+    }
+
+    /// Evaluates every parameter and basis coordinate (so that unused ones are
+    /// checked too) and returns the parameters in force, in definition order.
+    pub fn evaluate_all(&mut self, diags: &mut Diagnostics) -> Vec<(String, f64)> {
+        let mut names: Vec<String> = self.sources.keys().cloned().collect();
+        names.sort();
+        for name in &names {
+            self.value_of(name, diags);
+        }
+        self.parameter_order
+            .clone()
+            .into_iter()
+            .filter_map(|n| match self.state.get(&n) {
+                Some(State::Done(Some(v))) => Some((n, *v)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Basis coordinate values per axis, keyed by name.
+    pub fn basis_values(&self, axis: Axis) -> BTreeMap<String, f64> {
+        self.sources
+            .iter()
+            .filter_map(|(n, s)| match (s, self.state.get(n)) {
+                (Source::Basis { axis: a, .. }, Some(State::Done(Some(v)))) if *a == axis => Some((n.clone(), *v)),
+                _ => None,
+            })
+            .collect()
+    }
+
+    /// Parameters never used by any expression (their spans).
+    pub fn unused_parameters(&self) -> Vec<(String, Span)> {
+        let mut out: Vec<(String, Span)> = self
+            .sources
+            .iter()
+            .filter_map(|(n, s)| match s {
+                Source::Parameter { span, .. } if !self.used.contains(n) => Some((n.clone(), *span)),
+                _ => None,
+            })
+            .collect();
+        out.sort_by_key(|(_, s)| *s);
+        out
+    }
+}
