@@ -14,3 +14,18 @@ pub mod doc;
 pub mod geom;
 pub mod ir;
 pub mod resolve;
+pub mod lower;
+
+/// A number as messages show it (no trailing zeros).
+pub(crate) fn resolve_fmt(v: f64) -> String {
+    let magnitude = v.abs();
+    if magnitude != 0.0 && !(1e-4..1e9).contains(&magnitude) {
+        format!("{v:.3e}")
+    } else {
+        let rounded = (v * 1e9).round() / 1e9;
+        format!("{rounded}")
+    }
+}
+pub mod driver;
+pub mod valid;
+pub mod inspect;

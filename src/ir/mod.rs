@@ -106,8 +106,11 @@ pub struct Subdomain {
 pub struct Solid {
     pub name: String,
     pub shape: SolidShape,
-    /// Faces with `outward` relative to this solid (edges in 2D: see `edges`).
+    /// Faces with `outward` relative to this solid (3D).
     pub faces: Vec<OrientedFace>,
+    /// Boundary edges with `forward` when the region lies on their left, seen
+    /// from the region face's normal side (2D regions).
+    pub boundary_edges: Vec<OrientedEdge>,
     pub edges: Vec<EdgeId>,
     pub vertices: Vec<VertexId>,
 }

@@ -11,6 +11,7 @@ mod values;
 
 pub use geometry::{Geometry, LineCarrier, Link};
 pub use names::{is_plain_name, NameTable};
+pub use shapes::{fmt, fmt_point, perpendicular_pair};
 pub use values::{Ctx, Values};
 
 use crate::diag::{Code, Diagnostic, Diagnostics};

@@ -1,0 +1,49 @@
+//! `geomc inspect FILE`: the model's facts as text or JSON.
+
+use super::{out, report_usage, Format, InputOptions, EXIT_INVALID, EXIT_OK, EXIT_USAGE};
+use geomc::diag::render_human;
+use geomc::driver::check_file;
+use std::path::PathBuf;
+
+#[derive(clap::Args)]
+pub struct Args {
+    file: PathBuf,
+    /// Output format: human text or json.
+    #[arg(long, value_enum, default_value_t = Format::Human)]
+    format: Format,
+    /// Print the incidence matrices M_VE, M_EF, M_FD and the derived V–F, E–D.
+    #[arg(long)]
+    matrices: bool,
+    #[command(flatten)]
+    input: InputOptions,
+}
+
+pub fn run(args: &Args) -> i32 {
+    let options = match args.input.to_options() {
+        Ok(o) => o,
+        Err(diagnostics) => {
+            report_usage(&diagnostics);
+            return EXIT_INVALID;
+        }
+    };
+    let checked = match check_file(&args.file, &options) {
+        Ok(c) => c,
+        Err(e) => {
+            eprintln!("geomc: cannot read {}: {e}", args.file.display());
+            return EXIT_USAGE;
+        }
+    };
+    for d in &checked.diagnostics.items {
+        eprint!("{}", render_human(&checked.source, d));
+    }
+    let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
+        eprintln!("geomc: {} is invalid; fix the errors above to inspect it", args.file.display());
+        return EXIT_INVALID;
+    };
+    let report = geomc::inspect::Report::of(&lowered.model);
+    match args.format {
+        Format::Human => out(&report.render_text(&lowered.model, args.matrices)),
+        Format::Json => out(&format!("{}\n", report.render_json(&lowered.model, args.matrices))),
+    }
+    EXIT_OK
+}

@@ -1,0 +1,126 @@
+//! The command line: the only code that prints, reads files for the user, and
+//! decides exit codes. Each subcommand has its own file.
+
+mod explain;
+mod inspect;
+mod validate;
+
+use clap::{Parser, Subcommand};
+use geomc::diag::render_human;
+use geomc::driver::Options;
+use geomc::resolve::parse_override;
+use geomc::syntax::Limits;
+use std::io::Write;
+
+pub const EXIT_OK: i32 = 0;
+pub const EXIT_INVALID: i32 = 1;
+pub const EXIT_USAGE: i32 = 2;
+pub const EXIT_INTERNAL: i32 = 3;
+
+#[derive(Parser)]
+#[command(name = "geomc", version, about = "Compile XML descriptions of computational domains into checked topology and meshes")]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand)]
+enum Command {
+    /// Check files (or folders, recursively) and report every problem.
+    Validate(validate::Args),
+    /// Summarise a model: counts, subdomains, fragments, bounding box, parameters.
+    Inspect(inspect::Args),
+    /// Explain a diagnostic code, e.g. `geomc explain E201`.
+    Explain(explain::Args),
+}
+
+/// Options shared by every subcommand that reads XML.
+#[derive(clap::Args, Clone, Debug)]
+pub struct InputOptions {
+    /// Override a parameter: --set r=0.8 (repeatable).
+    #[arg(long = "set", value_name = "NAME=VALUE")]
+    pub set: Vec<String>,
+    /// Largest accepted input file, in bytes.
+    #[arg(long, value_name = "BYTES", default_value_t = Limits::default().max_file_size)]
+    pub max_file_size: usize,
+    /// Deepest accepted element nesting.
+    #[arg(long, value_name = "N", default_value_t = Limits::default().max_depth)]
+    pub max_depth: usize,
+    /// Most XML nodes in one file.
+    #[arg(long, value_name = "N", default_value_t = Limits::default().max_nodes)]
+    pub max_nodes: u32,
+}
+
+impl InputOptions {
+    /// The driver options, or the diagnostics of malformed --set options.
+    pub fn to_options(&self) -> Result<Options, Vec<geomc::diag::Diagnostic>> {
+        let mut overrides = Vec::new();
+        let mut errors = Vec::new();
+        for text in &self.set {
+            match parse_override(text) {
+                Ok(o) => overrides.push(o),
+                Err(d) => errors.push(d),
+            }
+        }
+        if !errors.is_empty() {
+            return Err(errors);
+        }
+        Ok(Options {
+            overrides,
+            limits: Limits { max_file_size: self.max_file_size, max_depth: self.max_depth, max_nodes: self.max_nodes },
+        })
+    }
+}
+
+#[derive(clap::ValueEnum, Clone, Copy, Debug, PartialEq, Eq, Default)]
+pub enum Format {
+    #[default]
+    Human,
+    Json,
+}
+
+pub fn run() -> i32 {
+    // A panic is a bug: say so, and exit with its own code.
+    std::panic::set_hook(Box::new(|info| {
+        eprintln!("geomc: internal error: {info}");
+        eprintln!("this is a bug in geomc; please report it with the input that caused it");
+    }));
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let code = if e.use_stderr() { EXIT_USAGE } else { EXIT_OK };
+            let _ = e.print();
+            return code;
+        }
+    };
+    let result = std::panic::catch_unwind(|| match cli.command {
+        Command::Validate(args) => validate::run(&args),
+        Command::Inspect(args) => inspect::run(&args),
+        Command::Explain(args) => explain::run(&args),
+    });
+    result.unwrap_or(EXIT_INTERNAL)
+}
+
+/// Writes to stdout, exiting quietly when the reader has gone (a broken pipe).
+pub fn out(text: &str) {
+    let mut stdout = std::io::stdout().lock();
+    if stdout.write_all(text.as_bytes()).and_then(|_| stdout.flush()).is_err() {
+        std::process::exit(EXIT_OK);
+    }
+}
+
+/// Diagnostics of the command line itself (malformed --set).
+pub fn report_usage(diagnostics: &[geomc::diag::Diagnostic]) {
+    let source = geomc::span::SourceFile::new("geomc", "");
+    for d in diagnostics {
+        eprint!("{}", render_human(&source, d));
+    }
+}
+
+/// The process's peak resident memory (Linux: VmHWM in /proc/self/status).
+pub fn peak_memory() -> Option<u64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kilobytes: u64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kilobytes * 1024)
+}

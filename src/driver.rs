@@ -1,0 +1,157 @@
+//! The pipeline as one call: source text → diagnostics and, when resolution
+//! got that far, the model. Used by the CLI and by tests; never prints.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::doc::{self, grammar};
+use crate::ir::{Dimension, SubdomainCells};
+use crate::lower::{self, Lowered};
+use crate::resolve::{self, Override};
+use crate::span::SourceFile;
+use crate::syntax::{self, Limits};
+use std::path::Path;
+
+#[derive(Debug, Clone, Default)]
+pub struct Options {
+    /// `--set NAME=VALUE` overrides, already parsed.
+    pub overrides: Vec<Override>,
+    pub limits: Limits,
+}
+
+/// The outcome of checking one source.
+#[derive(Debug, Clone)]
+pub struct Checked {
+    pub source: SourceFile,
+    pub diagnostics: Diagnostics,
+    /// The model, when the file parsed and resolved (it may still have errors).
+    pub lowered: Option<Lowered>,
+}
+
+impl Checked {
+    pub fn is_valid(&self) -> bool {
+        !self.diagnostics.has_errors()
+    }
+}
+
+/// Reads and checks a file. I/O problems are returned as errors (exit code 2
+/// in the CLI); everything about the content is a diagnostic.
+pub fn check_file(path: &Path, options: &Options) -> std::io::Result<Checked> {
+    let name = path.display().to_string();
+    let metadata = std::fs::metadata(path)?;
+    if metadata.len() > options.limits.max_file_size as u64 {
+        let mut diagnostics = Diagnostics::default();
+        diagnostics.push(
+            Diagnostic::new(
+                Code::FileTooLarge,
+                None,
+                format!("the file is {} bytes, over the limit of {} bytes", metadata.len(), options.limits.max_file_size),
+            )
+            .with_help("raise the limit with --max-file-size BYTES"),
+        );
+        return Ok(Checked { source: SourceFile::new(name, ""), diagnostics, lowered: None });
+    }
+    let bytes = std::fs::read(path)?;
+    Ok(check_bytes(name, bytes, options))
+}
+
+/// Checks raw bytes (refusing text that is not UTF-8).
+pub fn check_bytes(name: String, bytes: Vec<u8>, options: &Options) -> Checked {
+    match String::from_utf8(bytes) {
+        Ok(text) => check_source(SourceFile::new(name, text), options),
+        Err(error) => {
+            let offset = error.utf8_error().valid_up_to();
+            let text = String::from_utf8_lossy(error.as_bytes()).into_owned();
+            let source = SourceFile::new(name, text);
+            let mut diagnostics = Diagnostics::default();
+            diagnostics.push(
+                Diagnostic::new(
+                    Code::NotUtf8,
+                    crate::span::Span::new(offset, offset + 1),
+                    format!("byte {offset} is not valid UTF-8"),
+                )
+                .with_help("save the file as UTF-8 (for example: iconv -f latin1 -t utf-8)"),
+            );
+            Checked { source, diagnostics, lowered: None }
+        }
+    }
+}
+
+pub fn check_source(source: SourceFile, options: &Options) -> Checked {
+    let mut diags = Diagnostics::default();
+    let lowered = run(&source, options, &mut diags);
+    diags.sort();
+    Checked { source, diagnostics: diags, lowered }
+}
+
+fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Option<Lowered> {
+    let root = match syntax::parse(source, &options.limits) {
+        Ok(root) => root,
+        Err(d) => {
+            diags.push(d);
+            return None;
+        }
+    };
+    if root.name != grammar::GEOMETRY.name {
+        diags.push(
+            Diagnostic::new(Code::WrongRoot, root.name_span, format!("the root element is <{}>; a geomc file's root is <geometry>", root.name))
+                .with_help("wrap the content in <geometry version=\"1\"> … </geometry>"),
+        );
+        return None;
+    }
+    if let Some(version) = root.attribute("version") {
+        if version.value.trim() != "1" {
+            diags.push(
+                Diagnostic::new(Code::UnsupportedVersion, version.value_span, format!("format version \"{}\" is not supported; this geomc reads version 1", version.value))
+                    .with_help("set version=\"1\""),
+            );
+            return None;
+        }
+    }
+    doc::structure::check(&root, &grammar::GEOMETRY, diags);
+    let document = doc::build(source, &root, diags);
+    let resolved = resolve::resolve(source, &document, &options.overrides, diags);
+    let lowered = lower::lower(&document, &resolved, diags);
+    diags.extend(crate::valid::check_topology(&lowered.model, &lowered.source_map));
+    check_domain(&document, &lowered, diags);
+    Some(lowered)
+}
+
+/// Whole-model warnings: no subdomains, boundaries on no subdomain.
+fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnostics) {
+    let model = &lowered.model;
+    if model.subdomains.is_empty() && document.subdomains.is_empty() && !model.solids.is_empty() {
+        diags.push(
+            Diagnostic::new(
+                Code::EmptySubdomainList,
+                None,
+                format!("the file defines {} solid{} but no <subdomain>, so it describes no computational domain", model.solids.len(), if model.solids.len() == 1 { "" } else { "s" }),
+            )
+            .with_help("add <subdomain name=\"…\"><solid ref=\"…\"/></subdomain> to describe the domain"),
+        );
+    }
+    let bounding: std::collections::BTreeSet<usize> = model
+        .subdomains
+        .iter()
+        .flat_map(|s| match &s.cells {
+            SubdomainCells::Volume { boundary } => boundary.iter().map(|f| f.face.index()).collect::<Vec<_>>(),
+            SubdomainCells::Region { faces } => faces.iter().map(|f| f.index()).collect(),
+        })
+        .collect();
+    let bounding_edges: std::collections::BTreeSet<usize> = if model.dimension == Dimension::Two {
+        bounding.iter().flat_map(|&f| model.faces[f].loops.iter().flatten().map(|e| e.edge.index())).collect()
+    } else {
+        Default::default()
+    };
+    for (b, def) in model.boundaries.iter().zip(&document.boundaries) {
+        let stray_face = b.faces.iter().find(|f| !bounding.contains(&f.index()));
+        let stray_edge = b.edges.iter().find(|e| model.dimension == Dimension::Two && !bounding_edges.contains(&e.index()));
+        let stray = stray_face
+            .map(|f| model.face(*f).name.clone())
+            .or_else(|| stray_edge.map(|e| model.edge(*e).name.clone()));
+        if let Some(name) = stray {
+            diags.push(
+                Diagnostic::new(Code::BoundaryNotOnSubdomain, def.span, format!("boundary '{}' names '{name}', which bounds no subdomain", b.name))
+                    .with_help("name faces on the boundary of a subdomain; faces made interior by a union bound nothing"),
+            );
+        }
+    }
+}

@@ -1,0 +1,595 @@
+//! Subdomains: boolean trees of solids whose boundaries are disjoint, nested
+//! or share whole faces. Each face of each leaf solid is classified by
+//! evaluating the tree on its two sides; it bounds the subdomain when the
+//! sides differ. Crossing boundaries and overlapping subdomains are reported.
+
+use super::explicit::{lookup_entities, unknown_entity};
+use super::Entities;
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::doc::{Document, SolidTree, SubdomainDef};
+use crate::geom::{boundary_relation, Point3, Surface, Vec3};
+use crate::ir::{
+    Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId, SourceMap, Subdomain, SubdomainCells,
+    SubdomainId,
+};
+use crate::resolve::{Geometry, Resolved};
+use std::collections::{BTreeMap, BTreeSet, HashMap};
+
+/// A boolean tree over leaf solids (indices into `leaves`).
+#[derive(Debug, Clone)]
+enum Tree {
+    Leaf(usize),
+    Union(Vec<Tree>),
+    Intersection(Vec<Tree>),
+    Difference(Vec<Tree>),
+}
+
+impl Tree {
+    fn eval(&self, inside: &dyn Fn(usize) -> bool) -> bool {
+        match self {
+            Tree::Leaf(i) => inside(*i),
+            Tree::Union(ops) => ops.iter().any(|t| t.eval(inside)),
+            Tree::Intersection(ops) => ops.iter().all(|t| t.eval(inside)),
+            Tree::Difference(ops) => {
+                ops.first().is_some_and(|t| t.eval(inside)) && !ops.iter().skip(1).any(|t| t.eval(inside))
+            }
+        }
+    }
+}
+
+struct Built {
+    tree: Tree,
+    leaves: Vec<SolidId>,
+}
+
+pub(super) fn lower_subdomains(
+    doc: &Document,
+    resolved: &Resolved,
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    entities: &Entities,
+    face_samples: &HashMap<FaceId, Point3>,
+    diags: &mut Diagnostics,
+) {
+    let mut trees: Vec<(SubdomainId, Built)> = Vec::new();
+    for def in &doc.subdomains {
+        let id = SubdomainId(model.subdomains.len() as u32);
+        let cells = match (&def.faces, &def.tree) {
+            (Some(_), Some(_)) => {
+                diags.push(
+                    Diagnostic::new(Code::ConflictingForms, def.span, format!("subdomain '{}' has both faces= and a solid", def.name.text))
+                        .with_help("give either the faces that bound it or a solid tree"),
+                );
+                continue;
+            }
+            (Some((refs, _)), None) => match explicit_shell(model, entities, refs, diags) {
+                Some(boundary) => SubdomainCells::Volume { boundary },
+                None => continue,
+            },
+            (None, Some(tree)) => {
+                let mut leaves = Vec::new();
+                let Some(tree) = build_tree(tree, resolved, model, entities, &mut leaves, diags) else { continue };
+                trees.push((id, Built { tree, leaves }));
+                SubdomainCells::Volume { boundary: Vec::new() }
+            }
+            (None, None) => {
+                diags.push(
+                    Diagnostic::new(Code::MissingElement, def.span, format!("subdomain '{}' has neither faces= nor a solid", def.name.text))
+                        .with_help("add faces=\"…\" or a child such as <solid ref=\"…\"/>"),
+                );
+                continue;
+            }
+        };
+        model.subdomains.push(Subdomain {
+            name: def.name.text.clone(),
+            material: def.material.clone(),
+            cells,
+            solids: Vec::new(),
+        });
+        source_map.subdomains.insert(id, Origin { span: def.span });
+    }
+    if trees.is_empty() {
+        return;
+    }
+    if !check_relations(model, source_map, &trees, diags) {
+        return;
+    }
+    for (id, built) in &trees {
+        let def = &doc.subdomains.iter().find(|d| d.name.text == model.subdomain(*id).name);
+        let cells = match model.dimension {
+            Dimension::Three => SubdomainCells::Volume { boundary: classify_faces(model, built, face_samples) },
+            Dimension::Two => {
+                let edges = classify_edges(model, built);
+                let face = region_face(model, &model.subdomain(*id).name.clone(), &edges);
+                SubdomainCells::Region { faces: face.into_iter().collect() }
+            }
+        };
+        let empty = match &cells {
+            SubdomainCells::Volume { boundary } => boundary.is_empty(),
+            SubdomainCells::Region { faces } => faces.is_empty(),
+        };
+        if empty {
+            let span = def.map(|d: &SubdomainDef| d.span);
+            diags.push(
+                Diagnostic::new(Code::EmptySubdomain, span, format!("subdomain '{}' is empty: its solids leave no volume", model.subdomain(*id).name))
+                    .with_help("check the boolean tree: an intersection of disjoint solids, or a difference that removes everything"),
+            );
+        }
+        let subdomain = &mut model.subdomains[id.index()];
+        subdomain.cells = cells;
+        subdomain.solids = built.leaves.clone();
+    }
+    check_overlaps(model, source_map, &trees, face_samples, diags);
+}
+
+fn build_tree(
+    tree: &SolidTree,
+    resolved: &Resolved,
+    model: &Model,
+    entities: &Entities,
+    leaves: &mut Vec<SolidId>,
+    diags: &mut Diagnostics,
+) -> Option<Tree> {
+    let operands = |ops: &[SolidTree], leaves: &mut Vec<SolidId>, diags: &mut Diagnostics| -> Option<Vec<Tree>> {
+        let built: Vec<Option<Tree>> = ops.iter().map(|t| build_tree(t, resolved, model, entities, leaves, diags)).collect();
+        built.into_iter().collect()
+    };
+    Some(match tree {
+        SolidTree::Union(ops, _) => Tree::Union(operands(ops, leaves, diags)?),
+        SolidTree::Intersection(ops, _) => Tree::Intersection(operands(ops, leaves, diags)?),
+        SolidTree::Difference(ops, _) => Tree::Difference(operands(ops, leaves, diags)?),
+        SolidTree::Solid(r) => {
+            let Some(object) = resolved.object(&r.name) else {
+                let names = resolved.objects.iter().filter(|o| matches!(o.geometry, Some(Geometry::Solid(_)) | Some(Geometry::Group(_)))).map(|o| o.name.as_str());
+                let mut d = Diagnostic::new(Code::UndefinedName, r.span, format!("undefined solid '{}'", r.name));
+                d.help = Some(match crate::diag::did_you_mean(&r.name, names) {
+                    Some(best) => format!("did you mean '{best}'?"),
+                    None => "name a sphere, parallelepiped, truncated_cone, ellipsoid or torus".into(),
+                });
+                diags.push(d);
+                return None;
+            };
+            let geometry = object.geometry.as_ref()?;
+            let key = match r.index {
+                Some(k) => format!("{}[{k}]", r.name),
+                None => r.name.clone(),
+            };
+            let ids: Vec<SolidId> = match (geometry, r.index) {
+                (Geometry::Group(members), None) => (1..=members.len())
+                    .flat_map(|k| entities.solids.get(&format!("{}[{k}]", r.name)).cloned().unwrap_or_default())
+                    .collect(),
+                _ => entities.solids.get(&key).cloned().unwrap_or_default(),
+            };
+            let member_geometry = match (geometry, r.index) {
+                (Geometry::Group(members), Some(k)) => members.get(k.wrapping_sub(1)),
+                (Geometry::Group(members), None) => members.first(),
+                (g, _) => Some(g),
+            };
+            if ids.is_empty() {
+                let kind = member_geometry.map_or("object", Geometry::kind);
+                let (code, help) = match member_geometry {
+                    Some(Geometry::Group(_)) | None => (Code::IndexOutOfRange, "use an index within the replicate's count".to_string()),
+                    _ => (Code::NotASolid, "a subdomain's solid is a sphere, ellipsoid, torus, parallelepiped or truncated_cone (in 2D: circle, ellipse, triangle, parallelogram)".to_string()),
+                };
+                diags.push(Diagnostic::new(code, r.span, format!("'{}' is a {kind}, not a bounded solid", r.text)).with_help(help));
+                return None;
+            }
+            let planar = model.solids[ids[0].index()].shape.is_planar();
+            if planar != (model.dimension == Dimension::Two) {
+                let (what, help) = if planar {
+                    ("a 2D region", "set dimension=\"2\" on <geometry> for a planar model, or use a 3D solid")
+                } else {
+                    ("a 3D solid", "a 2D model's subdomains are circles, ellipses, triangles and parallelograms")
+                };
+                diags.push(
+                    Diagnostic::new(Code::DimensionMismatch, r.span, format!("'{}' is {what}, which cannot be a subdomain of a {}D model", r.text, if model.dimension == Dimension::Two { 2 } else { 3 }))
+                        .with_help(help),
+                );
+                return None;
+            }
+            let mut members = Vec::new();
+            for id in ids {
+                let index = leaves.iter().position(|&l| l == id).unwrap_or_else(|| {
+                    leaves.push(id);
+                    leaves.len() - 1
+                });
+                members.push(Tree::Leaf(index));
+            }
+            if members.len() == 1 { members.remove(0) } else { Tree::Union(members) }
+        }
+    })
+}
+
+/// Checks every pair of leaf solids: crossing boundaries, and touching
+/// without sharing whole faces, are reported (E408). Returns false if any was.
+fn check_relations(model: &Model, source_map: &SourceMap, trees: &[(SubdomainId, Built)], diags: &mut Diagnostics) -> bool {
+    let leaves: BTreeSet<SolidId> = trees.iter().flat_map(|(_, b)| b.leaves.iter().copied()).collect();
+    let leaves: Vec<SolidId> = leaves.into_iter().collect();
+    let boxes: Vec<crate::geom::Aabb> = leaves.iter().map(|id| model.solids[id.index()].shape.bbox()).collect();
+    let mut ok = true;
+    for (i, j) in candidate_pairs(&boxes, model.tolerance) {
+        ok &= check_pair(model, source_map, leaves[i], leaves[j], diags);
+    }
+    ok
+}
+
+/// Pairs of boxes that may overlap, found with a uniform grid whose cell is
+/// the median box size; boxes spanning many cells are compared with all.
+fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
+    let mut sizes: Vec<f64> = boxes.iter().map(|b| (b.max - b.min).max()).collect();
+    sizes.sort_by(f64::total_cmp);
+    let cell = sizes.get(sizes.len() / 2).copied().unwrap_or(1.0).max(tol * 1e3).max(f64::MIN_POSITIVE);
+    let key = |v: f64| (v / cell).floor() as i64;
+    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    let mut big = Vec::new();
+    for (i, b) in boxes.iter().enumerate() {
+        let lo = [key(b.min.x - tol), key(b.min.y - tol), key(b.min.z - tol)];
+        let hi = [key(b.max.x + tol), key(b.max.y + tol), key(b.max.z + tol)];
+        let count = (0..3).map(|k| (hi[k] - lo[k] + 1) as u128).product::<u128>();
+        if count > 64 {
+            big.push(i);
+            continue;
+        }
+        for x in lo[0]..=hi[0] {
+            for y in lo[1]..=hi[1] {
+                for z in lo[2]..=hi[2] {
+                    grid.entry([x, y, z]).or_default().push(i);
+                }
+            }
+        }
+    }
+    let mut pairs = BTreeSet::new();
+    for members in grid.values() {
+        for (k, &i) in members.iter().enumerate() {
+            for &j in &members[k + 1..] {
+                if boxes[i].overlaps(&boxes[j], tol) {
+                    pairs.insert((i.min(j), i.max(j)));
+                }
+            }
+        }
+    }
+    for &i in &big {
+        for j in 0..boxes.len() {
+            if i != j && boxes[i].overlaps(&boxes[j], tol) {
+                pairs.insert((i.min(j), i.max(j)));
+            }
+        }
+    }
+    pairs.into_iter().collect()
+}
+
+fn check_pair(model: &Model, source_map: &SourceMap, a: SolidId, b: SolidId, diags: &mut Diagnostics) -> bool {
+    let sa = &model.solids[a.index()];
+    let sb = &model.solids[b.index()];
+    if !sa.shape.bbox().overlaps(&sb.shape.bbox(), model.tolerance) {
+        return true;
+    }
+    let relation = boundary_relation(&sa.shape, &sb.shape, model.tolerance * 10.0);
+    let span = source_map.solid(b).or(source_map.solid(a));
+    if let Some(p) = relation.a_in_b.crossing_near.or(relation.b_in_a.crossing_near) {
+        diags.push(
+            Diagnostic::new(
+                Code::BoundariesIntersect,
+                span,
+                format!("the boundaries of '{}' and '{}' cross near {}", sa.name, sb.name, crate::resolve::fmt_point(&p)),
+            )
+            .with_help("move the solids apart, nest one inside the other, or make touching faces coincide exactly"),
+        );
+        return false;
+    }
+    if relation.a_in_b.crosses() || relation.b_in_a.crosses() {
+        diags.push(
+            Diagnostic::new(Code::BoundariesIntersect, span, format!("the boundaries of '{}' and '{}' cross", sa.name, sb.name))
+                .with_help("move the solids apart, nest one inside the other, or make touching faces coincide exactly"),
+        );
+        return false;
+    }
+    let touching = relation.a_in_b.on > 0 || relation.b_in_a.on > 0;
+    let shares_face = match model.dimension {
+        Dimension::Three => sa.faces.iter().any(|f| sb.faces.iter().any(|g| g.face == f.face)),
+        Dimension::Two => sa.boundary_edges.iter().any(|e| sb.boundary_edges.iter().any(|g| g.edge == e.edge)),
+    };
+    if touching && !shares_face {
+        diags.push(
+            Diagnostic::new(
+                Code::BoundariesIntersect,
+                span,
+                format!("'{}' and '{}' touch without sharing a whole face", sa.name, sb.name),
+            )
+            .with_help("make the touching faces coincide exactly (same corners), or move the solids apart"),
+        );
+        return false;
+    }
+    true
+}
+
+/// The faces of the subdomain's boundary, with `outward` set.
+fn classify_faces(model: &Model, built: &Built, samples: &HashMap<FaceId, Point3>) -> Vec<OrientedFace> {
+    let mut result: BTreeMap<FaceId, bool> = BTreeMap::new();
+    for &leaf in &built.leaves {
+        for of in &model.solids[leaf.index()].faces {
+            if result.contains_key(&of.face) {
+                continue;
+            }
+            let Some(sample) = samples.get(&of.face) else { continue };
+            // Membership of each leaf on the face's two sides: the side the face
+            // normal points away from ("behind") and the side it points to.
+            let side = |behind: bool| {
+                move |i: usize| -> bool {
+                    let solid = &model.solids[built.leaves[i].index()];
+                    match solid.faces.iter().find(|g| g.face == of.face) {
+                        Some(g) => g.outward == behind,
+                        None => solid.shape.value(sample) > 0.0,
+                    }
+                }
+            };
+            let behind = built.tree.eval(&side(true));
+            let front = built.tree.eval(&side(false));
+            if behind != front {
+                result.insert(of.face, behind);
+            }
+        }
+    }
+    result.into_iter().map(|(face, outward)| OrientedFace { face, outward }).collect()
+}
+
+/// The boundary edges of a 2D subdomain, `forward` with the region on the left.
+fn classify_edges(model: &Model, built: &Built) -> Vec<OrientedEdge> {
+    let mut result: BTreeMap<EdgeId, bool> = BTreeMap::new();
+    for &leaf in &built.leaves {
+        for oe in &model.solids[leaf.index()].boundary_edges {
+            if result.contains_key(&oe.edge) {
+                continue;
+            }
+            let sample = model.edge(oe.edge).curve.point(0.5);
+            // "left" = the side on the left of the edge's own direction.
+            let side = |left: bool| {
+                move |i: usize| -> bool {
+                    let solid = &model.solids[built.leaves[i].index()];
+                    match solid.boundary_edges.iter().find(|g| g.edge == oe.edge) {
+                        Some(g) => g.forward == left,
+                        None => solid.shape.value(&sample) > 0.0,
+                    }
+                }
+            };
+            let left = built.tree.eval(&side(true));
+            let right = built.tree.eval(&side(false));
+            if left != right {
+                result.insert(oe.edge, left);
+            }
+        }
+    }
+    result.into_iter().map(|(edge, forward)| OrientedEdge { edge, forward }).collect()
+}
+
+/// One planar face per 2D subdomain, its loops chained from the boundary edges.
+fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<FaceId> {
+    if edges.is_empty() {
+        return None;
+    }
+    let start_of = |m: &Model, e: &OrientedEdge| {
+        let edge = m.edge(e.edge);
+        if e.forward { edge.begin } else { edge.end }
+    };
+    let end_of = |m: &Model, e: &OrientedEdge| {
+        let edge = m.edge(e.edge);
+        if e.forward { edge.end } else { edge.begin }
+    };
+    let mut remaining: Vec<OrientedEdge> = edges.to_vec();
+    let mut loops = Vec::new();
+    while let Some(first) = remaining.first().copied() {
+        remaining.remove(0);
+        let mut l = vec![first];
+        let start = start_of(model, &first);
+        let mut at = end_of(model, &first);
+        while at != start {
+            let Some(k) = remaining.iter().position(|e| start_of(model, e) == at) else { break };
+            let next = remaining.remove(k);
+            at = end_of(model, &next);
+            l.push(next);
+        }
+        loops.push(l);
+    }
+    let origin = model.vertex(model.edge(edges[0].edge).begin).position;
+    let id = FaceId(model.faces.len() as u32);
+    model.faces.push(Face {
+        name: name.to_string(),
+        surface: Surface::Plane { origin, normal: Vec3::z() },
+        reversed: false,
+        loops,
+    });
+    Some(id)
+}
+
+/// Reports pairs of subdomains that share volume: a point just inside one
+/// subdomain, next to one of its boundary faces, lies inside the other.
+fn check_overlaps(
+    model: &Model,
+    source_map: &SourceMap,
+    trees: &[(SubdomainId, Built)],
+    samples: &HashMap<FaceId, Point3>,
+    diags: &mut Diagnostics,
+) {
+    let step = model.tolerance * 1000.0;
+    let inside = |built: &Built, p: &Point3| built.tree.eval(&|i| model.solids[built.leaves[i].index()].shape.value(p) > 0.0);
+    let probes: Vec<Vec<Point3>> = trees.iter().map(|(id, _)| interior_probes(model, *id, samples, step)).collect();
+    let boxes: Vec<crate::geom::Aabb> = trees
+        .iter()
+        .map(|(_, built)| {
+            built
+                .leaves
+                .iter()
+                .fold(crate::geom::Aabb::empty(), |acc, l| acc.union(&model.solids[l.index()].shape.bbox()))
+        })
+        .collect();
+    for (i, j) in candidate_pairs(&boxes, model.tolerance) {
+        let ((a, built_a), (b, built_b)) = (&trees[i], &trees[j]);
+        let overlap = probes[i].iter().any(|p| inside(built_b, p) && inside(built_a, p))
+            || probes[j].iter().any(|p| inside(built_a, p) && inside(built_b, p));
+        if overlap {
+            let (sa, sb) = (model.subdomain(*a), model.subdomain(*b));
+            diags.push(
+                Diagnostic::new(
+                    Code::SubdomainsOverlap,
+                    source_map.subdomain(*a.max(b)),
+                    format!("subdomains '{}' and '{}' overlap", sa.name, sb.name),
+                )
+                .with_help(format!(
+                    "carve one out of the other, e.g. <difference><solid ref=\"outer solid\"/><solid ref=\"inner solid\"/></difference> for the outer of '{}' and '{}'",
+                    sa.name, sb.name
+                )),
+            );
+        }
+    }
+}
+
+/// Points just inside a subdomain, next to each of its boundary faces (edges in 2D).
+fn interior_probes(model: &Model, id: SubdomainId, samples: &HashMap<FaceId, Point3>, step: f64) -> Vec<Point3> {
+    match &model.subdomain(id).cells {
+        SubdomainCells::Volume { boundary } => boundary
+            .iter()
+            .filter_map(|of| {
+                let p = samples.get(&of.face)?;
+                let face = model.face(of.face);
+                let n = face.surface.gradient(p);
+                if n.norm() == 0.0 {
+                    return None;
+                }
+                // Step against the outward normal, into the subdomain.
+                let sign = if of.outward != face.reversed { -1.0 } else { 1.0 };
+                Some(p + n.normalize() * (sign * step))
+            })
+            .collect(),
+        SubdomainCells::Region { faces } => faces
+            .iter()
+            .flat_map(|f| model.face(*f).loops.iter().flatten())
+            .map(|e| {
+                let curve = &model.edge(e.edge).curve;
+                let left = Vec3::z().cross(&curve.tangent(0.5));
+                curve.point(0.5) + left * (if e.forward { step } else { -step })
+            })
+            .collect(),
+    }
+}
+
+/// A subdomain given by its faces: the faces' outward flags are made
+/// consistent across shared edges, then all flipped if the enclosed volume is negative.
+fn explicit_shell(model: &Model, entities: &Entities, refs: &[crate::doc::Ref], diags: &mut Diagnostics) -> Option<Vec<OrientedFace>> {
+    let mut faces = Vec::new();
+    let mut ok = true;
+    for r in refs {
+        match lookup_entities(&entities.faces, &r.text) {
+            Some(ids) => faces.extend(ids),
+            None => {
+                if let Some(kind) = entities_kind(entities, &r.text) {
+                    diags.push(
+                        Diagnostic::new(Code::WrongKind, r.span, format!("'{}' is {kind}, but faces= lists faces", r.text))
+                            .with_help("name faces (explicit <face> names, or primitive faces such as box.xmin)"),
+                    );
+                } else {
+                    unknown_entity(r, "face", entities.faces.keys(), diags);
+                }
+                ok = false;
+            }
+        }
+    }
+    if !ok {
+        return None;
+    }
+    faces.dedup();
+    Some(orient_shell(model, &faces))
+}
+
+fn entities_kind(entities: &Entities, name: &str) -> Option<&'static str> {
+    if entities.edges.contains_key(name) {
+        Some("an edge")
+    } else if entities.vertices.contains_key(name) {
+        Some("a vertex")
+    } else if entities.solids.contains_key(name) {
+        None
+    } else {
+        None
+    }
+}
+
+/// Propagates outward flags across shared edges (an edge is run in opposite
+/// directions by its two faces in a consistently oriented shell), then fixes
+/// the overall sign by the signed volume.
+pub(super) fn orient_shell(model: &Model, faces: &[FaceId]) -> Vec<OrientedFace> {
+    let mut uses: HashMap<EdgeId, Vec<(usize, bool)>> = HashMap::new();
+    for (k, &f) in faces.iter().enumerate() {
+        for e in model.face(f).loops.iter().flatten() {
+            uses.entry(e.edge).or_default().push((k, e.forward));
+        }
+    }
+    let mut outward: Vec<Option<bool>> = vec![None; faces.len()];
+    for start in 0..faces.len() {
+        if outward[start].is_some() {
+            continue;
+        }
+        outward[start] = Some(true);
+        let mut stack = vec![start];
+        let mut component = vec![start];
+        while let Some(k) = stack.pop() {
+            let flag = outward[k].unwrap_or(true);
+            for e in model.face(faces[k]).loops.iter().flatten() {
+                for &(other, forward) in uses.get(&e.edge).map(Vec::as_slice).unwrap_or(&[]) {
+                    if other == k || outward[other].is_some() {
+                        continue;
+                    }
+                    // Effective directions must be opposite: flag·d = −flag'·d'.
+                    let same_direction = forward == e.forward;
+                    outward[other] = Some(if same_direction { !flag } else { flag });
+                    stack.push(other);
+                    component.push(other);
+                }
+            }
+        }
+        let volume: f64 = component
+            .iter()
+            .map(|&k| {
+                let sign = if outward[k] == Some(true) { 1.0 } else { -1.0 };
+                sign * face_volume(model, faces[k])
+            })
+            .sum();
+        if volume < 0.0 {
+            for &k in &component {
+                outward[k] = outward[k].map(|o| !o);
+            }
+        }
+    }
+    faces
+        .iter()
+        .zip(outward)
+        .map(|(&face, o)| OrientedFace { face, outward: o.unwrap_or(true) })
+        .collect()
+}
+
+/// The signed volume contribution ∫ p·n dA / 3 of a face, with its loops
+/// fanned from a point on the surface (n along the loop orientation).
+fn face_volume(model: &Model, face_id: FaceId) -> f64 {
+    let face = model.face(face_id);
+    let mut total = 0.0;
+    for l in &face.loops {
+        let mut points = Vec::new();
+        for e in l {
+            let mut s = model.edge(e.edge).curve.samples(16);
+            if !e.forward {
+                s.reverse();
+            }
+            s.pop();
+            points.extend(s);
+        }
+        if points.len() < 2 {
+            continue;
+        }
+        let centroid = Point3::from(points.iter().map(|p| p.coords).sum::<Vec3>() / points.len() as f64);
+        let apex = face.surface.project(&centroid).unwrap_or(centroid);
+        for i in 0..points.len() {
+            let a = points[i];
+            let b = points[(i + 1) % points.len()];
+            total += apex.coords.dot(&a.coords.cross(&b.coords)) / 6.0;
+        }
+    }
+    total
+}

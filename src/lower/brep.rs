@@ -1,0 +1,290 @@
+//! Canonical boundary representations of the primitive solids, with the
+//! documented entity names users refer to (`box.xmin`, `ball.equator`, …).
+//! Built in local indices; the welder merges them into the model.
+
+use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
+use std::f64::consts::TAU;
+
+pub struct BrepVertex {
+    pub name: &'static str,
+    pub position: Point3,
+}
+
+pub struct BrepEdge {
+    pub name: String,
+    pub curve: Curve,
+    pub begin: usize,
+    pub end: usize,
+}
+
+pub struct BrepFace {
+    pub name: &'static str,
+    pub surface: Surface,
+    /// Loops of (local edge index, forward), counter-clockwise about the
+    /// outward normal.
+    pub loops: Vec<Vec<(usize, bool)>>,
+    /// A canonical point inside the face (its centre), for welding and classification.
+    pub sample: Point3,
+}
+
+/// A primitive's boundary. For 2D regions `faces` holds the single region
+/// face (normal along the frame's third column) and `boundary` lists the rim
+/// edges with `forward` = region on the left about that normal.
+pub struct Brep {
+    pub vertices: Vec<BrepVertex>,
+    pub edges: Vec<BrepEdge>,
+    pub faces: Vec<BrepFace>,
+    pub boundary: Vec<(usize, bool)>,
+}
+
+pub fn of(shape: &SolidShape) -> Brep {
+    match shape {
+        SolidShape::Box { frame } => parallelepiped(frame),
+        SolidShape::Ball { frame } => ball(frame),
+        SolidShape::Cone { frame, r0, r1 } => cone(frame, *r0, *r1),
+        SolidShape::Torus { frame, major, minor } => torus(frame, *major, *minor),
+        SolidShape::Disk { frame } => disk(frame),
+        SolidShape::Polygon { frame, vertices } => polygon(frame, vertices),
+    }
+}
+
+/// True when the frame mirrors, so loops built counter-clockwise in local
+/// coordinates run clockwise in global ones.
+fn mirrors(frame: &Frame) -> bool {
+    frame.linear.determinant() < 0.0
+}
+
+fn ellipse(frame: &Frame, center: Vec3, a: Vec3, b: Vec3) -> Curve {
+    Curve::Ellipse {
+        center: frame.to_global(&Point3::from(center)),
+        major: frame.vector_to_global(&a),
+        minor: frame.vector_to_global(&b),
+        t0: 0.0,
+        t1: TAU,
+    }
+}
+
+const FACE_NAMES: [[&str; 2]; 3] = [["xmin", "xmax"], ["ymin", "ymax"], ["zmin", "zmax"]];
+const VERTEX_NAMES: [&str; 8] = ["v000", "v100", "v010", "v110", "v001", "v101", "v011", "v111"];
+
+fn parallelepiped(frame: &Frame) -> Brep {
+    let corner = |i: usize, j: usize, k: usize| i + 2 * j + 4 * k;
+    let vertices = (0..8)
+        .map(|n| BrepVertex {
+            name: VERTEX_NAMES[n],
+            position: frame.to_global(&Point3::new((n & 1) as f64, ((n >> 1) & 1) as f64, ((n >> 2) & 1) as f64)),
+        })
+        .collect::<Vec<_>>();
+    // Edges along axis `a` at fixed values of the other two axes.
+    let mut edges = Vec::new();
+    let mut edge_index = std::collections::HashMap::new();
+    for axis in 0..3 {
+        let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
+        let (lo, hi) = (p.min(q), p.max(q));
+        for s in 0..2 {
+            for t in 0..2 {
+                let mut at = [0usize; 3];
+                at[lo] = s;
+                at[hi] = t;
+                let begin = corner(at[0], at[1], at[2]);
+                at[axis] = 1;
+                let end = corner(at[0], at[1], at[2]);
+                edge_index.insert((axis, lo, s, hi, t), edges.len());
+                edges.push(BrepEdge {
+                    name: format!("{}_{}", FACE_NAMES[lo][s], FACE_NAMES[hi][t]),
+                    curve: Curve::Segment { a: vertices[begin].position, b: vertices[end].position },
+                    begin,
+                    end,
+                });
+            }
+        }
+    }
+    let flip = mirrors(frame);
+    let mut faces = Vec::new();
+    for axis in 0..3 {
+        let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
+        for side in 0..2 {
+            // The four edges of the face axis = side, walked p-then-q, which is
+            // counter-clockwise about +axis; reversed on the min side.
+            let e = |along: usize, fixed_axis: usize, fixed: usize| {
+                let (lo, hi) = (axis.min(fixed_axis), axis.max(fixed_axis));
+                let (s, t) = if axis < fixed_axis { (side, fixed) } else { (fixed, side) };
+                edge_index[&(along, lo, s, hi, t)]
+            };
+            let mut ring = vec![(e(p, q, 0), true), (e(q, p, 1), true), (e(p, q, 1), false), (e(q, p, 0), false)];
+            if (side == 0) != flip {
+                ring.reverse();
+                for item in &mut ring {
+                    item.1 = !item.1;
+                }
+            }
+            let mut local_normal = Vec3::zeros();
+            local_normal[axis] = if side == 0 { -1.0 } else { 1.0 };
+            let mut center = Point3::new(0.5, 0.5, 0.5);
+            center[axis] = side as f64;
+            let sample = frame.to_global(&center);
+            faces.push(BrepFace {
+                name: FACE_NAMES[axis][side],
+                surface: Surface::Plane { origin: sample, normal: frame.normal_to_global(&local_normal) },
+                loops: vec![ring],
+                sample,
+            });
+        }
+    }
+    Brep { vertices, edges, faces, boundary: Vec::new() }
+}
+
+fn ball(frame: &Frame) -> Brep {
+    let flip = mirrors(frame);
+    let seam = frame.to_global(&Point3::new(1.0, 0.0, 0.0));
+    let surface = Surface::Ellipsoid { frame: *frame };
+    Brep {
+        vertices: vec![BrepVertex { name: "seam", position: seam }],
+        edges: vec![BrepEdge {
+            name: "equator".into(),
+            curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
+            begin: 0,
+            end: 0,
+        }],
+        faces: vec![
+            BrepFace {
+                name: "north",
+                surface: surface.clone(),
+                loops: vec![vec![(0, !flip)]],
+                sample: frame.to_global(&Point3::new(0.0, 0.0, 1.0)),
+            },
+            BrepFace {
+                name: "south",
+                surface,
+                loops: vec![vec![(0, flip)]],
+                sample: frame.to_global(&Point3::new(0.0, 0.0, -1.0)),
+            },
+        ],
+        boundary: Vec::new(),
+    }
+}
+
+fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
+    let flip = mirrors(frame);
+    let mut vertices = Vec::new();
+    let mut edges = Vec::new();
+    let mut faces = Vec::new();
+    let mut side_loops = Vec::new();
+    let rims = [(0.0, r0, "bottom_seam", "bottom_rim", "bottom", -1.0), (1.0, r1, "top_seam", "top_rim", "top", 1.0)];
+    for (z, r, vertex, rim, cap, up) in rims {
+        if r <= 0.0 {
+            continue;
+        }
+        let v = vertices.len();
+        vertices.push(BrepVertex { name: vertex, position: frame.to_global(&Point3::new(r, 0.0, z)) });
+        let e = edges.len();
+        edges.push(BrepEdge {
+            name: rim.into(),
+            curve: ellipse(frame, Vec3::new(0.0, 0.0, z), Vec3::x() * r, Vec3::y() * r),
+            begin: v,
+            end: v,
+        });
+        // The cap's outward normal is ∓axis; the side meets the rim from the other side.
+        let cap_forward = (up > 0.0) != flip;
+        let center = frame.to_global(&Point3::new(0.0, 0.0, z));
+        faces.push(BrepFace {
+            name: cap,
+            surface: Surface::Plane { origin: center, normal: frame.normal_to_global(&Vec3::new(0.0, 0.0, up)) },
+            loops: vec![vec![(e, cap_forward)]],
+            sample: center,
+        });
+        side_loops.push(vec![(e, !cap_forward)]);
+    }
+    let mid_r = 0.5 * (r0 + r1);
+    faces.push(BrepFace {
+        name: "side",
+        surface: Surface::Cone { frame: *frame, r0, r1 },
+        loops: side_loops,
+        sample: frame.to_global(&Point3::new(-mid_r, 0.0, 0.5)),
+    });
+    Brep { vertices, edges, faces, boundary: Vec::new() }
+}
+
+fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
+    let flip = mirrors(frame);
+    let outer = major + minor;
+    let mut ring = vec![(0, true), (1, true), (0, false), (1, false)];
+    if flip {
+        ring.reverse();
+        for item in &mut ring {
+            item.1 = !item.1;
+        }
+    }
+    Brep {
+        vertices: vec![BrepVertex { name: "seam", position: frame.to_global(&Point3::new(outer, 0.0, 0.0)) }],
+        edges: vec![
+            BrepEdge { name: "parallel".into(), curve: ellipse(frame, Vec3::zeros(), Vec3::x() * outer, Vec3::y() * outer), begin: 0, end: 0 },
+            BrepEdge {
+                name: "meridian".into(),
+                curve: ellipse(frame, Vec3::new(major, 0.0, 0.0), Vec3::x() * minor, Vec3::z() * minor),
+                begin: 0,
+                end: 0,
+            },
+        ],
+        faces: vec![BrepFace {
+            name: "surface",
+            surface: Surface::Torus { frame: *frame, major, minor },
+            loops: vec![ring],
+            sample: frame.to_global(&Point3::new(-(major + minor), 0.0, 0.0)),
+        }],
+        boundary: Vec::new(),
+    }
+}
+
+fn region_normal(frame: &Frame) -> Vec3 {
+    let n = frame.linear.column(0).cross(&frame.linear.column(1));
+    if n.norm() > 0.0 { n.normalize() } else { Vec3::z() }
+}
+
+fn disk(frame: &Frame) -> Brep {
+    let center = frame.origin;
+    Brep {
+        vertices: vec![BrepVertex { name: "seam", position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)) }],
+        edges: vec![BrepEdge { name: "rim".into(), curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()), begin: 0, end: 0 }],
+        faces: vec![BrepFace {
+            name: "region",
+            surface: Surface::Plane { origin: center, normal: region_normal(frame) },
+            loops: vec![vec![(0, true)]],
+            sample: center,
+        }],
+        boundary: vec![(0, true)],
+    }
+}
+
+const POLYGON_VERTICES: [&str; 4] = ["v1", "v2", "v3", "v4"];
+
+fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
+    let n = local.len().min(POLYGON_VERTICES.len());
+    let vertices: Vec<BrepVertex> = (0..n)
+        .map(|i| BrepVertex { name: POLYGON_VERTICES[i], position: frame.to_global(&local[i]) })
+        .collect();
+    let edges: Vec<BrepEdge> = (0..n)
+        .map(|i| {
+            let j = (i + 1) % n;
+            BrepEdge {
+                name: format!("e{}", i + 1),
+                curve: Curve::Segment { a: vertices[i].position, b: vertices[j].position },
+                begin: i,
+                end: j,
+            }
+        })
+        .collect();
+    let centroid = Point3::from(vertices.iter().map(|v| v.position.coords).sum::<Vec3>() / n.max(1) as f64);
+    let ring: Vec<(usize, bool)> = (0..n).map(|i| (i, true)).collect();
+    Brep {
+        vertices,
+        edges,
+        faces: vec![BrepFace {
+            name: "region",
+            surface: Surface::Plane { origin: centroid, normal: region_normal(frame) },
+            loops: vec![ring.clone()],
+            sample: centroid,
+        }],
+        boundary: ring,
+    }
+}

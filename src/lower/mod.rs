@@ -1,0 +1,183 @@
+//! Lowering: resolved objects → the model IR. Primitive solids become their
+//! canonical boundary representations (welded where they coincide), explicit
+//! topology becomes vertices, edges and faces, subdomains become oriented
+//! shells (3D) or region faces (2D), and boundaries become named face sets.
+
+mod booleans;
+mod brep;
+mod explicit;
+mod prune;
+mod weld;
+
+use crate::diag::Diagnostics;
+use crate::doc::Document;
+use crate::geom::{Aabb, SolidShape};
+use crate::ir::{Dimension, Face, Model, OrientedEdge, OrientedFace, PointSet, Polyline, Solid, SolidId, SourceMap, Origin};
+use crate::resolve::{Geometry, Resolved};
+use crate::span::Span;
+use std::collections::HashMap;
+
+/// The model and its side table of source positions.
+#[derive(Debug, Clone)]
+pub struct Lowered {
+    pub model: Model,
+    pub source_map: SourceMap,
+}
+
+/// Names of lowered entities, for `faces=` and `edges=` lists.
+#[derive(Debug, Default)]
+pub(crate) struct Entities {
+    /// "box.xmin", explicit face names → face.
+    pub faces: HashMap<String, crate::ir::FaceId>,
+    pub edges: HashMap<String, crate::ir::EdgeId>,
+    pub vertices: HashMap<String, crate::ir::VertexId>,
+    /// Object name (or member "row[2]") → the solids it lowered to.
+    pub solids: HashMap<String, Vec<SolidId>>,
+}
+
+pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
+    let dimension = if resolved.dimension == 2 { Dimension::Two } else { Dimension::Three };
+    let mut model = Model::empty(dimension);
+    model.parameters = resolved.parameters.clone();
+    model.tolerance = tolerance(resolved);
+    let mut source_map = SourceMap::default();
+    let mut entities = Entities::default();
+    let mut welder = weld::Welder::new(model.tolerance);
+
+    for object in &resolved.objects {
+        let Some(geometry) = &object.geometry else { continue };
+        match geometry {
+            Geometry::Group(members) => {
+                for (k, member) in members.iter().enumerate() {
+                    let name = format!("{}[{}]", object.name, k + 1);
+                    lower_free(&mut model, &mut source_map, &mut entities, &mut welder, &name, member, object.span);
+                }
+            }
+            g => lower_free(&mut model, &mut source_map, &mut entities, &mut welder, &object.name, g, object.span),
+        }
+    }
+    explicit::lower_topology(doc, resolved, &mut model, &mut source_map, &mut entities, diags);
+    let face_samples = welder.face_samples;
+    booleans::lower_subdomains(doc, resolved, &mut model, &mut source_map, &mut entities, &face_samples, diags);
+    explicit::lower_boundaries(doc, &mut model, &entities, diags);
+    prune::prune_interior(&mut model, &mut source_map);
+    Lowered { model, source_map }
+}
+
+/// 1e-6 of the diagonal of everything the file places, at least 1e-12.
+fn tolerance(resolved: &Resolved) -> f64 {
+    let mut bbox = Aabb::empty();
+    fn visit(g: &Geometry, bbox: &mut Aabb) {
+        match g {
+            Geometry::Solid(s) => *bbox = bbox.union(&s.bbox()),
+            Geometry::Points { points } | Geometry::Polyline { points } => points.iter().for_each(|p| bbox.include(p)),
+            Geometry::Vertex(p) => bbox.include(p),
+            Geometry::Group(members) => members.iter().for_each(|m| visit(m, bbox)),
+            _ => {}
+        }
+    }
+    for o in &resolved.objects {
+        if let Some(g) = &o.geometry {
+            visit(g, &mut bbox);
+        }
+    }
+    (1e-6 * bbox.diagonal()).max(1e-12)
+}
+
+fn lower_free(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    entities: &mut Entities,
+    welder: &mut weld::Welder,
+    name: &str,
+    geometry: &Geometry,
+    span: Span,
+) {
+    match geometry {
+        Geometry::Points { points } => model.point_sets.push(PointSet { name: name.to_string(), points: points.clone() }),
+        Geometry::Polyline { points } => model.polylines.push(Polyline { name: name.to_string(), points: points.clone() }),
+        Geometry::Solid(shape) => {
+            let id = lower_solid(model, source_map, entities, welder, name, shape, span);
+            entities.solids.entry(name.to_string()).or_default().push(id);
+        }
+        _ => {}
+    }
+}
+
+fn lower_solid(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    entities: &mut Entities,
+    welder: &mut weld::Welder,
+    name: &str,
+    shape: &SolidShape,
+    span: Span,
+) -> SolidId {
+    let origin = Origin { span };
+    let brep = brep::of(shape);
+    let vertex_ids: Vec<_> = brep
+        .vertices
+        .iter()
+        .map(|v| {
+            let (id, new) = welder.vertex(model, format!("{name}.{}", v.name), v.position);
+            if new {
+                source_map.vertices.insert(id, origin);
+            }
+            entities.vertices.entry(format!("{name}.{}", v.name)).or_insert(id);
+            id
+        })
+        .collect();
+    let edge_ids: Vec<_> = brep
+        .edges
+        .into_iter()
+        .map(|e| {
+            let entity = format!("{name}.{}", e.name);
+            let (id, flipped, new) = welder.edge(model, entity.clone(), e.curve, vertex_ids[e.begin], vertex_ids[e.end]);
+            if new {
+                source_map.edges.insert(id, origin);
+            }
+            entities.edges.entry(entity).or_insert(id);
+            (id, flipped)
+        })
+        .collect();
+    let orient = |(local, forward): (usize, bool)| {
+        let (edge, flipped) = edge_ids[local];
+        OrientedEdge { edge, forward: forward != flipped }
+    };
+    let mut faces = Vec::new();
+    for f in brep.faces {
+        let loops: Vec<Vec<OrientedEdge>> = f.loops.iter().map(|l| l.iter().copied().map(orient).collect()).collect();
+        let first = loops.first().and_then(|l| l.first()).copied();
+        let entity = format!("{name}.{}", f.name);
+        let face = Face { name: entity.clone(), surface: f.surface, reversed: false, loops };
+        let (id, new) = welder.face(model, face, f.sample);
+        if new {
+            source_map.faces.insert(id, origin);
+        }
+        entities.faces.entry(entity).or_insert(id);
+        // A welded face keeps the first solid's orientation; this solid's
+        // outward side agrees when its loop runs the same way.
+        let outward = new || first.is_none_or(|probe| same_direction(model.face(id), probe));
+        faces.push(OrientedFace { face: id, outward });
+    }
+    let boundary_edges = brep.boundary.iter().copied().map(orient).collect();
+    let id = SolidId(model.solids.len() as u32);
+    model.solids.push(Solid {
+        name: name.to_string(),
+        shape: shape.clone(),
+        faces,
+        boundary_edges,
+        edges: edge_ids.iter().map(|&(e, _)| e).collect(),
+        vertices: vertex_ids,
+    });
+    source_map.solids.insert(id, origin);
+    id
+}
+
+fn same_direction(face: &Face, probe: OrientedEdge) -> bool {
+    face.loops
+        .iter()
+        .flatten()
+        .find(|e| e.edge == probe.edge)
+        .is_none_or(|e| e.forward == probe.forward)
+}

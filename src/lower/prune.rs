@@ -1,0 +1,152 @@
+//! Removing what the boolean trees made interior: faces of solids used by
+//! subdomains that bound no subdomain, and the edges and vertices only they used.
+
+use crate::ir::{EdgeId, FaceId, Model, SourceMap, SubdomainCells, VertexId};
+use std::collections::{BTreeSet, HashMap};
+
+pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
+    let used_by_subdomains: BTreeSet<usize> = model
+        .subdomains
+        .iter()
+        .flat_map(|s| s.solids.iter().map(|id| id.index()))
+        .collect();
+    let mut keep_face = vec![true; model.faces.len()];
+    for (k, solid) in model.solids.iter().enumerate() {
+        if used_by_subdomains.contains(&k) {
+            for of in &solid.faces {
+                keep_face[of.face.index()] = false;
+            }
+            // A used 2D region's own face is replaced by its subdomain's face.
+        }
+    }
+    for (k, solid) in model.solids.iter().enumerate() {
+        if !used_by_subdomains.contains(&k) {
+            solid.faces.iter().for_each(|of| keep_face[of.face.index()] = true);
+        }
+    }
+    for s in &model.subdomains {
+        match &s.cells {
+            SubdomainCells::Volume { boundary } => boundary.iter().for_each(|of| keep_face[of.face.index()] = true),
+            SubdomainCells::Region { faces } => faces.iter().for_each(|f| keep_face[f.index()] = true),
+        }
+    }
+    for b in &model.boundaries {
+        b.faces.iter().for_each(|f| keep_face[f.index()] = true);
+    }
+    // Map faces.
+    let face_map = compact(&keep_face);
+    let mut keep_edge = vec![false; model.edges.len()];
+    for (k, face) in model.faces.iter().enumerate() {
+        if keep_face[k] {
+            face.loops.iter().flatten().for_each(|e| keep_edge[e.edge.index()] = true);
+        }
+    }
+    let primitive_edges: BTreeSet<usize> = model.solids.iter().flat_map(|s| s.edges.iter().map(|e| e.index())).collect();
+    for (k, keep) in keep_edge.iter_mut().enumerate() {
+        // Explicit edges and edges of free-standing solids always stay.
+        if !primitive_edges.contains(&k) {
+            *keep = true;
+        }
+    }
+    for (k, solid) in model.solids.iter().enumerate() {
+        if !used_by_subdomains.contains(&k) {
+            solid.edges.iter().for_each(|e| keep_edge[e.index()] = true);
+        }
+    }
+    for b in &model.boundaries {
+        b.edges.iter().for_each(|e| keep_edge[e.index()] = true);
+    }
+    let edge_map = compact(&keep_edge);
+    let mut keep_vertex = vec![false; model.vertices.len()];
+    for (k, edge) in model.edges.iter().enumerate() {
+        if keep_edge[k] {
+            keep_vertex[edge.begin.index()] = true;
+            keep_vertex[edge.end.index()] = true;
+        }
+    }
+    let primitive_vertices: BTreeSet<usize> = model.solids.iter().flat_map(|s| s.vertices.iter().map(|v| v.index())).collect();
+    for (k, keep) in keep_vertex.iter_mut().enumerate() {
+        if !primitive_vertices.contains(&k) {
+            *keep = true;
+        }
+    }
+    let vertex_map = compact(&keep_vertex);
+    if keep_face.iter().all(|&k| k) && keep_edge.iter().all(|&k| k) && keep_vertex.iter().all(|&k| k) {
+        return;
+    }
+    apply(model, source_map, &face_map, &edge_map, &vertex_map);
+}
+
+fn compact(keep: &[bool]) -> Vec<Option<u32>> {
+    let mut next = 0u32;
+    keep.iter()
+        .map(|&k| {
+            k.then(|| {
+                next += 1;
+                next - 1
+            })
+        })
+        .collect()
+}
+
+fn retain_indexed<T>(items: &mut Vec<T>, map: &[Option<u32>]) {
+    let mut k = 0;
+    items.retain(|_| {
+        let keep = map.get(k).copied().flatten().is_some();
+        k += 1;
+        keep
+    });
+}
+
+fn apply(model: &mut Model, source_map: &mut SourceMap, faces: &[Option<u32>], edges: &[Option<u32>], vertices: &[Option<u32>]) {
+    let f = |id: FaceId| faces.get(id.index()).copied().flatten().map(FaceId);
+    let e = |id: EdgeId| edges.get(id.index()).copied().flatten().map(EdgeId);
+    let v = |id: VertexId| vertices.get(id.index()).copied().flatten().map(VertexId);
+    retain_indexed(&mut model.faces, faces);
+    retain_indexed(&mut model.edges, edges);
+    retain_indexed(&mut model.vertices, vertices);
+    for edge in &mut model.edges {
+        edge.begin = v(edge.begin).unwrap_or(edge.begin);
+        edge.end = v(edge.end).unwrap_or(edge.end);
+    }
+    for face in &mut model.faces {
+        for oe in face.loops.iter_mut().flatten() {
+            oe.edge = e(oe.edge).unwrap_or(oe.edge);
+        }
+    }
+    for s in &mut model.subdomains {
+        match &mut s.cells {
+            SubdomainCells::Volume { boundary } => {
+                boundary.retain(|of| f(of.face).is_some());
+                boundary.iter_mut().for_each(|of| of.face = f(of.face).unwrap_or(of.face));
+            }
+            SubdomainCells::Region { faces: list } => {
+                list.retain(|&x| f(x).is_some());
+                list.iter_mut().for_each(|x| *x = f(*x).unwrap_or(*x));
+            }
+        }
+    }
+    for solid in &mut model.solids {
+        solid.faces.retain(|of| f(of.face).is_some());
+        solid.faces.iter_mut().for_each(|of| of.face = f(of.face).unwrap_or(of.face));
+        solid.boundary_edges.retain(|oe| e(oe.edge).is_some());
+        solid.boundary_edges.iter_mut().for_each(|oe| oe.edge = e(oe.edge).unwrap_or(oe.edge));
+        solid.edges.retain(|&x| e(x).is_some());
+        solid.edges.iter_mut().for_each(|x| *x = e(*x).unwrap_or(*x));
+        solid.vertices.retain(|&x| v(x).is_some());
+        solid.vertices.iter_mut().for_each(|x| *x = v(*x).unwrap_or(*x));
+    }
+    for b in &mut model.boundaries {
+        b.faces.retain(|&x| f(x).is_some());
+        b.faces.iter_mut().for_each(|x| *x = f(*x).unwrap_or(*x));
+        b.edges.retain(|&x| e(x).is_some());
+        b.edges.iter_mut().for_each(|x| *x = e(*x).unwrap_or(*x));
+    }
+    source_map.faces = remap(&source_map.faces, |id| f(id));
+    source_map.edges = remap(&source_map.edges, |id| e(id));
+    source_map.vertices = remap(&source_map.vertices, |id| v(id));
+}
+
+fn remap<K: Copy + std::hash::Hash + Eq, V: Copy>(table: &HashMap<K, V>, map: impl Fn(K) -> Option<K>) -> HashMap<K, V> {
+    table.iter().filter_map(|(&k, &v)| map(k).map(|k| (k, v))).collect()
+}
