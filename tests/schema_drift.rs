@@ -8,7 +8,8 @@
 //! takes any attribute, its children (names, order in sequences, minimum and
 //! maximum counts) and the particle kind (empty / all / sequence / choice with its
 //! counts / choice between sequences). The test also requires documentation on
-//! every element and attribute declaration and forbids mixed content.
+//! every element and attribute declaration and forbids mixed content, and that
+//! docs/format.md's diagnostic table lists every code of src/diag/code.rs.
 
 use std::collections::{BTreeSet, HashMap, HashSet};
 use std::fmt;
@@ -992,5 +993,45 @@ fn catches_grammar_mutations() {
     assert_caught(
         &differences(root, &xsd),
         "geometry: attribute 'version' is optional in grammar.rs but required in the XSD",
+    );
+}
+
+// ---------------------------------------------------------------------------
+// docs/format.md's code table is generated from src/diag/code.rs: keep it so.
+// ---------------------------------------------------------------------------
+
+#[test]
+fn format_md_lists_every_code() {
+    use geomc::diag::{Code, Severity};
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/docs/format.md");
+    let text = std::fs::read_to_string(path).unwrap_or_else(|e| panic!("cannot read {path}: {e}"));
+    let rows: Vec<&str> = text
+        .lines()
+        .filter(|l| l.starts_with("| E") || l.starts_with("| W"))
+        .filter(|l| l.split('|').nth(1).is_some_and(|c| c.trim().len() == 4))
+        .collect();
+    let mut missing = Vec::new();
+    for code in Code::ALL {
+        let severity = match code.severity() {
+            Severity::Error => "error",
+            Severity::Warning => "warning",
+        };
+        let row = format!("| {} | {severity} | {} |", code.as_str(), code.title());
+        if !rows.contains(&row.as_str()) {
+            missing.push(row);
+        }
+    }
+    assert!(
+        missing.is_empty(),
+        "docs/format.md's diagnostic table lacks these rows (regenerate it from src/diag/code.rs):\n{}",
+        missing.join("\n")
+    );
+    let table_rows = rows
+        .iter()
+        .filter(|r| r.contains("| error |") || r.contains("| warning |"));
+    assert_eq!(
+        table_rows.count(),
+        Code::ALL.len(),
+        "docs/format.md's diagnostic table has rows for codes that src/diag/code.rs lacks"
     );
 }
