@@ -133,7 +133,7 @@ codes! {
     EdgeEndsCoincide = "E400", Error, "open edge with coincident ends",
         "An edge on an open line (a straight segment, an arc) must join two distinct vertices. Only an edge on a closed curve (a full circle or ellipse) may begin and end at the same vertex.";
     OpenLoop = "E401", Error, "face boundary is not a closed loop",
-        "The edges listed for a face must form closed loops: each edge must end where the next begins, and the last must end where the first begins. The message names the edge where the chain breaks.";
+        "The edges listed for a face must form closed loops: each edge must share an end vertex with the next (either way round), and the last with the first. The message names the edge where the chain breaks.";
     OpenShell = "E402", Error, "subdomain boundary is not closed",
         "Every edge of a subdomain's boundary must be shared by exactly two of its faces. The named edge is used by only one face: a face is missing, or an edge is listed with the wrong name.";
     NonManifoldEdge = "E403", Error, "non-manifold edge",
