@@ -18,11 +18,17 @@ impl Default for Frame {
 
 impl Frame {
     pub fn identity() -> Frame {
-        Frame { origin: Point3::origin(), linear: Mat3::identity() }
+        Frame {
+            origin: Point3::origin(),
+            linear: Mat3::identity(),
+        }
     }
 
     pub fn translation(shift: Vec3) -> Frame {
-        Frame { origin: Point3::from(shift), linear: Mat3::identity() }
+        Frame {
+            origin: Point3::from(shift),
+            linear: Mat3::identity(),
+        }
     }
 
     /// Rotation by angles in degrees about the x, then y, then z axis
@@ -31,11 +37,17 @@ impl Frame {
         let r = nalgebra::Rotation3::from_axis_angle(&Vec3::z_axis(), angles.z.to_radians())
             * nalgebra::Rotation3::from_axis_angle(&Vec3::y_axis(), angles.y.to_radians())
             * nalgebra::Rotation3::from_axis_angle(&Vec3::x_axis(), angles.x.to_radians());
-        Frame { origin: Point3::origin(), linear: *r.matrix() }
+        Frame {
+            origin: Point3::origin(),
+            linear: *r.matrix(),
+        }
     }
 
     pub fn scaling(factors: Vec3) -> Frame {
-        Frame { origin: Point3::origin(), linear: Mat3::from_diagonal(&factors) }
+        Frame {
+            origin: Point3::origin(),
+            linear: Mat3::from_diagonal(&factors),
+        }
     }
 
     pub fn to_global(&self, q: &Point3) -> Point3 {
@@ -48,7 +60,9 @@ impl Frame {
 
     /// Global → local; `None` when the frame is singular.
     pub fn to_local(&self, p: &Point3) -> Option<Point3> {
-        self.linear.try_inverse().map(|inv| Point3::from(inv * (p - self.origin)))
+        self.linear
+            .try_inverse()
+            .map(|inv| Point3::from(inv * (p - self.origin)))
     }
 
     /// `self ∘ inner`: first `inner`, then `self`.
@@ -61,7 +75,11 @@ impl Frame {
 
     /// Maps a normal vector (covector) to global coordinates: (L⁻¹)ᵀ n, normalised.
     pub fn normal_to_global(&self, n: &Vec3) -> Vec3 {
-        let m = self.linear.try_inverse().map(|inv| inv.transpose() * n).unwrap_or(*n);
+        let m = self
+            .linear
+            .try_inverse()
+            .map(|inv| inv.transpose() * n)
+            .unwrap_or(*n);
         let len = m.norm();
         if len > 0.0 { m / len } else { m }
     }
@@ -73,5 +91,28 @@ impl Frame {
 
     pub fn max_scale(&self) -> f64 {
         self.linear.singular_values().max()
+    }
+
+    /// L⁻¹, or `None` when the frame is singular or its inverse not finite
+    /// (callers then treat the frame's shape as empty).
+    pub fn inverse(&self) -> Option<Mat3> {
+        let inv = self.linear.try_inverse()?;
+        inv.iter().all(|v| v.is_finite()).then_some(inv)
+    }
+
+    pub fn determinant(&self) -> f64 {
+        self.linear.determinant()
+    }
+
+    /// `Some(s)` when the linear map is s times a rotation (to 1e-9 relative),
+    /// which lets spheres and balls use exact distances.
+    pub fn similarity_scale(&self) -> Option<f64> {
+        let m = self.linear.transpose() * self.linear;
+        let s2 = m.trace() / 3.0;
+        if s2.is_nan() || s2 <= 0.0 || !s2.is_finite() {
+            return None;
+        }
+        let deviation = (m - Mat3::identity() * s2).abs().max();
+        (deviation <= 1e-9 * s2).then(|| s2.sqrt())
     }
 }

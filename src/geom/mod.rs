@@ -11,12 +11,17 @@ mod curve;
 mod frame;
 mod intersect;
 mod newton;
+mod sampling;
+mod shape_eval;
 mod solid;
 mod surface;
+#[cfg(test)]
+mod tests;
+mod trace;
 
 pub use curve::Curve;
 pub use frame::Frame;
-pub use intersect::{boundary_relation, BoundaryRelation};
+pub use intersect::{BoundaryRelation, boundary_relation};
 pub use newton::{intersect_curves, intersect_surfaces};
 pub use solid::SolidShape;
 pub use surface::Surface;
@@ -57,7 +62,11 @@ impl Aabb {
     }
 
     pub fn diagonal(&self) -> f64 {
-        if self.is_empty() { 0.0 } else { (self.max - self.min).norm() }
+        if self.is_empty() {
+            0.0
+        } else {
+            (self.max - self.min).norm()
+        }
     }
 
     pub fn overlaps(&self, other: &Aabb, margin: f64) -> bool {
