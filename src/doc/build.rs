@@ -144,13 +144,13 @@ impl Builder<'_> {
             },
             "parallelepiped" => ObjectKind::Parallelepiped(
                 if let Some(base) = self.point_child(e, "base_point") {
-                    Some(ParallelepipedForm::Edges {
+                    Some(Box::new(ParallelepipedForm::Edges {
                         base,
                         vertices: self.points_named(e, "vertex"),
-                    })
+                    }))
                 } else {
                     match (self.point_child(e, "first_point"), self.point_child(e, "second_point")) {
-                        (Some(first), Some(second)) => Some(ParallelepipedForm::Corners { first, second }),
+                        (Some(first), Some(second)) => Some(Box::new(ParallelepipedForm::Corners { first, second })),
                         _ => None,
                     }
                 },

@@ -101,6 +101,8 @@ pub struct CoordinateSystem {
     pub rotation: Option<VectorSpec>,
 }
 
+// Both forms are a few points; the enum is boxed where it is stored.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParallelepipedForm {
     /// Base point and the ends of the three edges from it.
@@ -157,7 +159,7 @@ pub enum ObjectKind {
         bottom_radius: Option<Number>,
         top_radius: Option<Number>,
     },
-    Parallelepiped(Option<ParallelepipedForm>),
+    Parallelepiped(Option<Box<ParallelepipedForm>>),
     Sphere { center: Option<PointSpec>, radius: Option<Number> },
     Ellipsoid { center: Option<PointSpec>, semi_axes: Option<VectorSpec> },
     Torus { center: Option<PointSpec>, major: Option<Number>, minor: Option<Number>, axis: Option<VectorSpec> },

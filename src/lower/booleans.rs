@@ -505,8 +505,6 @@ fn entities_kind(entities: &Entities, name: &str) -> Option<&'static str> {
         Some("an edge")
     } else if entities.vertices.contains_key(name) {
         Some("a vertex")
-    } else if entities.solids.contains_key(name) {
-        None
     } else {
         None
     }

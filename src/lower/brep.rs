@@ -81,8 +81,8 @@ fn parallelepiped(frame: &Frame) -> Brep {
     for axis in 0..3 {
         let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
         let (lo, hi) = (p.min(q), p.max(q));
-        for s in 0..2 {
-            for t in 0..2 {
+        for (s, lo_name) in FACE_NAMES[lo].iter().enumerate() {
+            for (t, hi_name) in FACE_NAMES[hi].iter().enumerate() {
                 let mut at = [0usize; 3];
                 at[lo] = s;
                 at[hi] = t;
@@ -91,7 +91,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
                 let end = corner(at[0], at[1], at[2]);
                 edge_index.insert((axis, lo, s, hi, t), edges.len());
                 edges.push(BrepEdge {
-                    name: format!("{}_{}", FACE_NAMES[lo][s], FACE_NAMES[hi][t]),
+                    name: format!("{lo_name}_{hi_name}"),
                     curve: Curve::Segment { a: vertices[begin].position, b: vertices[end].position },
                     begin,
                     end,
@@ -103,7 +103,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
     let mut faces = Vec::new();
     for axis in 0..3 {
         let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
-        for side in 0..2 {
+        for (side, &face_name) in FACE_NAMES[axis].iter().enumerate() {
             // The four edges of the face axis = side, walked p-then-q, which is
             // counter-clockwise about +axis; reversed on the min side.
             let e = |along: usize, fixed_axis: usize, fixed: usize| {
@@ -124,7 +124,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
             center[axis] = side as f64;
             let sample = frame.to_global(&center);
             faces.push(BrepFace {
-                name: FACE_NAMES[axis][side],
+                name: face_name,
                 surface: Surface::Plane { origin: sample, normal: frame.normal_to_global(&local_normal) },
                 loops: vec![ring],
                 sample,

@@ -58,7 +58,7 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
     }
     explicit::lower_topology(doc, resolved, &mut model, &mut source_map, &mut entities, diags);
     let face_samples = welder.face_samples;
-    booleans::lower_subdomains(doc, resolved, &mut model, &mut source_map, &mut entities, &face_samples, diags);
+    booleans::lower_subdomains(doc, resolved, &mut model, &mut source_map, &entities, &face_samples, diags);
     explicit::lower_boundaries(doc, &mut model, &entities, diags);
     prune::prune_interior(&mut model, &mut source_map);
     Lowered { model, source_map }

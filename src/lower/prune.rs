@@ -142,9 +142,9 @@ fn apply(model: &mut Model, source_map: &mut SourceMap, faces: &[Option<u32>], e
         b.edges.retain(|&x| e(x).is_some());
         b.edges.iter_mut().for_each(|x| *x = e(*x).unwrap_or(*x));
     }
-    source_map.faces = remap(&source_map.faces, |id| f(id));
-    source_map.edges = remap(&source_map.edges, |id| e(id));
-    source_map.vertices = remap(&source_map.vertices, |id| v(id));
+    source_map.faces = remap(&source_map.faces, f);
+    source_map.edges = remap(&source_map.edges, e);
+    source_map.vertices = remap(&source_map.vertices, v);
 }
 
 fn remap<K: Copy + std::hash::Hash + Eq, V: Copy>(table: &HashMap<K, V>, map: impl Fn(K) -> Option<K>) -> HashMap<K, V> {

@@ -11,6 +11,9 @@ pub(super) enum FrameState {
     Done(Option<Frame>),
 }
 
+/// Evaluates a coordinate system's origin and rotation angles in its parent's frame.
+pub(super) type EvalFrame<'a> = dyn FnMut(&CoordinateSystem, &mut Diagnostics) -> Option<(Vec3, Vec3)> + 'a;
+
 /// Resolves coordinate system `name`; `eval` evaluates its origin and rotation
 /// in the parent's frame.
 pub(super) fn resolve_cs(
@@ -18,7 +21,7 @@ pub(super) fn resolve_cs(
     systems: &HashMap<String, &CoordinateSystem>,
     state: &mut HashMap<String, FrameState>,
     other_kind: Option<&str>,
-    eval: &mut dyn FnMut(&CoordinateSystem, &mut Diagnostics) -> Option<(Vec3, Vec3)>,
+    eval: &mut EvalFrame,
     diags: &mut Diagnostics,
 ) -> Option<Frame> {
     let name = reference.name.as_str();

@@ -336,7 +336,7 @@ fn parallelepiped(r: &mut Resolver, object: &Object, form: &ParallelepipedForm, 
     };
     let lengths = edges.map(|e| e.norm());
     let det = Mat3::from_columns(&edges).determinant();
-    if lengths.iter().any(|&l| l == 0.0) || det.abs() <= 1e-9 * lengths.iter().product::<f64>() {
+    if lengths.contains(&0.0) || det.abs() <= 1e-9 * lengths.iter().product::<f64>() {
         let detail = match form {
             ParallelepipedForm::Corners { .. } => "its two corners share a coordinate, so it is flat".to_string(),
             ParallelepipedForm::Edges { .. } => "its three edge vectors are coplanar, so it has no volume".to_string(),
