@@ -6,7 +6,7 @@
 use super::explicit::{lookup_entities, unknown_entity};
 use super::Entities;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::doc::{Document, SolidTree, SubdomainDef};
+use crate::doc::{Document, SolidTree};
 use crate::geom::{boundary_relation, Point3, Surface, Vec3};
 use crate::ir::{
     Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId, SourceMap, Subdomain, SubdomainCells,
@@ -40,6 +40,8 @@ impl Tree {
 struct Built {
     tree: Tree,
     leaves: Vec<SolidId>,
+    /// The subdomain element, for messages.
+    span: crate::span::Span,
 }
 
 pub(super) fn lower_subdomains(
@@ -69,7 +71,7 @@ pub(super) fn lower_subdomains(
             (None, Some(tree)) => {
                 let mut leaves = Vec::new();
                 let Some(tree) = build_tree(tree, resolved, model, entities, &mut leaves, diags) else { continue };
-                trees.push((id, Built { tree, leaves }));
+                trees.push((id, Built { tree, leaves, span: def.span }));
                 SubdomainCells::Volume { boundary: Vec::new() }
             }
             (None, None) => {
@@ -95,7 +97,6 @@ pub(super) fn lower_subdomains(
         return;
     }
     for (id, built) in &trees {
-        let def = &doc.subdomains.iter().find(|d| d.name.text == model.subdomain(*id).name);
         let cells = match model.dimension {
             Dimension::Three => SubdomainCells::Volume { boundary: classify_faces(model, built, face_samples) },
             Dimension::Two => {
@@ -109,7 +110,7 @@ pub(super) fn lower_subdomains(
             SubdomainCells::Region { faces } => faces.is_empty(),
         };
         if empty {
-            let span = def.map(|d: &SubdomainDef| d.span);
+            let span = built.span;
             diags.push(
                 Diagnostic::new(Code::EmptySubdomain, span, format!("subdomain '{}' is empty: its solids leave no volume", model.subdomain(*id).name))
                     .with_help("check the boolean tree: an intersection of disjoint solids, or a difference that removes everything"),
