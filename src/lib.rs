@@ -13,3 +13,4 @@ pub mod syntax;
 pub mod doc;
 pub mod geom;
 pub mod ir;
+pub mod valid;
