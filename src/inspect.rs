@@ -124,7 +124,7 @@ impl Report {
                 ("E–D (edge × subdomain)", &m.ed, &edges, &subdomains),
             ] {
                 let _ = writeln!(s, "\n{title}:");
-                s.push_str(&render_matrix(matrix, rows, cols));
+                s.push_str(&matrix.render(rows, cols));
             }
         }
         s
@@ -167,31 +167,3 @@ fn plural(n: usize) -> &'static str {
     if n == 1 { "" } else { "s" }
 }
 
-/// A compact table of a sparse incidence matrix: rows are entities, columns
-/// the other entities, cells `+` `-` `±` `1` or `.`.
-fn render_matrix(matrix: &crate::ir::Incidence, rows: &[String], cols: &[String]) -> String {
-    let mut cells = vec![vec!['.'; matrix.cols]; matrix.rows];
-    for &(r, c, v) in &matrix.entries {
-        if let Some(cell) = cells.get_mut(r as usize).and_then(|row| row.get_mut(c as usize)) {
-            *cell = match v {
-                -1 => '-',
-                2 => '±',
-                _ if matrix_is_signed(matrix) => '+',
-                _ => '1',
-            };
-        }
-    }
-    let width = rows.iter().map(|r| r.chars().count()).max().unwrap_or(0);
-    let mut s = String::new();
-    let _ = writeln!(s, "{:width$}  {}", "", (0..cols.len()).map(|c| (c % 10).to_string()).collect::<String>());
-    for (r, name) in rows.iter().enumerate() {
-        let row: String = cells.get(r).map(|c| c.iter().collect()).unwrap_or_default();
-        let _ = writeln!(s, "{name:width$}  {row}");
-    }
-    let _ = writeln!(s, "columns: {}", cols.iter().enumerate().map(|(i, c)| format!("{i}={c}")).collect::<Vec<_>>().join(" "));
-    s
-}
-
-fn matrix_is_signed(matrix: &crate::ir::Incidence) -> bool {
-    matrix.entries.iter().any(|e| e.2 < 0)
-}

@@ -2,21 +2,26 @@
 //!
 //! The pipeline, one module a stage: [`syntax`] (XML with spans) → [`doc`] (the
 //! typed document, names unresolved) → [`resolve`] (parameters, expressions,
-//! coordinate systems, references, global coordinates) → [`ir`] (the model:
-//! geometry and the topology graph, no spans) → [`valid`] (geometry and
-//! topology checks). The library never prints and never exits: only the CLI does.
+//! coordinate systems, references, global coordinates) → [`lower`] (boundary
+//! representations, welding, boolean subdomains) → [`ir`] (the model: geometry
+//! and the topology graph, no spans) → [`valid`] (topology checks). [`driver`]
+//! runs them all. The library never prints and never exits: only the CLI does.
 
 pub mod diag;
+pub mod doc;
+pub mod driver;
 pub mod expr;
+pub mod geom;
+pub mod inspect;
+pub mod ir;
+pub mod lower;
+pub mod resolve;
 pub mod span;
 pub mod syntax;
-pub mod doc;
-pub mod geom;
-pub mod ir;
-pub mod resolve;
-pub mod lower;
+pub mod valid;
 
-/// A number as messages show it (no trailing zeros).
+/// A number as messages show it: no trailing zeros, exponent form only for
+/// very large or very small magnitudes.
 pub(crate) fn resolve_fmt(v: f64) -> String {
     let magnitude = v.abs();
     if magnitude != 0.0 && !(1e-4..1e9).contains(&magnitude) {
@@ -26,6 +31,3 @@ pub(crate) fn resolve_fmt(v: f64) -> String {
         format!("{rounded}")
     }
 }
-pub mod driver;
-pub mod valid;
-pub mod inspect;

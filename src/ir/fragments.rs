@@ -2,7 +2,8 @@
 //! between two subdomains are interface fragments, faces of one subdomain only
 //! belong to its outer boundary Γ_{k,0}.
 
-use super::{EdgeId, FaceId, Model, SubdomainId};
+use super::{Dimension, EdgeId, FaceId, Model, SubdomainCells, SubdomainId};
+use std::collections::{BTreeMap, BTreeSet};
 
 /// The other side of a fragment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
@@ -16,9 +17,10 @@ pub struct Fragment {
     /// The user's <boundary> name when one names these faces, else
     /// "A|B" from the subdomain names ("A|exterior" for the outer boundary).
     pub name: String,
-    /// The subdomain on the side the faces' normals point away from... the
-    /// lower-numbered subdomain of the pair (k < k'), and the other side.
+    /// The lower-numbered subdomain of the pair (k < k'), or the only one for
+    /// an outer fragment.
     pub subdomain: SubdomainId,
+    /// The exterior, or the higher-numbered subdomain k'.
     pub other: Side,
     /// Faces of the fragment (3D), sorted.
     pub faces: Vec<FaceId>,
@@ -28,7 +30,264 @@ pub struct Fragment {
 
 /// Fragments grouped by (subdomain pair, boundary name), ordered by subdomain,
 /// then other side, then name: deterministic for the same model.
+///
+/// A face (edge) bounding more than two subdomains belongs to no fragment: it
+/// is an error the validator reports (E406). When several <boundary> elements
+/// name one face, the first in model order gives the name.
 pub fn derive_fragments(model: &Model) -> Vec<Fragment> {
-    let _ = model;
-    todo!("topology")
+    let sides = match model.dimension {
+        Dimension::Three => face_sides(model),
+        Dimension::Two => edge_sides(model),
+    };
+
+    // Which user boundary names each face (edge): the first one wins.
+    let mut names: BTreeMap<u32, &str> = BTreeMap::new();
+    for boundary in &model.boundaries {
+        let ids: Vec<u32> = match model.dimension {
+            Dimension::Three => boundary.faces.iter().map(|f| f.0).collect(),
+            Dimension::Two => boundary.edges.iter().map(|e| e.0).collect(),
+        };
+        for id in ids {
+            names.entry(id).or_insert(boundary.name.as_str());
+        }
+    }
+
+    let subdomain_name = |id: SubdomainId| {
+        model
+            .subdomains
+            .get(id.index())
+            .map_or_else(|| format!("#{}", id.0), |s| s.name.clone())
+    };
+
+    let mut groups: BTreeMap<(SubdomainId, Side, String), Vec<u32>> = BTreeMap::new();
+    for (id, subdomains) in sides {
+        let mut it = subdomains.iter().copied();
+        let (k, other) = match (it.next(), it.next(), it.next()) {
+            (Some(k), None, None) => (k, Side::Exterior),
+            (Some(k), Some(k2), None) => (k, Side::Subdomain(k2)),
+            _ => continue,
+        };
+        let name = match names.get(&id) {
+            Some(name) => (*name).to_string(),
+            None => match other {
+                Side::Exterior => format!("{}|exterior", subdomain_name(k)),
+                Side::Subdomain(k2) => format!("{}|{}", subdomain_name(k), subdomain_name(k2)),
+            },
+        };
+        groups.entry((k, other, name)).or_default().push(id);
+    }
+
+    groups
+        .into_iter()
+        .map(|((subdomain, other, name), ids)| {
+            // BTreeMap iteration gives ids ascending already.
+            let (faces, edges) = match model.dimension {
+                Dimension::Three => (ids.into_iter().map(FaceId).collect(), Vec::new()),
+                Dimension::Two => (Vec::new(), ids.into_iter().map(EdgeId).collect()),
+            };
+            Fragment {
+                name,
+                subdomain,
+                other,
+                faces,
+                edges,
+            }
+        })
+        .collect()
+}
+
+/// For every face, the subdomains whose Volume boundary lists it.
+fn face_sides(model: &Model) -> BTreeMap<u32, BTreeSet<SubdomainId>> {
+    let mut sides: BTreeMap<u32, BTreeSet<SubdomainId>> = BTreeMap::new();
+    for (k, subdomain) in model.subdomains.iter().enumerate() {
+        if let SubdomainCells::Volume { boundary } = &subdomain.cells {
+            for of in boundary
+                .iter()
+                .filter(|of| of.face.index() < model.faces.len())
+            {
+                sides
+                    .entry(of.face.0)
+                    .or_default()
+                    .insert(SubdomainId(k as u32));
+            }
+        }
+    }
+    sides
+}
+
+/// For every edge, the region subdomains it bounds. An edge lies on region
+/// k's boundary when exactly one face of k uses it; one shared by two faces
+/// of k is inside k and bounds nothing.
+fn edge_sides(model: &Model) -> BTreeMap<u32, BTreeSet<SubdomainId>> {
+    let mut sides: BTreeMap<u32, BTreeSet<SubdomainId>> = BTreeMap::new();
+    for (k, subdomain) in model.subdomains.iter().enumerate() {
+        let SubdomainCells::Region { faces } = &subdomain.cells else {
+            continue;
+        };
+        let mut uses: BTreeMap<u32, usize> = BTreeMap::new();
+        let distinct: BTreeSet<FaceId> = faces.iter().copied().collect();
+        for face in distinct.iter().filter_map(|f| model.faces.get(f.index())) {
+            let edges: BTreeSet<u32> = face
+                .loops
+                .iter()
+                .flatten()
+                .map(|oe| oe.edge.0)
+                .filter(|&e| (e as usize) < model.edges.len())
+                .collect();
+            for e in edges {
+                *uses.entry(e).or_default() += 1;
+            }
+        }
+        for (e, n) in uses {
+            if n == 1 {
+                sides.entry(e).or_default().insert(SubdomainId(k as u32));
+            }
+        }
+    }
+    sides
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::ir::Boundary;
+    use crate::valid::fixtures::{Builder, cube};
+
+    fn face_named(model: &Model, name: &str) -> FaceId {
+        FaceId(
+            model
+                .faces
+                .iter()
+                .position(|f| f.name == name)
+                .unwrap_or(99) as u32,
+        )
+    }
+
+    fn summary(fragments: &[Fragment]) -> Vec<(String, u32, Side, usize, usize)> {
+        fragments
+            .iter()
+            .map(|f| {
+                (
+                    f.name.clone(),
+                    f.subdomain.0,
+                    f.other,
+                    f.faces.len(),
+                    f.edges.len(),
+                )
+            })
+            .collect()
+    }
+
+    #[test]
+    fn one_cube_has_one_outer_fragment() {
+        let b = cube();
+        let fragments = derive_fragments(&b.model);
+        assert_eq!(
+            summary(&fragments),
+            [("box|exterior".into(), 0, Side::Exterior, 6, 0)]
+        );
+        assert_eq!(fragments[0].faces, (0..6).map(FaceId).collect::<Vec<_>>());
+    }
+
+    fn two_cubes() -> Builder {
+        let mut b = Builder::new(Dimension::Three);
+        b.unit_box("A", [0.0; 3]);
+        b.unit_box("B", [1.0, 0.0, 0.0]);
+        b
+    }
+
+    #[test]
+    fn two_cubes_share_an_interface() {
+        let b = two_cubes();
+        let fragments = derive_fragments(&b.model);
+        let b_side = Side::Subdomain(SubdomainId(1));
+        assert_eq!(
+            summary(&fragments),
+            [
+                ("A|exterior".into(), 0, Side::Exterior, 5, 0),
+                ("A|B".into(), 0, b_side, 1, 0),
+                ("B|exterior".into(), 1, Side::Exterior, 5, 0),
+            ]
+        );
+        assert_eq!(fragments[1].faces, [face_named(&b.model, "A.right")]);
+    }
+
+    #[test]
+    fn named_boundary_splits_the_outer_fragment() {
+        let mut b = two_cubes();
+        let inlet = face_named(&b.model, "A.left");
+        // A stray face in no subdomain makes no fragment, even when named.
+        let stray = b
+            .polygon("stray", &[[5., 5., 5.], [6., 5., 5.], [6., 6., 5.]])
+            .face;
+        b.model.boundaries.push(Boundary {
+            name: "inlet".into(),
+            faces: vec![inlet, stray],
+            edges: Vec::new(),
+        });
+        b.model.boundaries.push(Boundary {
+            name: "later".into(),
+            faces: vec![inlet],
+            edges: Vec::new(),
+        });
+        let fragments = derive_fragments(&b.model);
+        let b_side = Side::Subdomain(SubdomainId(1));
+        assert_eq!(
+            summary(&fragments),
+            [
+                ("A|exterior".into(), 0, Side::Exterior, 4, 0),
+                ("inlet".into(), 0, Side::Exterior, 1, 0),
+                ("A|B".into(), 0, b_side, 1, 0),
+                ("B|exterior".into(), 1, Side::Exterior, 5, 0),
+            ]
+        );
+        assert_eq!(fragments[1].faces, [inlet]);
+    }
+
+    #[test]
+    fn two_squares_share_one_edge() {
+        let mut b = Builder::new(Dimension::Two);
+        b.unit_square("A", 0.0, 0.0);
+        b.unit_square("B", 1.0, 0.0);
+        let fragments = derive_fragments(&b.model);
+        let b_side = Side::Subdomain(SubdomainId(1));
+        assert_eq!(
+            summary(&fragments),
+            [
+                ("A|exterior".into(), 0, Side::Exterior, 0, 3),
+                ("A|B".into(), 0, b_side, 0, 1),
+                ("B|exterior".into(), 1, Side::Exterior, 0, 3),
+            ]
+        );
+        // The shared edge runs (1,0) → (1,1): the second edge of A's loop.
+        assert_eq!(fragments[1].edges, [b.model.faces[0].loops[0][1].edge]);
+    }
+
+    #[test]
+    fn edge_inside_one_region_bounds_nothing() {
+        let mut b = Builder::new(Dimension::Two);
+        let left = b.polygon(
+            "l",
+            &[[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 1., 0.]],
+        );
+        let right = b.polygon(
+            "r",
+            &[[1., 0., 0.], [2., 0., 0.], [2., 1., 0.], [1., 1., 0.]],
+        );
+        let faces = vec![left.face, right.face];
+        b.push_subdomain("A", crate::ir::SubdomainCells::Region { faces });
+        b.model.boundaries.push(Boundary {
+            name: "wall".into(),
+            faces: Vec::new(),
+            edges: vec![EdgeId(0)],
+        });
+        let fragments = derive_fragments(&b.model);
+        assert_eq!(
+            summary(&fragments),
+            [
+                ("A|exterior".into(), 0, Side::Exterior, 0, 5),
+                ("wall".into(), 0, Side::Exterior, 0, 1),
+            ]
+        );
+    }
 }

@@ -1,0 +1,1017 @@
+//! Topological checks of the model: edges (E400), face loops (E401), the
+//! closed shells bounding 3D subdomains (E402–E405), and how faces and
+//! explicit entities are used (E406, W004).
+//!
+//! The checks look only at the topology graph and the enum fields of the
+//! curves; they never evaluate geometry, so they run on any model, and ids out
+//! of range (a malformed model) are skipped rather than indexed.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::geom::Curve;
+use crate::ir::{
+    EdgeId, FaceId, Model, OrientedFace, SourceMap, SubdomainCells, SubdomainId, VertexId,
+};
+use crate::span::Span;
+use std::collections::{BTreeMap, BTreeSet, VecDeque};
+
+/// How close t1 − t0 of an ellipse must be to 2π for the curve to be closed.
+const ANGLE_TOLERANCE: f64 = 1e-9;
+
+fn vertex_name(model: &Model, id: VertexId) -> String {
+    model
+        .vertices
+        .get(id.index())
+        .map_or_else(|| format!("#{}", id.0), |v| v.name.clone())
+}
+
+fn edge_name(model: &Model, id: EdgeId) -> String {
+    model
+        .edges
+        .get(id.index())
+        .map_or_else(|| format!("#{}", id.0), |e| e.name.clone())
+}
+
+fn face_name(model: &Model, id: FaceId) -> String {
+    model
+        .faces
+        .get(id.index())
+        .map_or_else(|| format!("#{}", id.0), |f| f.name.clone())
+}
+
+fn subdomain_name(model: &Model, id: SubdomainId) -> String {
+    model
+        .subdomains
+        .get(id.index())
+        .map_or_else(|| format!("#{}", id.0), |s| s.name.clone())
+}
+
+/// Whether the curve returns to its start, judged from its defining data
+/// only (the evaluation methods belong to the geometry kernel).
+fn curve_is_closed(curve: &Curve, tolerance: f64) -> bool {
+    match curve {
+        Curve::Segment { .. } => false,
+        Curve::Ellipse { t0, t1, .. } => {
+            ((t1 - t0) - std::f64::consts::TAU).abs() <= ANGLE_TOLERANCE
+        }
+        Curve::Intersection { a, b, .. } => (a - b).norm() <= tolerance,
+    }
+}
+
+fn curve_description(curve: &Curve) -> String {
+    match curve {
+        Curve::Segment { .. } => "a straight segment".to_string(),
+        Curve::Ellipse { t0, t1, .. } => format!("an arc spanning {:.6} rad, not 2π", t1 - t0),
+        Curve::Intersection { .. } => "an intersection curve with distinct ends".to_string(),
+    }
+}
+
+/// E400 for edges whose ends coincide on an open curve, then E401 for face
+/// loops that are not closed chains (the first break of each loop).
+pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostics) {
+    for (i, edge) in model.edges.iter().enumerate() {
+        let id = EdgeId(i as u32);
+        if edge.begin == edge.end && !curve_is_closed(&edge.curve, model.tolerance) {
+            diags.push(
+                Diagnostic::new(
+                    Code::EdgeEndsCoincide,
+                    source_map.edge(id),
+                    format!(
+                        "edge `{}` begins and ends at vertex `{}` but its curve is open ({})",
+                        edge.name,
+                        vertex_name(model, edge.begin),
+                        curve_description(&edge.curve)
+                    ),
+                )
+                .with_help(
+                    "give the edge two distinct vertices, or put it on a closed curve \
+                     (a full circle or ellipse)",
+                ),
+            );
+        }
+    }
+
+    for (i, face) in model.faces.iter().enumerate() {
+        let id = FaceId(i as u32);
+        for (l, edges) in face.loops.iter().enumerate() {
+            let which = if face.loops.len() == 1 {
+                format!("the loop of face `{}`", face.name)
+            } else {
+                format!("loop {} of face `{}`", l + 1, face.name)
+            };
+            if edges.is_empty() {
+                diags.push(
+                    Diagnostic::new(
+                        Code::OpenLoop,
+                        source_map.face(id),
+                        format!("{which} has no edges"),
+                    )
+                    .with_help("list the edges of the loop, or remove the empty loop"),
+                );
+                continue;
+            }
+            // (edge, tail, head) as the loop runs; a dangling edge id is
+            // another stage's error, so the loop is not judged.
+            let chain: Option<Vec<(EdgeId, VertexId, VertexId)>> = edges
+                .iter()
+                .map(|oe| {
+                    let e = model.edges.get(oe.edge.index())?;
+                    Some(if oe.forward {
+                        (oe.edge, e.begin, e.end)
+                    } else {
+                        (oe.edge, e.end, e.begin)
+                    })
+                })
+                .collect();
+            let Some(chain) = chain else { continue };
+            let n = chain.len();
+            let broken = (0..n).find(|&k| chain[k].2 != chain[(k + 1) % n].1);
+            let Some(k) = broken else { continue };
+            let (edge, tail, head) = chain[k];
+            let (next, next_tail, _) = chain[(k + 1) % n];
+            let message = if n == 1 {
+                format!(
+                    "{which} is not closed: its only edge `{}` runs from vertex `{}` to vertex `{}`",
+                    edge_name(model, edge),
+                    vertex_name(model, tail),
+                    vertex_name(model, head)
+                )
+            } else {
+                format!(
+                    "{which} is not closed: edge `{}` ends at vertex `{}` but the next edge `{}` \
+                     begins at vertex `{}`",
+                    edge_name(model, edge),
+                    vertex_name(model, head),
+                    edge_name(model, next),
+                    vertex_name(model, next_tail)
+                )
+            };
+            diags.push(
+                Diagnostic::new(Code::OpenLoop, source_map.face(id), message).with_help(
+                    "list the loop's edges in order, each beginning where the previous one ends \
+                     and the last ending where the first begins",
+                ),
+            );
+        }
+    }
+}
+
+/// One use of an edge by a face of a subdomain's boundary.
+#[derive(Debug, Clone, Copy)]
+struct EdgeUse {
+    /// Index into the subdomain's boundary list.
+    entry: usize,
+    /// Direction in the face's own loop.
+    forward: bool,
+}
+
+/// Every use of every edge by the listed faces, per edge id.
+fn edge_uses(model: &Model, boundary: &[OrientedFace]) -> BTreeMap<EdgeId, Vec<EdgeUse>> {
+    let mut uses: BTreeMap<EdgeId, Vec<EdgeUse>> = BTreeMap::new();
+    for (entry, of) in boundary.iter().enumerate() {
+        let Some(face) = model.faces.get(of.face.index()) else {
+            continue;
+        };
+        for oe in face.loops.iter().flatten() {
+            if oe.edge.index() < model.edges.len() {
+                uses.entry(oe.edge).or_default().push(EdgeUse {
+                    entry,
+                    forward: oe.forward,
+                });
+            }
+        }
+    }
+    uses
+}
+
+/// Groups boundary entries (with a valid face) connected through shared
+/// edges; components are ordered by their first entry, entries ascending.
+fn components(
+    model: &Model,
+    boundary: &[OrientedFace],
+    uses: &BTreeMap<EdgeId, Vec<EdgeUse>>,
+) -> Vec<Vec<usize>> {
+    let n = boundary.len();
+    let mut adjacent: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
+    for list in uses.values() {
+        for pair in list.windows(2) {
+            adjacent[pair[0].entry].insert(pair[1].entry);
+            adjacent[pair[1].entry].insert(pair[0].entry);
+        }
+    }
+    let mut seen = vec![false; n];
+    let mut out = Vec::new();
+    for start in 0..n {
+        if seen[start] || boundary[start].face.index() >= model.faces.len() {
+            continue;
+        }
+        seen[start] = true;
+        let mut members = vec![start];
+        let mut queue = VecDeque::from([start]);
+        while let Some(a) = queue.pop_front() {
+            for &b in &adjacent[a] {
+                if !seen[b] {
+                    seen[b] = true;
+                    members.push(b);
+                    queue.push_back(b);
+                }
+            }
+        }
+        members.sort_unstable();
+        out.push(members);
+    }
+    out
+}
+
+/// One connected shell of a subdomain's boundary (faces joined through shared
+/// edges) with the counts of the Euler–Poincaré formula.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Shell {
+    /// Faces of the shell, in the subdomain's boundary order.
+    pub faces: Vec<FaceId>,
+    pub vertices: usize,
+    pub edges: usize,
+    pub loops: usize,
+}
+
+impl Shell {
+    /// χ = V − E + F − (L − F): inner loops (rings) count against faces.
+    pub fn euler_characteristic(&self) -> i64 {
+        let f = self.faces.len() as i64;
+        self.vertices as i64 - self.edges as i64 + f - (self.loops as i64 - f)
+    }
+
+    /// G from χ = 2(1 − G) for one shell; `None` when no whole G ≥ 0 fits.
+    pub fn genus(&self) -> Option<u64> {
+        let chi = self.euler_characteristic();
+        (chi <= 2 && chi % 2 == 0).then(|| ((2 - chi) / 2) as u64)
+    }
+}
+
+fn shells_of(model: &Model, boundary: &[OrientedFace]) -> Vec<Shell> {
+    let uses = edge_uses(model, boundary);
+    components(model, boundary, &uses)
+        .into_iter()
+        .map(|members| {
+            let mut vertices = BTreeSet::new();
+            let mut edges = BTreeSet::new();
+            let mut loops = 0;
+            let mut faces = Vec::with_capacity(members.len());
+            for &entry in &members {
+                let id = boundary[entry].face;
+                let Some(face) = model.faces.get(id.index()) else {
+                    continue;
+                };
+                faces.push(id);
+                loops += face.loops.len();
+                for oe in face.loops.iter().flatten() {
+                    if let Some(edge) = model.edges.get(oe.edge.index()) {
+                        edges.insert(oe.edge);
+                        vertices.insert(edge.begin);
+                        vertices.insert(edge.end);
+                    }
+                }
+            }
+            Shell {
+                faces,
+                vertices: vertices.len(),
+                edges: edges.len(),
+                loops,
+            }
+        })
+        .collect()
+}
+
+/// The connected shells of a 3D subdomain's boundary; empty for a 2D region
+/// or an id out of range.
+pub fn shells(model: &Model, subdomain: SubdomainId) -> Vec<Shell> {
+    match model.subdomains.get(subdomain.index()).map(|s| &s.cells) {
+        Some(SubdomainCells::Volume { boundary }) => shells_of(model, boundary),
+        _ => Vec::new(),
+    }
+}
+
+/// E402/E403 (every edge used exactly twice), then, for 2-manifold
+/// boundaries only (so one missing face does not cascade), E404 (consistent
+/// outward orientation) and E405 (Euler–Poincaré per connected shell).
+pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut Diagnostics) {
+    for (k, subdomain) in model.subdomains.iter().enumerate() {
+        let SubdomainCells::Volume { boundary } = &subdomain.cells else {
+            continue;
+        };
+        let id = SubdomainId(k as u32);
+        let uses = edge_uses(model, boundary);
+        let mut manifold = true;
+        for (&edge, list) in &uses {
+            let span = source_map.subdomain(id).or_else(|| source_map.edge(edge));
+            match list.len() {
+                2 => {}
+                1 => {
+                    manifold = false;
+                    let face = face_name(model, boundary[list[0].entry].face);
+                    diags.push(
+                        Diagnostic::new(
+                            Code::OpenShell,
+                            span,
+                            format!(
+                                "the boundary of subdomain `{}` is not closed: edge `{}` is used \
+                                 only by face `{face}`",
+                                subdomain.name,
+                                edge_name(model, edge)
+                            ),
+                        )
+                        .with_help(format!(
+                            "add the missing face across edge `{}` to subdomain `{}`, or check \
+                             that the neighbouring face names the same edge",
+                            edge_name(model, edge),
+                            subdomain.name
+                        )),
+                    );
+                }
+                n => {
+                    manifold = false;
+                    let faces: BTreeSet<String> = list
+                        .iter()
+                        .map(|u| format!("`{}`", face_name(model, boundary[u.entry].face)))
+                        .collect();
+                    diags.push(
+                        Diagnostic::new(
+                            Code::NonManifoldEdge,
+                            span,
+                            format!(
+                                "edge `{}` is used {n} times in the boundary of subdomain `{}` \
+                                 (faces {}), more than twice",
+                                edge_name(model, edge),
+                                subdomain.name,
+                                faces.into_iter().collect::<Vec<_>>().join(", ")
+                            ),
+                        )
+                        .with_help(format!(
+                            "split subdomain `{}` so that each edge of a boundary is shared by \
+                             exactly two of its faces",
+                            subdomain.name
+                        )),
+                    );
+                }
+            }
+        }
+        if !manifold {
+            continue;
+        }
+        check_orientation(model, source_map, id, boundary, &uses, diags);
+        check_euler(model, source_map, id, boundary, diags);
+    }
+}
+
+/// Two faces sharing an edge must traverse it in opposite directions once
+/// their loops are taken as seen from outside (reversed for inward faces).
+/// Solves for a relative flip per face (2-colouring); a contradiction means
+/// the shell is one-sided, a solution that disagrees with the `outward` flags
+/// names the faces whose flags (or loops) are wrong.
+fn check_orientation(
+    model: &Model,
+    source_map: &SourceMap,
+    id: SubdomainId,
+    boundary: &[OrientedFace],
+    uses: &BTreeMap<EdgeId, Vec<EdgeUse>>,
+    diags: &mut Diagnostics,
+) {
+    let name = subdomain_name(model, id);
+    let n = boundary.len();
+    // (neighbour, whether the flips must differ, shared edge)
+    let mut adjacent: Vec<Vec<(usize, bool, EdgeId)>> = vec![Vec::new(); n];
+    // A seam used twice the same way by one face makes that face one-sided.
+    let mut seam_conflict: Vec<Option<EdgeId>> = vec![None; n];
+    for (&edge, list) in uses {
+        let [a, b] = list.as_slice() else { continue };
+        let differ = a.forward == b.forward;
+        if a.entry == b.entry {
+            if differ {
+                seam_conflict[a.entry].get_or_insert(edge);
+            }
+            continue;
+        }
+        adjacent[a.entry].push((b.entry, differ, edge));
+        adjacent[b.entry].push((a.entry, differ, edge));
+    }
+
+    let mut flip: Vec<Option<bool>> = vec![None; n];
+    for start in 0..n {
+        if flip[start].is_some() || boundary[start].face.index() >= model.faces.len() {
+            continue;
+        }
+        flip[start] = Some(false);
+        let mut members = vec![start];
+        let mut queue = VecDeque::from([start]);
+        let mut conflict = seam_conflict[start];
+        while let Some(a) = queue.pop_front() {
+            let fa = flip[a].unwrap_or(false);
+            for &(b, differ, edge) in &adjacent[a] {
+                match flip[b] {
+                    None => {
+                        flip[b] = Some(fa ^ differ);
+                        conflict = conflict.or(seam_conflict[b]);
+                        members.push(b);
+                        queue.push_back(b);
+                    }
+                    Some(fb) if fb != fa ^ differ => {
+                        conflict.get_or_insert(edge);
+                    }
+                    Some(_) => {}
+                }
+            }
+        }
+
+        if let Some(edge) = conflict {
+            diags.push(
+                Diagnostic::new(
+                    Code::InconsistentOrientation,
+                    source_map.subdomain(id),
+                    format!(
+                        "the boundary of subdomain `{name}` is one-sided: its faces cannot be \
+                         oriented consistently (the contradiction closes at edge `{}`)",
+                        edge_name(model, edge)
+                    ),
+                )
+                .with_help(
+                    "check the faces' loops: a closed boundary has an inside and an outside, \
+                     unlike a Möbius strip or a Klein bottle",
+                ),
+            );
+            continue;
+        }
+
+        // Relative to the solved orientation, a face is "wrong" when its
+        // outward flag disagrees; the minority is taken to be wrong, the first
+        // listed face breaking a tie.
+        let class = |e: usize| flip[e].unwrap_or(false) ^ !boundary[e].outward;
+        let odd = members.iter().filter(|&&e| class(e)).count();
+        if odd == 0 || odd == members.len() {
+            continue;
+        }
+        let wrong = if 2 * odd == members.len() {
+            !class(members[0])
+        } else {
+            2 * odd < members.len()
+        };
+        members.sort_unstable();
+        for &e in members.iter().filter(|&&e| class(e) == wrong) {
+            let face = boundary[e].face;
+            let neighbour = adjacent[e].iter().find(|&&(b, _, _)| class(b) != wrong);
+            let along = neighbour.map_or_else(String::new, |&(b, _, edge)| {
+                format!(
+                    ": it runs along edge `{}` in the same direction as face `{}`",
+                    edge_name(model, edge),
+                    face_name(model, boundary[b].face)
+                )
+            });
+            diags.push(
+                Diagnostic::new(
+                    Code::InconsistentOrientation,
+                    source_map.face(face).or_else(|| source_map.subdomain(id)),
+                    format!(
+                        "face `{}` is oriented against the rest of the boundary of subdomain \
+                         `{name}` (normal taken {}){along}",
+                        face_name(model, face),
+                        if boundary[e].outward {
+                            "outward"
+                        } else {
+                            "inward"
+                        }
+                    ),
+                )
+                .with_help(format!(
+                    "reverse the loop of face `{}` so that it runs counter-clockwise seen from \
+                     outside subdomain `{name}`",
+                    face_name(model, face)
+                )),
+            );
+        }
+    }
+}
+
+/// E405 for every connected shell whose V − E + F − (L − F) is not 2(1 − G)
+/// for a whole G ≥ 0.
+fn check_euler(
+    model: &Model,
+    source_map: &SourceMap,
+    id: SubdomainId,
+    boundary: &[OrientedFace],
+    diags: &mut Diagnostics,
+) {
+    let name = subdomain_name(model, id);
+    for shell in shells_of(model, boundary) {
+        if shell.genus().is_some() {
+            continue;
+        }
+        let first = shell.faces.first().map_or_else(String::new, |&f| {
+            format!(" (the shell with face `{}`)", face_name(model, f))
+        });
+        let f = shell.faces.len();
+        diags.push(
+            Diagnostic::new(
+                Code::EulerMismatch,
+                source_map.subdomain(id),
+                format!(
+                    "the boundary of subdomain `{name}`{first} fails the Euler–Poincaré check: \
+                     V − E + F − (L − F) = {} − {} + {f} − ({} − {f}) = {}, not 2(1 − G) for a \
+                     whole G ≥ 0",
+                    shell.vertices,
+                    shell.edges,
+                    shell.loops,
+                    shell.euler_characteristic()
+                ),
+            )
+            .with_help("check the faces of this shell for missing or extra edges and loops"),
+        );
+    }
+}
+
+/// E406 for faces listed by more than two 3D subdomains, then W004 for
+/// explicit vertices, edges and faces that nothing uses. Entities of solids
+/// are generated, so only those in the source map and in no solid count.
+pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagnostics) {
+    let mut bounded: BTreeMap<FaceId, BTreeSet<SubdomainId>> = BTreeMap::new();
+    let mut used_faces: BTreeSet<FaceId> = BTreeSet::new();
+    for (k, subdomain) in model.subdomains.iter().enumerate() {
+        match &subdomain.cells {
+            SubdomainCells::Volume { boundary } => {
+                for of in boundary {
+                    bounded
+                        .entry(of.face)
+                        .or_default()
+                        .insert(SubdomainId(k as u32));
+                    used_faces.insert(of.face);
+                }
+            }
+            SubdomainCells::Region { faces } => used_faces.extend(faces.iter().copied()),
+        }
+    }
+    used_faces.extend(
+        model
+            .boundaries
+            .iter()
+            .flat_map(|b| b.faces.iter().copied()),
+    );
+
+    for (&face, subdomains) in &bounded {
+        if subdomains.len() <= 2 || face.index() >= model.faces.len() {
+            continue;
+        }
+        let names: Vec<String> = subdomains
+            .iter()
+            .map(|&s| format!("`{}`", subdomain_name(model, s)))
+            .collect();
+        diags.push(
+            Diagnostic::new(
+                Code::TooManySubdomains,
+                source_map.face(face),
+                format!(
+                    "face `{}` bounds {} subdomains ({}); a face separates at most two",
+                    face_name(model, face),
+                    subdomains.len(),
+                    names.join(", ")
+                ),
+            )
+            .with_help(format!(
+                "keep face `{}` in the face lists of at most two of these subdomains",
+                face_name(model, face)
+            )),
+        );
+    }
+
+    let in_solids_v: BTreeSet<VertexId> = model
+        .solids
+        .iter()
+        .flat_map(|s| s.vertices.iter().copied())
+        .collect();
+    let in_solids_e: BTreeSet<EdgeId> = model
+        .solids
+        .iter()
+        .flat_map(|s| s.edges.iter().copied())
+        .collect();
+    let in_solids_f: BTreeSet<FaceId> = model
+        .solids
+        .iter()
+        .flat_map(|s| s.faces.iter().map(|of| of.face))
+        .collect();
+
+    let used_vertices: BTreeSet<VertexId> =
+        model.edges.iter().flat_map(|e| [e.begin, e.end]).collect();
+    let used_edges: BTreeSet<EdgeId> = model
+        .faces
+        .iter()
+        .flat_map(|f| f.loops.iter().flatten().map(|oe| oe.edge))
+        .collect();
+
+    let mut unused = |span: Option<Span>, message: String, help: &str| {
+        diags.push(Diagnostic::new(Code::Dangling, span, message).with_help(help));
+    };
+    for (i, vertex) in model.vertices.iter().enumerate() {
+        let id = VertexId(i as u32);
+        let explicit_unused = !in_solids_v.contains(&id) && !used_vertices.contains(&id);
+        if let Some(span) = source_map.vertex(id).filter(|_| explicit_unused) {
+            unused(
+                Some(span),
+                format!("vertex `{}` is not used by any edge", vertex.name),
+                "remove the vertex, or use it as the begin or end of an edge",
+            );
+        }
+    }
+    for (i, edge) in model.edges.iter().enumerate() {
+        let id = EdgeId(i as u32);
+        let explicit_unused = !in_solids_e.contains(&id) && !used_edges.contains(&id);
+        if let Some(span) = source_map.edge(id).filter(|_| explicit_unused) {
+            unused(
+                Some(span),
+                format!("edge `{}` is not used by any face", edge.name),
+                "remove the edge, or list it in a face's loop",
+            );
+        }
+    }
+    for (i, face) in model.faces.iter().enumerate() {
+        let id = FaceId(i as u32);
+        let explicit_unused = !in_solids_f.contains(&id) && !used_faces.contains(&id);
+        if let Some(span) = source_map.face(id).filter(|_| explicit_unused) {
+            unused(
+                Some(span),
+                format!(
+                    "face `{}` is not used by any subdomain or boundary",
+                    face.name
+                ),
+                "remove the face, or list it in a subdomain's faces",
+            );
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::diag::Severity;
+    use crate::geom::{Frame, Point3, SolidShape, Vec3};
+    use crate::ir::{Dimension, OrientedEdge, Solid};
+    use crate::valid::check_topology;
+    use crate::valid::fixtures::{Builder, cube, sphere, torus};
+
+    fn codes(diags: &Diagnostics) -> Vec<&'static str> {
+        diags.items.iter().map(|d| d.code.as_str()).collect()
+    }
+
+    fn messages(diags: &Diagnostics) -> Vec<&str> {
+        diags.items.iter().map(|d| d.message.as_str()).collect()
+    }
+
+    fn face_id(b: &Builder, name: &str) -> FaceId {
+        let i = b.model.faces.iter().position(|f| f.name == name);
+        FaceId(i.expect("fixture face") as u32)
+    }
+
+    fn boundary_mut(b: &mut Builder, k: usize) -> &mut Vec<OrientedFace> {
+        match &mut b.model.subdomains[k].cells {
+            SubdomainCells::Volume { boundary } => boundary,
+            SubdomainCells::Region { .. } => panic!("fixture is 3D"),
+        }
+    }
+
+    #[test]
+    fn cube_is_a_closed_sphere_like_shell() {
+        let b = cube();
+        assert_eq!(
+            (
+                b.model.vertices.len(),
+                b.model.edges.len(),
+                b.model.faces.len()
+            ),
+            (8, 12, 6)
+        );
+        let diags = check_topology(&b.model, &b.map);
+        assert!(diags.items.is_empty(), "{:?}", messages(&diags));
+        let shells = shells(&b.model, SubdomainId(0));
+        assert_eq!(shells.len(), 1);
+        let s = &shells[0];
+        assert_eq!((s.vertices, s.edges, s.faces.len(), s.loops), (8, 12, 6, 6));
+        assert_eq!(s.euler_characteristic(), 2);
+        assert_eq!(s.genus(), Some(0));
+    }
+
+    #[test]
+    fn cube_without_top_is_an_open_shell() {
+        let mut b = cube();
+        let top = face_id(&b, "box.top");
+        boundary_mut(&mut b, 0).retain(|of| of.face != top);
+        let mut diags = Diagnostics::default();
+        check_subdomain_shells(&b.model, &b.map, &mut diags);
+        assert_eq!(codes(&diags), ["E402"; 4]);
+        let top_edges: BTreeSet<String> = b.model.faces[top.index()].loops[0]
+            .iter()
+            .map(|oe| format!("edge `{}`", edge_name(&b.model, oe.edge)))
+            .collect();
+        for d in &diags.items {
+            assert!(
+                top_edges.iter().any(|e| d.message.contains(e)),
+                "{}",
+                d.message
+            );
+            assert!(d.message.contains("subdomain `box`"), "{}", d.message);
+            assert!(d.help.is_some());
+            assert_eq!(d.span, b.map.subdomain(SubdomainId(0)));
+        }
+        // e4 runs (0,0,1) → (1,0,1): the top's first edge, shared with the front.
+        assert_eq!(
+            diags.items[0].message,
+            "the boundary of subdomain `box` is not closed: edge `e4` is used only by face \
+             `box.front`"
+        );
+        // The unused top face is reported too, as a warning.
+        let all = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&all), ["E402", "E402", "E402", "E402", "W004"]);
+        assert_eq!(all.items[4].severity, Severity::Warning);
+        assert!(all.items[4].message.contains("face `box.top`"));
+    }
+
+    #[test]
+    fn reversed_loop_is_named() {
+        let mut b = cube();
+        let top = face_id(&b, "box.top");
+        let lp = &mut b.model.faces[top.index()].loops[0];
+        lp.reverse();
+        for oe in lp.iter_mut() {
+            oe.forward = !oe.forward;
+        }
+        let diags = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&diags), ["E404"]);
+        let d = &diags.items[0];
+        assert!(
+            d.message.starts_with("face `box.top` is oriented against"),
+            "{}",
+            d.message
+        );
+        assert_eq!(d.span, b.map.face(top));
+        assert!(d.help.as_deref().is_some_and(|h| h.contains("box.top")));
+    }
+
+    #[test]
+    fn wrong_outward_flag_is_named() {
+        let mut b = cube();
+        let left = face_id(&b, "box.left");
+        for of in boundary_mut(&mut b, 0)
+            .iter_mut()
+            .filter(|of| of.face == left)
+        {
+            of.outward = false;
+        }
+        let diags = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&diags), ["E404"]);
+        assert!(diags.items[0].message.contains("face `box.left`"));
+        assert!(diags.items[0].message.contains("(normal taken inward)"));
+    }
+
+    #[test]
+    fn two_cubes_sharing_a_face_are_valid() {
+        let mut b = Builder::new(Dimension::Three);
+        b.unit_box("A", [0.0; 3]);
+        b.unit_box("B", [1.0, 0.0, 0.0]);
+        assert_eq!(b.model.faces.len(), 11);
+        let diags = check_topology(&b.model, &b.map);
+        assert!(diags.items.is_empty(), "{:?}", messages(&diags));
+    }
+
+    #[test]
+    fn cubes_sharing_an_edge_in_one_subdomain_are_non_manifold() {
+        let mut b = Builder::new(Dimension::Three);
+        let mut boundary = b.unit_box_faces("A", [0.0; 3]);
+        boundary.extend(b.unit_box_faces("B", [1.0, 1.0, 0.0]));
+        b.push_subdomain("both", SubdomainCells::Volume { boundary });
+        let diags = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&diags), ["E403"]);
+        let d = &diags.items[0];
+        assert!(d.message.contains("is used 4 times"), "{}", d.message);
+        assert!(d.message.contains("subdomain `both`"), "{}", d.message);
+    }
+
+    #[test]
+    fn torus_has_genus_one() {
+        let b = torus(false);
+        let diags = check_topology(&b.model, &b.map);
+        assert!(diags.items.is_empty(), "{:?}", messages(&diags));
+        let shells = shells(&b.model, SubdomainId(0));
+        assert_eq!(shells.len(), 1);
+        let s = &shells[0];
+        assert_eq!((s.vertices, s.edges, s.faces.len(), s.loops), (1, 2, 1, 1));
+        assert_eq!(s.euler_characteristic(), 0);
+        assert_eq!(s.genus(), Some(1));
+    }
+
+    #[test]
+    fn klein_bottle_is_one_sided() {
+        let b = torus(true);
+        let diags = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&diags), ["E404"]);
+        assert!(diags.items[0].message.contains("one-sided"));
+        assert!(diags.items[0].message.contains("edge `m`"));
+    }
+
+    #[test]
+    fn hemispheres_make_a_sphere() {
+        let b = sphere();
+        let diags = check_topology(&b.model, &b.map);
+        assert!(diags.items.is_empty(), "{:?}", messages(&diags));
+        let shells = shells(&b.model, SubdomainId(0));
+        assert_eq!(shells.len(), 1);
+        let s = &shells[0];
+        assert_eq!((s.vertices, s.edges, s.faces.len(), s.loops), (1, 1, 2, 2));
+        assert_eq!(s.euler_characteristic(), 2);
+    }
+
+    #[test]
+    fn rings_make_a_handle_and_an_odd_count_fails_euler() {
+        let mut b = cube();
+        let v = b.vertex([0.5, 0.5, 1.0]);
+        let ring = b.push_edge(
+            Curve::Ellipse {
+                center: Point3::new(0.5, 0.5, 1.0),
+                major: Vec3::new(0.1, 0.0, 0.0),
+                minor: Vec3::new(0.0, 0.1, 0.0),
+                t0: 0.0,
+                t1: std::f64::consts::TAU,
+            },
+            v,
+            v,
+        );
+        // The same ring as an inner loop of the top and of the bottom glues
+        // them into a handle: V − E + F − (L − F) = 9 − 13 + 6 − (8 − 6) = 0,
+        // genus 1, accepted.
+        let top = face_id(&b, "box.top");
+        let bottom = face_id(&b, "box.bottom");
+        b.model.faces[top.index()].loops.push(vec![OrientedEdge {
+            edge: ring,
+            forward: false,
+        }]);
+        b.model.faces[bottom.index()].loops.push(vec![OrientedEdge {
+            edge: ring,
+            forward: true,
+        }]);
+        let diags = check_topology(&b.model, &b.map);
+        assert!(diags.items.is_empty(), "{:?}", messages(&diags));
+        // One more ring on the top alone leaves χ odd: V 10, E 14, F 6, L 9.
+        let w = b.vertex([0.2, 0.2, 1.0]);
+        let lonely = b.push_edge(
+            Curve::Ellipse {
+                center: Point3::new(0.2, 0.2, 1.0),
+                major: Vec3::new(0.05, 0.0, 0.0),
+                minor: Vec3::new(0.0, 0.05, 0.0),
+                t0: 0.0,
+                t1: std::f64::consts::TAU,
+            },
+            w,
+            w,
+        );
+        let twice = vec![
+            OrientedEdge {
+                edge: lonely,
+                forward: false,
+            },
+            OrientedEdge {
+                edge: lonely,
+                forward: true,
+            },
+        ];
+        // Traversed both ways in one loop, the lonely ring counts as used twice.
+        b.model.faces[top.index()].loops.push(twice);
+        let diags = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&diags), ["E405"]);
+        assert_eq!(
+            diags.items[0].message,
+            "the boundary of subdomain `box` (the shell with face `box.bottom`) fails the \
+             Euler–Poincaré check: V − E + F − (L − F) = 10 − 14 + 6 − (9 − 6) = -1, not \
+             2(1 − G) for a whole G ≥ 0"
+        );
+    }
+
+    #[test]
+    fn open_face_loop_names_the_break() {
+        let mut b = cube();
+        let front = face_id(&b, "box.front");
+        b.model.faces[front.index()].loops[0].swap(1, 2);
+        let diags = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&diags), ["E401"]);
+        let d = &diags.items[0];
+        assert_eq!(d.span, b.map.face(front));
+        assert!(
+            d.message
+                .starts_with("the loop of face `box.front` is not closed: edge `e")
+        );
+        let lp = &b.model.faces[front.index()].loops[0];
+        let expected = format!("edge `{}` ends at vertex", edge_name(&b.model, lp[0].edge));
+        assert!(d.message.contains(&expected), "{}", d.message);
+    }
+
+    #[test]
+    fn open_curve_with_coincident_ends() {
+        let mut b = Builder::new(Dimension::Three);
+        let v = b.vertex([0.0; 3]);
+        let p = Point3::origin();
+        let bad = b.push_edge(Curve::Segment { a: p, b: p }, v, v);
+        let arc = Curve::Ellipse {
+            center: Point3::new(1.0, 0.0, 0.0),
+            major: Vec3::new(-1.0, 0.0, 0.0),
+            minor: Vec3::new(0.0, 1.0, 0.0),
+            t0: 0.0,
+            t1: std::f64::consts::PI,
+        };
+        b.push_edge(arc, v, v);
+        let mut diags = Diagnostics::default();
+        check_faces(&b.model, &b.map, &mut diags);
+        assert_eq!(codes(&diags), ["E400", "E400"]);
+        assert_eq!(diags.items[0].span, b.map.edge(bad));
+        assert_eq!(
+            diags.items[0].message,
+            "edge `e0` begins and ends at vertex `v0` but its curve is open (a straight segment)"
+        );
+        assert!(
+            diags.items[1]
+                .message
+                .contains("an arc spanning 3.141593 rad")
+        );
+    }
+
+    #[test]
+    fn face_shared_by_three_subdomains() {
+        let mut b = cube();
+        let boundary = match &b.model.subdomains[0].cells {
+            SubdomainCells::Volume { boundary } => boundary.clone(),
+            SubdomainCells::Region { .. } => Vec::new(),
+        };
+        b.push_subdomain(
+            "twin",
+            SubdomainCells::Volume {
+                boundary: boundary.clone(),
+            },
+        );
+        b.push_subdomain("triplet", SubdomainCells::Volume { boundary });
+        let mut diags = Diagnostics::default();
+        check_face_usage(&b.model, &b.map, &mut diags);
+        assert_eq!(codes(&diags), ["E406"; 6]);
+        assert_eq!(
+            diags.items[0].message,
+            "face `box.bottom` bounds 3 subdomains (`box`, `twin`, `triplet`); a face separates \
+             at most two"
+        );
+    }
+
+    #[test]
+    fn unused_explicit_entities_warn_but_solid_entities_do_not() {
+        let mut b = cube();
+        let lonely = b.vertex([5.0, 5.0, 5.0]);
+        let u = b.vertex([6.0, 5.0, 5.0]);
+        let w = b.vertex([7.0, 5.0, 5.0]);
+        b.segment(u, w);
+        let generated = b.vertex([9.0, 9.0, 9.0]);
+        b.model.solids.push(Solid {
+            name: "ball".into(),
+            shape: SolidShape::Ball {
+                frame: Frame::identity(),
+            },
+            faces: Vec::new(),
+            edges: Vec::new(),
+            vertices: vec![generated],
+        });
+        // Not in the source map: not explicit, so not reported either.
+        b.model.vertices.push(crate::ir::Vertex {
+            name: "anon".into(),
+            position: Point3::origin(),
+        });
+        let diags = check_topology(&b.model, &b.map);
+        assert_eq!(codes(&diags), ["W004", "W004"]);
+        assert_eq!(
+            diags.items[0].message,
+            "vertex `v8` is not used by any edge"
+        );
+        assert_eq!(diags.items[0].span, b.map.vertex(lonely));
+        assert_eq!(diags.items[1].message, "edge `e12` is not used by any face");
+    }
+
+    #[test]
+    fn malformed_ids_do_not_panic() {
+        let mut b = cube();
+        b.model.edges[0].begin = VertexId(99);
+        b.model.faces[0].loops[0].push(OrientedEdge {
+            edge: EdgeId(77),
+            forward: true,
+        });
+        boundary_mut(&mut b, 0).push(OrientedFace {
+            face: FaceId(55),
+            outward: true,
+        });
+        b.model.boundaries.push(crate::ir::Boundary {
+            name: "x".into(),
+            faces: vec![FaceId(66)],
+            edges: vec![EdgeId(88)],
+        });
+        let _ = check_topology(&b.model, &b.map);
+        let _ = shells(&b.model, SubdomainId(0));
+        let _ = shells(&b.model, SubdomainId(9));
+        let _ = crate::ir::IncidenceMatrices::of(&b.model);
+        let _ = crate::ir::derive_fragments(&b.model);
+    }
+}
