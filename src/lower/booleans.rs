@@ -482,14 +482,7 @@ fn explicit_shell(model: &Model, entities: &Entities, refs: &[crate::doc::Ref], 
         match lookup_entities(&entities.faces, &r.text) {
             Some(ids) => faces.extend(ids),
             None => {
-                if let Some(kind) = entities_kind(entities, &r.text) {
-                    diags.push(
-                        Diagnostic::new(Code::WrongKind, r.span, format!("'{}' is {kind}, but faces= lists faces", r.text))
-                            .with_help("name faces (explicit <face> names, or primitive faces such as box.xmin)"),
-                    );
-                } else {
-                    unknown_entity(r, "face", entities.faces.keys(), diags);
-                }
+                unknown_entity(r, "face", entities, diags);
                 ok = false;
             }
         }
@@ -499,16 +492,6 @@ fn explicit_shell(model: &Model, entities: &Entities, refs: &[crate::doc::Ref], 
     }
     faces.dedup();
     Some(orient_shell(model, &faces))
-}
-
-fn entities_kind(entities: &Entities, name: &str) -> Option<&'static str> {
-    if entities.edges.contains_key(name) {
-        Some("an edge")
-    } else if entities.vertices.contains_key(name) {
-        Some("a vertex")
-    } else {
-        None
-    }
 }
 
 /// Propagates outward flags across shared edges (an edge is run in opposite

@@ -311,7 +311,7 @@ pub(super) fn lower_boundaries(doc: &Document, model: &mut Model, entities: &Ent
             for r in refs {
                 match lookup_entities(&entities.faces, &r.text) {
                     Some(ids) => boundary.faces.extend(ids),
-                    None => unknown_entity(r, "face", entities.faces.keys(), diags),
+                    None => unknown_entity(r, "face", entities, diags),
                 }
             }
         }
@@ -319,7 +319,7 @@ pub(super) fn lower_boundaries(doc: &Document, model: &mut Model, entities: &Ent
             for r in refs {
                 match lookup_entities(&entities.edges, &r.text) {
                     Some(ids) => boundary.edges.extend(ids),
-                    None => unknown_entity(r, "edge", entities.edges.keys(), diags),
+                    None => unknown_entity(r, "edge", entities, diags),
                 }
             }
         }
@@ -350,8 +350,30 @@ pub(super) fn lookup_entities<T: Copy + Ord>(table: &HashMap<String, T>, name: &
     (!ids.is_empty()).then_some(ids)
 }
 
-pub(super) fn unknown_entity<'a>(r: &crate::doc::Ref, kind: &str, names: impl Iterator<Item = &'a String>, diags: &mut Diagnostics) {
-    let names: Vec<&str> = names.map(String::as_str).collect();
+/// Reports a face or edge reference that names nothing of that kind: E202
+/// when it names another kind of entity, else E200 with a suggestion.
+pub(super) fn unknown_entity(r: &crate::doc::Ref, kind: &str, entities: &Entities, diags: &mut Diagnostics) {
+    let found_as = if kind != "face" && lookup_entities(&entities.faces, &r.text).is_some() {
+        Some("a face")
+    } else if kind != "edge" && lookup_entities(&entities.edges, &r.text).is_some() {
+        Some("an edge")
+    } else if entities.vertices.contains_key(&r.text) {
+        Some("a vertex")
+    } else {
+        None
+    };
+    if let Some(what) = found_as {
+        diags.push(
+            Diagnostic::new(Code::WrongKind, r.span, format!("'{}' is {what}, but a {kind} is expected here", r.text))
+                .with_help(format!("name a {kind} (an explicit <{kind}> or a primitive's {kind} such as {})", if kind == "face" { "box.xmin" } else { "box.xmin_ymin" })),
+        );
+        return;
+    }
+    let names: Vec<&str> = if kind == "face" {
+        entities.faces.keys().map(String::as_str).collect()
+    } else {
+        entities.edges.keys().map(String::as_str).collect()
+    };
     let mut d = Diagnostic::new(Code::UndefinedName, r.span, format!("no {kind} named '{}'", r.text));
     d.help = Some(match crate::diag::did_you_mean(&r.text, names.iter().copied()) {
         Some(best) => format!("did you mean '{best}'?"),

@@ -70,7 +70,7 @@ fn tolerance(resolved: &Resolved) -> f64 {
     fn visit(g: &Geometry, bbox: &mut Aabb) {
         match g {
             Geometry::Solid(s) => *bbox = bbox.union(&s.bbox()),
-            Geometry::Points { points } | Geometry::Polyline { points } => points.iter().for_each(|p| bbox.include(p)),
+            Geometry::Points { points, .. } | Geometry::Polyline { points } => points.iter().for_each(|p| bbox.include(p)),
             Geometry::Vertex(p) => bbox.include(p),
             Geometry::Group(members) => members.iter().for_each(|m| visit(m, bbox)),
             _ => {}
@@ -94,7 +94,7 @@ fn lower_free(
     span: Span,
 ) {
     match geometry {
-        Geometry::Points { points } => model.point_sets.push(PointSet { name: name.to_string(), points: points.clone() }),
+        Geometry::Points { points, .. } => model.point_sets.push(PointSet { name: name.to_string(), points: points.clone() }),
         Geometry::Polyline { points } => model.polylines.push(Polyline { name: name.to_string(), points: points.clone() }),
         Geometry::Solid(shape) => {
             let id = lower_solid(model, source_map, entities, welder, name, shape, span);

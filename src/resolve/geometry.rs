@@ -24,8 +24,9 @@ pub struct Link {
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum Geometry {
-    /// A named set of points; `dims` says how many coordinates each value gave.
-    Points { points: Vec<Point3> },
+    /// A named set of points; `partial[k]` when value k left out a coordinate
+    /// (paper 000's 2D and 1D points: lines and planes, taken as points with 0s).
+    Points { points: Vec<Point3>, partial: Vec<bool> },
     Polyline { points: Vec<Point3> },
     /// A bounded solid (3D) or region (2D).
     Solid(SolidShape),
@@ -59,8 +60,9 @@ impl Geometry {
     /// coordinate; `None` for kinds that cannot be transformed.
     pub fn transformed(&self, map: &Frame) -> Option<Geometry> {
         Some(match self {
-            Geometry::Points { points } => Geometry::Points {
+            Geometry::Points { points, partial } => Geometry::Points {
                 points: points.iter().map(|p| map.to_global(p)).collect(),
+                partial: partial.clone(),
             },
             Geometry::Polyline { points } => Geometry::Polyline {
                 points: points.iter().map(|p| map.to_global(p)).collect(),

@@ -2,7 +2,6 @@
 //! coordinate systems and transforms applied — every object of the document
 //! in global coordinates, ready to be lowered into the model IR.
 
-mod frames;
 mod geometry;
 mod names;
 mod objects;

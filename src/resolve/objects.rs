@@ -2,7 +2,7 @@
 //! transforms), evaluates points and vectors in their coordinate systems, and
 //! hands each primitive to [`super::shapes`].
 
-use super::frames::{resolve_cs, FrameState};
+
 use super::geometry::{Geometry, Link};
 use super::names::NameTable;
 use super::values::{Ctx, Values};
@@ -11,6 +11,12 @@ use crate::diag::{did_you_mean, Code, Diagnostic, Diagnostics};
 use crate::doc::{Axis, CoordinateSystem, Document, Number, Object, PointSpec, Ref, VectorSpec};
 use crate::geom::{Frame, Point3, Vec3};
 use std::collections::HashMap;
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum FrameState {
+    InProgress,
+    Done(Option<Frame>),
+}
 
 #[derive(Debug, Clone, PartialEq)]
 enum State {
@@ -49,6 +55,10 @@ impl<'a> Resolver<'a> {
             frames: HashMap::new(),
             state: vec![None; doc.objects.len()],
         }
+    }
+
+    pub fn by_name_index(&self, name: &str) -> Option<&usize> {
+        self.by_name.get(name)
     }
 
     pub fn finish(self) -> Values {
@@ -118,30 +128,72 @@ impl<'a> Resolver<'a> {
         super::shapes::resolve_kind(self, object, &frame)
     }
 
+    /// The frame of a coordinate system, through its parents (cycles reported).
     pub fn frame_of(&mut self, reference: &Ref) -> Option<Frame> {
-        let other_kind = self.names.kind_of(&reference.name);
-        let mut values = std::mem::replace(&mut self.values, Values::new(&Document::default(), &[]));
-        let result = resolve_cs(
-            reference,
-            &self.systems,
-            &mut self.frames,
-            other_kind,
-            &mut |cs, diags| {
-                let zero = Vec3::zeros();
-                let origin = match &cs.origin {
-                    Some(o) => vector3(&mut values, o.x.as_ref(), o.y.as_ref(), o.z.as_ref(), true, diags)?,
-                    None => zero,
-                };
-                let angles = match &cs.rotation {
-                    Some(r) => vector3(&mut values, r.x.as_ref(), r.y.as_ref(), r.z.as_ref(), false, diags)?,
-                    None => zero,
-                };
-                Some((origin, angles))
-            },
-            self.diags,
-        );
-        self.values = values;
-        result
+        let name = reference.name.as_str();
+        let Some(cs) = self.systems.get(name).copied() else {
+            let d = match self.names.kind_of(name) {
+                Some(kind) => Diagnostic::new(
+                    Code::WrongKind,
+                    reference.span,
+                    format!("cs=\"{name}\" names a {kind}, not a coordinate system"),
+                )
+                .with_help("name a <coordinate_system>"),
+                None => {
+                    let mut d = Diagnostic::new(
+                        Code::UndefinedName,
+                        reference.span,
+                        format!("undefined coordinate system '{name}'"),
+                    );
+                    d.help = Some(match did_you_mean(name, self.systems.keys().map(String::as_str)) {
+                        Some(best) => format!("did you mean '{best}'?"),
+                        None => format!("define it with <coordinate_system name=\"{name}\">"),
+                    });
+                    d
+                }
+            };
+            self.diags.push(d);
+            return None;
+        };
+        match self.frames.get(name) {
+            Some(FrameState::Done(frame)) => return *frame,
+            Some(FrameState::InProgress) => {
+                self.diags.push(
+                    Diagnostic::new(
+                        Code::ReferenceCycle,
+                        cs.name.span,
+                        format!("coordinate system '{name}' lies inside itself through its cs= chain"),
+                    )
+                    .with_help("remove cs= from one of the systems in the chain"),
+                );
+                self.frames.insert(name.to_string(), FrameState::Done(None));
+                return None;
+            }
+            None => {}
+        }
+        self.frames.insert(name.to_string(), FrameState::InProgress);
+        let parent = match &cs.parent {
+            Some(p) => self.frame_of(p),
+            None => Some(Frame::identity()),
+        };
+        if let Some(FrameState::Done(None)) = self.frames.get(name) {
+            return None;
+        }
+        let frame = parent.and_then(|parent| {
+            // The origin is given in the parent's coordinates (or as a named point).
+            let origin = match &cs.origin {
+                Some(o) => self.point(o, &parent, false)?,
+                None => parent.origin,
+            };
+            let angles = match &cs.rotation {
+                Some(r) => self.numbers3(r)?,
+                None => Vec3::zeros(),
+            };
+            let rotation = Frame::rotation_degrees(angles);
+            Some(Frame { origin, linear: parent.linear * rotation.linear })
+        });
+        self.frames.insert(name.to_string(), FrameState::Done(frame));
+        frame
     }
 
     // ---- numbers, points, vectors ----
@@ -165,7 +217,7 @@ impl<'a> Resolver<'a> {
                 );
                 return None;
             }
-            return self.point_reference(reference);
+            return self.point_reference(reference, need3);
         }
         if spec.x.is_none() && spec.y.is_none() && spec.z.is_none() {
             self.diags.push(
@@ -203,12 +255,24 @@ impl<'a> Resolver<'a> {
     }
 
     /// A point given by reference: a point set (member), or a vertex.
-    fn point_reference(&mut self, reference: &Ref) -> Option<Point3> {
+    fn point_reference(&mut self, reference: &Ref, need3: bool) -> Option<Point3> {
         let i = self.lookup(reference, &["point", "vertex"])?;
         match self.geometry(i)? {
-            Geometry::Points { points } => match (reference.index, points.len()) {
-                (None, 1) => points.first().copied(),
-                (Some(k), n) if k >= 1 && k <= n => points.get(k - 1).copied(),
+            Geometry::Points { points, partial } => match (reference.index, points.len()) {
+                (None, 1) | (Some(1..), _) if reference.index.unwrap_or(1) <= points.len() => {
+                    let k = reference.index.unwrap_or(1) - 1;
+                    if need3 && partial.get(k).copied().unwrap_or(false) {
+                        self.diags.push(
+                            Diagnostic::new(
+                                Code::PointValueShape,
+                                reference.span,
+                                format!("'{}' gives fewer than three coordinates (a line or plane in paper 000's sense); the missing ones are taken as 0", reference.text),
+                            )
+                            .with_help("give the point all three coordinates where a single point is needed"),
+                        );
+                    }
+                    points.get(k).copied()
+                }
                 (None, n) => {
                     self.diags.push(
                         Diagnostic::new(
@@ -320,9 +384,9 @@ impl<'a> Resolver<'a> {
             (Geometry::Group(members), None) => Some((i, Geometry::Group(members))),
             (g, None) => Some((i, g)),
             (g, Some(k)) => {
-                if let Geometry::Points { points } = &g {
+                if let Geometry::Points { points, partial } = &g {
                     if k >= 1 && k <= points.len() {
-                        return Some((i, Geometry::Points { points: vec![points[k - 1]] }));
+                        return Some((i, Geometry::Points { points: vec![points[k - 1]], partial: vec![partial[k - 1]] }));
                     }
                 }
                 self.diags.push(

@@ -19,10 +19,12 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
     match &object.kind {
         ObjectKind::Point { values } => {
             let mut points = Vec::with_capacity(values.len());
+            let mut partial = Vec::with_capacity(values.len());
             for v in values {
                 points.push(Point3::from(r.vector(v, frame)?) + frame.origin.coords);
+                partial.push(v.x.is_none() || v.y.is_none() || (need3 && v.z.is_none()));
             }
-            Some(Geometry::Points { points })
+            Some(Geometry::Points { points, partial })
         }
         ObjectKind::Circle { center, radius } => {
             let c = r.point(center.as_ref()?, frame, false)?;
@@ -494,9 +496,29 @@ fn vertex(r: &mut Resolver, spec: &VertexSpec, object: &Object, frame: &Frame) -
                 );
                 return None;
             };
+            let hint = hint_point(r, near.as_ref(), frame)?;
+            if let (Some(sa), Some(sb)) = (intersection_surfaces(r, a), intersection_surfaces(r, b)) {
+                // Two intersection lines meet where three of their four surfaces
+                // meet and the fourth passes through that point.
+                let tol = 1e-7 * hint.coords.norm().max(1.0);
+                let all = [&sa[0], &sa[1], &sb[0], &sb[1]];
+                let found = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)].iter().find_map(|&(i, j, k, rest)| {
+                    let p = intersect_surfaces([all[i], all[j], all[k]], hint, tol * 1e-2)?;
+                    (all[rest].distance(&p) <= tol).then_some(p)
+                });
+                return match found {
+                    Some(p) => Some(Geometry::Vertex(p)),
+                    None => {
+                        r.diags.push(
+                            Diagnostic::new(Code::NoConvergence, *span, format!("vertex '{name}': lines {} and {} do not meet near {}", a.text, b.text, fmt_point(&hint)))
+                                .with_help("check that the two lines intersect, and move <near> closer to the intersection"),
+                        );
+                        None
+                    }
+                };
+            }
             let ca = curve_of(r, a)?;
             let cb = curve_of(r, b)?;
-            let hint = hint_point(r, near.as_ref(), frame)?;
             let tol = 1e-7 * hint.coords.norm().max(1.0);
             match intersect_curves(&ca, &cb, hint, tol) {
                 Some(p) => Some(Geometry::Vertex(p)),
@@ -535,6 +557,15 @@ pub(super) fn surface_of(r: &mut Resolver, reference: &Ref) -> Option<Surface> {
             );
             None
         }
+    }
+}
+
+/// The two surfaces of an intersection line, without reporting anything.
+fn intersection_surfaces(r: &mut Resolver, reference: &Ref) -> Option<Box<[Surface; 2]>> {
+    let i = *r.by_name_index(&reference.name)?;
+    match r.geometry(i)? {
+        Geometry::Line(LineCarrier::Intersection { surfaces }) => Some(surfaces),
+        _ => None,
     }
 }
 
@@ -583,7 +614,7 @@ fn steps_map(r: &mut Resolver, steps: &[Step], name: &str) -> Option<Frame> {
                     Some(c) => {
                         let (_, g) = r.linked_geometry(c, &["point", "vertex"])?;
                         let p = match g {
-                            Geometry::Points { points } if points.len() == 1 => points[0],
+                            Geometry::Points { points, .. } if points.len() == 1 => points[0],
                             Geometry::Vertex(p) => p,
                             _ => {
                                 r.diags.push(

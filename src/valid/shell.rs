@@ -76,7 +76,7 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
                     Code::EdgeEndsCoincide,
                     source_map.edge(id),
                     format!(
-                        "edge `{}` begins and ends at vertex `{}` but its curve is open ({})",
+                        "edge '{}' begins and ends at vertex '{}' but its curve is open ({})",
                         edge.name,
                         vertex_name(model, edge.begin),
                         curve_description(&edge.curve)
@@ -94,9 +94,9 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
         let id = FaceId(i as u32);
         for (l, edges) in face.loops.iter().enumerate() {
             let which = if face.loops.len() == 1 {
-                format!("the loop of face `{}`", face.name)
+                format!("the loop of face '{}'", face.name)
             } else {
-                format!("loop {} of face `{}`", l + 1, face.name)
+                format!("loop {} of face '{}'", l + 1, face.name)
             };
             if edges.is_empty() {
                 diags.push(
@@ -130,15 +130,15 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
             let (next, next_tail, _) = chain[(k + 1) % n];
             let message = if n == 1 {
                 format!(
-                    "{which} is not closed: its only edge `{}` runs from vertex `{}` to vertex `{}`",
+                    "{which} is not closed: its only edge '{}' runs from vertex '{}' to vertex '{}'",
                     edge_name(model, edge),
                     vertex_name(model, tail),
                     vertex_name(model, head)
                 )
             } else {
                 format!(
-                    "{which} is not closed: edge `{}` ends at vertex `{}` but the next edge `{}` \
-                     begins at vertex `{}`",
+                    "{which} is not closed: edge '{}' ends at vertex '{}' but the next edge '{}' \
+                     begins at vertex '{}'",
                     edge_name(model, edge),
                     vertex_name(model, head),
                     edge_name(model, next),
@@ -281,6 +281,20 @@ fn shells_of(model: &Model, boundary: &[OrientedFace]) -> Vec<Shell> {
         .collect()
 }
 
+fn distinct_vertices(model: &Model, boundary: &[OrientedFace]) -> usize {
+    let mut vertices = BTreeSet::new();
+    for of in boundary {
+        let Some(face) = model.faces.get(of.face.index()) else { continue };
+        for oe in face.loops.iter().flatten() {
+            if let Some(edge) = model.edges.get(oe.edge.index()) {
+                vertices.insert(edge.begin);
+                vertices.insert(edge.end);
+            }
+        }
+    }
+    vertices.len()
+}
+
 /// The connected shells of a 3D subdomain's boundary; empty for a 2D region
 /// or an id out of range.
 pub fn shells(model: &Model, subdomain: SubdomainId) -> Vec<Shell> {
@@ -313,14 +327,14 @@ pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut
                             Code::OpenShell,
                             span,
                             format!(
-                                "the boundary of subdomain `{}` is not closed: edge `{}` is used \
-                                 only by face `{face}`",
+                                "the boundary of subdomain '{}' is not closed: edge '{}' is used \
+                                 only by face '{face}'",
                                 subdomain.name,
                                 edge_name(model, edge)
                             ),
                         )
                         .with_help(format!(
-                            "add the missing face across edge `{}` to subdomain `{}`, or check \
+                            "add the missing face across edge '{}' to subdomain '{}', or check \
                              that the neighbouring face names the same edge",
                             edge_name(model, edge),
                             subdomain.name
@@ -331,14 +345,14 @@ pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut
                     manifold = false;
                     let faces: BTreeSet<String> = list
                         .iter()
-                        .map(|u| format!("`{}`", face_name(model, boundary[u.entry].face)))
+                        .map(|u| format!("'{}'", face_name(model, boundary[u.entry].face)))
                         .collect();
                     diags.push(
                         Diagnostic::new(
                             Code::NonManifoldEdge,
                             span,
                             format!(
-                                "edge `{}` is used {n} times in the boundary of subdomain `{}` \
+                                "edge '{}' is used {n} times in the boundary of subdomain '{}' \
                                  (faces {}), more than twice",
                                 edge_name(model, edge),
                                 subdomain.name,
@@ -346,7 +360,7 @@ pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut
                             ),
                         )
                         .with_help(format!(
-                            "split subdomain `{}` so that each edge of a boundary is shared by \
+                            "split subdomain '{}' so that each edge of a boundary is shared by \
                              exactly two of its faces",
                             subdomain.name
                         )),
@@ -427,8 +441,8 @@ fn check_orientation(
                     Code::InconsistentOrientation,
                     source_map.subdomain(id),
                     format!(
-                        "the boundary of subdomain `{name}` is one-sided: its faces cannot be \
-                         oriented consistently (the contradiction closes at edge `{}`)",
+                        "the boundary of subdomain '{name}' is one-sided: its faces cannot be \
+                         oriented consistently (the contradiction closes at edge '{}')",
                         edge_name(model, edge)
                     ),
                 )
@@ -459,7 +473,7 @@ fn check_orientation(
             let neighbour = adjacent[e].iter().find(|&&(b, _, _)| class(b) != wrong);
             let along = neighbour.map_or_else(String::new, |&(b, _, edge)| {
                 format!(
-                    ": it runs along edge `{}` in the same direction as face `{}`",
+                    ": it runs along edge '{}' in the same direction as face '{}'",
                     edge_name(model, edge),
                     face_name(model, boundary[b].face)
                 )
@@ -469,8 +483,8 @@ fn check_orientation(
                     Code::InconsistentOrientation,
                     source_map.face(face).or_else(|| source_map.subdomain(id)),
                     format!(
-                        "face `{}` is oriented against the rest of the boundary of subdomain \
-                         `{name}` (normal taken {}){along}",
+                        "face '{}' is oriented against the rest of the boundary of subdomain \
+                         '{name}' (normal taken {}){along}",
                         face_name(model, face),
                         if boundary[e].outward {
                             "outward"
@@ -480,8 +494,8 @@ fn check_orientation(
                     ),
                 )
                 .with_help(format!(
-                    "reverse the loop of face `{}` so that it runs counter-clockwise seen from \
-                     outside subdomain `{name}`",
+                    "reverse the loop of face '{}' so that it runs counter-clockwise seen from \
+                     outside subdomain '{name}'",
                     face_name(model, face)
                 )),
             );
@@ -499,12 +513,31 @@ fn check_euler(
     diags: &mut Diagnostics,
 ) {
     let name = subdomain_name(model, id);
-    for shell in shells_of(model, boundary) {
+    let shells = shells_of(model, boundary);
+    let shared_vertices = shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices(model, boundary);
+    if shared_vertices > 0 && shells.iter().all(|s| s.genus().is_some()) {
+        // Shells that touch only at vertices: each is a closed surface, but the
+        // boundary is not a manifold there, and χ of the whole boundary shows it.
+        let chi: i64 = shells.iter().map(Shell::euler_characteristic).sum::<i64>() - shared_vertices as i64;
+        diags.push(
+            Diagnostic::new(
+                Code::EulerMismatch,
+                source_map.subdomain(id),
+                format!(
+                    "the boundary of subdomain '{name}' fails the Euler–Poincaré check: its {} shells share {shared_vertices} vertex{} so V − E + F − (L − F) = {chi}, not 2(S − G) for whole S, G",
+                    shells.len(),
+                    if shared_vertices == 1 { "" } else { "es" }
+                ),
+            )
+            .with_help("shells of one subdomain must not touch; split it into two subdomains or separate the solids"),
+        );
+    }
+    for shell in shells {
         if shell.genus().is_some() {
             continue;
         }
         let first = shell.faces.first().map_or_else(String::new, |&f| {
-            format!(" (the shell with face `{}`)", face_name(model, f))
+            format!(" (the shell with face '{}')", face_name(model, f))
         });
         let f = shell.faces.len();
         diags.push(
@@ -512,7 +545,7 @@ fn check_euler(
                 Code::EulerMismatch,
                 source_map.subdomain(id),
                 format!(
-                    "the boundary of subdomain `{name}`{first} fails the Euler–Poincaré check: \
+                    "the boundary of subdomain '{name}'{first} fails the Euler–Poincaré check: \
                      V − E + F − (L − F) = {} − {} + {f} − ({} − {f}) = {}, not 2(1 − G) for a \
                      whole G ≥ 0",
                     shell.vertices,
@@ -559,21 +592,21 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
         }
         let names: Vec<String> = subdomains
             .iter()
-            .map(|&s| format!("`{}`", subdomain_name(model, s)))
+            .map(|&s| format!("'{}'", subdomain_name(model, s)))
             .collect();
         diags.push(
             Diagnostic::new(
                 Code::TooManySubdomains,
                 source_map.face(face),
                 format!(
-                    "face `{}` bounds {} subdomains ({}); a face separates at most two",
+                    "face '{}' bounds {} subdomains ({}); a face separates at most two",
                     face_name(model, face),
                     subdomains.len(),
                     names.join(", ")
                 ),
             )
             .with_help(format!(
-                "keep face `{}` in the face lists of at most two of these subdomains",
+                "keep face '{}' in the face lists of at most two of these subdomains",
                 face_name(model, face)
             )),
         );
@@ -612,7 +645,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
         if let Some(span) = source_map.vertex(id).filter(|_| explicit_unused) {
             unused(
                 Some(span),
-                format!("vertex `{}` is not used by any edge", vertex.name),
+                format!("vertex '{}' is not used by any edge", vertex.name),
                 "remove the vertex, or use it as the begin or end of an edge",
             );
         }
@@ -623,7 +656,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
         if let Some(span) = source_map.edge(id).filter(|_| explicit_unused) {
             unused(
                 Some(span),
-                format!("edge `{}` is not used by any face", edge.name),
+                format!("edge '{}' is not used by any face", edge.name),
                 "remove the edge, or list it in a face's loop",
             );
         }
@@ -635,7 +668,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
             unused(
                 Some(span),
                 format!(
-                    "face `{}` is not used by any subdomain or boundary",
+                    "face '{}' is not used by any subdomain or boundary",
                     face.name
                 ),
                 "remove the face, or list it in a subdomain's faces",
@@ -704,7 +737,7 @@ mod tests {
         assert_eq!(codes(&diags), ["E402"; 4]);
         let top_edges: BTreeSet<String> = b.model.faces[top.index()].loops[0]
             .iter()
-            .map(|oe| format!("edge `{}`", edge_name(&b.model, oe.edge)))
+            .map(|oe| format!("edge '{}'", edge_name(&b.model, oe.edge)))
             .collect();
         for d in &diags.items {
             assert!(
@@ -712,21 +745,21 @@ mod tests {
                 "{}",
                 d.message
             );
-            assert!(d.message.contains("subdomain `box`"), "{}", d.message);
+            assert!(d.message.contains("subdomain 'box'"), "{}", d.message);
             assert!(d.help.is_some());
             assert_eq!(d.span, b.map.subdomain(SubdomainId(0)));
         }
         // e4 runs (0,0,1) → (1,0,1): the top's first edge, shared with the front.
         assert_eq!(
             diags.items[0].message,
-            "the boundary of subdomain `box` is not closed: edge `e4` is used only by face \
-             `box.front`"
+            "the boundary of subdomain 'box' is not closed: edge 'e4' is used only by face \
+             'box.front'"
         );
         // The unused top face is reported too, as a warning.
         let all = check_topology(&b.model, &b.map);
         assert_eq!(codes(&all), ["E402", "E402", "E402", "E402", "W004"]);
         assert_eq!(all.items[4].severity, Severity::Warning);
-        assert!(all.items[4].message.contains("face `box.top`"));
+        assert!(all.items[4].message.contains("face 'box.top'"));
     }
 
     #[test]
@@ -742,7 +775,7 @@ mod tests {
         assert_eq!(codes(&diags), ["E404"]);
         let d = &diags.items[0];
         assert!(
-            d.message.starts_with("face `box.top` is oriented against"),
+            d.message.starts_with("face 'box.top' is oriented against"),
             "{}",
             d.message
         );
@@ -762,7 +795,7 @@ mod tests {
         }
         let diags = check_topology(&b.model, &b.map);
         assert_eq!(codes(&diags), ["E404"]);
-        assert!(diags.items[0].message.contains("face `box.left`"));
+        assert!(diags.items[0].message.contains("face 'box.left'"));
         assert!(diags.items[0].message.contains("(normal taken inward)"));
     }
 
@@ -786,7 +819,7 @@ mod tests {
         assert_eq!(codes(&diags), ["E403"]);
         let d = &diags.items[0];
         assert!(d.message.contains("is used 4 times"), "{}", d.message);
-        assert!(d.message.contains("subdomain `both`"), "{}", d.message);
+        assert!(d.message.contains("subdomain 'both'"), "{}", d.message);
     }
 
     #[test]
@@ -808,7 +841,7 @@ mod tests {
         let diags = check_topology(&b.model, &b.map);
         assert_eq!(codes(&diags), ["E404"]);
         assert!(diags.items[0].message.contains("one-sided"));
-        assert!(diags.items[0].message.contains("edge `m`"));
+        assert!(diags.items[0].message.contains("edge 'm'"));
     }
 
     #[test]
@@ -882,7 +915,7 @@ mod tests {
         assert_eq!(codes(&diags), ["E405"]);
         assert_eq!(
             diags.items[0].message,
-            "the boundary of subdomain `box` (the shell with face `box.bottom`) fails the \
+            "the boundary of subdomain 'box' (the shell with face 'box.bottom') fails the \
              Euler–Poincaré check: V − E + F − (L − F) = 10 − 14 + 6 − (9 − 6) = -1, not \
              2(1 − G) for a whole G ≥ 0"
         );
@@ -899,10 +932,10 @@ mod tests {
         assert_eq!(d.span, b.map.face(front));
         assert!(
             d.message
-                .starts_with("the loop of face `box.front` is not closed: edge `e")
+                .starts_with("the loop of face 'box.front' is not closed: edge 'e")
         );
         let lp = &b.model.faces[front.index()].loops[0];
-        let expected = format!("edge `{}` ends at vertex", edge_name(&b.model, lp[0].edge));
+        let expected = format!("edge '{}' ends at vertex", edge_name(&b.model, lp[0].edge));
         assert!(d.message.contains(&expected), "{}", d.message);
     }
 
@@ -926,7 +959,7 @@ mod tests {
         assert_eq!(diags.items[0].span, b.map.edge(bad));
         assert_eq!(
             diags.items[0].message,
-            "edge `e0` begins and ends at vertex `v0` but its curve is open (a straight segment)"
+            "edge 'e0' begins and ends at vertex 'v0' but its curve is open (a straight segment)"
         );
         assert!(
             diags.items[1]
@@ -954,7 +987,7 @@ mod tests {
         assert_eq!(codes(&diags), ["E406"; 6]);
         assert_eq!(
             diags.items[0].message,
-            "face `box.bottom` bounds 3 subdomains (`box`, `twin`, `triplet`); a face separates \
+            "face 'box.bottom' bounds 3 subdomains ('box', 'twin', 'triplet'); a face separates \
              at most two"
         );
     }
@@ -973,6 +1006,7 @@ mod tests {
                 frame: Frame::identity(),
             },
             faces: Vec::new(),
+            boundary_edges: Vec::new(),
             edges: Vec::new(),
             vertices: vec![generated],
         });
@@ -985,10 +1019,10 @@ mod tests {
         assert_eq!(codes(&diags), ["W004", "W004"]);
         assert_eq!(
             diags.items[0].message,
-            "vertex `v8` is not used by any edge"
+            "vertex 'v8' is not used by any edge"
         );
         assert_eq!(diags.items[0].span, b.map.vertex(lonely));
-        assert_eq!(diags.items[1].message, "edge `e12` is not used by any face");
+        assert_eq!(diags.items[1].message, "edge 'e12' is not used by any face");
     }
 
     #[test]
