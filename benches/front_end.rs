@@ -14,7 +14,11 @@ fn generate(count: usize) -> String {
     xml.push_str("<geometry version=\"1\">\n  <parameters><parameter name=\"r\" value=\"0.3\"/></parameters>\n");
     let side = (count as f64).cbrt().ceil() as usize;
     for i in 0..count {
-        let (x, y, z) = ((i % side) as f64 * 2.0, ((i / side) % side) as f64 * 2.0, (i / (side * side)) as f64 * 2.0);
+        let (x, y, z) = (
+            (i % side) as f64 * 2.0,
+            ((i / side) % side) as f64 * 2.0,
+            (i / (side * side)) as f64 * 2.0,
+        );
         let name = format!("p{i}");
         match i % 5 {
             0 => writeln!(xml, "  <sphere name=\"{name}\"><center x=\"{x}\" y=\"{y}\" z=\"{z}\"/><radius value=\"r\"/></sphere>"),
@@ -40,7 +44,11 @@ fn generate(count: usize) -> String {
             ),
         }
         .expect("writing to a String");
-        writeln!(xml, "  <subdomain name=\"d{i}\"><solid ref=\"{name}\"/></subdomain>").expect("writing to a String");
+        writeln!(
+            xml,
+            "  <subdomain name=\"d{i}\"><solid ref=\"{name}\"/></subdomain>"
+        )
+        .expect("writing to a String");
     }
     xml.push_str("</geometry>\n");
     xml
@@ -71,15 +79,29 @@ fn main() {
     let options = geomc::driver::Options::default();
     let mut errors = 0;
     let full = best_of(3, || {
-        let checked = geomc::driver::check_source(geomc::span::SourceFile::new("bench.xml", xml.clone()), &options);
+        let checked = geomc::driver::check_source(
+            geomc::span::SourceFile::new("bench.xml", xml.clone()),
+            &options,
+        );
         errors = checked.diagnostics.error_count();
         std::hint::black_box(checked.lowered.map(|l| l.model.faces.len()));
     });
     assert_eq!(errors, 0, "the generated model must be valid");
     let ratio = bare.as_secs_f64() / full.as_secs_f64();
-    println!("  roxmltree parse only:            {:8.3} s  {:7.1} MB/s", bare.as_secs_f64(), mb / bare.as_secs_f64());
-    println!("  geomc parse+resolve+validate:    {:8.3} s  {:7.1} MB/s", full.as_secs_f64(), mb / full.as_secs_f64());
-    println!("  throughput ratio geomc/roxmltree: {ratio:.2} (target >= 0.40) {}", verdict(ratio >= 0.40));
+    println!(
+        "  roxmltree parse only:            {:8.3} s  {:7.1} MB/s",
+        bare.as_secs_f64(),
+        mb / bare.as_secs_f64()
+    );
+    println!(
+        "  geomc parse+resolve+validate:    {:8.3} s  {:7.1} MB/s",
+        full.as_secs_f64(),
+        mb / full.as_secs_f64()
+    );
+    println!(
+        "  throughput ratio geomc/roxmltree: {ratio:.2} (target >= 0.40) {}",
+        verdict(ratio >= 0.40)
+    );
 
     // Peak memory of the real command on the same file.
     let dir = std::env::temp_dir().join(format!("geomc-bench-{}", std::process::id()));
@@ -100,7 +122,11 @@ fn main() {
     match peak {
         Some(bytes) => {
             let ratio = bytes / xml.len() as f64;
-            println!("  geomc validate peak memory:      {:8.1} MB = {ratio:.1}x the file (target <= 10x) {}", bytes / 1e6, verdict(ratio <= 10.0));
+            println!(
+                "  geomc validate peak memory:      {:8.1} MB = {ratio:.1}x the file (target <= 10x) {}",
+                bytes / 1e6,
+                verdict(ratio <= 10.0)
+            );
         }
         None => println!("  peak memory: not available on this system"),
     }

@@ -43,11 +43,19 @@ pub fn check_file(path: &Path, options: &Options) -> std::io::Result<Checked> {
             Diagnostic::new(
                 Code::FileTooLarge,
                 None,
-                format!("the file is {} bytes, over the limit of {} bytes", metadata.len(), options.limits.max_file_size),
+                format!(
+                    "the file is {} bytes, over the limit of {} bytes",
+                    metadata.len(),
+                    options.limits.max_file_size
+                ),
             )
             .with_help("raise the limit with --max-file-size BYTES"),
         );
-        return Ok(Checked { source: SourceFile::new(name, ""), diagnostics, lowered: None });
+        return Ok(Checked {
+            source: SourceFile::new(name, ""),
+            diagnostics,
+            lowered: None,
+        });
     }
     let bytes = std::fs::read(path)?;
     Ok(check_bytes(name, bytes, options))
@@ -70,7 +78,11 @@ pub fn check_bytes(name: String, bytes: Vec<u8>, options: &Options) -> Checked {
                 )
                 .with_help("save the file as UTF-8 (for example: iconv -f latin1 -t utf-8)"),
             );
-            Checked { source, diagnostics, lowered: None }
+            Checked {
+                source,
+                diagnostics,
+                lowered: None,
+            }
         }
     }
 }
@@ -79,7 +91,11 @@ pub fn check_source(source: SourceFile, options: &Options) -> Checked {
     let mut diags = Diagnostics::default();
     let lowered = run(&source, options, &mut diags);
     diags.sort();
-    Checked { source, diagnostics: diags, lowered }
+    Checked {
+        source,
+        diagnostics: diags,
+        lowered,
+    }
 }
 
 fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Option<Lowered> {
@@ -92,16 +108,30 @@ fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Optio
     };
     if root.name != grammar::GEOMETRY.name {
         diags.push(
-            Diagnostic::new(Code::WrongRoot, root.name_span, format!("the root element is <{}>; a geomc file's root is <geometry>", root.name))
-                .with_help("wrap the content in <geometry version=\"1\"> … </geometry>"),
+            Diagnostic::new(
+                Code::WrongRoot,
+                root.name_span,
+                format!(
+                    "the root element is <{}>; a geomc file's root is <geometry>",
+                    root.name
+                ),
+            )
+            .with_help("wrap the content in <geometry version=\"1\"> … </geometry>"),
         );
         return None;
     }
     if let Some(version) = root.attribute("version") {
         if version.value.trim() != "1" {
             diags.push(
-                Diagnostic::new(Code::UnsupportedVersion, version.value_span, format!("format version \"{}\" is not supported; this geomc reads version 1", version.value))
-                    .with_help("set version=\"1\""),
+                Diagnostic::new(
+                    Code::UnsupportedVersion,
+                    version.value_span,
+                    format!(
+                        "format version \"{}\" is not supported; this geomc reads version 1",
+                        version.value
+                    ),
+                )
+                .with_help("set version=\"1\""),
             );
             return None;
         }
@@ -110,7 +140,10 @@ fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Optio
     let document = doc::build(source, &root, diags);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     let lowered = lower::lower(&document, &resolved, diags);
-    diags.extend(crate::valid::check_topology(&lowered.model, &lowered.source_map));
+    diags.extend(crate::valid::check_topology(
+        &lowered.model,
+        &lowered.source_map,
+    ));
     check_domain(&document, &lowered, diags);
     Some(lowered)
 }
@@ -132,18 +165,32 @@ fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnos
         .subdomains
         .iter()
         .flat_map(|s| match &s.cells {
-            SubdomainCells::Volume { boundary } => boundary.iter().map(|f| f.face.index()).collect::<Vec<_>>(),
+            SubdomainCells::Volume { boundary } => {
+                boundary.iter().map(|f| f.face.index()).collect::<Vec<_>>()
+            }
             SubdomainCells::Region { faces } => faces.iter().map(|f| f.index()).collect(),
         })
         .collect();
     let bounding_edges: std::collections::BTreeSet<usize> = if model.dimension == Dimension::Two {
-        bounding.iter().flat_map(|&f| model.faces[f].loops.iter().flatten().map(|e| e.edge.index())).collect()
+        bounding
+            .iter()
+            .flat_map(|&f| {
+                model.faces[f]
+                    .loops
+                    .iter()
+                    .flatten()
+                    .map(|e| e.edge.index())
+            })
+            .collect()
     } else {
         Default::default()
     };
     for (b, def) in model.boundaries.iter().zip(&document.boundaries) {
         let stray_face = b.faces.iter().find(|f| !bounding.contains(&f.index()));
-        let stray_edge = b.edges.iter().find(|e| model.dimension == Dimension::Two && !bounding_edges.contains(&e.index()));
+        let stray_edge = b
+            .edges
+            .iter()
+            .find(|e| model.dimension == Dimension::Two && !bounding_edges.contains(&e.index()));
         let stray = stray_face
             .map(|f| model.face(*f).name.clone())
             .or_else(|| stray_edge.map(|e| model.edge(*e).name.clone()));

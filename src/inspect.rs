@@ -3,7 +3,9 @@
 //! their subdomain pairs, the bounding box, parameters, incidence matrices.
 
 use crate::geom::Aabb;
-use crate::ir::{derive_fragments, Dimension, Fragment, IncidenceMatrices, Model, Side, SubdomainCells};
+use crate::ir::{
+    Dimension, Fragment, IncidenceMatrices, Model, Side, SubdomainCells, derive_fragments,
+};
 use serde::Serialize;
 use std::fmt::Write;
 
@@ -44,7 +46,11 @@ impl Report {
         let bbox: Aabb = model.bbox();
         let fragments = derive_fragments(model);
         Report {
-            dimension: if model.dimension == Dimension::Two { 2 } else { 3 },
+            dimension: if model.dimension == Dimension::Two {
+                2
+            } else {
+                3
+            },
             vertices: model.vertices.len(),
             edges: model.edges.len(),
             faces: model.faces.len(),
@@ -57,13 +63,24 @@ impl Report {
                     faces: match &s.cells {
                         SubdomainCells::Volume { boundary } => boundary
                             .iter()
-                            .map(|of| format!("{}{}", if of.outward { "" } else { "-" }, model.face(of.face).name))
+                            .map(|of| {
+                                format!(
+                                    "{}{}",
+                                    if of.outward { "" } else { "-" },
+                                    model.face(of.face).name
+                                )
+                            })
                             .collect(),
-                        SubdomainCells::Region { faces } => faces.iter().map(|f| model.face(*f).name.clone()).collect(),
+                        SubdomainCells::Region { faces } => {
+                            faces.iter().map(|f| model.face(*f).name.clone()).collect()
+                        }
                     },
                 })
                 .collect(),
-            fragments: fragments.iter().map(|f| fragment_summary(model, f)).collect(),
+            fragments: fragments
+                .iter()
+                .map(|f| fragment_summary(model, f))
+                .collect(),
             bbox_min: (!bbox.is_empty()).then(|| [bbox.min.x, bbox.min.y, bbox.min.z].map(round)),
             bbox_max: (!bbox.is_empty()).then(|| [bbox.max.x, bbox.max.y, bbox.max.z].map(round)),
             parameters: model.parameters.clone(),
@@ -85,7 +102,11 @@ impl Report {
             self.fragments.len()
         );
         if self.point_sets + self.polylines > 0 {
-            let _ = writeln!(s, "point sets: {}  poly_lines: {}", self.point_sets, self.polylines);
+            let _ = writeln!(
+                s,
+                "point sets: {}  poly_lines: {}",
+                self.point_sets, self.polylines
+            );
         }
         if let (Some(min), Some(max)) = (self.bbox_min, self.bbox_max) {
             let _ = writeln!(s, "bounding box: ({}) .. ({})", join(&min), join(&max));
@@ -99,15 +120,36 @@ impl Report {
         if !self.subdomains.is_empty() {
             let _ = writeln!(s, "subdomains:");
             for sub in &self.subdomains {
-                let material = sub.material.as_ref().map_or(String::new(), |m| format!(" [{m}]"));
-                let _ = writeln!(s, "  {}{material}: {} face{}: {}", sub.name, sub.faces.len(), plural(sub.faces.len()), sub.faces.join(" "));
+                let material = sub
+                    .material
+                    .as_ref()
+                    .map_or(String::new(), |m| format!(" [{m}]"));
+                let _ = writeln!(
+                    s,
+                    "  {}{material}: {} face{}: {}",
+                    sub.name,
+                    sub.faces.len(),
+                    plural(sub.faces.len()),
+                    sub.faces.join(" ")
+                );
             }
         }
         if !self.fragments.is_empty() {
             let _ = writeln!(s, "fragments:");
             for f in &self.fragments {
-                let items = if f.faces.is_empty() { &f.edges } else { &f.faces };
-                let _ = writeln!(s, "  {} ({} | {}): {}", f.name, f.subdomain, f.other, items.join(" "));
+                let items = if f.faces.is_empty() {
+                    &f.edges
+                } else {
+                    &f.faces
+                };
+                let _ = writeln!(
+                    s,
+                    "  {} ({} | {}): {}",
+                    f.name,
+                    f.subdomain,
+                    f.other,
+                    items.join(" ")
+                );
             }
         }
         if matrices {
@@ -133,7 +175,10 @@ impl Report {
     pub fn render_json(&self, model: &Model, matrices: bool) -> String {
         let mut value = serde_json::to_value(self).unwrap_or_default();
         if matrices {
-            if let (Some(obj), Ok(m)) = (value.as_object_mut(), serde_json::to_value(IncidenceMatrices::of(model))) {
+            if let (Some(obj), Ok(m)) = (
+                value.as_object_mut(),
+                serde_json::to_value(IncidenceMatrices::of(model)),
+            ) {
                 obj.insert("matrices".into(), m);
             }
         }
@@ -149,8 +194,16 @@ fn fragment_summary(model: &Model, f: &Fragment) -> FragmentSummary {
             Side::Exterior => "exterior".into(),
             Side::Subdomain(id) => model.subdomain(id).name.clone(),
         },
-        faces: f.faces.iter().map(|id| model.face(*id).name.clone()).collect(),
-        edges: f.edges.iter().map(|id| model.edge(*id).name.clone()).collect(),
+        faces: f
+            .faces
+            .iter()
+            .map(|id| model.face(*id).name.clone())
+            .collect(),
+        edges: f
+            .edges
+            .iter()
+            .map(|id| model.edge(*id).name.clone())
+            .collect(),
     }
 }
 
@@ -160,10 +213,12 @@ fn round(v: f64) -> f64 {
 }
 
 fn join(v: &[f64; 3]) -> String {
-    v.iter().map(|x| crate::resolve_fmt(*x)).collect::<Vec<_>>().join(", ")
+    v.iter()
+        .map(|x| crate::resolve_fmt(*x))
+        .collect::<Vec<_>>()
+        .join(", ")
 }
 
 fn plural(n: usize) -> &'static str {
     if n == 1 { "" } else { "s" }
 }
-

@@ -161,7 +161,8 @@ mod tests {
         assert_eq!(src.line_col(5), LineCol { line: 2, column: 2 });
         assert_eq!(src.lines.line_text(&src.text, 2), "дx y");
         assert_eq!(
-            src.lines.offset_of(&src.text, LineCol { line: 2, column: 3 }),
+            src.lines
+                .offset_of(&src.text, LineCol { line: 2, column: 3 }),
             Some(6)
         );
     }

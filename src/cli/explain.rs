@@ -1,6 +1,6 @@
 //! `geomc explain CODE`: what a diagnostic means and how to fix it.
 
-use super::{out, EXIT_OK, EXIT_USAGE};
+use super::{EXIT_OK, EXIT_USAGE, out};
 use geomc::diag::Code;
 
 #[derive(clap::Args)]
@@ -13,7 +13,12 @@ pub fn run(args: &Args) -> i32 {
     if args.code.eq_ignore_ascii_case("all") {
         let mut text = String::new();
         for code in Code::ALL {
-            text.push_str(&format!("{}  {:<8} {}\n", code.as_str(), code.severity().as_str(), code.title()));
+            text.push_str(&format!(
+                "{}  {:<8} {}\n",
+                code.as_str(),
+                code.severity().as_str(),
+                code.title()
+            ));
         }
         out(&text);
         return EXIT_OK;
@@ -33,7 +38,10 @@ pub fn run(args: &Args) -> i32 {
             let names = Code::ALL.iter().map(|c| c.as_str());
             let hint = geomc::diag::did_you_mean(&args.code.to_uppercase(), names)
                 .map_or(String::new(), |c| format!(" (did you mean {c}?)"));
-            eprintln!("geomc: no diagnostic code '{}'{hint}; `geomc explain all` lists them", args.code);
+            eprintln!(
+                "geomc: no diagnostic code '{}'{hint}; `geomc explain all` lists them",
+                args.code
+            );
             EXIT_USAGE
         }
     }

@@ -1,6 +1,6 @@
 //! `geomc inspect FILE`: the model's facts as text or JSON.
 
-use super::{out, report_usage, Format, InputOptions, EXIT_INVALID, EXIT_OK, EXIT_USAGE};
+use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, Format, InputOptions, out, report_usage};
 use geomc::diag::render_human;
 use geomc::driver::check_file;
 use std::path::PathBuf;
@@ -37,13 +37,19 @@ pub fn run(args: &Args) -> i32 {
         eprint!("{}", render_human(&checked.source, d));
     }
     let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
-        eprintln!("geomc: {} is invalid; fix the errors above to inspect it", args.file.display());
+        eprintln!(
+            "geomc: {} is invalid; fix the errors above to inspect it",
+            args.file.display()
+        );
         return EXIT_INVALID;
     };
     let report = geomc::inspect::Report::of(&lowered.model);
     match args.format {
         Format::Human => out(&report.render_text(&lowered.model, args.matrices)),
-        Format::Json => out(&format!("{}\n", report.render_json(&lowered.model, args.matrices))),
+        Format::Json => out(&format!(
+            "{}\n",
+            report.render_json(&lowered.model, args.matrices)
+        )),
     }
     EXIT_OK
 }

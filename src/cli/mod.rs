@@ -18,7 +18,11 @@ pub const EXIT_USAGE: i32 = 2;
 pub const EXIT_INTERNAL: i32 = 3;
 
 #[derive(Parser)]
-#[command(name = "geomc", version, about = "Compile XML descriptions of computational domains into checked topology and meshes")]
+#[command(
+    name = "geomc",
+    version,
+    about = "Compile XML descriptions of computational domains into checked topology and meshes"
+)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -67,7 +71,11 @@ impl InputOptions {
         }
         Ok(Options {
             overrides,
-            limits: Limits { max_file_size: self.max_file_size, max_depth: self.max_depth, max_nodes: self.max_nodes },
+            limits: Limits {
+                max_file_size: self.max_file_size,
+                max_depth: self.max_depth,
+                max_nodes: self.max_nodes,
+            },
         })
     }
 }
@@ -104,7 +112,11 @@ pub fn run() -> i32 {
 /// Writes to stdout, exiting quietly when the reader has gone (a broken pipe).
 pub fn out(text: &str) {
     let mut stdout = std::io::stdout().lock();
-    if stdout.write_all(text.as_bytes()).and_then(|_| stdout.flush()).is_err() {
+    if stdout
+        .write_all(text.as_bytes())
+        .and_then(|_| stdout.flush())
+        .is_err()
+    {
         std::process::exit(EXIT_OK);
     }
 }

@@ -1,7 +1,7 @@
 //! `geomc validate PATH…`: every problem of every file, as text or JSON.
 
-use super::{out, report_usage, Format, InputOptions, EXIT_INVALID, EXIT_OK, EXIT_USAGE};
-use geomc::diag::{render_human, render_json, Severity};
+use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, Format, InputOptions, out, report_usage};
+use geomc::diag::{Severity, render_human, render_json};
 use geomc::driver::check_file;
 use std::path::{Path, PathBuf};
 
@@ -41,8 +41,14 @@ fn validate(args: &Args) -> i32 {
         Err(diagnostics) => {
             if args.format == Format::Json {
                 let source = geomc::span::SourceFile::new("<command line>", "");
-                let json: Vec<_> = diagnostics.iter().map(|d| render_json(&source, d)).collect();
-                out(&format!("{}\n", serde_json::to_string_pretty(&json).unwrap_or_default()));
+                let json: Vec<_> = diagnostics
+                    .iter()
+                    .map(|d| render_json(&source, d))
+                    .collect();
+                out(&format!(
+                    "{}\n",
+                    serde_json::to_string_pretty(&json).unwrap_or_default()
+                ));
             } else {
                 report_usage(&diagnostics);
             }
@@ -89,7 +95,10 @@ fn validate(args: &Args) -> i32 {
         invalid_files += usize::from(file_failed);
     }
     match args.format {
-        Format::Json => out(&format!("{}\n", serde_json::to_string_pretty(&json).unwrap_or_default())),
+        Format::Json => out(&format!(
+            "{}\n",
+            serde_json::to_string_pretty(&json).unwrap_or_default()
+        )),
         Format::Human => eprintln!(
             "checked {} file{}: {} invalid, {errors} error{}, {warnings} warning{}",
             files.len(),
@@ -119,7 +128,9 @@ fn collect(path: &Path, files: &mut Vec<PathBuf>) -> std::io::Result<()> {
         files.push(path.to_path_buf());
         return Ok(());
     }
-    let mut entries: Vec<PathBuf> = std::fs::read_dir(path)?.map(|e| e.map(|e| e.path())).collect::<Result<_, _>>()?;
+    let mut entries: Vec<PathBuf> = std::fs::read_dir(path)?
+        .map(|e| e.map(|e| e.path()))
+        .collect::<Result<_, _>>()?;
     entries.sort();
     for entry in entries {
         if entry.is_dir() {

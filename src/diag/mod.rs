@@ -7,7 +7,7 @@ mod render;
 mod suggest;
 
 pub use code::Code;
-pub use render::{render_human, render_json, JsonDiagnostic};
+pub use render::{JsonDiagnostic, render_human, render_json};
 pub use suggest::did_you_mean;
 
 use crate::span::Span;
@@ -71,7 +71,12 @@ impl Diagnostics {
         self.items.push(diagnostic);
     }
 
-    pub fn error(&mut self, code: Code, span: impl Into<Option<Span>>, message: impl Into<String>) -> &mut Diagnostic {
+    pub fn error(
+        &mut self,
+        code: Code,
+        span: impl Into<Option<Span>>,
+        message: impl Into<String>,
+    ) -> &mut Diagnostic {
         self.items.push(Diagnostic::new(code, span, message));
         let last = self.items.len() - 1;
         &mut self.items[last]

@@ -40,7 +40,11 @@ pub fn render_human(source: &SourceFile, diagnostic: &Diagnostic) -> String {
             let _ = writeln!(out, "{pad} | {indent}{}", "^".repeat(width as usize));
         }
         None => {
-            let _ = writeln!(out, "{}: {severity}[{code}]: {}", source.name, diagnostic.message);
+            let _ = writeln!(
+                out,
+                "{}: {severity}[{code}]: {}",
+                source.name, diagnostic.message
+            );
         }
     }
     if let Some(help) = &diagnostic.help {

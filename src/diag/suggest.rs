@@ -2,7 +2,10 @@
 
 /// The candidate nearest to `name` by edit distance, if it is close enough to
 /// be a plausible typo (at most a third of the name's length, at least 1).
-pub fn did_you_mean<'c>(name: &str, candidates: impl IntoIterator<Item = &'c str>) -> Option<&'c str> {
+pub fn did_you_mean<'c>(
+    name: &str,
+    candidates: impl IntoIterator<Item = &'c str>,
+) -> Option<&'c str> {
     let limit = (name.chars().count() / 3).max(1);
     let lowered = name.to_lowercase();
     candidates

@@ -133,7 +133,12 @@ impl Builder<'_> {
             "poly_line" => ObjectKind::PolyLine {
                 segments: e
                     .children_named("line")
-                    .map(|l| (self.point_child(l, "begin_point"), self.point_child(l, "end_point")))
+                    .map(|l| {
+                        (
+                            self.point_child(l, "begin_point"),
+                            self.point_child(l, "end_point"),
+                        )
+                    })
                     .collect(),
             },
             "truncated_cone" => ObjectKind::TruncatedCone {
@@ -142,19 +147,24 @@ impl Builder<'_> {
                 bottom_radius: self.value_child(e, "bottom_radius"),
                 top_radius: self.value_child(e, "top_radius"),
             },
-            "parallelepiped" => ObjectKind::Parallelepiped(
-                if let Some(base) = self.point_child(e, "base_point") {
+            "parallelepiped" => {
+                ObjectKind::Parallelepiped(if let Some(base) = self.point_child(e, "base_point") {
                     Some(Box::new(ParallelepipedForm::Edges {
                         base,
                         vertices: self.points_named(e, "vertex"),
                     }))
                 } else {
-                    match (self.point_child(e, "first_point"), self.point_child(e, "second_point")) {
-                        (Some(first), Some(second)) => Some(Box::new(ParallelepipedForm::Corners { first, second })),
+                    match (
+                        self.point_child(e, "first_point"),
+                        self.point_child(e, "second_point"),
+                    ) {
+                        (Some(first), Some(second)) => {
+                            Some(Box::new(ParallelepipedForm::Corners { first, second }))
+                        }
                         _ => None,
                     }
-                },
-            ),
+                })
+            }
             "sphere" => ObjectKind::Sphere {
                 center: self.point_child(e, "center"),
                 radius: self.value_child(e, "radius"),
@@ -282,7 +292,10 @@ impl Builder<'_> {
                 radius_vertices: self.points_named(c, "radius_vertex"),
             },
             "intersection" => LineSpec::Intersection {
-                surfaces: self.ref_list(c, "surfaces").map(|(r, _)| r).unwrap_or_default(),
+                surfaces: self
+                    .ref_list(c, "surfaces")
+                    .map(|(r, _)| r)
+                    .unwrap_or_default(),
                 span: c.name_span,
             },
             _ => return None,
@@ -350,7 +363,11 @@ impl Builder<'_> {
         // equals the value (no entity references); otherwise point at the whole value.
         let raw = self.source.snippet(attr.value_span);
         let exact = raw == attr.value;
-        let base = if exact { attr.value_span.start as usize } else { 0 };
+        let base = if exact {
+            attr.value_span.start as usize
+        } else {
+            0
+        };
         let fix = |span: Span| if exact { span } else { attr.value_span };
         match expr::parse(&attr.value, base) {
             Ok(mut expr) => {
@@ -422,7 +439,11 @@ impl Builder<'_> {
         let mut offset = 0;
         for token in a.value.split(|c: char| c.is_whitespace()) {
             if !token.is_empty() {
-                let span = if exact { Span::new(base + offset, base + offset + token.len()) } else { a.value_span };
+                let span = if exact {
+                    Span::new(base + offset, base + offset + token.len())
+                } else {
+                    a.value_span
+                };
                 refs.push(parse_ref(token, span));
             }
             offset += token.len() + 1;
@@ -473,7 +494,9 @@ impl Builder<'_> {
     }
 
     fn value_child(&mut self, e: &Element, name: &str) -> Option<Number> {
-        e.children_named(name).next().and_then(|c| self.number(c, "value"))
+        e.children_named(name)
+            .next()
+            .and_then(|c| self.number(c, "value"))
     }
 }
 
@@ -529,9 +552,15 @@ mod tests {
         let r = parse_ref("pts[2]", Span::default());
         assert_eq!((r.name.as_str(), r.index, r.entity), ("pts", Some(2), None));
         let r = parse_ref("box.xmin", Span::default());
-        assert_eq!((r.name.as_str(), r.entity.as_deref()), ("box", Some("xmin")));
+        assert_eq!(
+            (r.name.as_str(), r.entity.as_deref()),
+            ("box", Some("xmin"))
+        );
         let r = parse_ref("row[3].top", Span::default());
-        assert_eq!((r.name.as_str(), r.index, r.entity.as_deref()), ("row", Some(3), Some("top")));
+        assert_eq!(
+            (r.name.as_str(), r.index, r.entity.as_deref()),
+            ("row", Some(3), Some("top"))
+        );
         let r = parse_ref("point 3D", Span::default());
         assert_eq!((r.name.as_str(), r.index), ("point 3D", None));
     }

@@ -96,25 +96,54 @@ impl Rule {
 }
 
 const fn req(name: &'static str, kind: AttrKind) -> Attr {
-    Attr { name, required: true, kind }
+    Attr {
+        name,
+        required: true,
+        kind,
+    }
 }
 const fn opt(name: &'static str, kind: AttrKind) -> Attr {
-    Attr { name, required: false, kind }
+    Attr {
+        name,
+        required: false,
+        kind,
+    }
 }
 const fn one(rule: &'static Rule) -> Child {
-    Child { rule, min: 1, max: Some(1) }
+    Child {
+        rule,
+        min: 1,
+        max: Some(1),
+    }
 }
 const fn maybe(rule: &'static Rule) -> Child {
-    Child { rule, min: 0, max: Some(1) }
+    Child {
+        rule,
+        min: 0,
+        max: Some(1),
+    }
 }
 const fn exactly(rule: &'static Rule, n: u32) -> Child {
-    Child { rule, min: n, max: Some(n) }
+    Child {
+        rule,
+        min: n,
+        max: Some(n),
+    }
 }
 const fn many(rule: &'static Rule, min: u32) -> Child {
-    Child { rule, min, max: None }
+    Child {
+        rule,
+        min,
+        max: None,
+    }
 }
 const fn leaf(name: &'static str, attrs: &'static [Attr]) -> Rule {
-    Rule { name, attrs, any_attrs: false, content: Content::Empty }
+    Rule {
+        name,
+        attrs,
+        any_attrs: false,
+        content: Content::Empty,
+    }
 }
 
 use AttrKind::{Expr, Name, Ref, RefList, Text};
@@ -163,13 +192,21 @@ pub static HALF_ANGLE: Rule = leaf("half_angle", VALUE_ATTRS);
 
 pub static PARAMETER: Rule = leaf(
     "parameter",
-    &[req("name", Name), req("value", Expr), opt("description", Text)],
+    &[
+        req("name", Name),
+        req("value", Expr),
+        opt("description", Text),
+    ],
 );
 pub static PARAMETERS: Rule = Rule {
     name: "parameters",
     attrs: &[],
     any_attrs: false,
-    content: Content::Choice { options: &[&PARAMETER], min: 0, max: None },
+    content: Content::Choice {
+        options: &[&PARAMETER],
+        min: 0,
+        max: None,
+    },
 };
 /// `<value x1='1' x2='10'/>`: every attribute defines a basis coordinate.
 pub static BASIS_VALUE: Rule = Rule {
@@ -188,7 +225,11 @@ pub static BASIS_COORDINATE: Rule = Rule {
     name: "basis_coordinate",
     attrs: &[],
     any_attrs: false,
-    content: Content::Choice { options: &[&COORDINATE], min: 1, max: None },
+    content: Content::Choice {
+        options: &[&COORDINATE],
+        min: 1,
+        max: None,
+    },
 };
 pub static COORDINATE_SYSTEM: Rule = Rule {
     name: "coordinate_system",
@@ -278,7 +319,12 @@ pub static TORUS: Rule = Rule {
     name: "torus",
     attrs: NAMED,
     any_attrs: false,
-    content: Content::All(&[one(&CENTER), one(&MAJOR_RADIUS), one(&MINOR_RADIUS), maybe(&AXIS)]),
+    content: Content::All(&[
+        one(&CENTER),
+        one(&MAJOR_RADIUS),
+        one(&MINOR_RADIUS),
+        maybe(&AXIS),
+    ]),
 };
 pub static PLANE: Rule = Rule {
     name: "plane",
@@ -302,20 +348,33 @@ pub static ROTATE: Rule = leaf(
 );
 pub static SCALE: Rule = leaf(
     "scale",
-    &[opt("x", Expr), opt("y", Expr), opt("z", Expr), opt("factor", Expr)],
+    &[
+        opt("x", Expr),
+        opt("y", Expr),
+        opt("z", Expr),
+        opt("factor", Expr),
+    ],
 );
 const STEPS: &[&Rule] = &[&SHIFT, &ROTATE, &SCALE];
 pub static TRANSFORM: Rule = Rule {
     name: "transform",
     attrs: &[req("name", Name), req("ref", Ref)],
     any_attrs: false,
-    content: Content::Choice { options: STEPS, min: 1, max: None },
+    content: Content::Choice {
+        options: STEPS,
+        min: 1,
+        max: None,
+    },
 };
 pub static REPLICATE: Rule = Rule {
     name: "replicate",
     attrs: &[req("name", Name), req("ref", Ref), req("count", Expr)],
     any_attrs: false,
-    content: Content::Choice { options: STEPS, min: 1, max: None },
+    content: Content::Choice {
+        options: STEPS,
+        min: 1,
+        max: None,
+    },
 };
 
 // ---- explicit topology ----
@@ -439,7 +498,11 @@ pub static EDGE: Rule = leaf(
 pub static LOOP: Rule = leaf("loop", &[req("edges", RefList)]);
 pub static FACE: Rule = Rule {
     name: "face",
-    attrs: &[req("name", Name), req("surface", Ref), opt("edges", RefList)],
+    attrs: &[
+        req("name", Name),
+        req("surface", Ref),
+        opt("edges", RefList),
+    ],
     any_attrs: false,
     content: Content::Sequence(&[many(&LOOP, 0)]),
 };
@@ -452,30 +515,54 @@ pub static UNION: Rule = Rule {
     name: "union",
     attrs: &[],
     any_attrs: false,
-    content: Content::Choice { options: &SOLID_TREE, min: 2, max: None },
+    content: Content::Choice {
+        options: &SOLID_TREE,
+        min: 2,
+        max: None,
+    },
 };
 pub static INTERSECTION: Rule = Rule {
     name: "intersection",
     attrs: &[],
     any_attrs: false,
-    content: Content::Choice { options: &SOLID_TREE, min: 2, max: None },
+    content: Content::Choice {
+        options: &SOLID_TREE,
+        min: 2,
+        max: None,
+    },
 };
 /// The first operand minus all the others.
 pub static DIFFERENCE: Rule = Rule {
     name: "difference",
     attrs: &[],
     any_attrs: false,
-    content: Content::Choice { options: &SOLID_TREE, min: 2, max: None },
+    content: Content::Choice {
+        options: &SOLID_TREE,
+        min: 2,
+        max: None,
+    },
 };
 pub static SUBDOMAIN: Rule = Rule {
     name: "subdomain",
-    attrs: &[req("name", Name), opt("faces", RefList), opt("material", Text)],
+    attrs: &[
+        req("name", Name),
+        opt("faces", RefList),
+        opt("material", Text),
+    ],
     any_attrs: false,
-    content: Content::Choice { options: &SOLID_TREE, min: 0, max: Some(1) },
+    content: Content::Choice {
+        options: &SOLID_TREE,
+        min: 0,
+        max: Some(1),
+    },
 };
 pub static BOUNDARY: Rule = leaf(
     "boundary",
-    &[req("name", Name), opt("faces", RefList), opt("edges", RefList)],
+    &[
+        req("name", Name),
+        opt("faces", RefList),
+        opt("edges", RefList),
+    ],
 );
 
 // ---- the root ----

@@ -106,7 +106,10 @@ pub struct CoordinateSystem {
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParallelepipedForm {
     /// Base point and the ends of the three edges from it.
-    Edges { base: PointSpec, vertices: Vec<PointSpec> },
+    Edges {
+        base: PointSpec,
+        vertices: Vec<PointSpec>,
+    },
     /// Two opposite corners of an axis-aligned box.
     Corners { first: PointSpec, second: PointSpec },
 }
@@ -114,45 +117,102 @@ pub enum ParallelepipedForm {
 #[derive(Debug, Clone, PartialEq)]
 pub enum Step {
     Shift(VectorSpec),
-    Rotate { angles: VectorSpec, center: Option<Ref> },
-    Scale { factors: VectorSpec, factor: Option<Number> },
+    Rotate {
+        angles: VectorSpec,
+        center: Option<Ref>,
+    },
+    Scale {
+        factors: VectorSpec,
+        factor: Option<Number>,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum SurfaceSpec {
-    Plane { base: Option<PointSpec>, normal: Option<VectorSpec> },
-    Sphere { center: Option<PointSpec>, radius: Option<Number> },
-    Cylinder { base: Option<PointSpec>, axis: Option<VectorSpec>, radius: Option<Number> },
-    Cone { apex: Option<PointSpec>, axis: Option<VectorSpec>, half_angle: Option<Number> },
+    Plane {
+        base: Option<PointSpec>,
+        normal: Option<VectorSpec>,
+    },
+    Sphere {
+        center: Option<PointSpec>,
+        radius: Option<Number>,
+    },
+    Cylinder {
+        base: Option<PointSpec>,
+        axis: Option<VectorSpec>,
+        radius: Option<Number>,
+    },
+    Cone {
+        apex: Option<PointSpec>,
+        axis: Option<VectorSpec>,
+        half_angle: Option<Number>,
+    },
     /// Coefficients xx yy zz xy yz zx x y z c (absent = 0).
-    Quadric { coefficients: [Option<Number>; 10], span: Span },
-    Implicit { equation: Option<Number> },
+    Quadric {
+        coefficients: [Option<Number>; 10],
+        span: Span,
+    },
+    Implicit {
+        equation: Option<Number>,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum LineSpec {
     Straight,
-    CircleArc { center: Option<PointSpec>, normal: Option<VectorSpec> },
-    EllipseArc { center: Option<PointSpec>, radius_vertices: Vec<PointSpec> },
-    Intersection { surfaces: Vec<Ref>, span: Span },
+    CircleArc {
+        center: Option<PointSpec>,
+        normal: Option<VectorSpec>,
+    },
+    EllipseArc {
+        center: Option<PointSpec>,
+        radius_vertices: Vec<PointSpec>,
+    },
+    Intersection {
+        surfaces: Vec<Ref>,
+        span: Span,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum VertexSpec {
     Coordinates(PointSpec),
-    Surfaces { surfaces: Vec<Ref>, near: Option<PointSpec>, span: Span },
-    Lines { lines: Vec<Ref>, near: Option<PointSpec>, span: Span },
+    Surfaces {
+        surfaces: Vec<Ref>,
+        near: Option<PointSpec>,
+        span: Span,
+    },
+    Lines {
+        lines: Vec<Ref>,
+        near: Option<PointSpec>,
+        span: Span,
+    },
 }
 
 /// What a named object is.
 #[derive(Debug, Clone, PartialEq)]
 pub enum ObjectKind {
-    Point { values: Vec<VectorSpec> },
-    Ellipse { center: Option<PointSpec>, radius_vertices: Vec<PointSpec> },
-    Circle { center: Option<PointSpec>, radius: Option<Number> },
-    Triangle { vertices: Vec<PointSpec> },
-    Parallelogram { base: Option<PointSpec>, vertices: Vec<PointSpec> },
-    PolyLine { segments: Vec<(Option<PointSpec>, Option<PointSpec>)> },
+    Point {
+        values: Vec<VectorSpec>,
+    },
+    Ellipse {
+        center: Option<PointSpec>,
+        radius_vertices: Vec<PointSpec>,
+    },
+    Circle {
+        center: Option<PointSpec>,
+        radius: Option<Number>,
+    },
+    Triangle {
+        vertices: Vec<PointSpec>,
+    },
+    Parallelogram {
+        base: Option<PointSpec>,
+        vertices: Vec<PointSpec>,
+    },
+    PolyLine {
+        segments: Vec<(Option<PointSpec>, Option<PointSpec>)>,
+    },
     TruncatedCone {
         bottom_center: Option<PointSpec>,
         top_center: Option<PointSpec>,
@@ -160,18 +220,47 @@ pub enum ObjectKind {
         top_radius: Option<Number>,
     },
     Parallelepiped(Option<Box<ParallelepipedForm>>),
-    Sphere { center: Option<PointSpec>, radius: Option<Number> },
-    Ellipsoid { center: Option<PointSpec>, semi_axes: Option<VectorSpec> },
-    Torus { center: Option<PointSpec>, major: Option<Number>, minor: Option<Number>, axis: Option<VectorSpec> },
-    Plane { base: Option<PointSpec>, normal: Option<VectorSpec> },
-    Transform { target: Option<Ref>, steps: Vec<Step> },
-    Replicate { target: Option<Ref>, count: Option<Number>, steps: Vec<Step> },
+    Sphere {
+        center: Option<PointSpec>,
+        radius: Option<Number>,
+    },
+    Ellipsoid {
+        center: Option<PointSpec>,
+        semi_axes: Option<VectorSpec>,
+    },
+    Torus {
+        center: Option<PointSpec>,
+        major: Option<Number>,
+        minor: Option<Number>,
+        axis: Option<VectorSpec>,
+    },
+    Plane {
+        base: Option<PointSpec>,
+        normal: Option<VectorSpec>,
+    },
+    Transform {
+        target: Option<Ref>,
+        steps: Vec<Step>,
+    },
+    Replicate {
+        target: Option<Ref>,
+        count: Option<Number>,
+        steps: Vec<Step>,
+    },
     Surface(Option<SurfaceSpec>),
     Line(Option<LineSpec>),
     Vertex(Option<VertexSpec>),
-    Edge { line: Option<Ref>, begin: Option<Ref>, end: Option<Ref> },
+    Edge {
+        line: Option<Ref>,
+        begin: Option<Ref>,
+        end: Option<Ref>,
+    },
     /// Loops of edge references; the first is the outer loop.
-    Face { surface: Option<Ref>, loops: Vec<Vec<Ref>>, loop_spans: Vec<Span> },
+    Face {
+        surface: Option<Ref>,
+        loops: Vec<Vec<Ref>>,
+        loop_spans: Vec<Span>,
+    },
 }
 
 impl ObjectKind {

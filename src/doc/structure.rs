@@ -3,7 +3,7 @@
 //! text where none belongs, and enumeration values outside their set.
 
 use super::grammar::{AttrKind, Child, Content, Rule};
-use crate::diag::{did_you_mean, Code, Diagnostic, Diagnostics};
+use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::syntax::Element;
 
 /// Checks `root` (and everything below it) against `rule`.
@@ -16,7 +16,11 @@ pub fn check(root: &Element, rule: &'static Rule, diags: &mut Diagnostics) {
                 Diagnostic::new(
                     Code::UnexpectedText,
                     *span,
-                    format!("unexpected text '{}' inside <{}>", abbreviate(text), element.name),
+                    format!(
+                        "unexpected text '{}' inside <{}>",
+                        abbreviate(text),
+                        element.name
+                    ),
                 )
                 .with_help("put data in attributes; use an XML comment <!-- … --> for notes"),
             );
@@ -44,7 +48,11 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
             Some(spec) => {
                 if let AttrKind::Enum(values) = spec.kind {
                     if !values.contains(&attr.value.trim()) {
-                        let listed = values.iter().map(|v| format!("\"{v}\"")).collect::<Vec<_>>().join(", ");
+                        let listed = values
+                            .iter()
+                            .map(|v| format!("\"{v}\""))
+                            .collect::<Vec<_>>()
+                            .join(", ");
                         diags.push(
                             Diagnostic::new(
                                 Code::InvalidValue,
@@ -59,11 +67,14 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
                     }
                 }
                 if spec.kind == AttrKind::Name && attr.value.trim().is_empty() {
-                    diags.push(Diagnostic::new(
-                        Code::InvalidValue,
-                        attr.value_span,
-                        format!("<{}> has an empty name", element.name),
-                    ).with_help("give the object a name of letters, digits, '_' and '-'"));
+                    diags.push(
+                        Diagnostic::new(
+                            Code::InvalidValue,
+                            attr.value_span,
+                            format!("<{}> has an empty name", element.name),
+                        )
+                        .with_help("give the object a name of letters, digits, '_' and '-'"),
+                    );
                 }
             }
             None if rule.any_attrs => {}
@@ -76,11 +87,17 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
                 );
                 d.help = Some(match did_you_mean(&attr.name, names) {
                     Some(best) => format!("did you mean '{best}'?"),
-                    None if rule.attrs.is_empty() => format!("<{}> takes no attributes", element.name),
+                    None if rule.attrs.is_empty() => {
+                        format!("<{}> takes no attributes", element.name)
+                    }
                     None => format!(
                         "<{}> takes {}",
                         element.name,
-                        rule.attrs.iter().map(|a| a.name).collect::<Vec<_>>().join(", ")
+                        rule.attrs
+                            .iter()
+                            .map(|a| a.name)
+                            .collect::<Vec<_>>()
+                            .join(", ")
                     ),
                 });
                 diags.push(d);
@@ -102,7 +119,11 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
 }
 
 /// Reports problems with the children and returns the ones whose rules are known.
-fn check_children<'e>(element: &'e Element, rule: &'static Rule, diags: &mut Diagnostics) -> Vec<&'e Element> {
+fn check_children<'e>(
+    element: &'e Element,
+    rule: &'static Rule,
+    diags: &mut Diagnostics,
+) -> Vec<&'e Element> {
     let allowed = rule.child_rules();
     let mut known = Vec::new();
     for child in &element.children {
@@ -114,15 +135,23 @@ fn check_children<'e>(element: &'e Element, rule: &'static Rule, diags: &mut Dia
                 child.name_span,
                 format!("unknown element <{}> inside <{}>", child.name, element.name),
             );
-            d.help = Some(match did_you_mean(&child.name, allowed.iter().map(|r| r.name)) {
-                Some(best) => format!("did you mean <{best}>?"),
-                None if allowed.is_empty() => format!("<{}> has no child elements", element.name),
-                None => format!(
-                    "<{}> may contain {}",
-                    element.name,
-                    allowed.iter().map(|r| format!("<{}>", r.name)).collect::<Vec<_>>().join(", ")
-                ),
-            });
+            d.help = Some(
+                match did_you_mean(&child.name, allowed.iter().map(|r| r.name)) {
+                    Some(best) => format!("did you mean <{best}>?"),
+                    None if allowed.is_empty() => {
+                        format!("<{}> has no child elements", element.name)
+                    }
+                    None => format!(
+                        "<{}> may contain {}",
+                        element.name,
+                        allowed
+                            .iter()
+                            .map(|r| format!("<{}>", r.name))
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    ),
+                },
+            );
             diags.push(d);
         }
     }
@@ -142,12 +171,20 @@ fn check_children<'e>(element: &'e Element, rule: &'static Rule, diags: &mut Dia
         Content::Choice { min, max, .. } => {
             let n = known.len() as u32;
             if n < min {
-                let options = allowed.iter().map(|r| format!("<{}>", r.name)).collect::<Vec<_>>().join(", ");
+                let options = allowed
+                    .iter()
+                    .map(|r| format!("<{}>", r.name))
+                    .collect::<Vec<_>>()
+                    .join(", ");
                 diags.push(
                     Diagnostic::new(
                         Code::MissingElement,
                         element.name_span,
-                        format!("<{}> needs at least {min} child element{} ({options}), found {n}", element.name, plural(min)),
+                        format!(
+                            "<{}> needs at least {min} child element{} ({options}), found {n}",
+                            element.name,
+                            plural(min)
+                        ),
                     )
                     .with_help(format!("add {} of {options}", min - n)),
                 );
@@ -159,7 +196,11 @@ fn check_children<'e>(element: &'e Element, rule: &'static Rule, diags: &mut Dia
                             Diagnostic::new(
                                 Code::DuplicateElement,
                                 extra.name_span,
-                                format!("<{}> may hold at most {max} child element{}, found {n}", element.name, plural(max)),
+                                format!(
+                                    "<{}> may hold at most {max} child element{}, found {n}",
+                                    element.name,
+                                    plural(max)
+                                ),
                             )
                             .with_help("remove the extra elements, or combine them with <union>"),
                         );
@@ -180,7 +221,11 @@ fn check_count(element: &Element, known: &[&Element], spec: &Child, diags: &mut 
     let found: Vec<&&Element> = known.iter().filter(|c| c.name == spec.rule.name).collect();
     let n = found.len() as u32;
     if n < spec.min {
-        let need = if spec.min == 1 { "a".to_string() } else { spec.min.to_string() };
+        let need = if spec.min == 1 {
+            "a".to_string()
+        } else {
+            spec.min.to_string()
+        };
         diags.push(
             Diagnostic::new(
                 Code::MissingElement,
@@ -192,7 +237,10 @@ fn check_count(element: &Element, known: &[&Element], spec: &Child, diags: &mut 
                     plural(spec.min)
                 ),
             )
-            .with_help(format!("add <{} …/> inside <{}>", spec.rule.name, element.name)),
+            .with_help(format!(
+                "add <{} …/> inside <{}>",
+                spec.rule.name, element.name
+            )),
         );
     }
     if let Some(max) = spec.max {
@@ -204,7 +252,11 @@ fn check_count(element: &Element, known: &[&Element], spec: &Child, diags: &mut 
                     format!(
                         "<{}> may have {} <{}> element{}, found {n}",
                         element.name,
-                        if max == 1 { "only one".to_string() } else { format!("at most {max}") },
+                        if max == 1 {
+                            "only one".to_string()
+                        } else {
+                            format!("at most {max}")
+                        },
                         spec.rule.name,
                         plural(max)
                     ),
@@ -220,7 +272,9 @@ fn check_order(element: &Element, known: &[&Element], children: &[Child], diags:
     let position = |name: &str| children.iter().position(|c| c.rule.name == name);
     let mut latest: Option<(usize, &Element)> = None;
     for child in known {
-        let Some(p) = position(&child.name) else { continue };
+        let Some(p) = position(&child.name) else {
+            continue;
+        };
         if let Some((q, previous)) = latest {
             if p < q {
                 diags.push(
@@ -235,7 +289,11 @@ fn check_order(element: &Element, known: &[&Element], children: &[Child], diags:
                     .with_help(format!(
                         "order the children of <{}> as {}",
                         element.name,
-                        children.iter().map(|c| format!("<{}>", c.rule.name)).collect::<Vec<_>>().join(", ")
+                        children
+                            .iter()
+                            .map(|c| format!("<{}>", c.rule.name))
+                            .collect::<Vec<_>>()
+                            .join(", ")
                     )),
                 );
                 continue;
@@ -247,10 +305,19 @@ fn check_order(element: &Element, known: &[&Element], children: &[Child], diags:
 
 fn check_forms(element: &Element, known: &[&Element], forms: &[&[Child]], diags: &mut Diagnostics) {
     let in_form = |form: &[Child], name: &str| form.iter().any(|c| c.rule.name == name);
-    let describe = |form: &[Child]| form.iter().map(|c| format!("<{}>", c.rule.name)).collect::<Vec<_>>().join(" + ");
+    let describe = |form: &[Child]| {
+        form.iter()
+            .map(|c| format!("<{}>", c.rule.name))
+            .collect::<Vec<_>>()
+            .join(" + ")
+    };
     // The form is chosen by the first child; a child of another form conflicts.
     let Some(first) = known.first() else {
-        let options = forms.iter().map(|f| describe(f)).collect::<Vec<_>>().join(", or ");
+        let options = forms
+            .iter()
+            .map(|f| describe(f))
+            .collect::<Vec<_>>()
+            .join(", or ");
         diags.push(
             Diagnostic::new(
                 Code::MissingElement,
@@ -261,7 +328,9 @@ fn check_forms(element: &Element, known: &[&Element], forms: &[&[Child]], diags:
         );
         return;
     };
-    let Some(form) = forms.iter().find(|f| in_form(f, &first.name)) else { return };
+    let Some(form) = forms.iter().find(|f| in_form(f, &first.name)) else {
+        return;
+    };
     let mut conflict = false;
     for child in known.iter().filter(|c| !in_form(form, &c.name)) {
         conflict = true;
@@ -274,7 +343,11 @@ fn check_forms(element: &Element, known: &[&Element], forms: &[&[Child]], diags:
                     child.name, first.name, element.name
                 ),
             )
-            .with_help(format!("give <{}> as {} only", element.name, describe(form))),
+            .with_help(format!(
+                "give <{}> as {} only",
+                element.name,
+                describe(form)
+            )),
         );
     }
     if !conflict {

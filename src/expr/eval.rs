@@ -13,7 +13,10 @@ pub enum EvalError {
 
 /// Evaluates `expr`; `lookup` gives the value of each name (`pi` is built in
 /// unless the lookup defines it).
-pub fn eval(expr: &Expr, lookup: &mut dyn FnMut(&str, Span) -> Option<f64>) -> Result<f64, EvalError> {
+pub fn eval(
+    expr: &Expr,
+    lookup: &mut dyn FnMut(&str, Span) -> Option<f64>,
+) -> Result<f64, EvalError> {
     let value = match &expr.kind {
         ExprKind::Number(v) => *v,
         ExprKind::Name(name) => match lookup(name, expr.span) {
@@ -23,7 +26,7 @@ pub fn eval(expr: &Expr, lookup: &mut dyn FnMut(&str, Span) -> Option<f64>) -> R
                 return Err(EvalError::Unknown {
                     name: name.clone(),
                     span: expr.span,
-                })
+                });
             }
         },
         ExprKind::Neg(inner) => -eval(inner, lookup)?,
@@ -80,7 +83,7 @@ pub fn eval(expr: &Expr, lookup: &mut dyn FnMut(&str, Span) -> Option<f64>) -> R
 
 #[cfg(test)]
 mod tests {
-    use super::super::{parse, ParseError};
+    use super::super::{ParseError, parse};
     use super::*;
 
     fn value(text: &str) -> f64 {
@@ -108,12 +111,21 @@ mod tests {
 
     #[test]
     fn errors_are_located() {
-        assert!(matches!(parse("1 +", 10), Err(ParseError::Syntax { span, .. }) if span.start == 13));
-        assert!(matches!(parse("foo(1)", 0), Err(ParseError::UnknownFunction { ref name, .. }) if name == "foo"));
-        assert!(matches!(parse("min(1)", 0), Err(ParseError::WrongArgumentCount { given: 1, .. })));
+        assert!(
+            matches!(parse("1 +", 10), Err(ParseError::Syntax { span, .. }) if span.start == 13)
+        );
+        assert!(
+            matches!(parse("foo(1)", 0), Err(ParseError::UnknownFunction { ref name, .. }) if name == "foo")
+        );
+        assert!(matches!(
+            parse("min(1)", 0),
+            Err(ParseError::WrongArgumentCount { given: 1, .. })
+        ));
         assert!(matches!(parse("(1 + 2", 0), Err(ParseError::Syntax { .. })));
         assert!(matches!(parse("1 2", 0), Err(ParseError::Syntax { span, .. }) if span.start == 2));
-        assert!(matches!(parse("1 $ 2", 0), Err(ParseError::Syntax { span, .. }) if span.start == 2));
+        assert!(
+            matches!(parse("1 $ 2", 0), Err(ParseError::Syntax { span, .. }) if span.start == 2)
+        );
         let expr = parse("1 / (r - r)", 0).expect("parses");
         let result = eval(&expr, &mut |_, _| Some(1.0));
         assert!(matches!(result, Err(EvalError::NonFinite { .. })));

@@ -5,8 +5,8 @@
 mod eval;
 mod parse;
 
-pub use eval::{eval, EvalError};
-pub use parse::{parse, ParseError};
+pub use eval::{EvalError, eval};
+pub use parse::{ParseError, parse};
 
 use crate::span::Span;
 
@@ -52,7 +52,10 @@ impl Function {
     ];
 
     pub fn lookup(name: &str) -> Option<Function> {
-        Function::ALL.iter().find(|(n, _)| *n == name).map(|&(_, f)| f)
+        Function::ALL
+            .iter()
+            .find(|(n, _)| *n == name)
+            .map(|&(_, f)| f)
     }
 
     pub fn name(self) -> &'static str {

@@ -12,10 +12,22 @@ pub const MAX_DEPTH: usize = 256;
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParseError {
     /// Malformed syntax; the message says what was expected.
-    Syntax { span: Span, message: String },
-    UnknownFunction { span: Span, name: String },
-    WrongArgumentCount { span: Span, function: Function, given: usize },
-    TooLarge { span: Span },
+    Syntax {
+        span: Span,
+        message: String,
+    },
+    UnknownFunction {
+        span: Span,
+        name: String,
+    },
+    WrongArgumentCount {
+        span: Span,
+        function: Function,
+        given: usize,
+    },
+    TooLarge {
+        span: Span,
+    },
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -105,7 +117,9 @@ fn lex(text: &str, base: usize) -> Result<Vec<(Token, Span)>, ParseError> {
                 tokens.push((Token::Number(value), Span::new(base + start, base + i)));
                 continue;
             }
-            b'+' | b'-' | b'*' | b'/' | b'^' => tokens.push((Token::Op(c as char), Span::new(base + i, base + i + 1))),
+            b'+' | b'-' | b'*' | b'/' | b'^' => {
+                tokens.push((Token::Op(c as char), Span::new(base + i, base + i + 1)))
+            }
             b'(' => tokens.push((Token::LParen, Span::new(base + i, base + i + 1))),
             b')' => tokens.push((Token::RParen, Span::new(base + i, base + i + 1))),
             b',' => tokens.push((Token::Comma, Span::new(base + i, base + i + 1))),
@@ -173,7 +187,9 @@ impl Parser {
     fn expression(&mut self, min_power: u8, depth: usize) -> Result<Expr, ParseError> {
         let mut left = self.prefix(depth)?;
         while let Some((Token::Op(op), _)) = self.peek() {
-            let Some((lp, rp, bin)) = infix_power(*op) else { break };
+            let Some((lp, rp, bin)) = infix_power(*op) else {
+                break;
+            };
             if lp < min_power {
                 break;
             }
@@ -230,14 +246,20 @@ impl Parser {
             }
             other => Err(ParseError::Syntax {
                 span,
-                message: format!("expected a number, a name or '(', found {}", describe(&other)),
+                message: format!(
+                    "expected a number, a name or '(', found {}",
+                    describe(&other)
+                ),
             }),
         }
     }
 
     fn call(&mut self, name: String, name_span: Span, depth: usize) -> Result<Expr, ParseError> {
         let Some(function) = Function::lookup(&name) else {
-            return Err(ParseError::UnknownFunction { span: name_span, name });
+            return Err(ParseError::UnknownFunction {
+                span: name_span,
+                name,
+            });
         };
         let mut args = Vec::new();
         if !matches!(self.peek(), Some((Token::RParen, _))) {
@@ -277,7 +299,11 @@ impl Parser {
             }
             Some((token, span)) => Err(ParseError::Syntax {
                 span,
-                message: format!("expected ')' to close the '(' at byte {}, found {}", open.start, describe(&token)),
+                message: format!(
+                    "expected ')' to close the '(' at byte {}, found {}",
+                    open.start,
+                    describe(&token)
+                ),
             }),
             None => Err(ParseError::Syntax {
                 span: self.end_span(),

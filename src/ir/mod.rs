@@ -12,11 +12,11 @@
 //!   the face normal points out of the subdomain;
 //! - entities are welded: two solids that share a face share one `Face`.
 
-mod incidence;
 mod fragments;
+mod incidence;
 mod source_map;
 
-pub use fragments::{derive_fragments, Fragment, Side};
+pub use fragments::{Fragment, Side, derive_fragments};
 pub use incidence::{Incidence, IncidenceMatrices};
 pub use source_map::{Origin, SourceMap};
 

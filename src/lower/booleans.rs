@@ -3,14 +3,14 @@
 //! evaluating the tree on its two sides; it bounds the subdomain when the
 //! sides differ. Crossing boundaries and overlapping subdomains are reported.
 
-use super::explicit::{lookup_entities, unknown_entity};
 use super::Entities;
+use super::explicit::{lookup_entities, unknown_entity};
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::{Document, SolidTree};
-use crate::geom::{boundary_relation, Point3, Surface, Vec3};
+use crate::geom::{Point3, Surface, Vec3, boundary_relation};
 use crate::ir::{
-    Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId, SourceMap, Subdomain, SubdomainCells,
-    SubdomainId,
+    Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId, SourceMap,
+    Subdomain, SubdomainCells, SubdomainId,
 };
 use crate::resolve::{Geometry, Resolved};
 use std::collections::{BTreeMap, BTreeSet, HashMap};
@@ -31,7 +31,8 @@ impl Tree {
             Tree::Union(ops) => ops.iter().any(|t| t.eval(inside)),
             Tree::Intersection(ops) => ops.iter().all(|t| t.eval(inside)),
             Tree::Difference(ops) => {
-                ops.first().is_some_and(|t| t.eval(inside)) && !ops.iter().skip(1).any(|t| t.eval(inside))
+                ops.first().is_some_and(|t| t.eval(inside))
+                    && !ops.iter().skip(1).any(|t| t.eval(inside))
             }
         }
     }
@@ -59,8 +60,12 @@ pub(super) fn lower_subdomains(
         let cells = match (&def.faces, &def.tree) {
             (Some(_), Some(_)) => {
                 diags.push(
-                    Diagnostic::new(Code::ConflictingForms, def.span, format!("subdomain '{}' has both faces= and a solid", def.name.text))
-                        .with_help("give either the faces that bound it or a solid tree"),
+                    Diagnostic::new(
+                        Code::ConflictingForms,
+                        def.span,
+                        format!("subdomain '{}' has both faces= and a solid", def.name.text),
+                    )
+                    .with_help("give either the faces that bound it or a solid tree"),
                 );
                 continue;
             }
@@ -70,14 +75,33 @@ pub(super) fn lower_subdomains(
             },
             (None, Some(tree)) => {
                 let mut leaves = Vec::new();
-                let Some(tree) = build_tree(tree, resolved, model, entities, &mut leaves, diags) else { continue };
-                trees.push((id, Built { tree, leaves, span: def.span }));
-                SubdomainCells::Volume { boundary: Vec::new() }
+                let Some(tree) = build_tree(tree, resolved, model, entities, &mut leaves, diags)
+                else {
+                    continue;
+                };
+                trees.push((
+                    id,
+                    Built {
+                        tree,
+                        leaves,
+                        span: def.span,
+                    },
+                ));
+                SubdomainCells::Volume {
+                    boundary: Vec::new(),
+                }
             }
             (None, None) => {
                 diags.push(
-                    Diagnostic::new(Code::MissingElement, def.span, format!("subdomain '{}' has neither faces= nor a solid", def.name.text))
-                        .with_help("add faces=\"…\" or a child such as <solid ref=\"…\"/>"),
+                    Diagnostic::new(
+                        Code::MissingElement,
+                        def.span,
+                        format!(
+                            "subdomain '{}' has neither faces= nor a solid",
+                            def.name.text
+                        ),
+                    )
+                    .with_help("add faces=\"…\" or a child such as <solid ref=\"…\"/>"),
                 );
                 continue;
             }
@@ -98,11 +122,15 @@ pub(super) fn lower_subdomains(
     }
     for (id, built) in &trees {
         let cells = match model.dimension {
-            Dimension::Three => SubdomainCells::Volume { boundary: classify_faces(model, built, face_samples) },
+            Dimension::Three => SubdomainCells::Volume {
+                boundary: classify_faces(model, built, face_samples),
+            },
             Dimension::Two => {
                 let edges = classify_edges(model, built);
                 let face = region_face(model, &model.subdomain(*id).name.clone(), &edges);
-                SubdomainCells::Region { faces: face.into_iter().collect() }
+                SubdomainCells::Region {
+                    faces: face.into_iter().collect(),
+                }
             }
         };
         let empty = match &cells {
@@ -131,8 +159,14 @@ fn build_tree(
     leaves: &mut Vec<SolidId>,
     diags: &mut Diagnostics,
 ) -> Option<Tree> {
-    let operands = |ops: &[SolidTree], leaves: &mut Vec<SolidId>, diags: &mut Diagnostics| -> Option<Vec<Tree>> {
-        let built: Vec<Option<Tree>> = ops.iter().map(|t| build_tree(t, resolved, model, entities, leaves, diags)).collect();
+    let operands = |ops: &[SolidTree],
+                    leaves: &mut Vec<SolidId>,
+                    diags: &mut Diagnostics|
+     -> Option<Vec<Tree>> {
+        let built: Vec<Option<Tree>> = ops
+            .iter()
+            .map(|t| build_tree(t, resolved, model, entities, leaves, diags))
+            .collect();
         built.into_iter().collect()
     };
     Some(match tree {
@@ -141,11 +175,26 @@ fn build_tree(
         SolidTree::Difference(ops, _) => Tree::Difference(operands(ops, leaves, diags)?),
         SolidTree::Solid(r) => {
             let Some(object) = resolved.object(&r.name) else {
-                let names = resolved.objects.iter().filter(|o| matches!(o.geometry, Some(Geometry::Solid(_)) | Some(Geometry::Group(_)))).map(|o| o.name.as_str());
-                let mut d = Diagnostic::new(Code::UndefinedName, r.span, format!("undefined solid '{}'", r.name));
+                let names = resolved
+                    .objects
+                    .iter()
+                    .filter(|o| {
+                        matches!(
+                            o.geometry,
+                            Some(Geometry::Solid(_)) | Some(Geometry::Group(_))
+                        )
+                    })
+                    .map(|o| o.name.as_str());
+                let mut d = Diagnostic::new(
+                    Code::UndefinedName,
+                    r.span,
+                    format!("undefined solid '{}'", r.name),
+                );
                 d.help = Some(match crate::diag::did_you_mean(&r.name, names) {
                     Some(best) => format!("did you mean '{best}'?"),
-                    None => "name a sphere, parallelepiped, truncated_cone, ellipsoid or torus".into(),
+                    None => {
+                        "name a sphere, parallelepiped, truncated_cone, ellipsoid or torus".into()
+                    }
                 });
                 diags.push(d);
                 return None;
@@ -157,7 +206,13 @@ fn build_tree(
             };
             let ids: Vec<SolidId> = match (geometry, r.index) {
                 (Geometry::Group(members), None) => (1..=members.len())
-                    .flat_map(|k| entities.solids.get(&format!("{}[{k}]", r.name)).cloned().unwrap_or_default())
+                    .flat_map(|k| {
+                        entities
+                            .solids
+                            .get(&format!("{}[{k}]", r.name))
+                            .cloned()
+                            .unwrap_or_default()
+                    })
                     .collect(),
                 _ => entities.solids.get(&key).cloned().unwrap_or_default(),
             };
@@ -172,19 +227,44 @@ fn build_tree(
                     Some(Geometry::Group(_)) | None => (Code::IndexOutOfRange, "use an index within the replicate's count".to_string()),
                     _ => (Code::NotASolid, "a subdomain's solid is a sphere, ellipsoid, torus, parallelepiped or truncated_cone (in 2D: circle, ellipse, triangle, parallelogram)".to_string()),
                 };
-                diags.push(Diagnostic::new(code, r.span, format!("'{}' is a {kind}, not a bounded solid", r.text)).with_help(help));
+                diags.push(
+                    Diagnostic::new(
+                        code,
+                        r.span,
+                        format!("'{}' is a {kind}, not a bounded solid", r.text),
+                    )
+                    .with_help(help),
+                );
                 return None;
             }
             let planar = model.solids[ids[0].index()].shape.is_planar();
             if planar != (model.dimension == Dimension::Two) {
                 let (what, help) = if planar {
-                    ("a 2D region", "set dimension=\"2\" on <geometry> for a planar model, or use a 3D solid")
+                    (
+                        "a 2D region",
+                        "set dimension=\"2\" on <geometry> for a planar model, or use a 3D solid",
+                    )
                 } else {
-                    ("a 3D solid", "a 2D model's subdomains are circles, ellipses, triangles and parallelograms")
+                    (
+                        "a 3D solid",
+                        "a 2D model's subdomains are circles, ellipses, triangles and parallelograms",
+                    )
                 };
                 diags.push(
-                    Diagnostic::new(Code::DimensionMismatch, r.span, format!("'{}' is {what}, which cannot be a subdomain of a {}D model", r.text, if model.dimension == Dimension::Two { 2 } else { 3 }))
-                        .with_help(help),
+                    Diagnostic::new(
+                        Code::DimensionMismatch,
+                        r.span,
+                        format!(
+                            "'{}' is {what}, which cannot be a subdomain of a {}D model",
+                            r.text,
+                            if model.dimension == Dimension::Two {
+                                2
+                            } else {
+                                3
+                            }
+                        ),
+                    )
+                    .with_help(help),
                 );
                 return None;
             }
@@ -196,17 +276,32 @@ fn build_tree(
                 });
                 members.push(Tree::Leaf(index));
             }
-            if members.len() == 1 { members.remove(0) } else { Tree::Union(members) }
+            if members.len() == 1 {
+                members.remove(0)
+            } else {
+                Tree::Union(members)
+            }
         }
     })
 }
 
 /// Checks every pair of leaf solids: crossing boundaries, and touching
 /// without sharing whole faces, are reported (E408). Returns false if any was.
-fn check_relations(model: &Model, source_map: &SourceMap, trees: &[(SubdomainId, Built)], diags: &mut Diagnostics) -> bool {
-    let leaves: BTreeSet<SolidId> = trees.iter().flat_map(|(_, b)| b.leaves.iter().copied()).collect();
+fn check_relations(
+    model: &Model,
+    source_map: &SourceMap,
+    trees: &[(SubdomainId, Built)],
+    diags: &mut Diagnostics,
+) -> bool {
+    let leaves: BTreeSet<SolidId> = trees
+        .iter()
+        .flat_map(|(_, b)| b.leaves.iter().copied())
+        .collect();
     let leaves: Vec<SolidId> = leaves.into_iter().collect();
-    let boxes: Vec<crate::geom::Aabb> = leaves.iter().map(|id| model.solids[id.index()].shape.bbox()).collect();
+    let boxes: Vec<crate::geom::Aabb> = leaves
+        .iter()
+        .map(|id| model.solids[id.index()].shape.bbox())
+        .collect();
     let mut ok = true;
     for (i, j) in candidate_pairs(&boxes, model.tolerance) {
         ok &= check_pair(model, source_map, leaves[i], leaves[j], diags);
@@ -219,14 +314,21 @@ fn check_relations(model: &Model, source_map: &SourceMap, trees: &[(SubdomainId,
 fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
     let mut sizes: Vec<f64> = boxes.iter().map(|b| (b.max - b.min).max()).collect();
     sizes.sort_by(f64::total_cmp);
-    let cell = sizes.get(sizes.len() / 2).copied().unwrap_or(1.0).max(tol * 1e3).max(f64::MIN_POSITIVE);
+    let cell = sizes
+        .get(sizes.len() / 2)
+        .copied()
+        .unwrap_or(1.0)
+        .max(tol * 1e3)
+        .max(f64::MIN_POSITIVE);
     let key = |v: f64| (v / cell).floor() as i64;
     let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
     let mut big = Vec::new();
     for (i, b) in boxes.iter().enumerate() {
         let lo = [key(b.min.x - tol), key(b.min.y - tol), key(b.min.z - tol)];
         let hi = [key(b.max.x + tol), key(b.max.y + tol), key(b.max.z + tol)];
-        let count = (0..3).map(|k| (hi[k] - lo[k] + 1) as u128).product::<u128>();
+        let count = (0..3)
+            .map(|k| (hi[k] - lo[k] + 1) as u128)
+            .product::<u128>();
         if count > 64 {
             big.push(i);
             continue;
@@ -259,7 +361,13 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
     pairs.into_iter().collect()
 }
 
-fn check_pair(model: &Model, source_map: &SourceMap, a: SolidId, b: SolidId, diags: &mut Diagnostics) -> bool {
+fn check_pair(
+    model: &Model,
+    source_map: &SourceMap,
+    a: SolidId,
+    b: SolidId,
+    diags: &mut Diagnostics,
+) -> bool {
     let sa = &model.solids[a.index()];
     let sb = &model.solids[b.index()];
     if !sa.shape.bbox().overlaps(&sb.shape.bbox(), model.tolerance) {
@@ -267,7 +375,11 @@ fn check_pair(model: &Model, source_map: &SourceMap, a: SolidId, b: SolidId, dia
     }
     let relation = boundary_relation(&sa.shape, &sb.shape, model.tolerance * 10.0);
     let span = source_map.solid(b).or(source_map.solid(a));
-    if let Some(p) = relation.a_in_b.crossing_near.or(relation.b_in_a.crossing_near) {
+    if let Some(p) = relation
+        .a_in_b
+        .crossing_near
+        .or(relation.b_in_a.crossing_near)
+    {
         diags.push(
             Diagnostic::new(
                 Code::BoundariesIntersect,
@@ -287,17 +399,28 @@ fn check_pair(model: &Model, source_map: &SourceMap, a: SolidId, b: SolidId, dia
     }
     let touching = relation.a_in_b.on > 0 || relation.b_in_a.on > 0;
     let shares_face = match model.dimension {
-        Dimension::Three => sa.faces.iter().any(|f| sb.faces.iter().any(|g| g.face == f.face)),
-        Dimension::Two => sa.boundary_edges.iter().any(|e| sb.boundary_edges.iter().any(|g| g.edge == e.edge)),
+        Dimension::Three => sa
+            .faces
+            .iter()
+            .any(|f| sb.faces.iter().any(|g| g.face == f.face)),
+        Dimension::Two => sa
+            .boundary_edges
+            .iter()
+            .any(|e| sb.boundary_edges.iter().any(|g| g.edge == e.edge)),
     };
     if touching && !shares_face {
         diags.push(
             Diagnostic::new(
                 Code::BoundariesIntersect,
                 span,
-                format!("'{}' and '{}' touch without sharing a whole face", sa.name, sb.name),
+                format!(
+                    "'{}' and '{}' touch without sharing a whole face",
+                    sa.name, sb.name
+                ),
             )
-            .with_help("make the touching faces coincide exactly (same corners), or move the solids apart"),
+            .with_help(
+                "make the touching faces coincide exactly (same corners), or move the solids apart",
+            ),
         );
         return false;
     }
@@ -305,14 +428,20 @@ fn check_pair(model: &Model, source_map: &SourceMap, a: SolidId, b: SolidId, dia
 }
 
 /// The faces of the subdomain's boundary, with `outward` set.
-fn classify_faces(model: &Model, built: &Built, samples: &HashMap<FaceId, Point3>) -> Vec<OrientedFace> {
+fn classify_faces(
+    model: &Model,
+    built: &Built,
+    samples: &HashMap<FaceId, Point3>,
+) -> Vec<OrientedFace> {
     let mut result: BTreeMap<FaceId, bool> = BTreeMap::new();
     for &leaf in &built.leaves {
         for of in &model.solids[leaf.index()].faces {
             if result.contains_key(&of.face) {
                 continue;
             }
-            let Some(sample) = samples.get(&of.face) else { continue };
+            let Some(sample) = samples.get(&of.face) else {
+                continue;
+            };
             // Membership of each leaf on the face's two sides: the side the face
             // normal points away from ("behind") and the side it points to.
             let side = |behind: bool| {
@@ -331,7 +460,10 @@ fn classify_faces(model: &Model, built: &Built, samples: &HashMap<FaceId, Point3
             }
         }
     }
-    result.into_iter().map(|(face, outward)| OrientedFace { face, outward }).collect()
+    result
+        .into_iter()
+        .map(|(face, outward)| OrientedFace { face, outward })
+        .collect()
 }
 
 /// The boundary edges of a 2D subdomain, `forward` with the region on the left.
@@ -360,7 +492,10 @@ fn classify_edges(model: &Model, built: &Built) -> Vec<OrientedEdge> {
             }
         }
     }
-    result.into_iter().map(|(edge, forward)| OrientedEdge { edge, forward }).collect()
+    result
+        .into_iter()
+        .map(|(edge, forward)| OrientedEdge { edge, forward })
+        .collect()
 }
 
 /// One planar face per 2D subdomain, its loops chained from the boundary edges.
@@ -384,7 +519,9 @@ fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<
         let start = start_of(model, &first);
         let mut at = end_of(model, &first);
         while at != start {
-            let Some(k) = remaining.iter().position(|e| start_of(model, e) == at) else { break };
+            let Some(k) = remaining.iter().position(|e| start_of(model, e) == at) else {
+                break;
+            };
             let next = remaining.remove(k);
             at = end_of(model, &next);
             l.push(next);
@@ -395,7 +532,10 @@ fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<
     let id = FaceId(model.faces.len() as u32);
     model.faces.push(Face {
         name: name.to_string(),
-        surface: Surface::Plane { origin, normal: Vec3::z() },
+        surface: Surface::Plane {
+            origin,
+            normal: Vec3::z(),
+        },
         reversed: false,
         loops,
     });
@@ -412,21 +552,34 @@ fn check_overlaps(
     diags: &mut Diagnostics,
 ) {
     let step = model.tolerance * 1000.0;
-    let inside = |built: &Built, p: &Point3| built.tree.eval(&|i| model.solids[built.leaves[i].index()].shape.value(p) > 0.0);
-    let probes: Vec<Vec<Point3>> = trees.iter().map(|(id, _)| interior_probes(model, *id, samples, step)).collect();
+    let inside = |built: &Built, p: &Point3| {
+        built
+            .tree
+            .eval(&|i| model.solids[built.leaves[i].index()].shape.value(p) > 0.0)
+    };
+    let probes: Vec<Vec<Point3>> = trees
+        .iter()
+        .map(|(id, _)| interior_probes(model, *id, samples, step))
+        .collect();
     let boxes: Vec<crate::geom::Aabb> = trees
         .iter()
         .map(|(_, built)| {
             built
                 .leaves
                 .iter()
-                .fold(crate::geom::Aabb::empty(), |acc, l| acc.union(&model.solids[l.index()].shape.bbox()))
+                .fold(crate::geom::Aabb::empty(), |acc, l| {
+                    acc.union(&model.solids[l.index()].shape.bbox())
+                })
         })
         .collect();
     for (i, j) in candidate_pairs(&boxes, model.tolerance) {
         let ((a, built_a), (b, built_b)) = (&trees[i], &trees[j]);
-        let overlap = probes[i].iter().any(|p| inside(built_b, p) && inside(built_a, p))
-            || probes[j].iter().any(|p| inside(built_a, p) && inside(built_b, p));
+        let overlap = probes[i]
+            .iter()
+            .any(|p| inside(built_b, p) && inside(built_a, p))
+            || probes[j]
+                .iter()
+                .any(|p| inside(built_a, p) && inside(built_b, p));
         if overlap {
             let (sa, sb) = (model.subdomain(*a), model.subdomain(*b));
             diags.push(
@@ -445,7 +598,12 @@ fn check_overlaps(
 }
 
 /// Points just inside a subdomain, next to each of its boundary faces (edges in 2D).
-fn interior_probes(model: &Model, id: SubdomainId, samples: &HashMap<FaceId, Point3>, step: f64) -> Vec<Point3> {
+fn interior_probes(
+    model: &Model,
+    id: SubdomainId,
+    samples: &HashMap<FaceId, Point3>,
+    step: f64,
+) -> Vec<Point3> {
     match &model.subdomain(id).cells {
         SubdomainCells::Volume { boundary } => boundary
             .iter()
@@ -457,7 +615,11 @@ fn interior_probes(model: &Model, id: SubdomainId, samples: &HashMap<FaceId, Poi
                     return None;
                 }
                 // Step against the outward normal, into the subdomain.
-                let sign = if of.outward != face.reversed { -1.0 } else { 1.0 };
+                let sign = if of.outward != face.reversed {
+                    -1.0
+                } else {
+                    1.0
+                };
                 Some(p + n.normalize() * (sign * step))
             })
             .collect(),
@@ -475,7 +637,12 @@ fn interior_probes(model: &Model, id: SubdomainId, samples: &HashMap<FaceId, Poi
 
 /// A subdomain given by its faces: the faces' outward flags are made
 /// consistent across shared edges, then all flipped if the enclosed volume is negative.
-fn explicit_shell(model: &Model, entities: &Entities, refs: &[crate::doc::Ref], diags: &mut Diagnostics) -> Option<Vec<OrientedFace>> {
+fn explicit_shell(
+    model: &Model,
+    entities: &Entities,
+    refs: &[crate::doc::Ref],
+    diags: &mut Diagnostics,
+) -> Option<Vec<OrientedFace>> {
     let mut faces = Vec::new();
     let mut ok = true;
     for r in refs {
@@ -543,7 +710,10 @@ pub(super) fn orient_shell(model: &Model, faces: &[FaceId]) -> Vec<OrientedFace>
     faces
         .iter()
         .zip(outward)
-        .map(|(&face, o)| OrientedFace { face, outward: o.unwrap_or(true) })
+        .map(|(&face, o)| OrientedFace {
+            face,
+            outward: o.unwrap_or(true),
+        })
         .collect()
 }
 
@@ -565,7 +735,8 @@ fn face_volume(model: &Model, face_id: FaceId) -> f64 {
         if points.len() < 2 {
             continue;
         }
-        let centroid = Point3::from(points.iter().map(|p| p.coords).sum::<Vec3>() / points.len() as f64);
+        let centroid =
+            Point3::from(points.iter().map(|p| p.coords).sum::<Vec3>() / points.len() as f64);
         let apex = face.surface.project(&centroid).unwrap_or(centroid);
         for i in 0..points.len() {
             let a = points[i];

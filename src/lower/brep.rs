@@ -42,7 +42,11 @@ pub fn of(shape: &SolidShape) -> Brep {
         SolidShape::Box { frame } => parallelepiped(frame),
         SolidShape::Ball { frame } => ball(frame),
         SolidShape::Cone { frame, r0, r1 } => cone(frame, *r0, *r1),
-        SolidShape::Torus { frame, major, minor } => torus(frame, *major, *minor),
+        SolidShape::Torus {
+            frame,
+            major,
+            minor,
+        } => torus(frame, *major, *minor),
         SolidShape::Disk { frame } => disk(frame),
         SolidShape::Polygon { frame, vertices } => polygon(frame, vertices),
     }
@@ -65,14 +69,20 @@ fn ellipse(frame: &Frame, center: Vec3, a: Vec3, b: Vec3) -> Curve {
 }
 
 const FACE_NAMES: [[&str; 2]; 3] = [["xmin", "xmax"], ["ymin", "ymax"], ["zmin", "zmax"]];
-const VERTEX_NAMES: [&str; 8] = ["v000", "v100", "v010", "v110", "v001", "v101", "v011", "v111"];
+const VERTEX_NAMES: [&str; 8] = [
+    "v000", "v100", "v010", "v110", "v001", "v101", "v011", "v111",
+];
 
 fn parallelepiped(frame: &Frame) -> Brep {
     let corner = |i: usize, j: usize, k: usize| i + 2 * j + 4 * k;
     let vertices = (0..8)
         .map(|n| BrepVertex {
             name: VERTEX_NAMES[n],
-            position: frame.to_global(&Point3::new((n & 1) as f64, ((n >> 1) & 1) as f64, ((n >> 2) & 1) as f64)),
+            position: frame.to_global(&Point3::new(
+                (n & 1) as f64,
+                ((n >> 1) & 1) as f64,
+                ((n >> 2) & 1) as f64,
+            )),
         })
         .collect::<Vec<_>>();
     // Edges along axis `a` at fixed values of the other two axes.
@@ -92,7 +102,10 @@ fn parallelepiped(frame: &Frame) -> Brep {
                 edge_index.insert((axis, lo, s, hi, t), edges.len());
                 edges.push(BrepEdge {
                     name: format!("{lo_name}_{hi_name}"),
-                    curve: Curve::Segment { a: vertices[begin].position, b: vertices[end].position },
+                    curve: Curve::Segment {
+                        a: vertices[begin].position,
+                        b: vertices[end].position,
+                    },
                     begin,
                     end,
                 });
@@ -108,10 +121,19 @@ fn parallelepiped(frame: &Frame) -> Brep {
             // counter-clockwise about +axis; reversed on the min side.
             let e = |along: usize, fixed_axis: usize, fixed: usize| {
                 let (lo, hi) = (axis.min(fixed_axis), axis.max(fixed_axis));
-                let (s, t) = if axis < fixed_axis { (side, fixed) } else { (fixed, side) };
+                let (s, t) = if axis < fixed_axis {
+                    (side, fixed)
+                } else {
+                    (fixed, side)
+                };
                 edge_index[&(along, lo, s, hi, t)]
             };
-            let mut ring = vec![(e(p, q, 0), true), (e(q, p, 1), true), (e(p, q, 1), false), (e(q, p, 0), false)];
+            let mut ring = vec![
+                (e(p, q, 0), true),
+                (e(q, p, 1), true),
+                (e(p, q, 1), false),
+                (e(q, p, 0), false),
+            ];
             if (side == 0) != flip {
                 ring.reverse();
                 for item in &mut ring {
@@ -125,13 +147,21 @@ fn parallelepiped(frame: &Frame) -> Brep {
             let sample = frame.to_global(&center);
             faces.push(BrepFace {
                 name: face_name,
-                surface: Surface::Plane { origin: sample, normal: frame.normal_to_global(&local_normal) },
+                surface: Surface::Plane {
+                    origin: sample,
+                    normal: frame.normal_to_global(&local_normal),
+                },
                 loops: vec![ring],
                 sample,
             });
         }
     }
-    Brep { vertices, edges, faces, boundary: Vec::new() }
+    Brep {
+        vertices,
+        edges,
+        faces,
+        boundary: Vec::new(),
+    }
 }
 
 fn ball(frame: &Frame) -> Brep {
@@ -139,7 +169,10 @@ fn ball(frame: &Frame) -> Brep {
     let seam = frame.to_global(&Point3::new(1.0, 0.0, 0.0));
     let surface = Surface::Ellipsoid { frame: *frame };
     Brep {
-        vertices: vec![BrepVertex { name: "seam", position: seam }],
+        vertices: vec![BrepVertex {
+            name: "seam",
+            position: seam,
+        }],
         edges: vec![BrepEdge {
             name: "equator".into(),
             curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
@@ -170,13 +203,19 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
     let mut edges = Vec::new();
     let mut faces = Vec::new();
     let mut side_loops = Vec::new();
-    let rims = [(0.0, r0, "bottom_seam", "bottom_rim", "bottom", -1.0), (1.0, r1, "top_seam", "top_rim", "top", 1.0)];
+    let rims = [
+        (0.0, r0, "bottom_seam", "bottom_rim", "bottom", -1.0),
+        (1.0, r1, "top_seam", "top_rim", "top", 1.0),
+    ];
     for (z, r, vertex, rim, cap, up) in rims {
         if r <= 0.0 {
             continue;
         }
         let v = vertices.len();
-        vertices.push(BrepVertex { name: vertex, position: frame.to_global(&Point3::new(r, 0.0, z)) });
+        vertices.push(BrepVertex {
+            name: vertex,
+            position: frame.to_global(&Point3::new(r, 0.0, z)),
+        });
         let e = edges.len();
         edges.push(BrepEdge {
             name: rim.into(),
@@ -189,7 +228,10 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
         let center = frame.to_global(&Point3::new(0.0, 0.0, z));
         faces.push(BrepFace {
             name: cap,
-            surface: Surface::Plane { origin: center, normal: frame.normal_to_global(&Vec3::new(0.0, 0.0, up)) },
+            surface: Surface::Plane {
+                origin: center,
+                normal: frame.normal_to_global(&Vec3::new(0.0, 0.0, up)),
+            },
             loops: vec![vec![(e, cap_forward)]],
             sample: center,
         });
@@ -198,11 +240,20 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
     let mid_r = 0.5 * (r0 + r1);
     faces.push(BrepFace {
         name: "side",
-        surface: Surface::Cone { frame: *frame, r0, r1 },
+        surface: Surface::Cone {
+            frame: *frame,
+            r0,
+            r1,
+        },
         loops: side_loops,
         sample: frame.to_global(&Point3::new(-mid_r, 0.0, 0.5)),
     });
-    Brep { vertices, edges, faces, boundary: Vec::new() }
+    Brep {
+        vertices,
+        edges,
+        faces,
+        boundary: Vec::new(),
+    }
 }
 
 fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
@@ -216,19 +267,36 @@ fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
         }
     }
     Brep {
-        vertices: vec![BrepVertex { name: "seam", position: frame.to_global(&Point3::new(outer, 0.0, 0.0)) }],
+        vertices: vec![BrepVertex {
+            name: "seam",
+            position: frame.to_global(&Point3::new(outer, 0.0, 0.0)),
+        }],
         edges: vec![
-            BrepEdge { name: "parallel".into(), curve: ellipse(frame, Vec3::zeros(), Vec3::x() * outer, Vec3::y() * outer), begin: 0, end: 0 },
+            BrepEdge {
+                name: "parallel".into(),
+                curve: ellipse(frame, Vec3::zeros(), Vec3::x() * outer, Vec3::y() * outer),
+                begin: 0,
+                end: 0,
+            },
             BrepEdge {
                 name: "meridian".into(),
-                curve: ellipse(frame, Vec3::new(major, 0.0, 0.0), Vec3::x() * minor, Vec3::z() * minor),
+                curve: ellipse(
+                    frame,
+                    Vec3::new(major, 0.0, 0.0),
+                    Vec3::x() * minor,
+                    Vec3::z() * minor,
+                ),
                 begin: 0,
                 end: 0,
             },
         ],
         faces: vec![BrepFace {
             name: "surface",
-            surface: Surface::Torus { frame: *frame, major, minor },
+            surface: Surface::Torus {
+                frame: *frame,
+                major,
+                minor,
+            },
             loops: vec![ring],
             sample: frame.to_global(&Point3::new(-(major + minor), 0.0, 0.0)),
         }],
@@ -238,17 +306,32 @@ fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
 
 fn region_normal(frame: &Frame) -> Vec3 {
     let n = frame.linear.column(0).cross(&frame.linear.column(1));
-    if n.norm() > 0.0 { n.normalize() } else { Vec3::z() }
+    if n.norm() > 0.0 {
+        n.normalize()
+    } else {
+        Vec3::z()
+    }
 }
 
 fn disk(frame: &Frame) -> Brep {
     let center = frame.origin;
     Brep {
-        vertices: vec![BrepVertex { name: "seam", position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)) }],
-        edges: vec![BrepEdge { name: "rim".into(), curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()), begin: 0, end: 0 }],
+        vertices: vec![BrepVertex {
+            name: "seam",
+            position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)),
+        }],
+        edges: vec![BrepEdge {
+            name: "rim".into(),
+            curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
+            begin: 0,
+            end: 0,
+        }],
         faces: vec![BrepFace {
             name: "region",
-            surface: Surface::Plane { origin: center, normal: region_normal(frame) },
+            surface: Surface::Plane {
+                origin: center,
+                normal: region_normal(frame),
+            },
             loops: vec![vec![(0, true)]],
             sample: center,
         }],
@@ -261,27 +344,37 @@ const POLYGON_VERTICES: [&str; 4] = ["v1", "v2", "v3", "v4"];
 fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
     let n = local.len().min(POLYGON_VERTICES.len());
     let vertices: Vec<BrepVertex> = (0..n)
-        .map(|i| BrepVertex { name: POLYGON_VERTICES[i], position: frame.to_global(&local[i]) })
+        .map(|i| BrepVertex {
+            name: POLYGON_VERTICES[i],
+            position: frame.to_global(&local[i]),
+        })
         .collect();
     let edges: Vec<BrepEdge> = (0..n)
         .map(|i| {
             let j = (i + 1) % n;
             BrepEdge {
                 name: format!("e{}", i + 1),
-                curve: Curve::Segment { a: vertices[i].position, b: vertices[j].position },
+                curve: Curve::Segment {
+                    a: vertices[i].position,
+                    b: vertices[j].position,
+                },
                 begin: i,
                 end: j,
             }
         })
         .collect();
-    let centroid = Point3::from(vertices.iter().map(|v| v.position.coords).sum::<Vec3>() / n.max(1) as f64);
+    let centroid =
+        Point3::from(vertices.iter().map(|v| v.position.coords).sum::<Vec3>() / n.max(1) as f64);
     let ring: Vec<(usize, bool)> = (0..n).map(|i| (i, true)).collect();
     Brep {
         vertices,
         edges,
         faces: vec![BrepFace {
             name: "region",
-            surface: Surface::Plane { origin: centroid, normal: region_normal(frame) },
+            surface: Surface::Plane {
+                origin: centroid,
+                normal: region_normal(frame),
+            },
             loops: vec![ring.clone()],
             sample: centroid,
         }],

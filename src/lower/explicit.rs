@@ -6,7 +6,10 @@ use super::Entities;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::{Document, ObjectKind};
 use crate::geom::{Curve, Point3, SolidShape, Surface, Vec3};
-use crate::ir::{Boundary, Dimension, Edge, EdgeId, Face, Model, OrientedEdge, Origin, SourceMap, Vertex, VertexId};
+use crate::ir::{
+    Boundary, Dimension, Edge, EdgeId, Face, Model, OrientedEdge, Origin, SourceMap, Vertex,
+    VertexId,
+};
 use crate::resolve::{Geometry, LineCarrier, Resolved};
 use crate::span::Span;
 use std::collections::HashMap;
@@ -26,17 +29,29 @@ pub(super) fn lower_topology(
     for (i, object) in resolved.objects.iter().enumerate() {
         if let Some(Geometry::Vertex(p)) = &object.geometry {
             let id = VertexId(model.vertices.len() as u32);
-            model.vertices.push(Vertex { name: object.name.clone(), position: *p });
+            model.vertices.push(Vertex {
+                name: object.name.clone(),
+                position: *p,
+            });
             source_map.vertices.insert(id, Origin { span: object.span });
             entities.vertices.insert(object.name.clone(), id);
             vertex_of.insert(i, id);
         }
     }
     for (i, object) in resolved.objects.iter().enumerate() {
-        let Some(Geometry::Edge { line, begin, end }) = &object.geometry else { continue };
-        let (Some(&b), Some(&e)) = (vertex_of.get(&begin.object), vertex_of.get(&end.object)) else { continue };
+        let Some(Geometry::Edge { line, begin, end }) = &object.geometry else {
+            continue;
+        };
+        let (Some(&b), Some(&e)) = (vertex_of.get(&begin.object), vertex_of.get(&end.object))
+        else {
+            continue;
+        };
         let carrier = match line {
-            Some(link) => match resolved.objects.get(link.object).and_then(|o| o.geometry.as_ref()) {
+            Some(link) => match resolved
+                .objects
+                .get(link.object)
+                .and_then(|o| o.geometry.as_ref())
+            {
                 Some(Geometry::Line(c)) => c.clone(),
                 _ => continue,
             },
@@ -44,28 +59,56 @@ pub(super) fn lower_topology(
         };
         let a = model.vertex(b).position;
         let z = model.vertex(e).position;
-        let Some(curve) = edge_curve(&carrier, a, z, tol, &object.name, object.span, diags) else { continue };
+        let Some(curve) = edge_curve(&carrier, a, z, tol, &object.name, object.span, diags) else {
+            continue;
+        };
         let id = EdgeId(model.edges.len() as u32);
-        model.edges.push(Edge { name: object.name.clone(), curve, begin: b, end: e });
+        model.edges.push(Edge {
+            name: object.name.clone(),
+            curve,
+            begin: b,
+            end: e,
+        });
         source_map.edges.insert(id, Origin { span: object.span });
         entities.edges.insert(object.name.clone(), id);
         edge_of.insert(i, id);
     }
     for (i, object) in resolved.objects.iter().enumerate() {
-        let Some(Geometry::Face { surface, loops }) = &object.geometry else { continue };
-        let surface = match resolved.objects.get(surface.object).and_then(|o| o.geometry.as_ref()) {
+        let Some(Geometry::Face { surface, loops }) = &object.geometry else {
+            continue;
+        };
+        let surface = match resolved
+            .objects
+            .get(surface.object)
+            .and_then(|o| o.geometry.as_ref())
+        {
             Some(Geometry::Surface(s)) => s.clone(),
-            Some(Geometry::Solid(SolidShape::Ball { frame })) => Surface::Ellipsoid { frame: *frame },
-            Some(Geometry::Solid(SolidShape::Cone { frame, r0, r1 })) => Surface::Cone { frame: *frame, r0: *r0, r1: *r1 },
-            Some(Geometry::Solid(SolidShape::Torus { frame, major, minor })) => {
-                Surface::Torus { frame: *frame, major: *major, minor: *minor }
+            Some(Geometry::Solid(SolidShape::Ball { frame })) => {
+                Surface::Ellipsoid { frame: *frame }
             }
+            Some(Geometry::Solid(SolidShape::Cone { frame, r0, r1 })) => Surface::Cone {
+                frame: *frame,
+                r0: *r0,
+                r1: *r1,
+            },
+            Some(Geometry::Solid(SolidShape::Torus {
+                frame,
+                major,
+                minor,
+            })) => Surface::Torus {
+                frame: *frame,
+                major: *major,
+                minor: *minor,
+            },
             _ => continue,
         };
         let mut chained = Vec::new();
         let mut complete = true;
         for l in loops {
-            let ids: Option<Vec<EdgeId>> = l.iter().map(|(link, _)| edge_of.get(&link.object).copied()).collect();
+            let ids: Option<Vec<EdgeId>> = l
+                .iter()
+                .map(|(link, _)| edge_of.get(&link.object).copied())
+                .collect();
             match ids {
                 Some(ids) => chained.push(chain(model, &ids)),
                 None => complete = false,
@@ -78,10 +121,23 @@ pub(super) fn lower_topology(
             ObjectKind::Face { loop_spans, .. } => loop_spans.clone(),
             _ => Vec::new(),
         };
-        check_edges_on_surface(model, &chained, &surface, &object.name, &loop_spans, object.span, diags);
+        check_edges_on_surface(
+            model,
+            &chained,
+            &surface,
+            &object.name,
+            &loop_spans,
+            object.span,
+            diags,
+        );
         let reversed = orient_loops(model, &mut chained, &surface);
         let id = crate::ir::FaceId(model.faces.len() as u32);
-        model.faces.push(Face { name: object.name.clone(), surface, reversed, loops: chained });
+        model.faces.push(Face {
+            name: object.name.clone(),
+            surface,
+            reversed,
+            loops: chained,
+        });
         source_map.faces.insert(id, Origin { span: object.span });
         entities.faces.insert(object.name.clone(), id);
     }
@@ -89,12 +145,30 @@ pub(super) fn lower_topology(
 
 /// The curve of an explicit edge from its carrier and end points; reports
 /// end points off the carrier (E305) and open edges that close on themselves (E400).
-fn edge_curve(carrier: &LineCarrier, a: Point3, b: Point3, tol: f64, name: &str, span: Span, diags: &mut Diagnostics) -> Option<Curve> {
+fn edge_curve(
+    carrier: &LineCarrier,
+    a: Point3,
+    b: Point3,
+    tol: f64,
+    name: &str,
+    span: Span,
+    diags: &mut Diagnostics,
+) -> Option<Curve> {
     let same = (a - b).norm() <= tol;
     let off = |what: &str, d: f64, diags: &mut Diagnostics| {
         diags.push(
-            Diagnostic::new(Code::NotOnCarrier, span, format!("the {what} vertex of edge '{name}' lies {} away from its line", crate::resolve_fmt(d)))
-                .with_help(format!("move the vertex onto the line (tolerance {})", crate::resolve_fmt(tol))),
+            Diagnostic::new(
+                Code::NotOnCarrier,
+                span,
+                format!(
+                    "the {what} vertex of edge '{name}' lies {} away from its line",
+                    crate::resolve_fmt(d)
+                ),
+            )
+            .with_help(format!(
+                "move the vertex onto the line (tolerance {})",
+                crate::resolve_fmt(tol)
+            )),
         );
     };
     match carrier {
@@ -115,8 +189,14 @@ fn edge_curve(carrier: &LineCarrier, a: Point3, b: Point3, tol: f64, name: &str,
             let in_plane_b = rb.dot(normal).abs();
             if ra.norm() <= tol {
                 diags.push(
-                    Diagnostic::new(Code::DegenerateCurve, span, format!("edge '{name}' begins at the centre of its circle_arc"))
-                        .with_help("the arc's radius is the distance from the centre to the begin vertex"),
+                    Diagnostic::new(
+                        Code::DegenerateCurve,
+                        span,
+                        format!("edge '{name}' begins at the centre of its circle_arc"),
+                    )
+                    .with_help(
+                        "the arc's radius is the distance from the centre to the begin vertex",
+                    ),
                 );
                 return None;
             }
@@ -129,10 +209,24 @@ fn edge_curve(carrier: &LineCarrier, a: Point3, b: Point3, tol: f64, name: &str,
                 return None;
             }
             let minor = normal.cross(&ra);
-            let sweep = if same { TAU } else { angle_from(&ra, &minor, &rb) };
-            Some(Curve::Ellipse { center: *center, major: ra, minor, t0: 0.0, t1: sweep })
+            let sweep = if same {
+                TAU
+            } else {
+                angle_from(&ra, &minor, &rb)
+            };
+            Some(Curve::Ellipse {
+                center: *center,
+                major: ra,
+                minor,
+                t0: 0.0,
+                t1: sweep,
+            })
         }
-        LineCarrier::Ellipse { center, major, minor } => {
+        LineCarrier::Ellipse {
+            center,
+            major,
+            minor,
+        } => {
             let ta = parameter_on(center, major, minor, &a, tol);
             let tb = parameter_on(center, major, minor, &b, tol);
             let (Some(ta), Some(tb)) = (ta, tb) else {
@@ -148,7 +242,13 @@ fn edge_curve(carrier: &LineCarrier, a: Point3, b: Point3, tol: f64, name: &str,
             if same {
                 t1 = ta + TAU;
             }
-            Some(Curve::Ellipse { center: *center, major: *major, minor: *minor, t0: ta, t1 })
+            Some(Curve::Ellipse {
+                center: *center,
+                major: *major,
+                minor: *minor,
+                t0: ta,
+                t1,
+            })
         }
         LineCarrier::Intersection { surfaces } => {
             for (which, p) in [("begin", a), ("end", b)] {
@@ -160,12 +260,22 @@ fn edge_curve(carrier: &LineCarrier, a: Point3, b: Point3, tol: f64, name: &str,
             }
             if same {
                 diags.push(
-                    Diagnostic::new(Code::EdgeEndsCoincide, span, format!("intersection edge '{name}' begins and ends at the same point"))
-                        .with_help("split a closed intersection curve into two edges at two distinct vertices"),
+                    Diagnostic::new(
+                        Code::EdgeEndsCoincide,
+                        span,
+                        format!("intersection edge '{name}' begins and ends at the same point"),
+                    )
+                    .with_help(
+                        "split a closed intersection curve into two edges at two distinct vertices",
+                    ),
                 );
                 return None;
             }
-            Some(Curve::Intersection { surfaces: surfaces.clone(), a, b })
+            Some(Curve::Intersection {
+                surfaces: surfaces.clone(),
+                a,
+                b,
+            })
         }
     }
 }
@@ -217,7 +327,11 @@ fn chain(model: &Model, ids: &[EdgeId]) -> Vec<OrientedEdge> {
             }
             Some(prev) => {
                 let prev_edge = model.edge(prev.edge);
-                let at = if prev.forward { prev_edge.end } else { prev_edge.begin };
+                let at = if prev.forward {
+                    prev_edge.end
+                } else {
+                    prev_edge.begin
+                };
                 edge.begin == at || edge.end != at
             }
         };
@@ -243,16 +357,22 @@ fn loop_points(model: &Model, l: &[OrientedEdge]) -> Vec<Point3> {
 /// Newell's vector area of a closed polygon.
 fn vector_area(points: &[Point3]) -> Vec3 {
     let n = points.len();
-    (0..n).map(|i| points[i].coords.cross(&points[(i + 1) % n].coords)).sum::<Vec3>() * 0.5
+    (0..n)
+        .map(|i| points[i].coords.cross(&points[(i + 1) % n].coords))
+        .sum::<Vec3>()
+        * 0.5
 }
 
 /// Makes the outer loop counter-clockwise and hole loops clockwise about the
 /// face normal; returns whether the face normal is −∇S.
 fn orient_loops(model: &Model, loops: &mut [Vec<OrientedEdge>], surface: &Surface) -> bool {
-    let Some(outer) = loops.first() else { return false };
+    let Some(outer) = loops.first() else {
+        return false;
+    };
     let points = loop_points(model, outer);
     let area = vector_area(&points);
-    let centroid = Point3::from(points.iter().map(|p| p.coords).sum::<Vec3>() / points.len().max(1) as f64);
+    let centroid =
+        Point3::from(points.iter().map(|p| p.coords).sum::<Vec3>() / points.len().max(1) as f64);
     let on_surface = surface.project(&centroid).unwrap_or(centroid);
     let gradient = surface.gradient(&on_surface);
     let reversed = area.dot(&gradient) < 0.0;
@@ -288,15 +408,27 @@ fn check_edges_on_surface(
     for (k, l) in loops.iter().enumerate() {
         for e in l {
             let edge = model.edge(e.edge);
-            let worst = edge.curve.samples(8).iter().map(|p| surface.distance(p)).fold(0.0, f64::max);
+            let worst = edge
+                .curve
+                .samples(8)
+                .iter()
+                .map(|p| surface.distance(p))
+                .fold(0.0, f64::max);
             if worst > tol {
                 diags.push(
                     Diagnostic::new(
                         Code::NotOnCarrier,
                         loop_spans.get(k).copied().unwrap_or(span),
-                        format!("edge '{}' of face '{name}' leaves the face's surface by up to {}", edge.name, crate::resolve_fmt(worst)),
+                        format!(
+                            "edge '{}' of face '{name}' leaves the face's surface by up to {}",
+                            edge.name,
+                            crate::resolve_fmt(worst)
+                        ),
                     )
-                    .with_help(format!("the edges of a face must lie on its surface (tolerance {})", crate::resolve_fmt(tol))),
+                    .with_help(format!(
+                        "the edges of a face must lie on its surface (tolerance {})",
+                        crate::resolve_fmt(tol)
+                    )),
                 );
             }
         }
@@ -304,9 +436,18 @@ fn check_edges_on_surface(
 }
 
 /// `<boundary>` elements: named sets of faces (3D) or edges (2D).
-pub(super) fn lower_boundaries(doc: &Document, model: &mut Model, entities: &Entities, diags: &mut Diagnostics) {
+pub(super) fn lower_boundaries(
+    doc: &Document,
+    model: &mut Model,
+    entities: &Entities,
+    diags: &mut Diagnostics,
+) {
     for b in &doc.boundaries {
-        let mut boundary = Boundary { name: b.name.text.clone(), faces: Vec::new(), edges: Vec::new() };
+        let mut boundary = Boundary {
+            name: b.name.text.clone(),
+            faces: Vec::new(),
+            edges: Vec::new(),
+        };
         if let Some((refs, _)) = &b.faces {
             for r in refs {
                 match lookup_entities(&entities.faces, &r.text) {
@@ -324,10 +465,18 @@ pub(super) fn lower_boundaries(doc: &Document, model: &mut Model, entities: &Ent
             }
         }
         if b.faces.is_none() && b.edges.is_none() {
-            let what = if model.dimension == Dimension::Two { "edges" } else { "faces" };
+            let what = if model.dimension == Dimension::Two {
+                "edges"
+            } else {
+                "faces"
+            };
             diags.push(
-                Diagnostic::new(Code::MissingAttribute, b.span, format!("boundary '{}' names no {what}", b.name.text))
-                    .with_help(format!("add {what}=\"…\" listing what it names")),
+                Diagnostic::new(
+                    Code::MissingAttribute,
+                    b.span,
+                    format!("boundary '{}' names no {what}", b.name.text),
+                )
+                .with_help(format!("add {what}=\"…\" listing what it names")),
             );
         }
         boundary.faces.sort();
@@ -339,12 +488,19 @@ pub(super) fn lower_boundaries(doc: &Document, model: &mut Model, entities: &Ent
 }
 
 /// `name` exactly, or every entity of primitive `name` ("box" → "box.*").
-pub(super) fn lookup_entities<T: Copy + Ord>(table: &HashMap<String, T>, name: &str) -> Option<Vec<T>> {
+pub(super) fn lookup_entities<T: Copy + Ord>(
+    table: &HashMap<String, T>,
+    name: &str,
+) -> Option<Vec<T>> {
     if let Some(&id) = table.get(name) {
         return Some(vec![id]);
     }
     let prefix = format!("{name}.");
-    let mut ids: Vec<T> = table.iter().filter(|(k, _)| k.starts_with(&prefix)).map(|(_, &v)| v).collect();
+    let mut ids: Vec<T> = table
+        .iter()
+        .filter(|(k, _)| k.starts_with(&prefix))
+        .map(|(_, &v)| v)
+        .collect();
     ids.sort();
     ids.dedup();
     (!ids.is_empty()).then_some(ids)
@@ -352,7 +508,12 @@ pub(super) fn lookup_entities<T: Copy + Ord>(table: &HashMap<String, T>, name: &
 
 /// Reports a face or edge reference that names nothing of that kind: E202
 /// when it names another kind of entity, else E200 with a suggestion.
-pub(super) fn unknown_entity(r: &crate::doc::Ref, kind: &str, entities: &Entities, diags: &mut Diagnostics) {
+pub(super) fn unknown_entity(
+    r: &crate::doc::Ref,
+    kind: &str,
+    entities: &Entities,
+    diags: &mut Diagnostics,
+) {
     let found_as = if kind != "face" && lookup_entities(&entities.faces, &r.text).is_some() {
         Some("a face")
     } else if kind != "edge" && lookup_entities(&entities.edges, &r.text).is_some() {
@@ -364,8 +525,19 @@ pub(super) fn unknown_entity(r: &crate::doc::Ref, kind: &str, entities: &Entitie
     };
     if let Some(what) = found_as {
         diags.push(
-            Diagnostic::new(Code::WrongKind, r.span, format!("'{}' is {what}, but a {kind} is expected here", r.text))
-                .with_help(format!("name a {kind} (an explicit <{kind}> or a primitive's {kind} such as {})", if kind == "face" { "box.xmin" } else { "box.xmin_ymin" })),
+            Diagnostic::new(
+                Code::WrongKind,
+                r.span,
+                format!("'{}' is {what}, but a {kind} is expected here", r.text),
+            )
+            .with_help(format!(
+                "name a {kind} (an explicit <{kind}> or a primitive's {kind} such as {})",
+                if kind == "face" {
+                    "box.xmin"
+                } else {
+                    "box.xmin_ymin"
+                }
+            )),
         );
         return;
     }
@@ -374,10 +546,18 @@ pub(super) fn unknown_entity(r: &crate::doc::Ref, kind: &str, entities: &Entitie
     } else {
         entities.edges.keys().map(String::as_str).collect()
     };
-    let mut d = Diagnostic::new(Code::UndefinedName, r.span, format!("no {kind} named '{}'", r.text));
-    d.help = Some(match crate::diag::did_you_mean(&r.text, names.iter().copied()) {
-        Some(best) => format!("did you mean '{best}'?"),
-        None => format!("name an explicit <{kind}> or a primitive's {kind} such as box.xmin (see docs/format.md)"),
-    });
+    let mut d = Diagnostic::new(
+        Code::UndefinedName,
+        r.span,
+        format!("no {kind} named '{}'", r.text),
+    );
+    d.help = Some(
+        match crate::diag::did_you_mean(&r.text, names.iter().copied()) {
+            Some(best) => format!("did you mean '{best}'?"),
+            None => format!(
+                "name an explicit <{kind}> or a primitive's {kind} such as box.xmin (see docs/format.md)"
+            ),
+        },
+    );
     diags.push(d);
 }

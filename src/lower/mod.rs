@@ -12,7 +12,10 @@ mod weld;
 use crate::diag::Diagnostics;
 use crate::doc::Document;
 use crate::geom::{Aabb, SolidShape};
-use crate::ir::{Dimension, Face, Model, OrientedEdge, OrientedFace, PointSet, Polyline, Solid, SolidId, SourceMap, Origin};
+use crate::ir::{
+    Dimension, Face, Model, OrientedEdge, OrientedFace, Origin, PointSet, Polyline, Solid, SolidId,
+    SourceMap,
+};
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
 use std::collections::HashMap;
@@ -36,7 +39,11 @@ pub(crate) struct Entities {
 }
 
 pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
-    let dimension = if resolved.dimension == 2 { Dimension::Two } else { Dimension::Three };
+    let dimension = if resolved.dimension == 2 {
+        Dimension::Two
+    } else {
+        Dimension::Three
+    };
     let mut model = Model::empty(dimension);
     model.parameters = resolved.parameters.clone();
     model.tolerance = tolerance(resolved);
@@ -45,20 +52,53 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
     let mut welder = weld::Welder::new(model.tolerance);
 
     for object in &resolved.objects {
-        let Some(geometry) = &object.geometry else { continue };
+        let Some(geometry) = &object.geometry else {
+            continue;
+        };
         match geometry {
             Geometry::Group(members) => {
                 for (k, member) in members.iter().enumerate() {
                     let name = format!("{}[{}]", object.name, k + 1);
-                    lower_free(&mut model, &mut source_map, &mut entities, &mut welder, &name, member, object.span);
+                    lower_free(
+                        &mut model,
+                        &mut source_map,
+                        &mut entities,
+                        &mut welder,
+                        &name,
+                        member,
+                        object.span,
+                    );
                 }
             }
-            g => lower_free(&mut model, &mut source_map, &mut entities, &mut welder, &object.name, g, object.span),
+            g => lower_free(
+                &mut model,
+                &mut source_map,
+                &mut entities,
+                &mut welder,
+                &object.name,
+                g,
+                object.span,
+            ),
         }
     }
-    explicit::lower_topology(doc, resolved, &mut model, &mut source_map, &mut entities, diags);
+    explicit::lower_topology(
+        doc,
+        resolved,
+        &mut model,
+        &mut source_map,
+        &mut entities,
+        diags,
+    );
     let face_samples = welder.face_samples;
-    booleans::lower_subdomains(doc, resolved, &mut model, &mut source_map, &entities, &face_samples, diags);
+    booleans::lower_subdomains(
+        doc,
+        resolved,
+        &mut model,
+        &mut source_map,
+        &entities,
+        &face_samples,
+        diags,
+    );
     explicit::lower_boundaries(doc, &mut model, &entities, diags);
     prune::prune_interior(&mut model, &mut source_map);
     Lowered { model, source_map }
@@ -70,7 +110,9 @@ fn tolerance(resolved: &Resolved) -> f64 {
     fn visit(g: &Geometry, bbox: &mut Aabb) {
         match g {
             Geometry::Solid(s) => *bbox = bbox.union(&s.bbox()),
-            Geometry::Points { points, .. } | Geometry::Polyline { points } => points.iter().for_each(|p| bbox.include(p)),
+            Geometry::Points { points, .. } | Geometry::Polyline { points } => {
+                points.iter().for_each(|p| bbox.include(p))
+            }
             Geometry::Vertex(p) => bbox.include(p),
             Geometry::Group(members) => members.iter().for_each(|m| visit(m, bbox)),
             _ => {}
@@ -94,11 +136,21 @@ fn lower_free(
     span: Span,
 ) {
     match geometry {
-        Geometry::Points { points, .. } => model.point_sets.push(PointSet { name: name.to_string(), points: points.clone() }),
-        Geometry::Polyline { points } => model.polylines.push(Polyline { name: name.to_string(), points: points.clone() }),
+        Geometry::Points { points, .. } => model.point_sets.push(PointSet {
+            name: name.to_string(),
+            points: points.clone(),
+        }),
+        Geometry::Polyline { points } => model.polylines.push(Polyline {
+            name: name.to_string(),
+            points: points.clone(),
+        }),
         Geometry::Solid(shape) => {
             let id = lower_solid(model, source_map, entities, welder, name, shape, span);
-            entities.solids.entry(name.to_string()).or_default().push(id);
+            entities
+                .solids
+                .entry(name.to_string())
+                .or_default()
+                .push(id);
         }
         _ => {}
     }
@@ -123,7 +175,10 @@ fn lower_solid(
             if new {
                 source_map.vertices.insert(id, origin);
             }
-            entities.vertices.entry(format!("{name}.{}", v.name)).or_insert(id);
+            entities
+                .vertices
+                .entry(format!("{name}.{}", v.name))
+                .or_insert(id);
             id
         })
         .collect();
@@ -132,7 +187,13 @@ fn lower_solid(
         .into_iter()
         .map(|e| {
             let entity = format!("{name}.{}", e.name);
-            let (id, flipped, new) = welder.edge(model, entity.clone(), e.curve, vertex_ids[e.begin], vertex_ids[e.end]);
+            let (id, flipped, new) = welder.edge(
+                model,
+                entity.clone(),
+                e.curve,
+                vertex_ids[e.begin],
+                vertex_ids[e.end],
+            );
             if new {
                 source_map.edges.insert(id, origin);
             }
@@ -142,14 +203,26 @@ fn lower_solid(
         .collect();
     let orient = |(local, forward): (usize, bool)| {
         let (edge, flipped) = edge_ids[local];
-        OrientedEdge { edge, forward: forward != flipped }
+        OrientedEdge {
+            edge,
+            forward: forward != flipped,
+        }
     };
     let mut faces = Vec::new();
     for f in brep.faces {
-        let loops: Vec<Vec<OrientedEdge>> = f.loops.iter().map(|l| l.iter().copied().map(orient).collect()).collect();
+        let loops: Vec<Vec<OrientedEdge>> = f
+            .loops
+            .iter()
+            .map(|l| l.iter().copied().map(orient).collect())
+            .collect();
         let first = loops.first().and_then(|l| l.first()).copied();
         let entity = format!("{name}.{}", f.name);
-        let face = Face { name: entity.clone(), surface: f.surface, reversed: false, loops };
+        let face = Face {
+            name: entity.clone(),
+            surface: f.surface,
+            reversed: false,
+            loops,
+        };
         let (id, new) = welder.face(model, face, f.sample);
         if new {
             source_map.faces.insert(id, origin);

@@ -21,13 +21,20 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     }
     for (k, solid) in model.solids.iter().enumerate() {
         if !used_by_subdomains.contains(&k) {
-            solid.faces.iter().for_each(|of| keep_face[of.face.index()] = true);
+            solid
+                .faces
+                .iter()
+                .for_each(|of| keep_face[of.face.index()] = true);
         }
     }
     for s in &model.subdomains {
         match &s.cells {
-            SubdomainCells::Volume { boundary } => boundary.iter().for_each(|of| keep_face[of.face.index()] = true),
-            SubdomainCells::Region { faces } => faces.iter().for_each(|f| keep_face[f.index()] = true),
+            SubdomainCells::Volume { boundary } => boundary
+                .iter()
+                .for_each(|of| keep_face[of.face.index()] = true),
+            SubdomainCells::Region { faces } => {
+                faces.iter().for_each(|f| keep_face[f.index()] = true)
+            }
         }
     }
     for b in &model.boundaries {
@@ -38,10 +45,17 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     let mut keep_edge = vec![false; model.edges.len()];
     for (k, face) in model.faces.iter().enumerate() {
         if keep_face[k] {
-            face.loops.iter().flatten().for_each(|e| keep_edge[e.edge.index()] = true);
+            face.loops
+                .iter()
+                .flatten()
+                .for_each(|e| keep_edge[e.edge.index()] = true);
         }
     }
-    let primitive_edges: BTreeSet<usize> = model.solids.iter().flat_map(|s| s.edges.iter().map(|e| e.index())).collect();
+    let primitive_edges: BTreeSet<usize> = model
+        .solids
+        .iter()
+        .flat_map(|s| s.edges.iter().map(|e| e.index()))
+        .collect();
     for (k, keep) in keep_edge.iter_mut().enumerate() {
         // Explicit edges and edges of free-standing solids always stay.
         if !primitive_edges.contains(&k) {
@@ -64,14 +78,21 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
             keep_vertex[edge.end.index()] = true;
         }
     }
-    let primitive_vertices: BTreeSet<usize> = model.solids.iter().flat_map(|s| s.vertices.iter().map(|v| v.index())).collect();
+    let primitive_vertices: BTreeSet<usize> = model
+        .solids
+        .iter()
+        .flat_map(|s| s.vertices.iter().map(|v| v.index()))
+        .collect();
     for (k, keep) in keep_vertex.iter_mut().enumerate() {
         if !primitive_vertices.contains(&k) {
             *keep = true;
         }
     }
     let vertex_map = compact(&keep_vertex);
-    if keep_face.iter().all(|&k| k) && keep_edge.iter().all(|&k| k) && keep_vertex.iter().all(|&k| k) {
+    if keep_face.iter().all(|&k| k)
+        && keep_edge.iter().all(|&k| k)
+        && keep_vertex.iter().all(|&k| k)
+    {
         return;
     }
     apply(model, source_map, &face_map, &edge_map, &vertex_map);
@@ -98,7 +119,13 @@ fn retain_indexed<T>(items: &mut Vec<T>, map: &[Option<u32>]) {
     });
 }
 
-fn apply(model: &mut Model, source_map: &mut SourceMap, faces: &[Option<u32>], edges: &[Option<u32>], vertices: &[Option<u32>]) {
+fn apply(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    faces: &[Option<u32>],
+    edges: &[Option<u32>],
+    vertices: &[Option<u32>],
+) {
     let f = |id: FaceId| faces.get(id.index()).copied().flatten().map(FaceId);
     let e = |id: EdgeId| edges.get(id.index()).copied().flatten().map(EdgeId);
     let v = |id: VertexId| vertices.get(id.index()).copied().flatten().map(VertexId);
@@ -118,7 +145,9 @@ fn apply(model: &mut Model, source_map: &mut SourceMap, faces: &[Option<u32>], e
         match &mut s.cells {
             SubdomainCells::Volume { boundary } => {
                 boundary.retain(|of| f(of.face).is_some());
-                boundary.iter_mut().for_each(|of| of.face = f(of.face).unwrap_or(of.face));
+                boundary
+                    .iter_mut()
+                    .for_each(|of| of.face = f(of.face).unwrap_or(of.face));
             }
             SubdomainCells::Region { faces: list } => {
                 list.retain(|&x| f(x).is_some());
@@ -128,13 +157,25 @@ fn apply(model: &mut Model, source_map: &mut SourceMap, faces: &[Option<u32>], e
     }
     for solid in &mut model.solids {
         solid.faces.retain(|of| f(of.face).is_some());
-        solid.faces.iter_mut().for_each(|of| of.face = f(of.face).unwrap_or(of.face));
+        solid
+            .faces
+            .iter_mut()
+            .for_each(|of| of.face = f(of.face).unwrap_or(of.face));
         solid.boundary_edges.retain(|oe| e(oe.edge).is_some());
-        solid.boundary_edges.iter_mut().for_each(|oe| oe.edge = e(oe.edge).unwrap_or(oe.edge));
+        solid
+            .boundary_edges
+            .iter_mut()
+            .for_each(|oe| oe.edge = e(oe.edge).unwrap_or(oe.edge));
         solid.edges.retain(|&x| e(x).is_some());
-        solid.edges.iter_mut().for_each(|x| *x = e(*x).unwrap_or(*x));
+        solid
+            .edges
+            .iter_mut()
+            .for_each(|x| *x = e(*x).unwrap_or(*x));
         solid.vertices.retain(|&x| v(x).is_some());
-        solid.vertices.iter_mut().for_each(|x| *x = v(*x).unwrap_or(*x));
+        solid
+            .vertices
+            .iter_mut()
+            .for_each(|x| *x = v(*x).unwrap_or(*x));
     }
     for b in &mut model.boundaries {
         b.faces.retain(|&x| f(x).is_some());
@@ -147,6 +188,12 @@ fn apply(model: &mut Model, source_map: &mut SourceMap, faces: &[Option<u32>], e
     source_map.vertices = remap(&source_map.vertices, v);
 }
 
-fn remap<K: Copy + std::hash::Hash + Eq, V: Copy>(table: &HashMap<K, V>, map: impl Fn(K) -> Option<K>) -> HashMap<K, V> {
-    table.iter().filter_map(|(&k, &v)| map(k).map(|k| (k, v))).collect()
+fn remap<K: Copy + std::hash::Hash + Eq, V: Copy>(
+    table: &HashMap<K, V>,
+    map: impl Fn(K) -> Option<K>,
+) -> HashMap<K, V> {
+    table
+        .iter()
+        .filter_map(|(&k, &v)| map(k).map(|k| (k, v)))
+        .collect()
 }

@@ -33,7 +33,12 @@ impl Welder {
     }
 
     /// The existing vertex within the tolerance of `position`, or a new one.
-    pub fn vertex(&mut self, model: &mut Model, name: String, position: Point3) -> (VertexId, bool) {
+    pub fn vertex(
+        &mut self,
+        model: &mut Model,
+        name: String,
+        position: Point3,
+    ) -> (VertexId, bool) {
         let key = self.key(&position);
         for dx in -1..=1 {
             for dy in -1..=1 {
@@ -57,17 +62,34 @@ impl Welder {
 
     /// The existing edge with the same ends and the same curve, or a new one.
     /// Returns the id and whether the existing edge runs the other way.
-    pub fn edge(&mut self, model: &mut Model, name: String, curve: Curve, begin: VertexId, end: VertexId) -> (EdgeId, bool, bool) {
-        let key = if begin <= end { (begin, end) } else { (end, begin) };
+    pub fn edge(
+        &mut self,
+        model: &mut Model,
+        name: String,
+        curve: Curve,
+        begin: VertexId,
+        end: VertexId,
+    ) -> (EdgeId, bool, bool) {
+        let key = if begin <= end {
+            (begin, end)
+        } else {
+            (end, begin)
+        };
         let probes = probe_points(&curve);
         if let Some(ids) = self.edges_by_ends.get(&key) {
             for &id in ids {
                 let existing = &model.edges[id.index()];
                 let theirs = probe_points(&existing.curve);
-                let same = probes.iter().zip(&theirs).all(|(a, b)| (a - b).norm() <= self.tol);
+                let same = probes
+                    .iter()
+                    .zip(&theirs)
+                    .all(|(a, b)| (a - b).norm() <= self.tol);
                 let mut reversed_probes = probes;
                 reversed_probes.reverse();
-                let opposite = reversed_probes.iter().zip(&theirs).all(|(a, b)| (a - b).norm() <= self.tol);
+                let opposite = reversed_probes
+                    .iter()
+                    .zip(&theirs)
+                    .all(|(a, b)| (a - b).norm() <= self.tol);
                 if same && (existing.begin == begin || begin == end) {
                     return (id, false, false);
                 }
@@ -77,14 +99,24 @@ impl Welder {
             }
         }
         let id = EdgeId(model.edges.len() as u32);
-        model.edges.push(Edge { name, curve, begin, end });
+        model.edges.push(Edge {
+            name,
+            curve,
+            begin,
+            end,
+        });
         self.edges_by_ends.entry(key).or_default().push(id);
         (id, false, true)
     }
 
     /// The existing face with the same edges and the same interior point, or a new one.
     pub fn face(&mut self, model: &mut Model, face: Face, sample: Point3) -> (FaceId, bool) {
-        let mut key: Vec<EdgeId> = face.loops.iter().flatten().map(|e: &OrientedEdge| e.edge).collect();
+        let mut key: Vec<EdgeId> = face
+            .loops
+            .iter()
+            .flatten()
+            .map(|e: &OrientedEdge| e.edge)
+            .collect();
         key.sort();
         if let Some(ids) = self.faces_by_edges.get(&key) {
             for &id in ids {

@@ -9,10 +9,19 @@ use crate::span::Span;
 pub enum LineCarrier {
     Straight,
     /// Circle about `center` in the plane with unit `normal`.
-    Circle { center: Point3, normal: Vec3 },
+    Circle {
+        center: Point3,
+        normal: Vec3,
+    },
     /// center + major·cos t + minor·sin t.
-    Ellipse { center: Point3, major: Vec3, minor: Vec3 },
-    Intersection { surfaces: Box<[Surface; 2]> },
+    Ellipse {
+        center: Point3,
+        major: Vec3,
+        minor: Vec3,
+    },
+    Intersection {
+        surfaces: Box<[Surface; 2]>,
+    },
 }
 
 /// A reference to another object, resolved to its index in [`super::Resolved::objects`].
@@ -26,16 +35,28 @@ pub struct Link {
 pub enum Geometry {
     /// A named set of points; `partial[k]` when value k left out a coordinate
     /// (paper 000's 2D and 1D points: lines and planes, taken as points with 0s).
-    Points { points: Vec<Point3>, partial: Vec<bool> },
-    Polyline { points: Vec<Point3> },
+    Points {
+        points: Vec<Point3>,
+        partial: Vec<bool>,
+    },
+    Polyline {
+        points: Vec<Point3>,
+    },
     /// A bounded solid (3D) or region (2D).
     Solid(SolidShape),
     /// A surface that bounds nothing by itself (plane primitive, explicit surface).
     Surface(Surface),
     Line(LineCarrier),
     Vertex(Point3),
-    Edge { line: Option<Link>, begin: Link, end: Link },
-    Face { surface: Link, loops: Vec<Vec<(Link, Option<String>)>> },
+    Edge {
+        line: Option<Link>,
+        begin: Link,
+        end: Link,
+    },
+    Face {
+        surface: Link,
+        loops: Vec<Vec<(Link, Option<String>)>>,
+    },
     /// Members of a replicate: `name[1]` … `name[n]`.
     Group(Vec<Geometry>),
 }
@@ -68,26 +89,39 @@ impl Geometry {
                 points: points.iter().map(|p| map.to_global(p)).collect(),
             },
             Geometry::Solid(shape) => Geometry::Solid(transform_shape(shape, map)),
-            Geometry::Surface(Surface::Plane { origin, normal }) => Geometry::Surface(Surface::Plane {
-                origin: map.to_global(origin),
-                normal: map.normal_to_global(normal),
-            }),
-            Geometry::Surface(Surface::Ellipsoid { frame }) => {
-                Geometry::Surface(Surface::Ellipsoid { frame: map.compose(frame) })
+            Geometry::Surface(Surface::Plane { origin, normal }) => {
+                Geometry::Surface(Surface::Plane {
+                    origin: map.to_global(origin),
+                    normal: map.normal_to_global(normal),
+                })
             }
-            Geometry::Surface(Surface::Cone { frame, r0, r1 }) => Geometry::Surface(Surface::Cone {
-                frame: map.compose(frame),
-                r0: *r0,
-                r1: *r1,
-            }),
-            Geometry::Surface(Surface::Torus { frame, major, minor }) => Geometry::Surface(Surface::Torus {
+            Geometry::Surface(Surface::Ellipsoid { frame }) => {
+                Geometry::Surface(Surface::Ellipsoid {
+                    frame: map.compose(frame),
+                })
+            }
+            Geometry::Surface(Surface::Cone { frame, r0, r1 }) => {
+                Geometry::Surface(Surface::Cone {
+                    frame: map.compose(frame),
+                    r0: *r0,
+                    r1: *r1,
+                })
+            }
+            Geometry::Surface(Surface::Torus {
+                frame,
+                major,
+                minor,
+            }) => Geometry::Surface(Surface::Torus {
                 frame: map.compose(frame),
                 major: *major,
                 minor: *minor,
             }),
-            Geometry::Group(members) => {
-                Geometry::Group(members.iter().map(|m| m.transformed(map)).collect::<Option<Vec<_>>>()?)
-            }
+            Geometry::Group(members) => Geometry::Group(
+                members
+                    .iter()
+                    .map(|m| m.transformed(map))
+                    .collect::<Option<Vec<_>>>()?,
+            ),
             _ => return None,
         })
     }
@@ -95,19 +129,29 @@ impl Geometry {
 
 fn transform_shape(shape: &SolidShape, map: &Frame) -> SolidShape {
     match shape {
-        SolidShape::Ball { frame } => SolidShape::Ball { frame: map.compose(frame) },
-        SolidShape::Box { frame } => SolidShape::Box { frame: map.compose(frame) },
+        SolidShape::Ball { frame } => SolidShape::Ball {
+            frame: map.compose(frame),
+        },
+        SolidShape::Box { frame } => SolidShape::Box {
+            frame: map.compose(frame),
+        },
         SolidShape::Cone { frame, r0, r1 } => SolidShape::Cone {
             frame: map.compose(frame),
             r0: *r0,
             r1: *r1,
         },
-        SolidShape::Torus { frame, major, minor } => SolidShape::Torus {
+        SolidShape::Torus {
+            frame,
+            major,
+            minor,
+        } => SolidShape::Torus {
             frame: map.compose(frame),
             major: *major,
             minor: *minor,
         },
-        SolidShape::Disk { frame } => SolidShape::Disk { frame: map.compose(frame) },
+        SolidShape::Disk { frame } => SolidShape::Disk {
+            frame: map.compose(frame),
+        },
         SolidShape::Polygon { frame, vertices } => SolidShape::Polygon {
             frame: map.compose(frame),
             vertices: vertices.clone(),

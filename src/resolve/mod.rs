@@ -9,7 +9,7 @@ mod shapes;
 mod values;
 
 pub use geometry::{Geometry, LineCarrier, Link};
-pub use names::{is_plain_name, NameTable};
+pub use names::{NameTable, is_plain_name};
 pub use shapes::{fmt, fmt_point, perpendicular_pair};
 pub use values::{Ctx, Values};
 
@@ -72,7 +72,10 @@ pub fn parse_override(text: &str) -> Result<Override, Diagnostic> {
         .with_help("write for example --set r=0.8"));
     }
     match crate::expr::parse(value, 0) {
-        Ok(expr) => Ok(Override { name: name.to_string(), value: expr }),
+        Ok(expr) => Ok(Override {
+            name: name.to_string(),
+            value: expr,
+        }),
         Err(_) => Err(Diagnostic::new(
             Code::BadOverride,
             None,
@@ -83,9 +86,17 @@ pub fn parse_override(text: &str) -> Result<Override, Diagnostic> {
 }
 
 /// Resolves a typed document. Overrides naming no parameter are reported with E204.
-pub fn resolve(source: &SourceFile, doc: &Document, overrides: &[Override], diags: &mut Diagnostics) -> Resolved {
+pub fn resolve(
+    source: &SourceFile,
+    doc: &Document,
+    overrides: &[Override],
+    diags: &mut Diagnostics,
+) -> Resolved {
     let names = NameTable::build(source, doc, diags);
-    let pairs: Vec<(String, Expr)> = overrides.iter().map(|o| (o.name.clone(), o.value.clone())).collect();
+    let pairs: Vec<(String, Expr)> = overrides
+        .iter()
+        .map(|o| (o.name.clone(), o.value.clone()))
+        .collect();
     let mut values = Values::new(doc, &pairs);
     for o in overrides {
         if !values.is_parameter(&o.name) {
@@ -93,13 +104,18 @@ pub fn resolve(source: &SourceFile, doc: &Document, overrides: &[Override], diag
             let mut d = Diagnostic::new(
                 Code::UnknownParameterOverride,
                 None,
-                format!("--set {}: the file defines no parameter '{}'", o.name, o.name),
+                format!(
+                    "--set {}: the file defines no parameter '{}'",
+                    o.name, o.name
+                ),
             );
-            d.help = Some(match crate::diag::did_you_mean(&o.name, candidates.iter().copied()) {
-                Some(best) => format!("did you mean --set {best}=…?"),
-                None if candidates.is_empty() => "the file defines no parameters".to_string(),
-                None => format!("parameters: {}", candidates.join(", ")),
-            });
+            d.help = Some(
+                match crate::diag::did_you_mean(&o.name, candidates.iter().copied()) {
+                    Some(best) => format!("did you mean --set {best}=…?"),
+                    None if candidates.is_empty() => "the file defines no parameters".to_string(),
+                    None => format!("parameters: {}", candidates.join(", ")),
+                },
+            );
             diags.push(d);
         }
     }
@@ -115,8 +131,12 @@ pub fn resolve(source: &SourceFile, doc: &Document, overrides: &[Override], diag
     let values = resolver.finish();
     for (name, span) in values.unused_parameters() {
         diags.push(
-            Diagnostic::new(Code::UnusedParameter, span, format!("parameter '{name}' is never used"))
-                .with_help("remove it, or use it in an attribute"),
+            Diagnostic::new(
+                Code::UnusedParameter,
+                span,
+                format!("parameter '{name}' is never used"),
+            )
+            .with_help("remove it, or use it in an attribute"),
         );
     }
     let by_name = objects
@@ -142,9 +162,20 @@ fn check_basis_order(doc: &Document, values: &Values, diags: &mut Diagnostics) {
             .iter()
             .filter(|b| b.axis == axis)
             .filter_map(|b| {
-                let digits: String = b.name.text.chars().rev().take_while(char::is_ascii_digit).collect();
+                let digits: String = b
+                    .name
+                    .text
+                    .chars()
+                    .rev()
+                    .take_while(char::is_ascii_digit)
+                    .collect();
                 let index: u64 = digits.chars().rev().collect::<String>().parse().ok()?;
-                Some((index, b.name.text.as_str(), *known.get(&b.name.text)?, b.name.span))
+                Some((
+                    index,
+                    b.name.text.as_str(),
+                    *known.get(&b.name.text)?,
+                    b.name.span,
+                ))
             })
             .collect();
         indexed.sort_by_key(|&(i, _, _, _)| i);

@@ -21,16 +21,36 @@ impl NameTable {
     pub fn build(source: &SourceFile, doc: &Document, diags: &mut Diagnostics) -> NameTable {
         let mut table = NameTable::default();
         let mut all: Vec<(&str, &'static str, Span)> = Vec::new();
-        all.extend(doc.parameters.iter().map(|p| (p.name.text.as_str(), "parameter", p.name.span)));
-        all.extend(doc.basis.iter().map(|b| (b.name.text.as_str(), "basis coordinate", b.name.span)));
+        all.extend(
+            doc.parameters
+                .iter()
+                .map(|p| (p.name.text.as_str(), "parameter", p.name.span)),
+        );
+        all.extend(
+            doc.basis
+                .iter()
+                .map(|b| (b.name.text.as_str(), "basis coordinate", b.name.span)),
+        );
         all.extend(
             doc.coordinate_systems
                 .iter()
                 .map(|c| (c.name.text.as_str(), "coordinate system", c.name.span)),
         );
-        all.extend(doc.objects.iter().map(|o| (o.name.text.as_str(), o.kind.element(), o.name.span)));
-        all.extend(doc.subdomains.iter().map(|s| (s.name.text.as_str(), "subdomain", s.name.span)));
-        all.extend(doc.boundaries.iter().map(|b| (b.name.text.as_str(), "boundary", b.name.span)));
+        all.extend(
+            doc.objects
+                .iter()
+                .map(|o| (o.name.text.as_str(), o.kind.element(), o.name.span)),
+        );
+        all.extend(
+            doc.subdomains
+                .iter()
+                .map(|s| (s.name.text.as_str(), "subdomain", s.name.span)),
+        );
+        all.extend(
+            doc.boundaries
+                .iter()
+                .map(|b| (b.name.text.as_str(), "boundary", b.name.span)),
+        );
         all.sort_by_key(|&(_, _, span)| span);
         for (name, kind, span) in all {
             if name.is_empty() {
@@ -42,7 +62,10 @@ impl NameTable {
                     Diagnostic::new(
                         Code::DuplicateName,
                         span,
-                        format!("the name '{name}' is already used by the {} on line {line}", first.kind),
+                        format!(
+                            "the name '{name}' is already used by the {} on line {line}",
+                            first.kind
+                        ),
                     )
                     .with_help("names are global across all objects; rename one of them"),
                 );
@@ -61,7 +84,9 @@ impl NameTable {
                     )),
                 );
             }
-            table.defs.insert(name.to_string(), Definition { kind, span });
+            table
+                .defs
+                .insert(name.to_string(), Definition { kind, span });
         }
         table
     }
@@ -81,7 +106,13 @@ pub fn is_plain_name(name: &str) -> bool {
 fn plain_version(name: &str) -> String {
     let mut out: String = name
         .chars()
-        .map(|c| if c.is_alphanumeric() || c == '-' { c } else { '_' })
+        .map(|c| {
+            if c.is_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
         .collect();
     if out.starts_with(|c: char| c.is_ascii_digit() || c == '-') {
         out.insert(0, '_');

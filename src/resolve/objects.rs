@@ -2,12 +2,11 @@
 //! transforms), evaluates points and vectors in their coordinate systems, and
 //! hands each primitive to [`super::shapes`].
 
-
+use super::ResolvedObject;
 use super::geometry::{Geometry, Link};
 use super::names::NameTable;
 use super::values::{Ctx, Values};
-use super::ResolvedObject;
-use crate::diag::{did_you_mean, Code, Diagnostic, Diagnostics};
+use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::doc::{Axis, CoordinateSystem, Document, Number, Object, PointSpec, Ref, VectorSpec};
 use crate::geom::{Frame, Point3, Vec3};
 use std::collections::HashMap;
@@ -36,7 +35,12 @@ pub(super) struct Resolver<'a> {
 }
 
 impl<'a> Resolver<'a> {
-    pub fn new(doc: &'a Document, names: &'a NameTable, values: Values, diags: &'a mut Diagnostics) -> Self {
+    pub fn new(
+        doc: &'a Document,
+        names: &'a NameTable,
+        values: Values,
+        diags: &'a mut Diagnostics,
+    ) -> Self {
         let mut by_name = HashMap::new();
         for (i, o) in doc.objects.iter().enumerate() {
             by_name.entry(o.name.text.as_str()).or_insert(i);
@@ -101,9 +105,15 @@ impl<'a> Resolver<'a> {
                     Diagnostic::new(
                         Code::ReferenceCycle,
                         object.name.span,
-                        format!("{} '{}' is defined through itself", object.kind.element(), object.name.text),
+                        format!(
+                            "{} '{}' is defined through itself",
+                            object.kind.element(),
+                            object.name.text
+                        ),
                     )
-                    .with_help("a transform or reference chain leads back to this object; break the chain"),
+                    .with_help(
+                        "a transform or reference chain leads back to this object; break the chain",
+                    ),
                 );
                 self.state[i] = Some(State::Done(None));
                 return None;
@@ -145,10 +155,12 @@ impl<'a> Resolver<'a> {
                         reference.span,
                         format!("undefined coordinate system '{name}'"),
                     );
-                    d.help = Some(match did_you_mean(name, self.systems.keys().map(String::as_str)) {
-                        Some(best) => format!("did you mean '{best}'?"),
-                        None => format!("define it with <coordinate_system name=\"{name}\">"),
-                    });
+                    d.help = Some(
+                        match did_you_mean(name, self.systems.keys().map(String::as_str)) {
+                            Some(best) => format!("did you mean '{best}'?"),
+                            None => format!("define it with <coordinate_system name=\"{name}\">"),
+                        },
+                    );
                     d
                 }
             };
@@ -162,7 +174,9 @@ impl<'a> Resolver<'a> {
                     Diagnostic::new(
                         Code::ReferenceCycle,
                         cs.name.span,
-                        format!("coordinate system '{name}' lies inside itself through its cs= chain"),
+                        format!(
+                            "coordinate system '{name}' lies inside itself through its cs= chain"
+                        ),
                     )
                     .with_help("remove cs= from one of the systems in the chain"),
                 );
@@ -190,9 +204,13 @@ impl<'a> Resolver<'a> {
                 None => Vec3::zeros(),
             };
             let rotation = Frame::rotation_degrees(angles);
-            Some(Frame { origin, linear: parent.linear * rotation.linear })
+            Some(Frame {
+                origin,
+                linear: parent.linear * rotation.linear,
+            })
         });
-        self.frames.insert(name.to_string(), FrameState::Done(frame));
+        self.frames
+            .insert(name.to_string(), FrameState::Done(frame));
         frame
     }
 
@@ -211,7 +229,11 @@ impl<'a> Resolver<'a> {
                     Diagnostic::new(
                         Code::ConflictingForms,
                         spec.span,
-                        format!("<{}> gives both coordinates and point=\"{}\"", self.tag(spec), reference.text),
+                        format!(
+                            "<{}> gives both coordinates and point=\"{}\"",
+                            self.tag(spec),
+                            reference.text
+                        ),
                     )
                     .with_help("give either x/y/z or point=, not both"),
                 );
@@ -230,19 +252,34 @@ impl<'a> Resolver<'a> {
             );
             return None;
         }
-        let local = vector3(&mut self.values, spec.x.as_ref(), spec.y.as_ref(), spec.z.as_ref(), true, self.diags)?;
+        let local = vector3(
+            &mut self.values,
+            spec.x.as_ref(),
+            spec.y.as_ref(),
+            spec.z.as_ref(),
+            true,
+            self.diags,
+        )?;
         let missing_z = spec.z.is_none() && self.doc.dimension == 3;
         if need3 && (spec.x.is_none() || spec.y.is_none() || missing_z) {
-            let missing: Vec<&str> = [("x", spec.x.is_none()), ("y", spec.y.is_none()), ("z", missing_z)]
-                .iter()
-                .filter(|(_, m)| *m)
-                .map(|(n, _)| *n)
-                .collect();
+            let missing: Vec<&str> = [
+                ("x", spec.x.is_none()),
+                ("y", spec.y.is_none()),
+                ("z", missing_z),
+            ]
+            .iter()
+            .filter(|(_, m)| *m)
+            .map(|(n, _)| *n)
+            .collect();
             self.diags.push(
                 Diagnostic::new(
                     Code::PointValueShape,
                     spec.span,
-                    format!("<{}> gives no {}; taken as 0", self.tag(spec), missing.join(", ")),
+                    format!(
+                        "<{}> gives no {}; taken as 0",
+                        self.tag(spec),
+                        missing.join(", ")
+                    ),
                 )
                 .with_help("give all three coordinates of a 3D point"),
             );
@@ -280,7 +317,10 @@ impl<'a> Resolver<'a> {
                             reference.span,
                             format!("point '{}' holds {n} points; say which one", reference.name),
                         )
-                        .with_help(format!("write {}[1] … {}[{n}]", reference.name, reference.name)),
+                        .with_help(format!(
+                            "write {}[1] … {}[{n}]",
+                            reference.name, reference.name
+                        )),
                     );
                     None
                 }
@@ -289,7 +329,11 @@ impl<'a> Resolver<'a> {
                         Diagnostic::new(
                             Code::IndexOutOfRange,
                             reference.span,
-                            format!("point '{}' has no member {k}: it holds {n} point{}", reference.name, if n == 1 { "" } else { "s" }),
+                            format!(
+                                "point '{}' has no member {k}: it holds {n} point{}",
+                                reference.name,
+                                if n == 1 { "" } else { "s" }
+                            ),
                         )
                         .with_help(format!("use an index from 1 to {n}")),
                     );
@@ -302,13 +346,27 @@ impl<'a> Resolver<'a> {
     }
 
     pub fn vector(&mut self, spec: &VectorSpec, frame: &Frame) -> Option<Vec3> {
-        let v = vector3(&mut self.values, spec.x.as_ref(), spec.y.as_ref(), spec.z.as_ref(), true, self.diags)?;
+        let v = vector3(
+            &mut self.values,
+            spec.x.as_ref(),
+            spec.y.as_ref(),
+            spec.z.as_ref(),
+            true,
+            self.diags,
+        )?;
         Some(frame.linear * v)
     }
 
     /// A vector of plain numbers (angles, scale factors): basis coordinates not allowed.
     pub fn numbers3(&mut self, spec: &VectorSpec) -> Option<Vec3> {
-        vector3(&mut self.values, spec.x.as_ref(), spec.y.as_ref(), spec.z.as_ref(), false, self.diags)
+        vector3(
+            &mut self.values,
+            spec.x.as_ref(),
+            spec.y.as_ref(),
+            spec.z.as_ref(),
+            false,
+            self.diags,
+        )
     }
 
     // ---- references ----
@@ -321,7 +379,11 @@ impl<'a> Resolver<'a> {
                 Some(kind) => Diagnostic::new(
                     Code::WrongKind,
                     reference.span,
-                    format!("'{}' is a {kind}, but a {} is expected here", reference.name, kinds.join(" or ")),
+                    format!(
+                        "'{}' is a {kind}, but a {} is expected here",
+                        reference.name,
+                        kinds.join(" or ")
+                    ),
                 )
                 .with_help(format!("name a {}", kinds.join(" or "))),
                 None => {
@@ -338,7 +400,9 @@ impl<'a> Resolver<'a> {
                         .map(|o| o.name.text.as_str());
                     d.help = Some(match did_you_mean(&reference.name, candidates) {
                         Some(best) => format!("did you mean '{best}'?"),
-                        None => format!("define a {} named '{}'", kinds.join(" or "), reference.name),
+                        None => {
+                            format!("define a {} named '{}'", kinds.join(" or "), reference.name)
+                        }
                     });
                     d
                 }
@@ -353,7 +417,11 @@ impl<'a> Resolver<'a> {
                 Diagnostic::new(
                     Code::WrongKind,
                     reference.span,
-                    format!("'{}' is a {element}, but a {} is expected here", reference.name, kinds.join(" or ")),
+                    format!(
+                        "'{}' is a {element}, but a {} is expected here",
+                        reference.name,
+                        kinds.join(" or ")
+                    ),
                 )
                 .with_help(format!("name a {}", kinds.join(" or "))),
             );
@@ -363,7 +431,11 @@ impl<'a> Resolver<'a> {
     }
 
     /// Resolves a reference to geometry, picking a replicate's member when indexed.
-    pub fn linked_geometry(&mut self, reference: &Ref, kinds: &[&str]) -> Option<(usize, Geometry)> {
+    pub fn linked_geometry(
+        &mut self,
+        reference: &Ref,
+        kinds: &[&str],
+    ) -> Option<(usize, Geometry)> {
         let i = self.lookup(reference, kinds)?;
         let g = self.geometry(i)?;
         match (g, reference.index) {
@@ -374,7 +446,11 @@ impl<'a> Resolver<'a> {
                         Diagnostic::new(
                             Code::IndexOutOfRange,
                             reference.span,
-                            format!("'{}' has {} members; there is no [{k}]", reference.name, members.len()),
+                            format!(
+                                "'{}' has {} members; there is no [{k}]",
+                                reference.name,
+                                members.len()
+                            ),
                         )
                         .with_help(format!("use an index from 1 to {}", members.len())),
                     );
@@ -386,14 +462,24 @@ impl<'a> Resolver<'a> {
             (g, Some(k)) => {
                 if let Geometry::Points { points, partial } = &g {
                     if k >= 1 && k <= points.len() {
-                        return Some((i, Geometry::Points { points: vec![points[k - 1]], partial: vec![partial[k - 1]] }));
+                        return Some((
+                            i,
+                            Geometry::Points {
+                                points: vec![points[k - 1]],
+                                partial: vec![partial[k - 1]],
+                            },
+                        ));
                     }
                 }
                 self.diags.push(
                     Diagnostic::new(
                         Code::IndexOutOfRange,
                         reference.span,
-                        format!("'{}' is a single {}; it has no member [{k}]", reference.name, g.kind()),
+                        format!(
+                            "'{}' is a single {}; it has no member [{k}]",
+                            reference.name,
+                            g.kind()
+                        ),
                     )
                     .with_help(format!("write '{}' without an index", reference.name)),
                 );
@@ -404,7 +490,10 @@ impl<'a> Resolver<'a> {
 
     pub fn link(&mut self, reference: &Ref, kinds: &[&str]) -> Option<Link> {
         let i = self.lookup(reference, kinds)?;
-        Some(Link { object: i, span: reference.span })
+        Some(Link {
+            object: i,
+            span: reference.span,
+        })
     }
 }
 
@@ -420,9 +509,16 @@ fn vector3(
 ) -> Option<Vec3> {
     let mut out = Vec3::zeros();
     let mut ok = true;
-    for (slot, (n, axis)) in [(x, Axis::X), (y, Axis::Y), (z, Axis::Z)].into_iter().enumerate() {
+    for (slot, (n, axis)) in [(x, Axis::X), (y, Axis::Y), (z, Axis::Z)]
+        .into_iter()
+        .enumerate()
+    {
         if let Some(n) = n {
-            let ctx = if coordinates { Ctx::Coordinate(axis) } else { Ctx::Any };
+            let ctx = if coordinates {
+                Ctx::Coordinate(axis)
+            } else {
+                Ctx::Any
+            };
             match values.eval(n, ctx, diags) {
                 Some(v) => out[slot] = v,
                 None => ok = false,

@@ -5,9 +5,14 @@
 use super::geometry::{Geometry, LineCarrier, Link};
 use super::objects::Resolver;
 use crate::diag::{Code, Diagnostic};
-use crate::doc::{LineSpec, Number, Object, ObjectKind, ParallelepipedForm, PointSpec, Ref, Step, SurfaceSpec, VertexSpec};
+use crate::doc::{
+    LineSpec, Number, Object, ObjectKind, ParallelepipedForm, PointSpec, Ref, Step, SurfaceSpec,
+    VertexSpec,
+};
 use crate::expr::{Expr, ExprKind};
-use crate::geom::{intersect_curves, intersect_surfaces, Curve, Frame, Mat3, Point3, SolidShape, Surface, Vec3};
+use crate::geom::{
+    Curve, Frame, Mat3, Point3, SolidShape, Surface, Vec3, intersect_curves, intersect_surfaces,
+};
 use crate::span::Span;
 
 /// Relative tolerance of degeneracy tests at resolution time.
@@ -33,23 +38,40 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             Some(Geometry::Solid(SolidShape::Disk {
                 frame: Frame {
                     origin: c,
-                    linear: Mat3::from_columns(&[axes.column(0) * radius, axes.column(1) * radius, axes.column(2).into_owned()]),
+                    linear: Mat3::from_columns(&[
+                        axes.column(0) * radius,
+                        axes.column(1) * radius,
+                        axes.column(2).into_owned(),
+                    ]),
                 },
             }))
         }
-        ObjectKind::Ellipse { center, radius_vertices } => {
+        ObjectKind::Ellipse {
+            center,
+            radius_vertices,
+        } => {
             let c = r.point(center.as_ref()?, frame, false)?;
-            let [v1, v2] = radius_vertices.as_slice() else { return None };
+            let [v1, v2] = radius_vertices.as_slice() else {
+                return None;
+            };
             let p1 = r.point(v1, frame, false)?;
             let p2 = r.point(v2, frame, false)?;
             let a = p1 - c;
             let mut b = p2 - c;
             let scale = a.norm().max(b.norm());
             if a.norm() <= REL * scale.max(1.0) || b.norm() <= REL * scale.max(1.0) {
-                let span = if a.norm() <= REL * scale.max(1.0) { v1.span } else { v2.span };
+                let span = if a.norm() <= REL * scale.max(1.0) {
+                    v1.span
+                } else {
+                    v2.span
+                };
                 r.diags.push(
-                    Diagnostic::new(Code::CoincidentPoints, span, format!("a radius vertex of ellipse '{name}' coincides with its centre"))
-                        .with_help("give the ends of the two semi-axes, away from the centre"),
+                    Diagnostic::new(
+                        Code::CoincidentPoints,
+                        span,
+                        format!("a radius vertex of ellipse '{name}' coincides with its centre"),
+                    )
+                    .with_help("give the ends of the two semi-axes, away from the centre"),
                 );
                 return None;
             }
@@ -72,31 +94,62 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             }
             let n = a.cross(&b).normalize();
             Some(Geometry::Solid(SolidShape::Disk {
-                frame: Frame { origin: c, linear: Mat3::from_columns(&[a, b, n]) },
+                frame: Frame {
+                    origin: c,
+                    linear: Mat3::from_columns(&[a, b, n]),
+                },
             }))
         }
         ObjectKind::Triangle { vertices } => {
-            let [v1, v2, v3] = vertices.as_slice() else { return None };
-            let p = [r.point(v1, frame, false)?, r.point(v2, frame, false)?, r.point(v3, frame, false)?];
+            let [v1, v2, v3] = vertices.as_slice() else {
+                return None;
+            };
+            let p = [
+                r.point(v1, frame, false)?,
+                r.point(v2, frame, false)?,
+                r.point(v3, frame, false)?,
+            ];
             let (a, b) = (p[1] - p[0], p[2] - p[0]);
-            if a.cross(&b).norm() <= 1e-9 * a.norm() * b.norm() || a.norm() == 0.0 || b.norm() == 0.0 {
+            if a.cross(&b).norm() <= 1e-9 * a.norm() * b.norm()
+                || a.norm() == 0.0
+                || b.norm() == 0.0
+            {
                 r.diags.push(
-                    Diagnostic::new(Code::CollinearPoints, object.span, format!("the three vertices of triangle '{name}' lie on one line"))
-                        .with_help("move one vertex off the line through the other two"),
+                    Diagnostic::new(
+                        Code::CollinearPoints,
+                        object.span,
+                        format!("the three vertices of triangle '{name}' lie on one line"),
+                    )
+                    .with_help("move one vertex off the line through the other two"),
                 );
                 return None;
             }
             let n = a.cross(&b).normalize();
             Some(Geometry::Solid(SolidShape::Polygon {
-                frame: Frame { origin: p[0], linear: Mat3::from_columns(&[a, b, n]) },
-                vertices: vec![Point3::new(0.0, 0.0, 0.0), Point3::new(1.0, 0.0, 0.0), Point3::new(0.0, 1.0, 0.0)],
+                frame: Frame {
+                    origin: p[0],
+                    linear: Mat3::from_columns(&[a, b, n]),
+                },
+                vertices: vec![
+                    Point3::new(0.0, 0.0, 0.0),
+                    Point3::new(1.0, 0.0, 0.0),
+                    Point3::new(0.0, 1.0, 0.0),
+                ],
             }))
         }
         ObjectKind::Parallelogram { base, vertices } => {
             let o = r.point(base.as_ref()?, frame, false)?;
-            let [v1, v2] = vertices.as_slice() else { return None };
-            let (a, b) = (r.point(v1, frame, false)? - o, r.point(v2, frame, false)? - o);
-            if a.cross(&b).norm() <= 1e-9 * a.norm() * b.norm() || a.norm() == 0.0 || b.norm() == 0.0 {
+            let [v1, v2] = vertices.as_slice() else {
+                return None;
+            };
+            let (a, b) = (
+                r.point(v1, frame, false)? - o,
+                r.point(v2, frame, false)? - o,
+            );
+            if a.cross(&b).norm() <= 1e-9 * a.norm() * b.norm()
+                || a.norm() == 0.0
+                || b.norm() == 0.0
+            {
                 r.diags.push(
                     Diagnostic::new(Code::CollinearPoints, object.span, format!("the base point and vertices of parallelogram '{name}' lie on one line"))
                         .with_help("the two vertices are the ends of two non-parallel edges from the base point"),
@@ -105,7 +158,10 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             }
             let n = a.cross(&b).normalize();
             Some(Geometry::Solid(SolidShape::Polygon {
-                frame: Frame { origin: o, linear: Mat3::from_columns(&[a, b, n]) },
+                frame: Frame {
+                    origin: o,
+                    linear: Mat3::from_columns(&[a, b, n]),
+                },
                 vertices: vec![
                     Point3::new(0.0, 0.0, 0.0),
                     Point3::new(1.0, 0.0, 0.0),
@@ -146,7 +202,12 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             }
             Some(Geometry::Polyline { points })
         }
-        ObjectKind::TruncatedCone { bottom_center, top_center, bottom_radius, top_radius } => {
+        ObjectKind::TruncatedCone {
+            bottom_center,
+            top_center,
+            bottom_radius,
+            top_radius,
+        } => {
             let bc = r.point(bottom_center.as_ref()?, frame, need3)?;
             let tc = r.point(top_center.as_ref()?, frame, need3)?;
             let rb = non_negative(r, bottom_radius.as_ref()?, "bottom_radius", name)?;
@@ -174,14 +235,23 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             }
             if rb == 0.0 && rt == 0.0 {
                 r.diags.push(
-                    Diagnostic::new(Code::DegenerateCone, object.span, format!("truncated_cone '{name}' has both radii zero"))
-                        .with_help("give at least one of bottom_radius and top_radius a positive value"),
+                    Diagnostic::new(
+                        Code::DegenerateCone,
+                        object.span,
+                        format!("truncated_cone '{name}' has both radii zero"),
+                    )
+                    .with_help(
+                        "give at least one of bottom_radius and top_radius a positive value",
+                    ),
                 );
                 return None;
             }
             let (x, y) = perpendicular_pair(&axis, &frame.linear.column(0).into_owned());
             Some(Geometry::Solid(SolidShape::Cone {
-                frame: Frame { origin: bc, linear: Mat3::from_columns(&[x, y, axis]) },
+                frame: Frame {
+                    origin: bc,
+                    linear: Mat3::from_columns(&[x, y, axis]),
+                },
                 r0: rb,
                 r1: rt,
             }))
@@ -191,7 +261,10 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             let c = r.point(center.as_ref()?, frame, need3)?;
             let radius = positive(r, radius.as_ref()?, "radius", name)?;
             Some(Geometry::Solid(SolidShape::Ball {
-                frame: Frame { origin: c, linear: frame.linear * radius },
+                frame: Frame {
+                    origin: c,
+                    linear: frame.linear * radius,
+                },
             }))
         }
         ObjectKind::Ellipsoid { center, semi_axes } => {
@@ -200,16 +273,33 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             let axes = r.numbers3(spec)?;
             if axes.iter().any(|&v| v <= 0.0) {
                 r.diags.push(
-                    Diagnostic::new(Code::NonPositiveSize, spec.span, format!("ellipsoid '{name}' has semi-axes ({}, {}, {}); all must be positive", fmt(axes.x), fmt(axes.y), fmt(axes.z)))
-                        .with_help("give x=, y= and z= of <semi_axes> positive values"),
+                    Diagnostic::new(
+                        Code::NonPositiveSize,
+                        spec.span,
+                        format!(
+                            "ellipsoid '{name}' has semi-axes ({}, {}, {}); all must be positive",
+                            fmt(axes.x),
+                            fmt(axes.y),
+                            fmt(axes.z)
+                        ),
+                    )
+                    .with_help("give x=, y= and z= of <semi_axes> positive values"),
                 );
                 return None;
             }
             Some(Geometry::Solid(SolidShape::Ball {
-                frame: Frame { origin: c, linear: frame.linear * Mat3::from_diagonal(&axes) },
+                frame: Frame {
+                    origin: c,
+                    linear: frame.linear * Mat3::from_diagonal(&axes),
+                },
             }))
         }
-        ObjectKind::Torus { center, major, minor, axis } => {
+        ObjectKind::Torus {
+            center,
+            major,
+            minor,
+            axis,
+        } => {
             let c = r.point(center.as_ref()?, frame, need3)?;
             let major_r = positive(r, major.as_ref()?, "major_radius", name)?;
             let minor_r = positive(r, minor.as_ref()?, "minor_radius", name)?;
@@ -218,7 +308,11 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
                     Diagnostic::new(
                         Code::SelfIntersectingTorus,
                         minor.as_ref().map_or(object.span, |n| n.span),
-                        format!("torus '{name}' has minor_radius {} not smaller than major_radius {}", fmt(minor_r), fmt(major_r)),
+                        format!(
+                            "torus '{name}' has minor_radius {} not smaller than major_radius {}",
+                            fmt(minor_r),
+                            fmt(major_r)
+                        ),
                     )
                     .with_help("make minor_radius smaller than major_radius"),
                 );
@@ -230,7 +324,10 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             };
             let (x, y) = perpendicular_pair(&axis_dir, &frame.linear.column(0).into_owned());
             Some(Geometry::Solid(SolidShape::Torus {
-                frame: Frame { origin: c, linear: Mat3::from_columns(&[x, y, axis_dir.normalize()]) },
+                frame: Frame {
+                    origin: c,
+                    linear: Mat3::from_columns(&[x, y, axis_dir.normalize()]),
+                },
                 major: major_r,
                 minor: minor_r,
             }))
@@ -239,14 +336,21 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             let origin = r.point(base.as_ref()?, frame, need3)?;
             let spec = normal.as_ref()?;
             let n = nonzero_vector(r, spec, frame, "normal", name)?;
-            Some(Geometry::Surface(Surface::Plane { origin, normal: n.normalize() }))
+            Some(Geometry::Surface(Surface::Plane {
+                origin,
+                normal: n.normalize(),
+            }))
         }
         ObjectKind::Transform { target, steps } => {
             let (_, geometry) = r.linked_geometry(target.as_ref()?, &["*"])?;
             let map = steps_map(r, steps, name)?;
             transformed(r, &geometry, &map, target.as_ref()?, name)
         }
-        ObjectKind::Replicate { target, count, steps } => {
+        ObjectKind::Replicate {
+            target,
+            count,
+            steps,
+        } => {
             let target = target.as_ref()?;
             let (_, geometry) = r.linked_geometry(target, &["*"])?;
             let count_spec = count.as_ref()?;
@@ -287,7 +391,17 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             Some(Geometry::Edge { line, begin, end })
         }
         ObjectKind::Face { surface, loops, .. } => {
-            let surface = r.link(surface.as_ref()?, &["surface", "plane", "sphere", "ellipsoid", "truncated_cone", "torus"])?;
+            let surface = r.link(
+                surface.as_ref()?,
+                &[
+                    "surface",
+                    "plane",
+                    "sphere",
+                    "ellipsoid",
+                    "truncated_cone",
+                    "torus",
+                ],
+            )?;
             let mut out = Vec::new();
             let mut ok = true;
             for l in loops {
@@ -308,19 +422,33 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
                 }
                 out.push(edges);
             }
-            ok.then_some(Geometry::Face { surface, loops: out })
+            ok.then_some(Geometry::Face {
+                surface,
+                loops: out,
+            })
         }
     }
 }
 
-fn parallelepiped(r: &mut Resolver, object: &Object, form: &ParallelepipedForm, frame: &Frame) -> Option<Geometry> {
+fn parallelepiped(
+    r: &mut Resolver,
+    object: &Object,
+    form: &ParallelepipedForm,
+    frame: &Frame,
+) -> Option<Geometry> {
     let name = object.name.text.as_str();
     let need3 = r.doc.dimension == 3;
     let (origin, edges) = match form {
         ParallelepipedForm::Edges { base, vertices } => {
             let o = r.point(base, frame, need3)?;
-            let [v1, v2, v3] = vertices.as_slice() else { return None };
-            let a = [r.point(v1, frame, need3)? - o, r.point(v2, frame, need3)? - o, r.point(v3, frame, need3)? - o];
+            let [v1, v2, v3] = vertices.as_slice() else {
+                return None;
+            };
+            let a = [
+                r.point(v1, frame, need3)? - o,
+                r.point(v2, frame, need3)? - o,
+                r.point(v3, frame, need3)? - o,
+            ];
             (o, a)
         }
         ParallelepipedForm::Corners { first, second } => {
@@ -332,7 +460,11 @@ fn parallelepiped(r: &mut Resolver, object: &Object, form: &ParallelepipedForm, 
             let lo = lp.inf(&lq);
             let d = lp.sup(&lq) - lo;
             let o = frame.to_global(&lo);
-            let cols = [frame.linear.column(0) * d.x, frame.linear.column(1) * d.y, frame.linear.column(2) * d.z];
+            let cols = [
+                frame.linear.column(0) * d.x,
+                frame.linear.column(1) * d.y,
+                frame.linear.column(2) * d.z,
+            ];
             (o, cols)
         }
     };
@@ -340,8 +472,12 @@ fn parallelepiped(r: &mut Resolver, object: &Object, form: &ParallelepipedForm, 
     let det = Mat3::from_columns(&edges).determinant();
     if lengths.contains(&0.0) || det.abs() <= 1e-9 * lengths.iter().product::<f64>() {
         let detail = match form {
-            ParallelepipedForm::Corners { .. } => "its two corners share a coordinate, so it is flat".to_string(),
-            ParallelepipedForm::Edges { .. } => "its three edge vectors are coplanar, so it has no volume".to_string(),
+            ParallelepipedForm::Corners { .. } => {
+                "its two corners share a coordinate, so it is flat".to_string()
+            }
+            ParallelepipedForm::Edges { .. } => {
+                "its three edge vectors are coplanar, so it has no volume".to_string()
+            }
         };
         r.diags.push(
             Diagnostic::new(Code::DegenerateParallelepiped, object.span, format!("parallelepiped '{name}' is degenerate: {detail}"))
@@ -349,22 +485,40 @@ fn parallelepiped(r: &mut Resolver, object: &Object, form: &ParallelepipedForm, 
         );
         return None;
     }
-    Some(Geometry::Solid(SolidShape::Box { frame: Frame { origin, linear: Mat3::from_columns(&edges) } }))
+    Some(Geometry::Solid(SolidShape::Box {
+        frame: Frame {
+            origin,
+            linear: Mat3::from_columns(&edges),
+        },
+    }))
 }
 
-fn surface(r: &mut Resolver, spec: &SurfaceSpec, object: &Object, frame: &Frame) -> Option<Geometry> {
+fn surface(
+    r: &mut Resolver,
+    spec: &SurfaceSpec,
+    object: &Object,
+    frame: &Frame,
+) -> Option<Geometry> {
     let name = object.name.text.as_str();
     let s = match spec {
         SurfaceSpec::Plane { base, normal } => {
             let origin = r.point(base.as_ref()?, frame, true)?;
             let n_spec = normal.as_ref()?;
             let n = nonzero_vector(r, n_spec, frame, "normal", name)?;
-            Surface::Plane { origin, normal: n.normalize() }
+            Surface::Plane {
+                origin,
+                normal: n.normalize(),
+            }
         }
         SurfaceSpec::Sphere { center, radius } => {
             let c = r.point(center.as_ref()?, frame, true)?;
             let radius = positive(r, radius.as_ref()?, "radius", name)?;
-            Surface::Ellipsoid { frame: Frame { origin: c, linear: frame.linear * radius } }
+            Surface::Ellipsoid {
+                frame: Frame {
+                    origin: c,
+                    linear: frame.linear * radius,
+                },
+            }
         }
         SurfaceSpec::Cylinder { base, axis, radius } => {
             let o = r.point(base.as_ref()?, frame, true)?;
@@ -372,9 +526,20 @@ fn surface(r: &mut Resolver, spec: &SurfaceSpec, object: &Object, frame: &Frame)
             let a = nonzero_vector(r, a_spec, frame, "axis", name)?.normalize();
             let radius = positive(r, radius.as_ref()?, "radius", name)?;
             let (x, y) = perpendicular_pair(&a, &frame.linear.column(0).into_owned());
-            Surface::Cone { frame: Frame { origin: o, linear: Mat3::from_columns(&[x, y, a]) }, r0: radius, r1: radius }
+            Surface::Cone {
+                frame: Frame {
+                    origin: o,
+                    linear: Mat3::from_columns(&[x, y, a]),
+                },
+                r0: radius,
+                r1: radius,
+            }
         }
-        SurfaceSpec::Cone { apex, axis, half_angle } => {
+        SurfaceSpec::Cone {
+            apex,
+            axis,
+            half_angle,
+        } => {
             let o = r.point(apex.as_ref()?, frame, true)?;
             let a_spec = axis.as_ref()?;
             let a = nonzero_vector(r, a_spec, frame, "axis", name)?.normalize();
@@ -388,7 +553,14 @@ fn surface(r: &mut Resolver, spec: &SurfaceSpec, object: &Object, frame: &Frame)
                 return None;
             }
             let (x, y) = perpendicular_pair(&a, &frame.linear.column(0).into_owned());
-            Surface::Cone { frame: Frame { origin: o, linear: Mat3::from_columns(&[x, y, a]) }, r0: 0.0, r1: angle.to_radians().tan() }
+            Surface::Cone {
+                frame: Frame {
+                    origin: o,
+                    linear: Mat3::from_columns(&[x, y, a]),
+                },
+                r0: 0.0,
+                r1: angle.to_radians().tan(),
+            }
         }
         SurfaceSpec::Quadric { coefficients, span } => {
             let mut c = [0.0; 10];
@@ -399,23 +571,35 @@ fn surface(r: &mut Resolver, spec: &SurfaceSpec, object: &Object, frame: &Frame)
             }
             if c[..9].iter().all(|&v| v == 0.0) {
                 r.diags.push(
-                    Diagnostic::new(Code::ZeroVector, *span, format!("quadric '{name}' has all coefficients of x, y and z zero"))
-                        .with_help("give at least one non-zero coefficient"),
+                    Diagnostic::new(
+                        Code::ZeroVector,
+                        *span,
+                        format!("quadric '{name}' has all coefficients of x, y and z zero"),
+                    )
+                    .with_help("give at least one non-zero coefficient"),
                 );
                 return None;
             }
-            Surface::Quadric { coefficients: transform_quadric(&c, frame) }
+            Surface::Quadric {
+                coefficients: transform_quadric(&c, frame),
+            }
         }
         SurfaceSpec::Implicit { equation } => {
             let eq = equation.as_ref()?;
             if object.cs.is_some() {
                 r.diags.push(
-                    Diagnostic::new(Code::ConflictingForms, object.span, format!("surface '{name}': cs= does not apply to an <implicit> equation"))
-                        .with_help("write the equation in global x, y, z and remove cs="),
+                    Diagnostic::new(
+                        Code::ConflictingForms,
+                        object.span,
+                        format!("surface '{name}': cs= does not apply to an <implicit> equation"),
+                    )
+                    .with_help("write the equation in global x, y, z and remove cs="),
                 );
                 return None;
             }
-            Surface::Implicit { expr: fold_parameters(r, eq.expr.as_ref()?)? }
+            Surface::Implicit {
+                expr: fold_parameters(r, eq.expr.as_ref()?)?,
+            }
         }
     };
     Some(Geometry::Surface(s))
@@ -431,21 +615,36 @@ fn line(r: &mut Resolver, spec: &LineSpec, object: &Object, frame: &Frame) -> Op
                 Some(spec) => nonzero_vector(r, spec, frame, "normal", name)?,
                 None => frame.linear.column(2).into_owned(),
             };
-            LineCarrier::Circle { center: c, normal: n.normalize() }
+            LineCarrier::Circle {
+                center: c,
+                normal: n.normalize(),
+            }
         }
-        LineSpec::EllipseArc { center, radius_vertices } => {
+        LineSpec::EllipseArc {
+            center,
+            radius_vertices,
+        } => {
             let c = r.point(center.as_ref()?, frame, true)?;
-            let [v1, v2] = radius_vertices.as_slice() else { return None };
+            let [v1, v2] = radius_vertices.as_slice() else {
+                return None;
+            };
             let major = r.point(v1, frame, true)? - c;
             let minor = r.point(v2, frame, true)? - c;
-            if major.cross(&minor).norm() <= 1e-9 * major.norm() * minor.norm() || major.norm() == 0.0 || minor.norm() == 0.0 {
+            if major.cross(&minor).norm() <= 1e-9 * major.norm() * minor.norm()
+                || major.norm() == 0.0
+                || minor.norm() == 0.0
+            {
                 r.diags.push(
                     Diagnostic::new(Code::DegenerateCurve, object.span, format!("ellipse_arc '{name}': the two radius vertices and the centre lie on one line"))
                         .with_help("give the ends of two non-parallel semi-axes"),
                 );
                 return None;
             }
-            LineCarrier::Ellipse { center: c, major, minor }
+            LineCarrier::Ellipse {
+                center: c,
+                major,
+                minor,
+            }
         }
         LineSpec::Intersection { surfaces, span } => {
             let [a, b] = surfaces.as_slice() else {
@@ -457,7 +656,9 @@ fn line(r: &mut Resolver, spec: &LineSpec, object: &Object, frame: &Frame) -> Op
             };
             let sa = surface_of(r, a)?;
             let sb = surface_of(r, b)?;
-            LineCarrier::Intersection { surfaces: Box::new([sa, sb]) }
+            LineCarrier::Intersection {
+                surfaces: Box::new([sa, sb]),
+            }
         }
     }))
 }
@@ -466,11 +667,22 @@ fn vertex(r: &mut Resolver, spec: &VertexSpec, object: &Object, frame: &Frame) -
     let name = object.name.text.as_str();
     match spec {
         VertexSpec::Coordinates(p) => Some(Geometry::Vertex(r.point(p, frame, true)?)),
-        VertexSpec::Surfaces { surfaces, near, span } => {
+        VertexSpec::Surfaces {
+            surfaces,
+            near,
+            span,
+        } => {
             let [a, b, c] = surfaces.as_slice() else {
                 r.diags.push(
-                    Diagnostic::new(Code::MissingAttribute, *span, format!("vertex '{name}' names {} surfaces; an intersection vertex needs three", surfaces.len()))
-                        .with_help("write surfaces=\"s1 s2 s3\""),
+                    Diagnostic::new(
+                        Code::MissingAttribute,
+                        *span,
+                        format!(
+                            "vertex '{name}' names {} surfaces; an intersection vertex needs three",
+                            surfaces.len()
+                        ),
+                    )
+                    .with_help("write surfaces=\"s1 s2 s3\""),
                 );
                 return None;
             };
@@ -491,21 +703,31 @@ fn vertex(r: &mut Resolver, spec: &VertexSpec, object: &Object, frame: &Frame) -
         VertexSpec::Lines { lines, near, span } => {
             let [a, b] = lines.as_slice() else {
                 r.diags.push(
-                    Diagnostic::new(Code::MissingAttribute, *span, format!("vertex '{name}' names {} lines; an intersection vertex needs two", lines.len()))
-                        .with_help("write lines=\"l1 l2\""),
+                    Diagnostic::new(
+                        Code::MissingAttribute,
+                        *span,
+                        format!(
+                            "vertex '{name}' names {} lines; an intersection vertex needs two",
+                            lines.len()
+                        ),
+                    )
+                    .with_help("write lines=\"l1 l2\""),
                 );
                 return None;
             };
             let hint = hint_point(r, near.as_ref(), frame)?;
-            if let (Some(sa), Some(sb)) = (intersection_surfaces(r, a), intersection_surfaces(r, b)) {
+            if let (Some(sa), Some(sb)) = (intersection_surfaces(r, a), intersection_surfaces(r, b))
+            {
                 // Two intersection lines meet where three of their four surfaces
                 // meet and the fourth passes through that point.
                 let tol = 1e-7 * hint.coords.norm().max(1.0);
                 let all = [&sa[0], &sa[1], &sb[0], &sb[1]];
-                let found = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)].iter().find_map(|&(i, j, k, rest)| {
-                    let p = intersect_surfaces([all[i], all[j], all[k]], hint, tol * 1e-2)?;
-                    (all[rest].distance(&p) <= tol).then_some(p)
-                });
+                let found = [(0, 1, 2, 3), (0, 1, 3, 2), (0, 2, 3, 1), (1, 2, 3, 0)]
+                    .iter()
+                    .find_map(|&(i, j, k, rest)| {
+                        let p = intersect_surfaces([all[i], all[j], all[k]], hint, tol * 1e-2)?;
+                        (all[rest].distance(&p) <= tol).then_some(p)
+                    });
                 return match found {
                     Some(p) => Some(Geometry::Vertex(p)),
                     None => {
@@ -544,16 +766,44 @@ fn hint_point(r: &mut Resolver, near: Option<&PointSpec>, frame: &Frame) -> Opti
 /// The surface a reference names: an explicit surface, a plane primitive, or
 /// the carrier of a one-surface solid (sphere, ellipsoid; a cone's side).
 pub(super) fn surface_of(r: &mut Resolver, reference: &Ref) -> Option<Surface> {
-    let (_, g) = r.linked_geometry(reference, &["surface", "plane", "sphere", "ellipsoid", "truncated_cone", "torus"])?;
+    let (_, g) = r.linked_geometry(
+        reference,
+        &[
+            "surface",
+            "plane",
+            "sphere",
+            "ellipsoid",
+            "truncated_cone",
+            "torus",
+        ],
+    )?;
     match g {
         Geometry::Surface(s) => Some(s),
         Geometry::Solid(SolidShape::Ball { frame }) => Some(Surface::Ellipsoid { frame }),
-        Geometry::Solid(SolidShape::Cone { frame, r0, r1 }) => Some(Surface::Cone { frame, r0, r1 }),
-        Geometry::Solid(SolidShape::Torus { frame, major, minor }) => Some(Surface::Torus { frame, major, minor }),
+        Geometry::Solid(SolidShape::Cone { frame, r0, r1 }) => {
+            Some(Surface::Cone { frame, r0, r1 })
+        }
+        Geometry::Solid(SolidShape::Torus {
+            frame,
+            major,
+            minor,
+        }) => Some(Surface::Torus {
+            frame,
+            major,
+            minor,
+        }),
         other => {
             r.diags.push(
-                Diagnostic::new(Code::WrongKind, reference.span, format!("'{}' is a {}, which is not one surface", reference.text, other.kind()))
-                    .with_help("name a <surface>, a plane, or a sphere"),
+                Diagnostic::new(
+                    Code::WrongKind,
+                    reference.span,
+                    format!(
+                        "'{}' is a {}, which is not one surface",
+                        reference.text,
+                        other.kind()
+                    ),
+                )
+                .with_help("name a <surface>, a plane, or a sphere"),
             );
             None
         }
@@ -574,22 +824,38 @@ fn intersection_surfaces(r: &mut Resolver, reference: &Ref) -> Option<Box<[Surfa
 fn curve_of(r: &mut Resolver, reference: &Ref) -> Option<Curve> {
     let (_, g) = r.linked_geometry(reference, &["line", "edge"])?;
     match g {
-        Geometry::Line(LineCarrier::Ellipse { center, major, minor }) => Some(Curve::Ellipse {
+        Geometry::Line(LineCarrier::Ellipse {
+            center,
+            major,
+            minor,
+        }) => Some(Curve::Ellipse {
             center,
             major,
             minor,
             t0: 0.0,
             t1: std::f64::consts::TAU,
         }),
-        Geometry::Edge { line: None, begin, end } => {
+        Geometry::Edge {
+            line: None,
+            begin,
+            end,
+        } => {
             let a = vertex_point(r, begin)?;
             let b = vertex_point(r, end)?;
             Some(Curve::Segment { a, b })
         }
         other => {
             r.diags.push(
-                Diagnostic::new(Code::WrongKind, reference.span, format!("'{}' is a {} whose position is not fixed by itself", reference.text, other.kind()))
-                    .with_help("name straight edges or ellipse_arc lines"),
+                Diagnostic::new(
+                    Code::WrongKind,
+                    reference.span,
+                    format!(
+                        "'{}' is a {} whose position is not fixed by itself",
+                        reference.text,
+                        other.kind()
+                    ),
+                )
+                .with_help("name straight edges or ellipse_arc lines"),
             );
             None
         }
@@ -618,13 +884,22 @@ fn steps_map(r: &mut Resolver, steps: &[Step], name: &str) -> Option<Frame> {
                             Geometry::Vertex(p) => p,
                             _ => {
                                 r.diags.push(
-                                    Diagnostic::new(Code::IndexOutOfRange, c.span, format!("center=\"{}\" holds several points; name one", c.text))
-                                        .with_help(format!("write {}[1]", c.name)),
+                                    Diagnostic::new(
+                                        Code::IndexOutOfRange,
+                                        c.span,
+                                        format!(
+                                            "center=\"{}\" holds several points; name one",
+                                            c.text
+                                        ),
+                                    )
+                                    .with_help(format!("write {}[1]", c.name)),
                                 );
                                 return None;
                             }
                         };
-                        Frame::translation(p.coords).compose(&rotation).compose(&Frame::translation(-p.coords))
+                        Frame::translation(p.coords)
+                            .compose(&rotation)
+                            .compose(&Frame::translation(-p.coords))
                     }
                     None => rotation,
                 }
@@ -637,7 +912,9 @@ fn steps_map(r: &mut Resolver, steps: &[Step], name: &str) -> Option<Frame> {
                     }
                     None => {
                         let mut v = r.numbers3(factors)?;
-                        for (i, component) in [&factors.x, &factors.y, &factors.z].iter().enumerate() {
+                        for (i, component) in
+                            [&factors.x, &factors.y, &factors.z].iter().enumerate()
+                        {
                             if component.is_none() {
                                 v[i] = 1.0;
                             }
@@ -647,8 +924,19 @@ fn steps_map(r: &mut Resolver, steps: &[Step], name: &str) -> Option<Frame> {
                 };
                 if f.iter().any(|&v| v <= 0.0) {
                     r.diags.push(
-                        Diagnostic::new(Code::NonPositiveSize, factors.span, format!("scale in '{name}' has factors ({}, {}, {}); all must be positive", fmt(f.x), fmt(f.y), fmt(f.z)))
-                            .with_help("scale factors must be greater than zero (mirroring is not supported)"),
+                        Diagnostic::new(
+                            Code::NonPositiveSize,
+                            factors.span,
+                            format!(
+                                "scale in '{name}' has factors ({}, {}, {}); all must be positive",
+                                fmt(f.x),
+                                fmt(f.y),
+                                fmt(f.z)
+                            ),
+                        )
+                        .with_help(
+                            "scale factors must be greater than zero (mirroring is not supported)",
+                        ),
                     );
                     return None;
                 }
@@ -660,13 +948,27 @@ fn steps_map(r: &mut Resolver, steps: &[Step], name: &str) -> Option<Frame> {
     Some(map)
 }
 
-fn transformed(r: &mut Resolver, geometry: &Geometry, map: &Frame, target: &Ref, name: &str) -> Option<Geometry> {
+fn transformed(
+    r: &mut Resolver,
+    geometry: &Geometry,
+    map: &Frame,
+    target: &Ref,
+    name: &str,
+) -> Option<Geometry> {
     match geometry.transformed(map) {
         Some(g) => Some(g),
         None => {
             r.diags.push(
-                Diagnostic::new(Code::WrongKind, target.span, format!("'{name}' transforms '{}', a {}, which cannot be transformed", target.text, geometry.kind()))
-                    .with_help("transforms apply to solids, 2D regions, points, poly_lines and planes"),
+                Diagnostic::new(
+                    Code::WrongKind,
+                    target.span,
+                    format!(
+                        "'{name}' transforms '{}', a {}, which cannot be transformed",
+                        target.text,
+                        geometry.kind()
+                    ),
+                )
+                .with_help("transforms apply to solids, 2D regions, points, poly_lines and planes"),
             );
             None
         }
@@ -677,8 +979,12 @@ fn positive(r: &mut Resolver, n: &Number, what: &str, name: &str) -> Option<f64>
     let v = r.number(n)?;
     if v <= 0.0 {
         r.diags.push(
-            Diagnostic::new(Code::NonPositiveSize, n.span, format!("{what} of '{name}' is {}; it must be positive", fmt(v)))
-                .with_help(format!("give {what} a value greater than zero")),
+            Diagnostic::new(
+                Code::NonPositiveSize,
+                n.span,
+                format!("{what} of '{name}' is {}; it must be positive", fmt(v)),
+            )
+            .with_help(format!("give {what} a value greater than zero")),
         );
         return None;
     }
@@ -689,15 +995,25 @@ fn non_negative(r: &mut Resolver, n: &Number, what: &str, name: &str) -> Option<
     let v = r.number(n)?;
     if v < 0.0 {
         r.diags.push(
-            Diagnostic::new(Code::NonPositiveSize, n.span, format!("{what} of '{name}' is {}; it must not be negative", fmt(v)))
-                .with_help(format!("give {what} a value of zero or more")),
+            Diagnostic::new(
+                Code::NonPositiveSize,
+                n.span,
+                format!("{what} of '{name}' is {}; it must not be negative", fmt(v)),
+            )
+            .with_help(format!("give {what} a value of zero or more")),
         );
         return None;
     }
     Some(v)
 }
 
-fn nonzero_vector(r: &mut Resolver, spec: &crate::doc::VectorSpec, frame: &Frame, what: &str, name: &str) -> Option<Vec3> {
+fn nonzero_vector(
+    r: &mut Resolver,
+    spec: &crate::doc::VectorSpec,
+    frame: &Frame,
+    what: &str,
+    name: &str,
+) -> Option<Vec3> {
     let v = r.vector(spec, frame)?;
     nonzero(r, v, spec.span, what, name)
 }
@@ -705,8 +1021,14 @@ fn nonzero_vector(r: &mut Resolver, spec: &crate::doc::VectorSpec, frame: &Frame
 fn nonzero(r: &mut Resolver, v: Vec3, span: Span, what: &str, name: &str) -> Option<Vec3> {
     if v.norm() == 0.0 || !v.norm().is_finite() {
         r.diags.push(
-            Diagnostic::new(Code::ZeroVector, span, format!("the {what} of '{name}' is the zero vector"))
-                .with_help(format!("give the {what} a non-zero direction, e.g. z=\"1\"")),
+            Diagnostic::new(
+                Code::ZeroVector,
+                span,
+                format!("the {what} of '{name}' is the zero vector"),
+            )
+            .with_help(format!(
+                "give the {what} a non-zero direction, e.g. z=\"1\""
+            )),
         );
         return None;
     }
@@ -719,7 +1041,11 @@ pub fn perpendicular_pair(axis: &Vec3, hint: &Vec3) -> (Vec3, Vec3) {
     let z = axis.normalize();
     let mut x = hint - z * hint.dot(&z);
     if x.norm() < 1e-6 {
-        let fallback = if z.x.abs() < 0.9 { Vec3::x() } else { Vec3::y() };
+        let fallback = if z.x.abs() < 0.9 {
+            Vec3::x()
+        } else {
+            Vec3::y()
+        };
         x = fallback - z * fallback.dot(&z);
     }
     let x = x.normalize();
@@ -733,12 +1059,26 @@ fn transform_quadric(c: &[f64; 10], frame: &Frame) -> [f64; 10] {
     }
     let [xx, yy, zz, xy, yz, zx, x, y, z, k] = *c;
     let q = nalgebra::Matrix4::new(
-        xx, xy / 2.0, zx / 2.0, x / 2.0,
-        xy / 2.0, yy, yz / 2.0, y / 2.0,
-        zx / 2.0, yz / 2.0, zz, z / 2.0,
-        x / 2.0, y / 2.0, z / 2.0, k,
+        xx,
+        xy / 2.0,
+        zx / 2.0,
+        x / 2.0,
+        xy / 2.0,
+        yy,
+        yz / 2.0,
+        y / 2.0,
+        zx / 2.0,
+        yz / 2.0,
+        zz,
+        z / 2.0,
+        x / 2.0,
+        y / 2.0,
+        z / 2.0,
+        k,
     );
-    let Some(inv) = frame.linear.try_inverse() else { return *c };
+    let Some(inv) = frame.linear.try_inverse() else {
+        return *c;
+    };
     // Local q = inv·(p − o): homogeneous map M with local = M·[p; 1].
     let t = -(inv * frame.origin.coords);
     let mut m = nalgebra::Matrix4::identity();
@@ -746,9 +1086,15 @@ fn transform_quadric(c: &[f64; 10], frame: &Frame) -> [f64; 10] {
     m.fixed_view_mut::<3, 1>(0, 3).copy_from(&t);
     let g = m.transpose() * q * m;
     [
-        g[(0, 0)], g[(1, 1)], g[(2, 2)],
-        2.0 * g[(0, 1)], 2.0 * g[(1, 2)], 2.0 * g[(0, 2)],
-        2.0 * g[(0, 3)], 2.0 * g[(1, 3)], 2.0 * g[(2, 3)],
+        g[(0, 0)],
+        g[(1, 1)],
+        g[(2, 2)],
+        2.0 * g[(0, 1)],
+        2.0 * g[(1, 2)],
+        2.0 * g[(0, 2)],
+        2.0 * g[(0, 3)],
+        2.0 * g[(1, 3)],
+        2.0 * g[(2, 3)],
         g[(3, 3)],
     ]
 }
@@ -759,17 +1105,32 @@ fn fold_parameters(r: &mut Resolver, expr: &Expr) -> Option<Expr> {
     Some(match &expr.kind {
         ExprKind::Name(n) if matches!(n.as_str(), "x" | "y" | "z" | "pi") => expr.clone(),
         ExprKind::Name(_) => {
-            let number = Number { expr: Some(expr.clone()), span: expr.span };
+            let number = Number {
+                expr: Some(expr.clone()),
+                span: expr.span,
+            };
             Expr::number(r.number(&number)?, expr.span)
         }
         ExprKind::Number(_) => expr.clone(),
-        ExprKind::Neg(inner) => Expr { kind: ExprKind::Neg(Box::new(fold_parameters(r, inner)?)), span: expr.span },
+        ExprKind::Neg(inner) => Expr {
+            kind: ExprKind::Neg(Box::new(fold_parameters(r, inner)?)),
+            span: expr.span,
+        },
         ExprKind::Binary(op, a, b) => Expr {
-            kind: ExprKind::Binary(*op, Box::new(fold_parameters(r, a)?), Box::new(fold_parameters(r, b)?)),
+            kind: ExprKind::Binary(
+                *op,
+                Box::new(fold_parameters(r, a)?),
+                Box::new(fold_parameters(r, b)?),
+            ),
             span: expr.span,
         },
         ExprKind::Call(f, args) => Expr {
-            kind: ExprKind::Call(*f, args.iter().map(|a| fold_parameters(r, a)).collect::<Option<Vec<_>>>()?),
+            kind: ExprKind::Call(
+                *f,
+                args.iter()
+                    .map(|a| fold_parameters(r, a))
+                    .collect::<Option<Vec<_>>>()?,
+            ),
             span: expr.span,
         },
     })

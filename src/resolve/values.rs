@@ -2,7 +2,7 @@
 //! evaluated on demand with cycle detection, and the evaluation of every other
 //! numeric attribute against them.
 
-use crate::diag::{did_you_mean, Code, Diagnostic, Diagnostics};
+use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::doc::{Axis, Document, Number};
 use crate::expr::{self, EvalError, Expr};
 use crate::span::Span;
@@ -18,8 +18,15 @@ pub enum Ctx {
 
 #[derive(Debug, Clone)]
 enum Source {
-    Parameter { expr: Option<Expr>, span: Span },
-    Basis { axis: Axis, expr: Option<Expr>, span: Span },
+    Parameter {
+        expr: Option<Expr>,
+        span: Span,
+    },
+    Basis {
+        axis: Axis,
+        expr: Option<Expr>,
+        span: Span,
+    },
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -54,7 +61,10 @@ impl Values {
             parameter_order.push(p.name.text.clone());
             sources.insert(
                 p.name.text.clone(),
-                Source::Parameter { expr: p.value.expr.clone(), span: p.name.span },
+                Source::Parameter {
+                    expr: p.value.expr.clone(),
+                    span: p.name.span,
+                },
             );
         }
         for b in &doc.basis {
@@ -93,7 +103,12 @@ impl Values {
         self.eval_expr(expr, ctx, diags)
     }
 
-    pub fn eval_opt(&mut self, number: &Option<Number>, ctx: Ctx, diags: &mut Diagnostics) -> Option<Option<f64>> {
+    pub fn eval_opt(
+        &mut self,
+        number: &Option<Number>,
+        ctx: Ctx,
+        diags: &mut Diagnostics,
+    ) -> Option<Option<f64>> {
         match number {
             None => Some(None),
             Some(n) => self.eval(n, ctx, diags).map(Some),
@@ -117,8 +132,12 @@ impl Values {
             Err(EvalError::Unknown { .. }) => None,
             Err(EvalError::NonFinite { span, what }) => {
                 diags.push(
-                    Diagnostic::new(Code::NonFiniteValue, span, format!("this expression has no finite value: {what}"))
-                        .with_help("check the values of the parameters it uses"),
+                    Diagnostic::new(
+                        Code::NonFiniteValue,
+                        span,
+                        format!("this expression has no finite value: {what}"),
+                    )
+                    .with_help("check the values of the parameters it uses"),
                 );
                 None
             }
@@ -179,10 +198,16 @@ impl Values {
                     );
                 } else {
                     let candidates: Vec<&str> = self.sources.keys().map(String::as_str).collect();
-                    let mut d = Diagnostic::new(Code::UndefinedName, span, format!("undefined name '{name}'"));
+                    let mut d = Diagnostic::new(
+                        Code::UndefinedName,
+                        span,
+                        format!("undefined name '{name}'"),
+                    );
                     d.help = Some(match did_you_mean(name, candidates) {
                         Some(best) => format!("did you mean '{best}'?"),
-                        None => format!("define it: <parameters><parameter name=\"{name}\" value=\"…\"/></parameters>"),
+                        None => format!(
+                            "define it: <parameters><parameter name=\"{name}\" value=\"…\"/></parameters>"
+                        ),
                     });
                     diags.push(d);
                 }
@@ -200,7 +225,9 @@ impl Values {
                 let mut cycle: Vec<&str> = self.stack[start..].iter().map(String::as_str).collect();
                 cycle.push(name);
                 let span = match self.sources.get(name) {
-                    Some(Source::Parameter { span, .. } | Source::Basis { span, .. }) => Some(*span),
+                    Some(Source::Parameter { span, .. } | Source::Basis { span, .. }) => {
+                        Some(*span)
+                    }
                     None => None,
                 };
                 diags.push(
@@ -259,7 +286,9 @@ impl Values {
         self.sources
             .iter()
             .filter_map(|(n, s)| match (s, self.state.get(n)) {
-                (Source::Basis { axis: a, .. }, Some(State::Done(Some(v)))) if *a == axis => Some((n.clone(), *v)),
+                (Source::Basis { axis: a, .. }, Some(State::Done(Some(v)))) if *a == axis => {
+                    Some((n.clone(), *v))
+                }
                 _ => None,
             })
             .collect()
@@ -271,7 +300,9 @@ impl Values {
             .sources
             .iter()
             .filter_map(|(n, s)| match s {
-                Source::Parameter { span, .. } if !self.used.contains(n) => Some((n.clone(), *span)),
+                Source::Parameter { span, .. } if !self.used.contains(n) => {
+                    Some((n.clone(), *span))
+                }
                 _ => None,
             })
             .collect();

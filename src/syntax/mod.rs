@@ -92,7 +92,11 @@ fn check_depth(root: roxmltree::Node, limits: &Limits) -> Result<(), Diagnostic>
             )
             .with_help("flatten the nesting, or raise the limit with --max-depth N"));
         }
-        stack.extend(node.children().filter(|c| c.is_element()).map(|c| (c, depth + 1)));
+        stack.extend(
+            node.children()
+                .filter(|c| c.is_element())
+                .map(|c| (c, depth + 1)),
+        );
     }
     Ok(())
 }

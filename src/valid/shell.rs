@@ -284,7 +284,9 @@ fn shells_of(model: &Model, boundary: &[OrientedFace]) -> Vec<Shell> {
 fn distinct_vertices(model: &Model, boundary: &[OrientedFace]) -> usize {
     let mut vertices = BTreeSet::new();
     for of in boundary {
-        let Some(face) = model.faces.get(of.face.index()) else { continue };
+        let Some(face) = model.faces.get(of.face.index()) else {
+            continue;
+        };
         for oe in face.loops.iter().flatten() {
             if let Some(edge) = model.edges.get(oe.edge.index()) {
                 vertices.insert(edge.begin);
@@ -514,11 +516,13 @@ fn check_euler(
 ) {
     let name = subdomain_name(model, id);
     let shells = shells_of(model, boundary);
-    let shared_vertices = shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices(model, boundary);
+    let shared_vertices =
+        shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices(model, boundary);
     if shared_vertices > 0 && shells.iter().all(|s| s.genus().is_some()) {
         // Shells that touch only at vertices: each is a closed surface, but the
         // boundary is not a manifold there, and χ of the whole boundary shows it.
-        let chi: i64 = shells.iter().map(Shell::euler_characteristic).sum::<i64>() - shared_vertices as i64;
+        let chi: i64 =
+            shells.iter().map(Shell::euler_characteristic).sum::<i64>() - shared_vertices as i64;
         diags.push(
             Diagnostic::new(
                 Code::EulerMismatch,

@@ -91,4 +91,3 @@ fn box_partially_covering_a_face() {
         "{p}"
     );
 }
-
