@@ -31,3 +31,4 @@ pub(crate) fn resolve_fmt(v: f64) -> String {
         format!("{rounded}")
     }
 }
+pub mod mesh;
