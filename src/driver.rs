@@ -145,6 +145,11 @@ fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Optio
         &lowered.source_map,
     ));
     check_domain(&document, &lowered, diags);
+    if diags.has_errors() {
+        // An entity left unused because something else failed is a consequence,
+        // not a finding of its own.
+        diags.items.retain(|d| d.code != Code::Dangling);
+    }
     Some(lowered)
 }
 

@@ -222,19 +222,24 @@ fn build_tree(
                 (g, _) => Some(g),
             };
             if ids.is_empty() {
-                let kind = member_geometry.map_or("object", Geometry::kind);
-                let (code, help) = match member_geometry {
-                    Some(Geometry::Group(_)) | None => (Code::IndexOutOfRange, "use an index within the replicate's count".to_string()),
-                    _ => (Code::NotASolid, "a subdomain's solid is a sphere, ellipsoid, torus, parallelepiped or truncated_cone (in 2D: circle, ellipse, triangle, parallelogram)".to_string()),
-                };
-                diags.push(
-                    Diagnostic::new(
-                        code,
+                let d = match (geometry, r.index, member_geometry) {
+                    (Geometry::Group(members), Some(k), None) => Diagnostic::new(
+                        Code::IndexOutOfRange,
                         r.span,
-                        format!("'{}' is a {kind}, not a bounded solid", r.text),
+                        format!(
+                            "'{}' has {} members; there is no [{k}]",
+                            r.name,
+                            members.len()
+                        ),
                     )
-                    .with_help(help),
-                );
+                    .with_help(format!("use an index from 1 to {}", members.len())),
+                    (_, _, g) => {
+                        let kind = g.map_or("object", Geometry::kind);
+                        Diagnostic::new(Code::NotASolid, r.span, format!("'{}' is {}, not a bounded solid", r.text, crate::resolve::a(kind)))
+                            .with_help("a subdomain's solid is a sphere, ellipsoid, torus, parallelepiped or truncated_cone (in 2D: circle, ellipse, triangle, parallelogram)")
+                    }
+                };
+                diags.push(d);
                 return None;
             }
             let planar = model.solids[ids[0].index()].shape.is_planar();

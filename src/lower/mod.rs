@@ -36,6 +36,9 @@ pub(crate) struct Entities {
     pub vertices: HashMap<String, crate::ir::VertexId>,
     /// Object name (or member "row[2]") → the solids it lowered to.
     pub solids: HashMap<String, Vec<SolidId>>,
+    /// Objects that failed to resolve (already reported): references to them
+    /// are not reported again.
+    pub failed: std::collections::HashSet<String>,
 }
 
 pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
@@ -53,6 +56,7 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
 
     for object in &resolved.objects {
         let Some(geometry) = &object.geometry else {
+            entities.failed.insert(object.name.clone());
             continue;
         };
         match geometry {

@@ -10,6 +10,7 @@ mod values;
 
 pub use geometry::{Geometry, LineCarrier, Link};
 pub use names::{NameTable, is_plain_name};
+pub use objects::a;
 pub use shapes::{fmt, fmt_point, perpendicular_pair};
 pub use values::{Ctx, Values};
 

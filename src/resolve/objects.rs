@@ -380,12 +380,13 @@ impl<'a> Resolver<'a> {
                     Code::WrongKind,
                     reference.span,
                     format!(
-                        "'{}' is a {kind}, but a {} is expected here",
+                        "'{}' is {}, but {} is expected here",
                         reference.name,
-                        kinds.join(" or ")
+                        a(kind),
+                        describe_kinds(kinds)
                     ),
                 )
-                .with_help(format!("name a {}", kinds.join(" or "))),
+                .with_help(format!("name {}", describe_kinds(kinds))),
                 None => {
                     let mut d = Diagnostic::new(
                         Code::UndefinedName,
@@ -401,7 +402,11 @@ impl<'a> Resolver<'a> {
                     d.help = Some(match did_you_mean(&reference.name, candidates) {
                         Some(best) => format!("did you mean '{best}'?"),
                         None => {
-                            format!("define a {} named '{}'", kinds.join(" or "), reference.name)
+                            format!(
+                                "define {} named '{}'",
+                                describe_kinds(kinds),
+                                reference.name
+                            )
                         }
                     });
                     d
@@ -418,12 +423,13 @@ impl<'a> Resolver<'a> {
                     Code::WrongKind,
                     reference.span,
                     format!(
-                        "'{}' is a {element}, but a {} is expected here",
+                        "'{}' is {}, but {} is expected here",
                         reference.name,
-                        kinds.join(" or ")
+                        a(element),
+                        describe_kinds(kinds)
                     ),
                 )
-                .with_help(format!("name a {}", kinds.join(" or "))),
+                .with_help(format!("name {}", describe_kinds(kinds))),
             );
             return None;
         }
@@ -495,6 +501,24 @@ impl<'a> Resolver<'a> {
             span: reference.span,
         })
     }
+}
+
+/// "a sphere", "an edge".
+pub fn a(kind: &str) -> String {
+    let article = if kind.starts_with(['a', 'e', 'i', 'o', 'u']) {
+        "an"
+    } else {
+        "a"
+    };
+    format!("{article} {kind}")
+}
+
+/// "a point or a vertex"; "*" is any object.
+fn describe_kinds(kinds: &[&str]) -> String {
+    if kinds.contains(&"*") {
+        return "a named object (a solid, point, surface, …)".to_string();
+    }
+    kinds.iter().map(|k| a(k)).collect::<Vec<_>>().join(" or ")
 }
 
 /// Evaluates three optional components (missing = 0). As coordinates, each
