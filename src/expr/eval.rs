@@ -129,6 +129,15 @@ mod tests {
         let expr = parse("1 / (r - r)", 0).expect("parses");
         let result = eval(&expr, &mut |_, _| Some(1.0));
         assert!(matches!(result, Err(EvalError::NonFinite { .. })));
+        // The tree's depth is bounded, not only the parser's recursion: a long
+        // left-associative chain is as deep as it is long.
+        let chain = vec!["1"; 300].join("+");
+        assert!(matches!(parse(&chain, 0), Err(ParseError::TooLarge { .. })));
+        let chain = vec!["1"; 200].join("+");
+        assert_eq!(
+            eval(&parse(&chain, 0).expect("parses"), &mut |_, _| None),
+            Ok(200.0)
+        );
         let deep = "(".repeat(1000) + "1" + &")".repeat(1000);
         assert!(matches!(parse(&deep, 0), Err(ParseError::TooLarge { .. })));
     }

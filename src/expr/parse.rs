@@ -56,7 +56,7 @@ pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
             message: "expected a number or an expression, found nothing".into(),
         });
     }
-    let expr = parser.expression(0, 0)?;
+    let (expr, _) = parser.expression(0, 0)?;
     if let Some((token, span)) = parser.tokens.get(parser.pos) {
         let what = match token {
             Token::RParen => "an unmatched ')'".to_string(),
@@ -184,8 +184,11 @@ impl Parser {
         Ok(())
     }
 
-    fn expression(&mut self, min_power: u8, depth: usize) -> Result<Expr, ParseError> {
-        let mut left = self.prefix(depth)?;
+    /// Parses an expression and returns it with the depth of its tree: the
+    /// tree's depth is bounded (not only the parser's recursion), so that every
+    /// recursive walk over it (evaluation, folding, dropping) stays shallow.
+    fn expression(&mut self, min_power: u8, depth: usize) -> Result<(Expr, usize), ParseError> {
+        let (mut left, mut left_depth) = self.prefix(depth)?;
         while let Some((Token::Op(op), _)) = self.peek() {
             let Some((lp, rp, bin)) = infix_power(*op) else {
                 break;
@@ -194,18 +197,22 @@ impl Parser {
                 break;
             }
             self.pos += 1;
-            let right = self.expression(rp, depth + 1)?;
+            let (right, right_depth) = self.expression(rp, depth + 1)?;
             let span = Span::new(left.span.start as usize, right.span.end as usize);
             self.node(span)?;
+            left_depth = left_depth.max(right_depth) + 1;
+            if left_depth > MAX_DEPTH {
+                return Err(ParseError::TooLarge { span });
+            }
             left = Expr {
                 kind: ExprKind::Binary(bin, Box::new(left), Box::new(right)),
                 span,
             };
         }
-        Ok(left)
+        Ok((left, left_depth))
     }
 
-    fn prefix(&mut self, depth: usize) -> Result<Expr, ParseError> {
+    fn prefix(&mut self, depth: usize) -> Result<(Expr, usize), ParseError> {
         let Some((token, span)) = self.peek().cloned() else {
             return Err(ParseError::Syntax {
                 span: self.end_span(),
@@ -218,14 +225,17 @@ impl Parser {
         self.node(span)?;
         self.pos += 1;
         match token {
-            Token::Number(value) => Ok(Expr::number(value, span)),
+            Token::Number(value) => Ok((Expr::number(value, span), 1)),
             Token::Op('-') => {
-                let inner = self.expression(PREFIX_POWER, depth + 1)?;
+                let (inner, inner_depth) = self.expression(PREFIX_POWER, depth + 1)?;
                 let span = Span::new(span.start as usize, inner.span.end as usize);
-                Ok(Expr {
-                    kind: ExprKind::Neg(Box::new(inner)),
-                    span,
-                })
+                Ok((
+                    Expr {
+                        kind: ExprKind::Neg(Box::new(inner)),
+                        span,
+                    },
+                    inner_depth + 1,
+                ))
             }
             Token::Op('+') => self.expression(PREFIX_POWER, depth + 1),
             Token::LParen => {
@@ -238,10 +248,13 @@ impl Parser {
                     self.pos += 1;
                     self.call(name, span, depth)
                 } else {
-                    Ok(Expr {
-                        kind: ExprKind::Name(name),
-                        span,
-                    })
+                    Ok((
+                        Expr {
+                            kind: ExprKind::Name(name),
+                            span,
+                        },
+                        1,
+                    ))
                 }
             }
             other => Err(ParseError::Syntax {
@@ -254,7 +267,12 @@ impl Parser {
         }
     }
 
-    fn call(&mut self, name: String, name_span: Span, depth: usize) -> Result<Expr, ParseError> {
+    fn call(
+        &mut self,
+        name: String,
+        name_span: Span,
+        depth: usize,
+    ) -> Result<(Expr, usize), ParseError> {
         let Some(function) = Function::lookup(&name) else {
             return Err(ParseError::UnknownFunction {
                 span: name_span,
@@ -262,9 +280,12 @@ impl Parser {
             });
         };
         let mut args = Vec::new();
+        let mut deepest = 0;
         if !matches!(self.peek(), Some((Token::RParen, _))) {
             loop {
-                args.push(self.expression(0, depth + 1)?);
+                let (arg, arg_depth) = self.expression(0, depth + 1)?;
+                deepest = deepest.max(arg_depth);
+                args.push(arg);
                 match self.peek() {
                     Some((Token::Comma, _)) => self.pos += 1,
                     _ => break,
@@ -285,10 +306,13 @@ impl Parser {
                 given: args.len(),
             });
         }
-        Ok(Expr {
-            kind: ExprKind::Call(function, args),
-            span,
-        })
+        Ok((
+            Expr {
+                kind: ExprKind::Call(function, args),
+                span,
+            },
+            deepest + 1,
+        ))
     }
 
     fn expect_rparen(&mut self, open: Span) -> Result<Span, ParseError> {
