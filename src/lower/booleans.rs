@@ -114,9 +114,6 @@ pub(super) fn lower_subdomains(
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
     }
-    if trees.is_empty() {
-        return;
-    }
     if !check_relations(model, source_map, &trees, diags) {
         return;
     }
@@ -329,11 +326,16 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
     let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
     let mut big = Vec::new();
     for (i, b) in boxes.iter().enumerate() {
+        let finite = [b.min, b.max].iter().all(|p| p.iter().all(|c| c.is_finite()));
+        if b.is_empty() || !finite {
+            // Nothing, or nothing placeable: it cannot overlap anything.
+            continue;
+        }
         let lo = [key(b.min.x - tol), key(b.min.y - tol), key(b.min.z - tol)];
         let hi = [key(b.max.x + tol), key(b.max.y + tol), key(b.max.z + tol)];
         let count = (0..3)
-            .map(|k| (hi[k] - lo[k] + 1) as u128)
-            .product::<u128>();
+            .map(|k| (i128::from(hi[k]) - i128::from(lo[k]) + 1).max(0))
+            .fold(1i128, |acc, n| acc.saturating_mul(n));
         if count > 64 {
             big.push(i);
             continue;
@@ -548,6 +550,14 @@ fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<
 }
 
 /// Reports pairs of subdomains that share volume: a point just inside one
+/// How a subdomain answers "is this point inside?": its boolean tree of
+/// solids, or the winding number of its explicit faces.
+enum Member<'a> {
+    Tree(&'a Built),
+    Shell(super::winding::ShellTriangles),
+}
+
+/// Reports pairs of subdomains that share volume: a point just inside one
 /// subdomain, next to one of its boundary faces, lies inside the other.
 fn check_overlaps(
     model: &Model,
@@ -557,34 +567,60 @@ fn check_overlaps(
     diags: &mut Diagnostics,
 ) {
     let step = model.tolerance * 1000.0;
-    let inside = |built: &Built, p: &Point3| {
-        built
-            .tree
-            .eval(&|i| model.solids[built.leaves[i].index()].shape.value(p) > 0.0)
-    };
-    let probes: Vec<Vec<Point3>> = trees
-        .iter()
-        .map(|(id, _)| interior_probes(model, *id, samples, step))
-        .collect();
-    let boxes: Vec<crate::geom::Aabb> = trees
-        .iter()
-        .map(|(_, built)| {
-            built
-                .leaves
-                .iter()
-                .fold(crate::geom::Aabb::empty(), |acc, l| {
-                    acc.union(&model.solids[l.index()].shape.bbox())
-                })
-        })
-        .collect();
-    for (i, j) in candidate_pairs(&boxes, model.tolerance) {
-        let ((a, built_a), (b, built_b)) = (&trees[i], &trees[j]);
-        let overlap = probes[i]
+    let mut members: Vec<(SubdomainId, Member, crate::geom::Aabb, Vec<Point3>)> = Vec::new();
+    for (id, built) in trees {
+        let bbox = built
+            .leaves
             .iter()
-            .any(|p| inside(built_b, p) && inside(built_a, p))
-            || probes[j]
+            .fold(crate::geom::Aabb::empty(), |acc, l| {
+                acc.union(&model.solids[l.index()].shape.bbox())
+            });
+        members.push((
+            *id,
+            Member::Tree(built),
+            bbox,
+            interior_probes(model, *id, samples, step),
+        ));
+    }
+    for (k, subdomain) in model.subdomains.iter().enumerate() {
+        let id = SubdomainId(k as u32);
+        if trees.iter().any(|(t, _)| *t == id) {
+            continue;
+        }
+        let SubdomainCells::Volume { boundary } = &subdomain.cells else {
+            continue;
+        };
+        let shell = super::winding::ShellTriangles::of(model, boundary);
+        let mut bbox = crate::geom::Aabb::empty();
+        let mut face_points = HashMap::new();
+        for of in boundary {
+            for e in model.face(of.face).loops.iter().flatten() {
+                let edge = model.edge(e.edge);
+                bbox.include(&model.vertex(edge.begin).position);
+                edge.curve.samples(8).iter().for_each(|p| bbox.include(p));
+            }
+            if let Some(p) = super::winding::face_sample(model, of.face) {
+                face_points.insert(of.face, p);
+            }
+        }
+        let probes = interior_probes(model, id, &face_points, step);
+        members.push((id, Member::Shell(shell), bbox, probes));
+    }
+    let inside = |member: &Member, p: &Point3| match member {
+        Member::Tree(built) => built
+            .tree
+            .eval(&|i| model.solids[built.leaves[i].index()].shape.value(p) > 0.0),
+        Member::Shell(shell) => shell.contains(p),
+    };
+    let boxes: Vec<crate::geom::Aabb> = members.iter().map(|m| m.2).collect();
+    for (i, j) in candidate_pairs(&boxes, model.tolerance) {
+        let ((a, member_a, _, probes_a), (b, member_b, _, probes_b)) = (&members[i], &members[j]);
+        let overlap = probes_a
+            .iter()
+            .any(|p| inside(member_b, p) && inside(member_a, p))
+            || probes_b
                 .iter()
-                .any(|p| inside(built_a, p) && inside(built_b, p));
+                .any(|p| inside(member_a, p) && inside(member_b, p));
         if overlap {
             let (sa, sb) = (model.subdomain(*a), model.subdomain(*b));
             diags.push(

@@ -8,6 +8,7 @@ mod brep;
 mod explicit;
 mod prune;
 mod weld;
+mod winding;
 
 use crate::diag::Diagnostics;
 use crate::doc::Document;
