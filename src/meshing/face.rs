@@ -107,7 +107,7 @@ pub(crate) fn mesh_face(
         let mut handles = Vec::with_capacity(lp.len());
         for (point, uv) in lp.iter().zip(uv) {
             let handle = cdt
-                .insert(Point2::new(uv[0], uv[1]))
+                .insert(point2(*uv))
                 .map_err(|e| failed(format!("a boundary node cannot be triangulated: {e:?}")))?;
             let index = handle.index();
             if index == keys.len() {
@@ -199,10 +199,10 @@ pub(crate) fn mesh_face(
                 settings,
             ) {
                 let [pa, pb, pc] = f.positions();
-                bad.push(Point2::new(
+                bad.push(point2([
                     (pa.x + pb.x + pc.x) / 3.0,
                     (pa.y + pb.y + pc.y) / 3.0,
-                ));
+                ]));
             }
         }
         if bad.is_empty() {
@@ -221,7 +221,16 @@ pub(crate) fn mesh_face(
     if inner.is_empty() {
         return Err(failed("its loops enclose no area".into()));
     }
-    orient(face, &positions, &mut inner);
+    // Spade's triangles run counter-clockwise in the chart; the loops run
+    // counter-clockwise about the face normal, so their signed area in the
+    // chart says whether the chart keeps or mirrors that orientation. (The
+    // loops are trusted over `reversed`, which some explicit faces get wrong.)
+    let signed: f64 = uv_loops.iter().map(|lp| shoelace(lp)).sum();
+    if signed < 0.0 {
+        for t in &mut inner {
+            t.swap(1, 2);
+        }
+    }
     Ok(Outcome::Meshed(FaceMesh {
         points: keys,
         triangles: inner,
@@ -406,26 +415,19 @@ fn too_coarse(face: &Face, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool
         .any(|p| face.surface.distance(p) > settings.tolerance)
 }
 
-/// Flips every triangle when most of the area faces away from the face normal
-/// (the chart may mirror).
-fn orient(face: &Face, positions: &[Point3], triangles: &mut [[usize; 3]]) {
-    let mut agreement = 0.0;
-    for t in triangles.iter() {
-        let [a, b, c] = t.map(|i| positions[i]);
-        let normal = (b - a).cross(&(c - a));
-        let centroid = Point3::from((a.coords + b.coords + c.coords) / 3.0);
-        let mut surface_normal = face.surface.gradient(&centroid);
-        if face.reversed {
-            surface_normal = -surface_normal;
-        }
-        let d = normal.dot(&surface_normal.try_normalize(0.0).unwrap_or_default());
-        if d.is_finite() {
-            agreement += d;
-        }
-    }
-    if agreement < 0.0 {
-        for t in triangles.iter_mut() {
-            t.swap(1, 2);
-        }
-    }
+/// Twice the signed area of a closed polygon.
+fn shoelace(points: &[[f64; 2]]) -> f64 {
+    (0..points.len())
+        .map(|i| {
+            let (a, b) = (points[i], points[(i + 1) % points.len()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum()
+}
+
+/// Spade refuses coordinates below about 1e-43 in magnitude: such values
+/// are zero for meshing purposes.
+fn point2([u, v]: [f64; 2]) -> Point2<f64> {
+    let snap = |x: f64| if x.abs() < 1e-30 { 0.0 } else { x };
+    Point2::new(snap(u), snap(v))
 }
