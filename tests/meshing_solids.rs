@@ -198,3 +198,40 @@ fn ellipsoid_volume_converges() {
         last = dv;
     }
 }
+
+#[test]
+fn curved_faces_keep_reasonable_angles() {
+    // Conformal charts carry the plane's Delaunay angles onto the surface
+    // up to the distortion across one triangle.
+    let shapes = [
+        BALL.to_string(),
+        r#"<torus name="a"><center x="0" y="0" z="0"/><major_radius value="2"/><minor_radius value="0.5"/></torus>"#.to_string(),
+        r#"<truncated_cone name="a"><bottom_center x="0" y="0" z="0"/><top_center x="0" y="0" z="2"/><bottom_radius value="1"/><top_radius value="0.5"/></truncated_cone>"#.to_string(),
+    ];
+    for shape in shapes {
+        let (mesh, q) = mesh(&model(&solid(&shape)), 0.005);
+        let triangles: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
+        eprintln!(
+            "{} triangles, min angle {:.1}°, max aspect {:.2}, histogram {:?}",
+            triangles, q.min_angle, q.max_aspect_ratio, q.min_angle_histogram
+        );
+        assert!(q.min_angle >= 20.0, "min angle {}", q.min_angle);
+    }
+}
+
+#[test]
+fn sanity_check_finds_holes_and_flips() {
+    let m = model(&solid(BALL));
+    let (mesh, _) = mesh(&m, 0.02);
+    let mut open = mesh.clone();
+    open.faces[0].triangles.pop();
+    assert!(sanity_check(&open).is_err());
+    let mut flipped = mesh.clone();
+    if let Some(t) = flipped.faces[0].triangles.first_mut() {
+        t.swap(1, 2);
+    }
+    assert!(sanity_check(&flipped).is_err());
+    let mut out_of_range = mesh;
+    out_of_range.faces[1].triangles[0][0] = u32::MAX;
+    assert!(sanity_check(&out_of_range).is_err());
+}
