@@ -235,3 +235,24 @@ fn sanity_check_finds_holes_and_flips() {
     out_of_range.faces[1].triangles[0][0] = u32::MAX;
     assert!(sanity_check(&out_of_range).is_err());
 }
+
+#[test]
+fn bad_options_are_errors_not_panics() {
+    let m = model(&solid(BALL));
+    for options in [
+        MeshOptions {
+            tolerance: Tolerance::Absolute(0.0),
+            ..MeshOptions::default()
+        },
+        MeshOptions {
+            max_edge: Some(-1.0),
+            ..MeshOptions::default()
+        },
+        MeshOptions {
+            min_angle_degrees: 45.0,
+            ..MeshOptions::default()
+        },
+    ] {
+        assert!(mesh_model(&m, &options).is_err(), "{options:?}");
+    }
+}

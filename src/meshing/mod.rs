@@ -14,7 +14,10 @@
 //! - Deterministic: the same model and options give the same mesh.
 //!
 //! # Limitations
-//! - Faces without loops (unbounded surfaces) get no triangles.
+//! - Faces without loops (unbounded surfaces) get no triangles; one that
+//!   bounds a subdomain is an error.
+//! - Spade's refinement can panic on loss of precision (its own `expect`);
+//!   that is not caught here.
 //! - See the module docs of [`chart`] and [`face`] for per-surface limits.
 
 mod chart;
@@ -126,6 +129,26 @@ fn mesh_faces(
     for (f, face) in model.faces.iter().enumerate() {
         for oe in face.loops.iter().flatten() {
             faces_of_edge.entry(oe.edge.index()).or_default().push(f);
+        }
+    }
+    // A face without loops (an unbounded surface) gets no triangles, which
+    // would leave a hole in any subdomain it bounds.
+    for sub in &model.subdomains {
+        let faces: Vec<ir::FaceId> = match &sub.cells {
+            SubdomainCells::Volume { boundary } => boundary.iter().map(|of| of.face).collect(),
+            SubdomainCells::Region { faces } => faces.clone(),
+        };
+        for f in faces {
+            let face = model.faces.get(f.index()).ok_or_else(|| MeshError::Face {
+                face: format!("#{}", f.0),
+                reason: format!("subdomain `{}` names a face that does not exist", sub.name),
+            })?;
+            if face.loops.is_empty() {
+                return Err(MeshError::Face {
+                    face: face.name.clone(),
+                    reason: format!("it bounds subdomain `{}` but has no loops", sub.name),
+                });
+            }
         }
     }
     let mut meshes: Vec<Option<FaceMesh>> = vec![None; model.faces.len()];
