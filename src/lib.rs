@@ -15,6 +15,7 @@ pub mod geom;
 pub mod inspect;
 pub mod ir;
 pub mod lower;
+pub mod meshing;
 pub mod resolve;
 pub mod span;
 pub mod syntax;

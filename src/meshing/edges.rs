@@ -1,0 +1,133 @@
+//! Edge discretisation: each model edge becomes one polyline shared by every
+//! face that uses it, so the face meshes conform along it.
+//!
+//! # Guarantees
+//! - The first and last points are the edge's vertex positions exactly; the
+//!   others lie on the curve (`Curve::point`/`samples`).
+//! - Every chord deviates from the curve by at most the given tolerance,
+//!   judged at the curve point halfway in parameter between the chord's ends
+//!   after uniform doubling, and is no longer than `max_edge`.
+//! - Closed edges get at least three segments and arcs at least two, so no
+//!   loop collapses to a segment.
+//!
+//! # Limitations
+//! - Deviation is measured at parameter midpoints only: wiggles finer than the
+//!   sampling go unseen (not a concern for segments, conics and intersection
+//!   curves of quadrics).
+
+use super::MeshError;
+use crate::geom::{Curve, Point3};
+use crate::ir::{Edge, Model};
+
+/// Largest number of segments tried for one edge.
+const MAX_SEGMENTS: usize = 1 << 16;
+
+/// An edge's discretisation: curve parameters s ∈ [0, 1] ascending and the
+/// points there.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct EdgeNodes {
+    pub params: Vec<f64>,
+    pub points: Vec<Point3>,
+}
+
+/// Discretises `edge` to chordal `tolerance` and chord length `max_edge`.
+pub(crate) fn discretise(
+    model: &Model,
+    edge: &Edge,
+    tolerance: f64,
+    max_edge: f64,
+) -> Result<EdgeNodes, MeshError> {
+    let failed = |reason: &str| MeshError::Edge {
+        edge: edge.name.clone(),
+        reason: reason.to_string(),
+    };
+    let begin = model
+        .vertices
+        .get(edge.begin.index())
+        .ok_or_else(|| failed("its begin vertex does not exist"))?
+        .position;
+    let end = model
+        .vertices
+        .get(edge.end.index())
+        .ok_or_else(|| failed("its end vertex does not exist"))?
+        .position;
+    let mut n = match &edge.curve {
+        _ if edge.is_closed() => 3,
+        Curve::Segment { .. } => 1,
+        _ => 2,
+    };
+    if let Curve::Segment { a, b } = &edge.curve {
+        // A straight edge only needs the length limit.
+        let length = (b - a).norm();
+        if max_edge.is_finite() && max_edge > 0.0 {
+            n = n.max((length / max_edge).ceil() as usize);
+        }
+        if n > MAX_SEGMENTS {
+            return Err(failed("it needs too many segments for max_edge"));
+        }
+        return Ok(finish(edge.curve.samples(n), n, begin, end));
+    }
+    loop {
+        if n > MAX_SEGMENTS {
+            return Err(failed("its discretisation did not reach the tolerance"));
+        }
+        let fine = edge.curve.samples(2 * n);
+        if !fine.iter().all(|p| p.coords.iter().all(|x| x.is_finite())) {
+            return Err(failed("its curve has points that are not finite"));
+        }
+        let good = (0..n).all(|i| {
+            let (a, m, b) = (&fine[2 * i], &fine[2 * i + 1], &fine[2 * i + 2]);
+            (b - a).norm() <= max_edge && distance_to_segment(m, a, b) <= tolerance
+        });
+        if good {
+            let coarse: Vec<Point3> = fine.iter().step_by(2).copied().collect();
+            return Ok(finish(coarse, n, begin, end));
+        }
+        n *= 2;
+    }
+}
+
+fn finish(mut points: Vec<Point3>, n: usize, begin: Point3, end: Point3) -> EdgeNodes {
+    if let Some(first) = points.first_mut() {
+        *first = begin;
+    }
+    if let Some(last) = points.last_mut() {
+        *last = end;
+    }
+    EdgeNodes {
+        params: (0..=n).map(|i| i as f64 / n as f64).collect(),
+        points,
+    }
+}
+
+impl EdgeNodes {
+    /// Adds the curve point at parameter `s` (a split requested by a face's
+    /// refinement); false when it is already there.
+    pub(crate) fn insert(&mut self, curve: &Curve, s: f64) -> bool {
+        if !(s > 0.0 && s < 1.0) {
+            return false;
+        }
+        let at = self.params.partition_point(|&t| t < s);
+        let near = |i: usize| self.params.get(i).is_some_and(|t| (t - s).abs() <= 1e-12);
+        if near(at) || (at > 0 && near(at - 1)) {
+            return false;
+        }
+        let point = curve.point(s);
+        if !point.coords.iter().all(|x| x.is_finite()) {
+            return false;
+        }
+        self.params.insert(at, s);
+        self.points.insert(at, point);
+        true
+    }
+}
+
+pub(crate) fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
+    let d = b - a;
+    let len2 = d.norm_squared();
+    if len2 <= 0.0 {
+        return (p - a).norm();
+    }
+    let t = ((p - a).dot(&d) / len2).clamp(0.0, 1.0);
+    (p - (a + d * t)).norm()
+}

@@ -1,0 +1,433 @@
+//! Meshing one face: its loops, mapped through the face's [`Chart`], become the
+//! constraint edges of a constrained Delaunay triangulation (spade), refined
+//! for angles in the parameter plane and then for chordal deviation and edge
+//! length on the surface.
+//!
+//! # Guarantees
+//! - Boundary nodes are exactly the edges' nodes: when refinement wants to
+//!   split a boundary segment, the face returns [`Outcome::Split`] with the
+//!   curve parameters instead of a mesh, the caller adds those points to the
+//!   edge for every face that uses it, and meshes again. In the last round
+//!   (`keep_boundary`) splitting is forbidden instead.
+//! - Every triangle's distance from the surface at its centroid and edge
+//!   midpoints is at most `tolerance` and its longest edge at most `max_edge`,
+//!   unless the pass limit is reached first.
+//! - Triangles run counter-clockwise about the face normal.
+//!
+//! # Limitations
+//! - Angles are refined in the parameter plane; on the surface they are only
+//!   as good as the chart is conformal (exact for planes, spheres, circular
+//!   cones and tori).
+//! - Loops of a periodic chart (torus) are unwrapped one at a time: a face
+//!   with several loops on a torus may place them a period apart.
+
+use super::MeshError;
+use super::chart::Chart;
+use super::edges::EdgeNodes;
+use crate::geom::{Point3, Vec3};
+use crate::ir::{Face, Model};
+use spade::{
+    AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
+};
+use std::collections::BTreeMap;
+
+type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+
+/// Rounds of "refine in the plane, then insert points where the surface is
+/// missed" before giving up on a face's tolerance.
+const MAX_PASSES: usize = 60;
+/// Nodes one face may have.
+const MAX_FACE_VERTICES: usize = 2_000_000;
+
+/// A node of a face mesh before global numbering.
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) enum FacePoint {
+    Vertex(u32),
+    /// Interior node `index` of an edge's discretisation.
+    Edge {
+        edge: usize,
+        index: usize,
+    },
+    Interior(Point3),
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub(crate) struct FaceMesh {
+    pub points: Vec<FacePoint>,
+    pub triangles: Vec<[usize; 3]>,
+}
+
+pub(crate) enum Outcome {
+    Meshed(FaceMesh),
+    /// Boundary points to add: (edge index, curve parameter).
+    Split(Vec<(usize, f64)>),
+}
+
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Settings {
+    pub tolerance: f64,
+    pub max_edge: f64,
+    pub min_angle: f64,
+    pub keep_boundary: bool,
+}
+
+/// One point of a loop: its node, position, and the segment to the next point.
+struct LoopPoint {
+    key: FacePoint,
+    point: Point3,
+    edge: usize,
+    s: f64,
+    s_next: f64,
+}
+
+/// A boundary segment of the triangulation: its edge and curve parameters
+/// at its lower- and higher-numbered vertex.
+type Segments = BTreeMap<(usize, usize), (usize, f64, f64)>;
+
+pub(crate) fn mesh_face(
+    model: &Model,
+    face: &Face,
+    edges: &[EdgeNodes],
+    settings: &Settings,
+) -> Result<Outcome, MeshError> {
+    let failed = |reason: String| MeshError::Face {
+        face: face.name.clone(),
+        reason,
+    };
+    let loops = walk_loops(model, face, edges).map_err(failed)?;
+    let boundary: Vec<Point3> = loops.iter().flatten().map(|p| p.point).collect();
+    let chart = Chart::new(&face.surface, &boundary, area_vector(face, &loops)).map_err(failed)?;
+    let uv_loops = unwrap_loops(&chart, &loops).map_err(failed)?;
+
+    let mut cdt = Cdt::new();
+    let mut keys: Vec<FacePoint> = Vec::new();
+    let mut positions: Vec<Point3> = Vec::new();
+    let mut segments = Segments::new();
+    for (lp, uv) in loops.iter().zip(&uv_loops) {
+        let mut handles = Vec::with_capacity(lp.len());
+        for (point, uv) in lp.iter().zip(uv) {
+            let handle = cdt
+                .insert(point2(*uv))
+                .map_err(|e| failed(format!("a boundary node cannot be triangulated: {e:?}")))?;
+            let index = handle.index();
+            if index == keys.len() {
+                keys.push(point.key.clone());
+                positions.push(point.point);
+            } else if keys.get(index) != Some(&point.key) {
+                return Err(failed(
+                    "two boundary nodes share one point of its parametrisation".into(),
+                ));
+            }
+            handles.push(handle);
+        }
+        for (i, point) in lp.iter().enumerate() {
+            let (a, b) = (handles[i], handles[(i + 1) % handles.len()]);
+            if a == b {
+                return Err(failed("a loop segment has no length".into()));
+            }
+            if !cdt.can_add_constraint(a, b) {
+                return Err(failed("its loops cross in the parameter plane".into()));
+            }
+            cdt.add_constraint(a, b);
+            let entry = if a.index() < b.index() {
+                (point.edge, point.s, point.s_next)
+            } else {
+                (point.edge, point.s_next, point.s)
+            };
+            segments.insert((a.index().min(b.index()), a.index().max(b.index())), entry);
+        }
+    }
+    if let Some((uv, p)) = chart.singular_point()
+        && winding_odd(&uv_loops, uv)
+    {
+        let handle = cdt
+            .insert(Point2::new(uv[0], uv[1]))
+            .map_err(|e| failed(format!("the apex cannot be triangulated: {e:?}")))?;
+        if handle.index() == keys.len() {
+            keys.push(FacePoint::Interior(p));
+            positions.push(p);
+        }
+    }
+    let fixed = cdt.num_vertices();
+
+    let mut parameters = RefinementParameters::<f64>::new()
+        .exclude_outer_faces(true)
+        .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
+        .with_max_additional_vertices(200_000);
+    if settings.keep_boundary {
+        parameters = parameters.keep_constraint_edges();
+    }
+    let mut inner = Vec::new();
+    for _ in 0..MAX_PASSES {
+        let result = cdt.refine(parameters.clone());
+        if !settings.keep_boundary {
+            let splits = boundary_splits(&cdt, fixed, &segments).map_err(failed)?;
+            if !splits.is_empty() {
+                return Ok(Outcome::Split(splits));
+            }
+        }
+        for v in positions.len()..cdt.num_vertices() {
+            let uv = cdt
+                .vertex(spade::handles::FixedVertexHandle::from_index(v))
+                .position();
+            let p = chart.lift([uv.x, uv.y]).ok_or_else(|| {
+                failed(format!(
+                    "the parameter point ({}, {}) does not lift onto its surface",
+                    uv.x, uv.y
+                ))
+            })?;
+            keys.push(FacePoint::Interior(p));
+            positions.push(p);
+        }
+        let mut excluded = vec![false; cdt.num_all_faces()];
+        for f in &result.excluded_faces {
+            if let Some(slot) = excluded.get_mut(f.index()) {
+                *slot = true;
+            }
+        }
+        inner.clear();
+        let mut bad = Vec::new();
+        for f in cdt.inner_faces() {
+            if excluded.get(f.fix().index()).copied().unwrap_or(true) {
+                continue;
+            }
+            let [a, b, c] = f.vertices().map(|v| v.fix().index());
+            inner.push([a, b, c]);
+            if too_coarse(
+                face,
+                [&positions[a], &positions[b], &positions[c]],
+                settings,
+            ) {
+                let [pa, pb, pc] = f.positions();
+                bad.push(point2([
+                    (pa.x + pb.x + pc.x) / 3.0,
+                    (pa.y + pb.y + pc.y) / 3.0,
+                ]));
+            }
+        }
+        if bad.is_empty() {
+            break;
+        }
+        if cdt.num_vertices() + bad.len() > MAX_FACE_VERTICES {
+            return Err(failed(format!(
+                "it needs more than {MAX_FACE_VERTICES} nodes for the tolerance"
+            )));
+        }
+        for point in bad {
+            cdt.insert(point)
+                .map_err(|e| failed(format!("a refinement point cannot be inserted: {e:?}")))?;
+        }
+    }
+    if inner.is_empty() {
+        return Err(failed("its loops enclose no area".into()));
+    }
+    // Spade's triangles run counter-clockwise in the chart; the loops run
+    // counter-clockwise about the face normal, so their signed area in the
+    // chart says whether the chart keeps or mirrors that orientation. (The
+    // loops are trusted over `reversed`, which some explicit faces get wrong.)
+    let signed: f64 = uv_loops.iter().map(|lp| shoelace(lp)).sum();
+    if signed < 0.0 {
+        for t in &mut inner {
+            t.swap(1, 2);
+        }
+    }
+    Ok(Outcome::Meshed(FaceMesh {
+        points: keys,
+        triangles: inner,
+    }))
+}
+
+/// The face's loops as point sequences, each point with the segment after it.
+fn walk_loops(
+    model: &Model,
+    face: &Face,
+    edges: &[EdgeNodes],
+) -> Result<Vec<Vec<LoopPoint>>, String> {
+    let mut loops = Vec::new();
+    for lp in &face.loops {
+        let mut points = Vec::new();
+        for (k, oe) in lp.iter().enumerate() {
+            let i = oe.edge.index();
+            let (edge, nodes) = model
+                .edges
+                .get(i)
+                .zip(edges.get(i))
+                .ok_or("a loop names an edge that does not exist")?;
+            let last = if oe.forward { edge.end } else { edge.begin };
+            let next = &lp[(k + 1) % lp.len()];
+            let next_first = model
+                .edges
+                .get(next.edge.index())
+                .map(|e| if next.forward { e.begin } else { e.end });
+            if next_first != Some(last) {
+                return Err(format!("its loop is not closed after edge {}", edge.name));
+            }
+            let n = nodes.points.len();
+            let key = |j: usize| {
+                if j == 0 {
+                    FacePoint::Vertex(edge.begin.0)
+                } else if j + 1 == n {
+                    FacePoint::Vertex(edge.end.0)
+                } else {
+                    FacePoint::Edge { edge: i, index: j }
+                }
+            };
+            let order: Vec<usize> = if oe.forward {
+                (0..n).collect()
+            } else {
+                (0..n).rev().collect()
+            };
+            for w in order.windows(2) {
+                points.push(LoopPoint {
+                    key: key(w[0]),
+                    point: nodes.points[w[0]],
+                    edge: i,
+                    s: nodes.params[w[0]],
+                    s_next: nodes.params[w[1]],
+                });
+            }
+        }
+        if points.len() >= 2 {
+            loops.push(points);
+        } else if !points.is_empty() {
+            return Err("a loop has fewer than two nodes".into());
+        }
+    }
+    if loops.is_empty() {
+        return Err("it has no loops".into());
+    }
+    Ok(loops)
+}
+
+/// ∫ n dA over the face along the gradient side: ½ Σ p × p' over its loops,
+/// negated for reversed faces.
+fn area_vector(face: &Face, loops: &[Vec<LoopPoint>]) -> Vec3 {
+    let mut sum = Vec3::zeros();
+    for lp in loops {
+        for (i, p) in lp.iter().enumerate() {
+            let q = &lp[(i + 1) % lp.len()];
+            sum += p.point.coords.cross(&q.point.coords);
+        }
+    }
+    if face.reversed { -0.5 * sum } else { 0.5 * sum }
+}
+
+/// Parameters of every loop point, periodic coordinates made continuous
+/// along each loop.
+fn unwrap_loops(chart: &Chart, loops: &[Vec<LoopPoint>]) -> Result<Vec<Vec<[f64; 2]>>, String> {
+    let periods = chart.periods();
+    let mut out = Vec::new();
+    for lp in loops {
+        let mut uv: Vec<[f64; 2]> = Vec::with_capacity(lp.len());
+        for p in lp {
+            let mut q = chart
+                .to_param(&p.point)
+                .ok_or("a boundary node has no parameters in its surface's chart")?;
+            if let Some(prev) = uv.last() {
+                for k in 0..2 {
+                    if let Some(period) = periods[k] {
+                        q[k] += period * ((prev[k] - q[k]) / period).round();
+                    }
+                }
+            }
+            uv.push(q);
+        }
+        if let (Some(first), Some(last)) = (uv.first(), uv.last()) {
+            for k in 0..2 {
+                if let Some(period) = periods[k]
+                    && ((first[k] - last[k]) / period).round() != 0.0
+                {
+                    return Err("a loop winds around its periodic surface".into());
+                }
+            }
+        }
+        out.push(uv);
+    }
+    Ok(out)
+}
+
+/// Even–odd point-in-polygon test over all loops.
+fn winding_odd(loops: &[Vec<[f64; 2]>], p: [f64; 2]) -> bool {
+    let mut inside = false;
+    for lp in loops {
+        for (i, a) in lp.iter().enumerate() {
+            let b = &lp[(i + 1) % lp.len()];
+            if (a[1] > p[1]) != (b[1] > p[1]) {
+                let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if x > p[0] {
+                    inside = !inside;
+                }
+            }
+        }
+    }
+    inside
+}
+
+/// Vertices the refinement put on boundary segments, as curve parameters.
+fn boundary_splits(
+    cdt: &Cdt,
+    fixed: usize,
+    segments: &Segments,
+) -> Result<Vec<(usize, f64)>, String> {
+    let mut splits = Vec::new();
+    for v in fixed..cdt.num_vertices() {
+        let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(v));
+        if !vertex.out_edges().any(|e| e.is_constraint_edge()) {
+            continue;
+        }
+        let p = vertex.position();
+        let found = segments.iter().find_map(|(&(a, b), &(edge, sa, sb))| {
+            let pa = cdt
+                .vertex(spade::handles::FixedVertexHandle::from_index(a))
+                .position();
+            let pb = cdt
+                .vertex(spade::handles::FixedVertexHandle::from_index(b))
+                .position();
+            let (dx, dy) = (pb.x - pa.x, pb.y - pa.y);
+            let len2 = dx * dx + dy * dy;
+            let t = ((p.x - pa.x) * dx + (p.y - pa.y) * dy) / len2;
+            let off = ((p.x - pa.x) * dy - (p.y - pa.y) * dx).abs() / len2.sqrt();
+            (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some((edge, sa + t * (sb - sa)))
+        });
+        splits.push(found.ok_or("refinement put a node on its boundary away from every edge")?);
+    }
+    Ok(splits)
+}
+
+/// True when a triangle is longer than `max_edge` or strays from the surface
+/// by more than the tolerance at its centroid or an edge midpoint.
+fn too_coarse(face: &Face, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
+    let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+    if longest > settings.max_edge {
+        return true;
+    }
+    if matches!(face.surface, crate::geom::Surface::Plane { .. }) {
+        return false;
+    }
+    let probes = [
+        Point3::from((a.coords + b.coords + c.coords) / 3.0),
+        Point3::from((a.coords + b.coords) / 2.0),
+        Point3::from((b.coords + c.coords) / 2.0),
+        Point3::from((c.coords + a.coords) / 2.0),
+    ];
+    probes
+        .iter()
+        .any(|p| face.surface.distance(p) > settings.tolerance)
+}
+
+/// Twice the signed area of a closed polygon.
+fn shoelace(points: &[[f64; 2]]) -> f64 {
+    (0..points.len())
+        .map(|i| {
+            let (a, b) = (points[i], points[(i + 1) % points.len()]);
+            a[0] * b[1] - a[1] * b[0]
+        })
+        .sum()
+}
+
+/// Spade refuses coordinates below about 1e-43 in magnitude: such values
+/// are zero for meshing purposes.
+fn point2([u, v]: [f64; 2]) -> Point2<f64> {
+    let snap = |x: f64| if x.abs() < 1e-30 { 0.0 } else { x };
+    Point2::new(snap(u), snap(v))
+}

@@ -1,0 +1,327 @@
+//! The surface mesher: model IR → [`Mesh`]. Edges are discretised once and
+//! shared ([`edges`]), each face is triangulated against them in a chart of
+//! its surface ([`chart`], [`face`]), and the groups (subdomains, fragments,
+//! points, poly_lines) are copied over. [`check`] verifies and measures the
+//! result.
+//!
+//! # Guarantees
+//! - Every model vertex is one node (node i is vertex i); an edge's nodes are
+//!   shared by every face that uses it, so the mesh conforms.
+//! - Chordal deviation ≤ tolerance on edges (≤ half of it) and faces;
+//!   planar faces have angles ≥ `min_angle_degrees` except where their own
+//!   loops meet at smaller angles (or the last round had to forbid boundary
+//!   splits).
+//! - Deterministic: the same model and options give the same mesh.
+//!
+//! # Limitations
+//! - Faces without loops (unbounded surfaces) get no triangles; one that
+//!   bounds a subdomain is an error.
+//! - Spade's refinement can panic on loss of precision (its own `expect`);
+//!   that is not caught here.
+//! - See the module docs of [`chart`] and [`face`] for per-surface limits.
+
+mod chart;
+mod check;
+mod edges;
+mod face;
+
+pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
+
+use crate::ir::{self, Dimension, Model, Side, SubdomainCells};
+use crate::mesh::{
+    Mesh, MeshEdge, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain, MeshVertex,
+};
+use edges::EdgeNodes;
+use face::{FaceMesh, FacePoint, Outcome, Settings};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// Rounds of "mesh faces, add the boundary points they asked for" before
+/// boundary splitting is forbidden.
+const MAX_ROUNDS: usize = 8;
+
+/// The chordal tolerance: the largest distance allowed between the model's
+/// curves and surfaces and their chords and triangles.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Tolerance {
+    Absolute(f64),
+    /// A fraction of the model's bounding-box diagonal.
+    Relative(f64),
+}
+
+impl Default for Tolerance {
+    fn default() -> Tolerance {
+        Tolerance::Relative(1e-3)
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct MeshOptions {
+    pub tolerance: Tolerance,
+    /// Longest edge allowed anywhere; `None` = no limit.
+    pub max_edge: Option<f64>,
+    /// The smallest triangle angle refinement aims for (planar faces exactly,
+    /// curved faces in their chart).
+    pub min_angle_degrees: f64,
+}
+
+impl Default for MeshOptions {
+    fn default() -> MeshOptions {
+        MeshOptions {
+            tolerance: Tolerance::default(),
+            max_edge: None,
+            min_angle_degrees: 25.0,
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+pub enum MeshError {
+    #[error("invalid mesh options: {0}")]
+    Options(String),
+    #[error("cannot discretise edge `{edge}`: {reason}")]
+    Edge { edge: String, reason: String },
+    #[error("cannot mesh face `{face}`: {reason}")]
+    Face { face: String, reason: String },
+}
+
+/// Meshes every edge and face of `model` and copies its groups.
+pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshError> {
+    let tolerance = match options.tolerance {
+        Tolerance::Absolute(t) => t,
+        Tolerance::Relative(r) => r * model.bbox().diagonal(),
+    };
+    if !(tolerance.is_finite() && tolerance > 0.0) {
+        return Err(MeshError::Options(format!(
+            "the tolerance must be positive and finite (got {tolerance})"
+        )));
+    }
+    let max_edge = options.max_edge.unwrap_or(f64::INFINITY);
+    if max_edge.is_nan() || max_edge <= 0.0 {
+        return Err(MeshError::Options("max_edge must be positive".into()));
+    }
+    // Spade's refinement may not terminate above about 30°.
+    let min_angle = options.min_angle_degrees;
+    if !(0.0..=33.0).contains(&min_angle) {
+        return Err(MeshError::Options(format!(
+            "min_angle_degrees must lie in [0, 33] (got {min_angle})"
+        )));
+    }
+
+    // Half the tolerance on edges leaves room for the triangles beside them.
+    let mut edge_nodes = model
+        .edges
+        .iter()
+        .map(|e| edges::discretise(model, e, 0.5 * tolerance, max_edge))
+        .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
+    let face_meshes = mesh_faces(model, &mut edge_nodes, tolerance, max_edge, min_angle)?;
+    Ok(assemble(model, &edge_nodes, &face_meshes))
+}
+
+/// Meshes the faces in rounds until no face asks for new boundary points.
+fn mesh_faces(
+    model: &Model,
+    edge_nodes: &mut [EdgeNodes],
+    tolerance: f64,
+    max_edge: f64,
+    min_angle: f64,
+) -> Result<Vec<Option<FaceMesh>>, MeshError> {
+    let mut faces_of_edge: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+    for (f, face) in model.faces.iter().enumerate() {
+        for oe in face.loops.iter().flatten() {
+            faces_of_edge.entry(oe.edge.index()).or_default().push(f);
+        }
+    }
+    // A face without loops (an unbounded surface) gets no triangles, which
+    // would leave a hole in any subdomain it bounds.
+    for sub in &model.subdomains {
+        let faces: Vec<ir::FaceId> = match &sub.cells {
+            SubdomainCells::Volume { boundary } => boundary.iter().map(|of| of.face).collect(),
+            SubdomainCells::Region { faces } => faces.clone(),
+        };
+        for f in faces {
+            let face = model.faces.get(f.index()).ok_or_else(|| MeshError::Face {
+                face: format!("#{}", f.0),
+                reason: format!("subdomain `{}` names a face that does not exist", sub.name),
+            })?;
+            if face.loops.is_empty() {
+                return Err(MeshError::Face {
+                    face: face.name.clone(),
+                    reason: format!("it bounds subdomain `{}` but has no loops", sub.name),
+                });
+            }
+        }
+    }
+    let mut meshes: Vec<Option<FaceMesh>> = vec![None; model.faces.len()];
+    let mut todo: BTreeSet<usize> = (0..model.faces.len())
+        .filter(|&f| !model.faces[f].loops.is_empty())
+        .collect();
+    for round in 0..=MAX_ROUNDS {
+        let settings = Settings {
+            tolerance,
+            max_edge,
+            min_angle,
+            keep_boundary: round == MAX_ROUNDS,
+        };
+        let mut splits: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
+        for &f in &todo {
+            match face::mesh_face(model, &model.faces[f], edge_nodes, &settings)? {
+                Outcome::Meshed(mesh) => meshes[f] = Some(mesh),
+                Outcome::Split(points) => {
+                    for (edge, s) in points {
+                        splits.entry(edge).or_default().push(s);
+                    }
+                }
+            }
+        }
+        todo.clear();
+        for (edge, params) in splits {
+            let (Some(nodes), Some(model_edge)) = (edge_nodes.get_mut(edge), model.edges.get(edge))
+            else {
+                continue;
+            };
+            let mut changed = false;
+            for s in params {
+                changed |= nodes.insert(&model_edge.curve, s);
+            }
+            if changed {
+                todo.extend(faces_of_edge.get(&edge).into_iter().flatten().copied());
+            }
+        }
+        if todo.is_empty() {
+            break;
+        }
+    }
+    Ok(meshes)
+}
+
+/// Numbers the nodes (vertices, then edge interiors, then face interiors,
+/// then points and poly_lines) and fills the mesh IR.
+fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceMesh>]) -> Mesh {
+    let mut nodes: Vec<[f64; 3]> = model
+        .vertices
+        .iter()
+        .map(|v| [v.position.x, v.position.y, v.position.z])
+        .collect();
+    let push = |nodes: &mut Vec<[f64; 3]>, p: &crate::geom::Point3| {
+        nodes.push([p.x, p.y, p.z]);
+        (nodes.len() - 1) as u32
+    };
+    let mut edge_ids: Vec<Vec<u32>> = Vec::with_capacity(model.edges.len());
+    let mut edges = Vec::with_capacity(model.edges.len());
+    for (edge, disc) in model.edges.iter().zip(edge_nodes) {
+        let n = disc.points.len();
+        let mut ids = Vec::with_capacity(n);
+        for (j, p) in disc.points.iter().enumerate() {
+            ids.push(match j {
+                0 => edge.begin.0,
+                j if j + 1 == n => edge.end.0,
+                _ => push(&mut nodes, p),
+            });
+        }
+        edges.push(MeshEdge {
+            name: edge.name.clone(),
+            nodes: ids.clone(),
+        });
+        edge_ids.push(ids);
+    }
+    let mut faces = Vec::with_capacity(model.faces.len());
+    for (face, mesh) in model.faces.iter().zip(face_meshes) {
+        let mut triangles = Vec::new();
+        if let Some(mesh) = mesh {
+            let mut ids: Vec<Option<u32>> = vec![None; mesh.points.len()];
+            for t in &mesh.triangles {
+                let mut tri = [0u32; 3];
+                for (slot, &i) in tri.iter_mut().zip(t) {
+                    let id = match (&mesh.points[i], ids[i]) {
+                        (_, Some(id)) => id,
+                        (FacePoint::Vertex(v), None) => *v,
+                        (FacePoint::Edge { edge, index }, None) => edge_ids
+                            .get(*edge)
+                            .and_then(|e| e.get(*index))
+                            .copied()
+                            .unwrap_or(0),
+                        (FacePoint::Interior(p), None) => push(&mut nodes, p),
+                    };
+                    ids[i] = Some(id);
+                    *slot = id;
+                }
+                triangles.push(tri);
+            }
+        }
+        faces.push(MeshFace {
+            name: face.name.clone(),
+            triangles,
+            boundary: face
+                .loops
+                .iter()
+                .flatten()
+                .map(|oe| (oe.edge.0, oe.forward))
+                .collect(),
+        });
+    }
+    let subdomains = model
+        .subdomains
+        .iter()
+        .map(|s| MeshSubdomain {
+            name: s.name.clone(),
+            material: s.material.clone(),
+            faces: match &s.cells {
+                SubdomainCells::Volume { boundary } => {
+                    boundary.iter().map(|of| (of.face.0, of.outward)).collect()
+                }
+                SubdomainCells::Region { faces } => faces.iter().map(|f| (f.0, true)).collect(),
+            },
+        })
+        .collect();
+    let fragments = ir::derive_fragments(model)
+        .into_iter()
+        .map(|f| MeshFragment {
+            name: f.name,
+            subdomain: f.subdomain.0,
+            other: match f.other {
+                Side::Exterior => None,
+                Side::Subdomain(k) => Some(k.0),
+            },
+            faces: f.faces.iter().map(|id| id.0).collect(),
+            edges: f.edges.iter().map(|id| id.0).collect(),
+        })
+        .collect();
+    let mut point_sets = Vec::new();
+    for set in &model.point_sets {
+        let ids = set.points.iter().map(|p| push(&mut nodes, p)).collect();
+        point_sets.push(MeshPolyline {
+            name: set.name.clone(),
+            nodes: ids,
+        });
+    }
+    let mut polylines = Vec::new();
+    for line in &model.polylines {
+        let ids = line.points.iter().map(|p| push(&mut nodes, p)).collect();
+        polylines.push(MeshPolyline {
+            name: line.name.clone(),
+            nodes: ids,
+        });
+    }
+    Mesh {
+        dimension: match model.dimension {
+            Dimension::Two => 2,
+            Dimension::Three => 3,
+        },
+        nodes,
+        vertices: model
+            .vertices
+            .iter()
+            .enumerate()
+            .map(|(i, v)| MeshVertex {
+                name: v.name.clone(),
+                node: i as u32,
+            })
+            .collect(),
+        edges,
+        faces,
+        subdomains,
+        fragments,
+        point_sets,
+        polylines,
+    }
+}
