@@ -376,7 +376,8 @@ fn orient_loops(model: &Model, loops: &mut [Vec<OrientedEdge>], surface: &Surfac
     let on_surface = surface.project(&centroid).unwrap_or(centroid);
     let gradient = surface.gradient(&on_surface);
     let reversed = area.dot(&gradient) < 0.0;
-    let normal = if reversed { -area } else { area };
+    // The face normal (±∇S, chosen above) points along the outer loop's vector area.
+    let normal = area;
     for (k, l) in loops.iter_mut().enumerate() {
         let a = vector_area(&loop_points(model, l));
         let counter_clockwise = a.dot(&normal) > 0.0;
