@@ -234,18 +234,26 @@ impl Model {
             }
         }
 
-        let entities = [points, curves, surfaces, volumes];
+        let mut entities = [points, curves, surfaces, volumes];
         // Lowest dimension first, so a node on a vertex belongs to its point,
         // one on an edge to its curve.
         let mut owner: Vec<Option<(u8, usize)>> = vec![None; mesh.nodes.len()];
         for (dim, list) in entities.iter().enumerate() {
             for (i, e) in list.iter().enumerate() {
-                for &n in e.elements.iter().flatten() {
+                for &n in &e.used {
                     let slot = &mut owner[n as usize];
                     if slot.is_none() {
                         *slot = Some((dim as u8, i));
                     }
                 }
+            }
+        }
+        // Elements only where a physical group holds them, as Gmsh saves by
+        // default: readers such as meshio expect every element block to have a
+        // physical tag. The entities and their nodes stay.
+        for e in entities.iter_mut().flatten() {
+            if e.physicals.is_empty() {
+                e.elements.clear();
             }
         }
         let unused_nodes = owner.iter().filter(|o| o.is_none()).count();
