@@ -278,8 +278,8 @@ fn parse_msh(t: &str) -> MshSummary {
     let mut physicals: BTreeMap<(i32, i32), Vec<i32>> = BTreeMap::new();
     let mut volume_boundaries = Vec::new();
     let mut line = 1;
-    for dim in 0..4 {
-        for _ in 0..entities[dim] {
+    for (dim, &count) in entities.iter().enumerate() {
+        for _ in 0..count {
             let v = ints(entity_lines[line]);
             line += 1;
             let at = if dim == 0 { 4 } else { 7 };
