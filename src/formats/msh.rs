@@ -3,12 +3,13 @@
 //! points (begin positive, end negative: Gmsh's own convention), surfaces the
 //! faces with their signed bounding curves, volumes (3D) the subdomains with
 //! their signed boundary surfaces. Each mesh node is written once, on the
-//! lowest-dimensional entity that uses it; elements are written per entity
-//! (15 point, 1 line, 2 triangle). Physical groups: every fragment (dim 2 in
-//! 3D, 1 in 2D), every subdomain (dim 3 in 3D; in 2D its region faces, dim 2),
-//! faces in neither kind of group (dim 2, by face name), poly_lines (dim 1)
-//! and point sets (dim 0, one point entity per point). Poly_lines become
-//! extra curves, point-set points extra point entities.
+//! lowest-dimensional entity that uses it. Physical groups: every fragment
+//! (dim 2 in 3D, 1 in 2D), every subdomain (dim 3 in 3D; in 2D its region
+//! faces, dim 2), faces in neither kind of group (dim 2, by face name),
+//! poly_lines (dim 1, as extra curves) and point sets (dim 0, one extra point
+//! entity per point). Elements (15 point, 1 line, 2 triangle) are written per
+//! entity, only for entities in a physical group — what Gmsh itself saves by
+//! default, and what meshio needs to attach groups to every element block.
 
 use super::groups;
 use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, fmt_num, warning};
