@@ -11,6 +11,7 @@ pub mod diag;
 pub mod doc;
 pub mod driver;
 pub mod expr;
+pub mod formats;
 pub mod geom;
 pub mod inspect;
 pub mod ir;

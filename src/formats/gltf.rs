@@ -1,0 +1,385 @@
+//! glTF 2.0, as `.gltf` (JSON; the buffer in a side file `NAME.bin` when the
+//! file name is known, else embedded as a base64 data URI) or `.glb` (one
+//! binary file). The scene has up to four parent nodes: `surfaces` (a node and
+//! mesh per fragment in 3D, per region in 2D, per face outside those),
+//! `subdomains` (3D: each subdomain's whole boundary, outward), `lines`
+//! (LINES: 2D fragments, edges, poly_lines) and `point_sets` (POINTS).
+//! Triangles carry vertex normals, smooth within a face and flat across its
+//! edges; each node's `extras` say what it is and, for a fragment, its
+//! subdomain pair. Floats are `f32`, as glTF requires.
+
+use super::groups::{self, Source};
+use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
+use crate::mesh::Mesh;
+use serde_json::{Value, json};
+use std::io::Write;
+
+pub(crate) struct Gltf {
+    glb: bool,
+}
+
+pub(crate) static GLTF: Gltf = Gltf { glb: false };
+pub(crate) static GLB: Gltf = Gltf { glb: true };
+
+const ARRAY_BUFFER: u32 = 34962;
+const ELEMENT_ARRAY_BUFFER: u32 = 34963;
+const FLOAT: u32 = 5126;
+const UNSIGNED_INT: u32 = 5125;
+
+impl MeshWriter for Gltf {
+    fn name(&self) -> &'static str {
+        if self.glb { "glb" } else { "gltf" }
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        if self.glb { &["glb"] } else { &["gltf"] }
+    }
+
+    fn write(
+        &self,
+        mesh: &Mesh,
+        options: &WriteOptions,
+        out: &mut dyn Write,
+    ) -> Result<Vec<Warning>, WriteError> {
+        groups::check(mesh)?;
+        let doc = Document::of(mesh, self.name());
+        let mut warnings = doc.warnings.clone();
+        if options.encoding.is_some() {
+            warnings.push(warning(
+                self.name(),
+                "glTF has one encoding: the encoding option is ignored",
+            ));
+        }
+        if self.glb {
+            let json = doc.json(None);
+            write_glb(&json, &doc.buffer, out)?;
+        } else {
+            let uri = match bin_name(options) {
+                Some(name) => percent_encode(&name),
+                None => format!(
+                    "data:application/octet-stream;base64,{}",
+                    base64::encode(&doc.buffer)
+                ),
+            };
+            out.write_all(&doc.json(Some(uri)))?;
+        }
+        Ok(warnings)
+    }
+
+    fn side_files(&self, mesh: &Mesh, options: &WriteOptions) -> Result<Vec<SideFile>, WriteError> {
+        if self.glb {
+            return Ok(Vec::new());
+        }
+        groups::check(mesh)?;
+        Ok(match bin_name(options) {
+            Some(name) => vec![SideFile {
+                name,
+                bytes: Document::of(mesh, self.name()).buffer,
+            }],
+            None => Vec::new(),
+        })
+    }
+}
+
+/// `part.gltf` → `part.bin`.
+fn bin_name(options: &WriteOptions) -> Option<String> {
+    let name = options.file_name.as_deref()?;
+    let stem = if name.to_ascii_lowercase().ends_with(".gltf") {
+        &name[..name.len() - 5]
+    } else {
+        name
+    };
+    Some(format!("{stem}.bin"))
+}
+
+/// URIs are percent-encoded: a file name with a space must still resolve.
+fn percent_encode(s: &str) -> String {
+    let mut out = String::new();
+    for b in s.bytes() {
+        if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
+            out.push(char::from(b));
+        } else {
+            out.push_str(&format!("%{b:02X}"));
+        }
+    }
+    out
+}
+
+/// The JSON parts and the binary buffer, built together.
+struct Document {
+    nodes: Vec<Value>,
+    meshes: Vec<Value>,
+    accessors: Vec<Value>,
+    views: Vec<Value>,
+    buffer: Vec<u8>,
+    scene: Vec<usize>,
+    warnings: Vec<Warning>,
+}
+
+impl Document {
+    fn of(mesh: &Mesh, format: &'static str) -> Document {
+        let mut d = Document {
+            nodes: Vec::new(),
+            meshes: Vec::new(),
+            accessors: Vec::new(),
+            views: Vec::new(),
+            buffer: Vec::new(),
+            scene: Vec::new(),
+            warnings: Vec::new(),
+        };
+        let mut empty = Vec::new();
+
+        let mut children = Vec::new();
+        for g in groups::surface_groups(mesh) {
+            let ex = groups::expand(mesh, &g.faces);
+            if ex.triangles.is_empty() {
+                empty.push(g.name.to_string());
+                continue;
+            }
+            let primitive = d.triangles(&ex);
+            children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+        }
+        d.parent("surfaces", children);
+
+        let mut children = Vec::new();
+        for g in groups::subdomain_surfaces(mesh) {
+            let ex = groups::expand(mesh, &g.faces);
+            if ex.triangles.is_empty() {
+                empty.push(g.name.to_string());
+                continue;
+            }
+            let primitive = d.triangles(&ex);
+            children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+        }
+        d.parent("subdomains", children);
+
+        let mut children = Vec::new();
+        for g in groups::line_groups(mesh) {
+            if g.segments.is_empty() {
+                empty.push(g.name.to_string());
+                continue;
+            }
+            let (nodes, local) = compact(g.segments.iter().flatten().copied());
+            let primitive = d.indexed(mesh, &nodes, Some(&local), 1);
+            children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+        }
+        d.parent("lines", children);
+
+        let mut children = Vec::new();
+        for p in &mesh.point_sets {
+            if p.nodes.is_empty() {
+                empty.push(p.name.clone());
+                continue;
+            }
+            let primitive = d.indexed(mesh, &p.nodes, None, 0);
+            children.push(d.node(&p.name, primitive, json!({"kind": "point_set"})));
+        }
+        d.parent("point_sets", children);
+
+        if !empty.is_empty() {
+            d.warnings.push(warning(
+                format,
+                format!(
+                    "glTF meshes cannot be empty: {} without elements left out ({})",
+                    count(empty.len(), "group"),
+                    empty.join(", ")
+                ),
+            ));
+        }
+        d
+    }
+
+    /// Appends 4-byte values as a new buffer view; returns its index.
+    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
+        let offset = self.buffer.len();
+        self.buffer.extend_from_slice(bytes);
+        self.views.push(json!({
+            "buffer": 0,
+            "byteOffset": offset,
+            "byteLength": bytes.len(),
+            "target": target,
+        }));
+        self.views.len() - 1
+    }
+
+    fn vec3_accessor(&mut self, values: &[[f32; 3]], with_bounds: bool) -> usize {
+        let bytes: Vec<u8> = values
+            .iter()
+            .flatten()
+            .flat_map(|c| c.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes, ARRAY_BUFFER);
+        let mut accessor = json!({
+            "bufferView": view,
+            "componentType": FLOAT,
+            "count": values.len(),
+            "type": "VEC3",
+        });
+        if with_bounds {
+            // The validator compares these with the stored f32 values exactly.
+            let mut lo = [f32::INFINITY; 3];
+            let mut hi = [f32::NEG_INFINITY; 3];
+            for v in values {
+                for k in 0..3 {
+                    lo[k] = lo[k].min(v[k]);
+                    hi[k] = hi[k].max(v[k]);
+                }
+            }
+            accessor["min"] = json!(lo);
+            accessor["max"] = json!(hi);
+        }
+        self.accessors.push(accessor);
+        self.accessors.len() - 1
+    }
+
+    fn index_accessor(&mut self, indices: &[u32]) -> usize {
+        let bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
+        let view = self.view(&bytes, ELEMENT_ARRAY_BUFFER);
+        self.accessors.push(json!({
+            "bufferView": view,
+            "componentType": UNSIGNED_INT,
+            "count": indices.len(),
+            "type": "SCALAR",
+        }));
+        self.accessors.len() - 1
+    }
+
+    fn triangles(&mut self, ex: &groups::Expanded) -> Value {
+        let positions: Vec<[f32; 3]> = ex.positions.iter().map(|p| p.map(|c| c as f32)).collect();
+        let normals: Vec<[f32; 3]> = ex.normals.iter().map(|n| n.map(|c| c as f32)).collect();
+        let indices: Vec<u32> = ex.triangles.iter().flatten().copied().collect();
+        let position = self.vec3_accessor(&positions, true);
+        let normal = self.vec3_accessor(&normals, false);
+        let indices = self.index_accessor(&indices);
+        json!({
+            "attributes": {"POSITION": position, "NORMAL": normal},
+            "indices": indices,
+            "mode": 4,
+        })
+    }
+
+    /// A LINES (mode 1) or POINTS (mode 0) primitive over some mesh nodes.
+    fn indexed(&mut self, mesh: &Mesh, nodes: &[u32], indices: Option<&[u32]>, mode: u32) -> Value {
+        let positions: Vec<[f32; 3]> = nodes
+            .iter()
+            .map(|&n| mesh.nodes[n as usize].map(|c| c as f32))
+            .collect();
+        let position = self.vec3_accessor(&positions, true);
+        let mut primitive = json!({"attributes": {"POSITION": position}, "mode": mode});
+        if let Some(indices) = indices {
+            primitive["indices"] = json!(self.index_accessor(indices));
+        }
+        primitive
+    }
+
+    fn node(&mut self, name: &str, primitive: Value, extras: Value) -> usize {
+        self.meshes
+            .push(json!({"name": name, "primitives": [primitive]}));
+        self.nodes.push(json!({
+            "name": name,
+            "mesh": self.meshes.len() - 1,
+            "extras": extras,
+        }));
+        self.nodes.len() - 1
+    }
+
+    fn parent(&mut self, name: &str, children: Vec<usize>) {
+        if children.is_empty() {
+            return;
+        }
+        self.nodes.push(json!({"name": name, "children": children}));
+        self.scene.push(self.nodes.len() - 1);
+    }
+
+    fn json(&self, uri: Option<String>) -> Vec<u8> {
+        let mut root = json!({
+            "asset": {"version": "2.0", "generator": "geomc"},
+            "scene": 0,
+            "scenes": [{"nodes": self.scene}],
+        });
+        if !self.nodes.is_empty() {
+            root["nodes"] = json!(self.nodes);
+        }
+        if !self.meshes.is_empty() {
+            root["meshes"] = json!(self.meshes);
+            root["accessors"] = json!(self.accessors);
+            root["bufferViews"] = json!(self.views);
+            let mut buffer = json!({"byteLength": self.buffer.len()});
+            if let Some(uri) = uri {
+                buffer["uri"] = json!(uri);
+            }
+            root["buffers"] = json!([buffer]);
+        }
+        // serde_json's maps are sorted: the same document gives the same bytes.
+        serde_json::to_vec_pretty(&root).unwrap_or_default()
+    }
+}
+
+/// Distinct nodes in first-use order, and each input node's index among them.
+fn compact(nodes: impl Iterator<Item = u32>) -> (Vec<u32>, Vec<u32>) {
+    let mut seen = std::collections::HashMap::new();
+    let mut distinct = Vec::new();
+    let local = nodes
+        .map(|n| {
+            *seen.entry(n).or_insert_with(|| {
+                distinct.push(n);
+                (distinct.len() - 1) as u32
+            })
+        })
+        .collect();
+    (distinct, local)
+}
+
+fn extras(mesh: &Mesh, source: Source) -> Value {
+    let name = |s: u32| mesh.subdomains.get(s as usize).map(|s| s.name.clone());
+    match source {
+        Source::Fragment(i) => {
+            let Some(fr) = mesh.fragments.get(i as usize) else {
+                return json!({"kind": "fragment"});
+            };
+            json!({
+                "kind": "fragment",
+                "subdomain": name(fr.subdomain),
+                "other": fr.other.map_or(Some("exterior".to_string()), name),
+                "subdomain_index": fr.subdomain,
+                "other_index": fr.other,
+            })
+        }
+        Source::Subdomain(i) => json!({
+            "kind": "subdomain",
+            "material": mesh.subdomains.get(i as usize).and_then(|s| s.material.clone()),
+        }),
+        Source::Face(_) => json!({"kind": "face"}),
+        Source::Edge(_) => json!({"kind": "edge"}),
+        Source::Polyline(_) => json!({"kind": "poly_line"}),
+    }
+}
+
+/// GLB container: a 12-byte header, the JSON chunk padded with spaces and the
+/// BIN chunk padded with zeros, both to 4 bytes.
+fn write_glb(json: &[u8], bin: &[u8], out: &mut dyn Write) -> Result<(), WriteError> {
+    let pad = |n: usize| (4 - n % 4) % 4;
+    let json_len = json.len() + pad(json.len());
+    let bin_len = bin.len() + pad(bin.len());
+    let mut total = 12 + 8 + json_len;
+    if !bin.is_empty() {
+        total += 8 + bin_len;
+    }
+    let total = u32::try_from(total).map_err(|_| {
+        WriteError::Unsupported(format!("GLB files hold at most 4 GiB, not {total} bytes"))
+    })?;
+    out.write_all(b"glTF")?;
+    out.write_all(&2u32.to_le_bytes())?;
+    out.write_all(&total.to_le_bytes())?;
+    out.write_all(&(json_len as u32).to_le_bytes())?;
+    out.write_all(b"JSON")?;
+    out.write_all(json)?;
+    out.write_all(&b"   "[..pad(json.len())])?;
+    if !bin.is_empty() {
+        out.write_all(&(bin_len as u32).to_le_bytes())?;
+        out.write_all(b"BIN\0")?;
+        out.write_all(bin)?;
+        out.write_all(&[0u8; 3][..pad(bin.len())])?;
+    }
+    Ok(())
+}

@@ -1,0 +1,348 @@
+//! What several writers share: the mesh check that lets them index without
+//! panicking, the groups viewer formats show (fragments, subdomain surfaces,
+//! faces, edges), triangles oriented out of a fragment's subdomain, and
+//! vertex normals that are smooth within a face and flat across its edges.
+
+use super::WriteError;
+use crate::mesh::Mesh;
+use std::collections::HashMap;
+
+/// Rejects a mesh whose indices leave their tables or whose coordinates are
+/// not finite. After it, writers may index the mesh's tables directly.
+pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
+    let bad = |what: String| Err(WriteError::InvalidMesh(what));
+    if mesh.dimension != 2 && mesh.dimension != 3 {
+        return bad(format!("dimension {} (2 or 3 expected)", mesh.dimension));
+    }
+    if u32::try_from(mesh.nodes.len()).is_err() {
+        return bad(format!(
+            "{} nodes: more than u32 can number",
+            mesh.nodes.len()
+        ));
+    }
+    if let Some(i) = mesh
+        .nodes
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
+    {
+        return bad(format!("node {i} has a coordinate that is not finite"));
+    }
+    let n = mesh.nodes.len();
+    let node_ok = |v: &u32| (*v as usize) < n;
+    for v in &mesh.vertices {
+        if !node_ok(&v.node) {
+            return bad(format!(
+                "vertex `{}` refers to node {} of {n}",
+                v.name, v.node
+            ));
+        }
+    }
+    for e in &mesh.edges {
+        if !e.nodes.iter().all(node_ok) {
+            return bad(format!("edge `{}` refers to a node out of range", e.name));
+        }
+    }
+    for f in &mesh.faces {
+        if !f.triangles.iter().flatten().all(node_ok) {
+            return bad(format!("face `{}` refers to a node out of range", f.name));
+        }
+        if f.boundary
+            .iter()
+            .any(|(e, _)| *e as usize >= mesh.edges.len())
+        {
+            return bad(format!(
+                "face `{}` is bounded by an edge out of range",
+                f.name
+            ));
+        }
+    }
+    for s in &mesh.subdomains {
+        if s.faces.iter().any(|(f, _)| *f as usize >= mesh.faces.len()) {
+            return bad(format!("subdomain `{}` lists a face out of range", s.name));
+        }
+    }
+    let nd = mesh.subdomains.len();
+    for fr in &mesh.fragments {
+        let sides_ok = (fr.subdomain as usize) < nd && fr.other.is_none_or(|o| (o as usize) < nd);
+        if !sides_ok
+            || fr.faces.iter().any(|f| *f as usize >= mesh.faces.len())
+            || fr.edges.iter().any(|e| *e as usize >= mesh.edges.len())
+        {
+            return bad(format!(
+                "fragment `{}` refers to an entity out of range",
+                fr.name
+            ));
+        }
+    }
+    for p in mesh.polylines.iter().chain(&mesh.point_sets) {
+        if !p.nodes.iter().all(node_ok) {
+            return bad(format!("`{}` refers to a node out of range", p.name));
+        }
+    }
+    Ok(())
+}
+
+/// What a group stands for.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Source {
+    Fragment(u32),
+    Subdomain(u32),
+    Face(u32),
+    Edge(u32),
+    Polyline(u32),
+}
+
+/// Triangles of some faces, each face flipped or not.
+#[derive(Debug, Clone)]
+pub(crate) struct SurfaceGroup<'a> {
+    pub name: &'a str,
+    pub source: Source,
+    /// (face, flip): flip reverses the face's triangles.
+    pub faces: Vec<(u32, bool)>,
+}
+
+/// Line segments (node pairs).
+#[derive(Debug, Clone)]
+pub(crate) struct LineGroup<'a> {
+    pub name: &'a str,
+    pub source: Source,
+    pub segments: Vec<[u32; 2]>,
+}
+
+/// The surface partition viewers show: in 3D one group per fragment, faces
+/// oriented out of the fragment's first subdomain; in 2D one per region
+/// subdomain. Faces in no such group get a group each, so every triangle is
+/// shown once (a mesh without subdomains gives one group per face).
+pub(crate) fn surface_groups(mesh: &Mesh) -> Vec<SurfaceGroup<'_>> {
+    let mut covered = vec![false; mesh.faces.len()];
+    let mut groups = Vec::new();
+    if mesh.dimension == 3 {
+        for (i, fr) in mesh.fragments.iter().enumerate() {
+            let faces = fr
+                .faces
+                .iter()
+                .map(|&f| (f, !outward(mesh, fr.subdomain, f)))
+                .collect();
+            for &f in &fr.faces {
+                covered[f as usize] = true;
+            }
+            groups.push(SurfaceGroup {
+                name: &fr.name,
+                source: Source::Fragment(i as u32),
+                faces,
+            });
+        }
+    } else {
+        for (i, s) in mesh.subdomains.iter().enumerate() {
+            for &(f, _) in &s.faces {
+                covered[f as usize] = true;
+            }
+            groups.push(SurfaceGroup {
+                name: &s.name,
+                source: Source::Subdomain(i as u32),
+                faces: s.faces.iter().map(|&(f, _)| (f, false)).collect(),
+            });
+        }
+    }
+    for (i, face) in mesh.faces.iter().enumerate() {
+        if !covered[i] {
+            groups.push(SurfaceGroup {
+                name: &face.name,
+                source: Source::Face(i as u32),
+                faces: vec![(i as u32, false)],
+            });
+        }
+    }
+    groups
+}
+
+/// 3D only: each subdomain's whole boundary, oriented outward.
+pub(crate) fn subdomain_surfaces(mesh: &Mesh) -> Vec<SurfaceGroup<'_>> {
+    if mesh.dimension != 3 {
+        return Vec::new();
+    }
+    mesh.subdomains
+        .iter()
+        .enumerate()
+        .map(|(i, s)| SurfaceGroup {
+            name: &s.name,
+            source: Source::Subdomain(i as u32),
+            faces: s.faces.iter().map(|&(f, out)| (f, !out)).collect(),
+        })
+        .collect()
+}
+
+/// Whether `face` is listed outward in `subdomain` (true when not listed: the
+/// face's own orientation is then the only one there is).
+fn outward(mesh: &Mesh, subdomain: u32, face: u32) -> bool {
+    mesh.subdomains
+        .get(subdomain as usize)
+        .and_then(|s| s.faces.iter().find(|(f, _)| *f == face))
+        .is_none_or(|(_, out)| *out)
+}
+
+/// Line groups: in 2D the fragments (their edges), then every edge in no
+/// fragment; in 3D every edge; then the poly_lines.
+pub(crate) fn line_groups(mesh: &Mesh) -> Vec<LineGroup<'_>> {
+    let mut groups = Vec::new();
+    let mut covered = vec![false; mesh.edges.len()];
+    if mesh.dimension == 2 {
+        for (i, fr) in mesh.fragments.iter().enumerate() {
+            let segments = fr
+                .edges
+                .iter()
+                .flat_map(|&e| segments(&mesh.edges[e as usize].nodes))
+                .collect();
+            for &e in &fr.edges {
+                covered[e as usize] = true;
+            }
+            groups.push(LineGroup {
+                name: &fr.name,
+                source: Source::Fragment(i as u32),
+                segments,
+            });
+        }
+    }
+    for (i, edge) in mesh.edges.iter().enumerate() {
+        if !covered[i] {
+            groups.push(LineGroup {
+                name: &edge.name,
+                source: Source::Edge(i as u32),
+                segments: segments(&edge.nodes),
+            });
+        }
+    }
+    for (i, p) in mesh.polylines.iter().enumerate() {
+        groups.push(LineGroup {
+            name: &p.name,
+            source: Source::Polyline(i as u32),
+            segments: segments(&p.nodes),
+        });
+    }
+    groups
+}
+
+/// Consecutive node pairs of a polyline.
+pub(crate) fn segments(nodes: &[u32]) -> Vec<[u32; 2]> {
+    nodes.windows(2).map(|w| [w[0], w[1]]).collect()
+}
+
+/// A face's triangles in the requested orientation.
+pub(crate) fn oriented(mesh: &Mesh, face: u32, flip: bool) -> impl Iterator<Item = [u32; 3]> + '_ {
+    mesh.faces[face as usize]
+        .triangles
+        .iter()
+        .map(move |&[a, b, c]| if flip { [a, c, b] } else { [a, b, c] })
+}
+
+/// A group's triangles with vertices of their own: a mesh node used by two
+/// faces becomes two vertices, so normals are smooth within a face and flat
+/// across the edges between faces (the creases).
+#[derive(Debug, Default)]
+pub(crate) struct Expanded {
+    pub positions: Vec<[f64; 3]>,
+    pub normals: Vec<[f64; 3]>,
+    /// The mesh node each vertex copies.
+    pub nodes: Vec<u32>,
+    pub triangles: Vec<[u32; 3]>,
+}
+
+pub(crate) fn expand(mesh: &Mesh, faces: &[(u32, bool)]) -> Expanded {
+    let mut out = Expanded::default();
+    for &(face, flip) in faces {
+        let first = out.positions.len();
+        // Lookup only, never iterated: the order stays deterministic.
+        let mut local: HashMap<u32, u32> = HashMap::new();
+        let mut sums: Vec<[f64; 3]> = Vec::new();
+        let mut total = [0.0; 3];
+        for tri in oriented(mesh, face, flip) {
+            let n = triangle_normal(mesh, tri);
+            total = add(total, n);
+            let mut t = [0u32; 3];
+            for (k, &node) in tri.iter().enumerate() {
+                let index = *local.entry(node).or_insert_with(|| {
+                    out.positions.push(mesh.nodes[node as usize]);
+                    out.nodes.push(node);
+                    sums.push([0.0; 3]);
+                    (out.positions.len() - 1) as u32
+                });
+                // Area weighting: the unnormalised cross product is twice the area.
+                sums[index as usize - first] = add(sums[index as usize - first], n);
+                t[k] = index;
+            }
+            out.triangles.push(t);
+        }
+        let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
+        out.normals
+            .extend(sums.into_iter().map(|s| unit(s).unwrap_or(fallback)));
+    }
+    out
+}
+
+/// Twice the area times the unit normal, by the right-hand rule.
+pub(crate) fn triangle_normal(mesh: &Mesh, [a, b, c]: [u32; 3]) -> [f64; 3] {
+    let (p, q, r) = (
+        mesh.nodes[a as usize],
+        mesh.nodes[b as usize],
+        mesh.nodes[c as usize],
+    );
+    cross(sub(q, p), sub(r, p))
+}
+
+pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [
+        a[1] * b[2] - a[2] * b[1],
+        a[2] * b[0] - a[0] * b[2],
+        a[0] * b[1] - a[1] * b[0],
+    ]
+}
+
+pub(crate) fn norm(a: [f64; 3]) -> f64 {
+    (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
+}
+
+/// The unit vector along `a`, `None` for a (near) zero vector.
+pub(crate) fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
+    let n = norm(a);
+    (n > 0.0 && n.is_finite()).then(|| [a[0] / n, a[1] / n, a[2] / n])
+}
+
+/// The area of a face's triangulation.
+pub(crate) fn face_area(mesh: &Mesh, face: u32) -> f64 {
+    mesh.faces[face as usize]
+        .triangles
+        .iter()
+        .map(|&t| norm(triangle_normal(mesh, t)) / 2.0)
+        .sum()
+}
+
+/// The length of a polyline.
+pub(crate) fn length(mesh: &Mesh, nodes: &[u32]) -> f64 {
+    segments(nodes)
+        .iter()
+        .map(|&[a, b]| norm(sub(mesh.nodes[b as usize], mesh.nodes[a as usize])))
+        .sum()
+}
+
+/// The bounding box of some nodes, `None` when there are none.
+pub(crate) fn bounds(
+    mesh: &Mesh,
+    nodes: impl IntoIterator<Item = u32>,
+) -> Option<([f64; 3], [f64; 3])> {
+    let mut it = nodes.into_iter().map(|n| mesh.nodes[n as usize]);
+    let first = it.next()?;
+    Some(it.fold((first, first), |(lo, hi), p| {
+        (
+            [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
+            [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
+        )
+    }))
+}

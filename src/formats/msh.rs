@@ -1,0 +1,530 @@
+//! Gmsh MSH 4.1, ASCII (the default) or binary. `$Entities` carries the
+//! topology: points are the model vertices, curves the edges with their end
+//! points (begin positive, end negative: Gmsh's own convention), surfaces the
+//! faces with their signed bounding curves, volumes (3D) the subdomains with
+//! their signed boundary surfaces. Each mesh node is written once, on the
+//! lowest-dimensional entity that uses it. Physical groups: every fragment
+//! (dim 2 in 3D, 1 in 2D), every subdomain (dim 3 in 3D; in 2D its region
+//! faces, dim 2), faces in neither kind of group (dim 2, by face name),
+//! poly_lines (dim 1, as extra curves) and point sets (dim 0, one extra point
+//! entity per point). Elements (15 point, 1 line, 2 triangle) are written per
+//! entity, only for entities in a physical group — what Gmsh itself saves by
+//! default, and what meshio needs to attach groups to every element block.
+
+use super::groups;
+use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, fmt_num, warning};
+use crate::mesh::Mesh;
+use std::collections::BTreeMap;
+use std::io::Write;
+
+pub(crate) struct Msh;
+
+impl MeshWriter for Msh {
+    fn name(&self) -> &'static str {
+        "msh"
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        &["msh"]
+    }
+
+    fn write(
+        &self,
+        mesh: &Mesh,
+        options: &WriteOptions,
+        out: &mut dyn Write,
+    ) -> Result<Vec<Warning>, WriteError> {
+        groups::check(mesh)?;
+        let model = Model::of(mesh);
+        let mut warnings = Vec::new();
+        if model.renamed > 0 {
+            warnings.push(warning(
+                "msh",
+                format!(
+                    "MSH names cannot hold `\"`: replaced by `'` in {}",
+                    count(model.renamed, "name")
+                ),
+            ));
+        }
+        if model.unused_nodes > 0 {
+            warnings.push(warning(
+                "msh",
+                format!(
+                    "{} used by no vertex, edge, face, poly_line or point set: not written",
+                    count(model.unused_nodes, "node")
+                ),
+            ));
+        }
+        let binary = options.encoding == Some(Encoding::Binary);
+        write_all(&model, mesh, binary, out)?;
+        Ok(warnings)
+    }
+}
+
+/// An entity of the Gmsh model.
+struct Entity {
+    tag: i32,
+    physicals: Vec<i32>,
+    /// Signed tags of the bounding entities one dimension down.
+    bounding: Vec<i32>,
+    /// Mesh nodes whose bounding box the entity has (all it uses).
+    used: Vec<u32>,
+    /// Elements, as mesh node lists (1, 2 or 3 nodes).
+    elements: Vec<Vec<u32>>,
+}
+
+impl Entity {
+    fn new(tag: usize) -> Entity {
+        Entity {
+            tag: tag as i32,
+            physicals: Vec::new(),
+            bounding: Vec::new(),
+            used: Vec::new(),
+            elements: Vec::new(),
+        }
+    }
+}
+
+/// The MSH view of a mesh: entities per dimension, physical names, node owners.
+struct Model {
+    /// Index = dimension.
+    entities: [Vec<Entity>; 4],
+    /// (dim, tag, name).
+    physical_names: Vec<(u8, i32, String)>,
+    /// The (dimension, entity index) owning each node; `None` for nodes no
+    /// element uses.
+    owner: Vec<Option<(u8, usize)>>,
+    renamed: usize,
+    unused_nodes: usize,
+}
+
+impl Model {
+    fn of(mesh: &Mesh) -> Model {
+        let three = mesh.dimension == 3;
+        let vertex_of_node: BTreeMap<u32, usize> = mesh
+            .vertices
+            .iter()
+            .enumerate()
+            .map(|(i, v)| (v.node, i))
+            .rev() // the first vertex on a node wins
+            .collect();
+
+        let mut points: Vec<Entity> = mesh
+            .vertices
+            .iter()
+            .enumerate()
+            .map(|(i, v)| {
+                let mut e = Entity::new(i + 1);
+                e.used = vec![v.node];
+                e.elements = vec![vec![v.node]];
+                e
+            })
+            .collect();
+        let mut curves: Vec<Entity> = mesh
+            .edges
+            .iter()
+            .enumerate()
+            .map(|(i, edge)| {
+                let mut e = Entity::new(i + 1);
+                e.bounding = end_points(&edge.nodes, &vertex_of_node);
+                e.used = edge.nodes.clone();
+                e.elements = groups::segments(&edge.nodes)
+                    .iter()
+                    .map(|s| s.to_vec())
+                    .collect();
+                e
+            })
+            .collect();
+        let mut surfaces: Vec<Entity> = mesh
+            .faces
+            .iter()
+            .enumerate()
+            .map(|(i, face)| {
+                let mut e = Entity::new(i + 1);
+                e.bounding = face
+                    .boundary
+                    .iter()
+                    .map(|&(edge, fwd)| signed(edge as usize + 1, fwd))
+                    .collect();
+                e.used = face.triangles.iter().flatten().copied().collect();
+                e.elements = face.triangles.iter().map(|t| t.to_vec()).collect();
+                e
+            })
+            .collect();
+        let mut volumes: Vec<Entity> = Vec::new();
+        if three {
+            volumes = mesh
+                .subdomains
+                .iter()
+                .enumerate()
+                .map(|(i, s)| {
+                    let mut e = Entity::new(i + 1);
+                    e.bounding = s
+                        .faces
+                        .iter()
+                        .map(|&(f, out)| signed(f as usize + 1, out))
+                        .collect();
+                    e.used = s
+                        .faces
+                        .iter()
+                        .flat_map(|&(f, _)| {
+                            mesh.faces[f as usize].triangles.iter().flatten().copied()
+                        })
+                        .collect();
+                    e
+                })
+                .collect();
+        }
+
+        let mut names = Names::default();
+        // Fragments: faces in 3D, edges in 2D.
+        let mut face_grouped = vec![false; mesh.faces.len()];
+        for fr in &mesh.fragments {
+            if three {
+                let tag = names.add(2, &fr.name);
+                for &f in &fr.faces {
+                    surfaces[f as usize].physicals.push(tag);
+                    face_grouped[f as usize] = true;
+                }
+            } else {
+                let tag = names.add(1, &fr.name);
+                for &e in &fr.edges {
+                    curves[e as usize].physicals.push(tag);
+                }
+            }
+        }
+        for (i, s) in mesh.subdomains.iter().enumerate() {
+            if three {
+                let tag = names.add(3, &s.name);
+                volumes[i].physicals.push(tag);
+            } else {
+                let tag = names.add(2, &s.name);
+                for &(f, _) in &s.faces {
+                    surfaces[f as usize].physicals.push(tag);
+                    face_grouped[f as usize] = true;
+                }
+            }
+        }
+        for (i, face) in mesh.faces.iter().enumerate() {
+            if !face_grouped[i] {
+                let tag = names.add(2, &face.name);
+                surfaces[i].physicals.push(tag);
+            }
+        }
+        for p in &mesh.polylines {
+            let tag = names.add(1, &p.name);
+            let mut e = Entity::new(curves.len() + 1);
+            e.physicals.push(tag);
+            // Only when a poly_line ends on model vertices does it have bounding points.
+            e.bounding = end_points(&p.nodes, &vertex_of_node);
+            e.used = p.nodes.clone();
+            e.elements = groups::segments(&p.nodes)
+                .iter()
+                .map(|s| s.to_vec())
+                .collect();
+            curves.push(e);
+        }
+        for p in &mesh.point_sets {
+            let tag = names.add(0, &p.name);
+            for &node in &p.nodes {
+                let mut e = Entity::new(points.len() + 1);
+                e.physicals.push(tag);
+                e.used = vec![node];
+                e.elements = vec![vec![node]];
+                points.push(e);
+            }
+        }
+
+        let mut entities = [points, curves, surfaces, volumes];
+        // Lowest dimension first, so a node on a vertex belongs to its point,
+        // one on an edge to its curve.
+        let mut owner: Vec<Option<(u8, usize)>> = vec![None; mesh.nodes.len()];
+        for (dim, list) in entities.iter().enumerate() {
+            for (i, e) in list.iter().enumerate() {
+                for &n in &e.used {
+                    let slot = &mut owner[n as usize];
+                    if slot.is_none() {
+                        *slot = Some((dim as u8, i));
+                    }
+                }
+            }
+        }
+        // Elements only where a physical group holds them, as Gmsh saves by
+        // default: readers such as meshio expect every element block to have a
+        // physical tag. The entities and their nodes stay.
+        for e in entities.iter_mut().flatten() {
+            if e.physicals.is_empty() {
+                e.elements.clear();
+            }
+        }
+        let unused_nodes = owner.iter().filter(|o| o.is_none()).count();
+        Model {
+            entities,
+            physical_names: names.list,
+            owner,
+            renamed: names.renamed,
+            unused_nodes,
+        }
+    }
+}
+
+/// Physical tags numbered per dimension from 1, with their names.
+#[derive(Default)]
+struct Names {
+    list: Vec<(u8, i32, String)>,
+    next: [i32; 4],
+    renamed: usize,
+}
+
+impl Names {
+    fn add(&mut self, dim: u8, name: &str) -> i32 {
+        let d = dim as usize;
+        self.next[d] += 1;
+        let tag = self.next[d];
+        let clean = name.replace('"', "'");
+        if clean != name {
+            self.renamed += 1;
+        }
+        self.list.push((dim, tag, clean));
+        tag
+    }
+}
+
+fn signed(tag: usize, positive: bool) -> i32 {
+    if positive { tag as i32 } else { -(tag as i32) }
+}
+
+/// A polyline's bounding points, Gmsh's way: +begin, −end, when on vertices.
+fn end_points(nodes: &[u32], vertex_of_node: &BTreeMap<u32, usize>) -> Vec<i32> {
+    let mut out = Vec::new();
+    if let Some(v) = nodes.first().and_then(|n| vertex_of_node.get(n)) {
+        out.push(*v as i32 + 1);
+    }
+    if let Some(v) = nodes.last().and_then(|n| vertex_of_node.get(n)) {
+        out.push(-(*v as i32 + 1));
+    }
+    out
+}
+
+/// Writes values as ASCII tokens on lines, or as little-endian binary (the
+/// header's integer 1 tells readers the byte order).
+struct Sink<'a> {
+    out: &'a mut dyn Write,
+    binary: bool,
+    line: String,
+}
+
+impl Sink<'_> {
+    fn token(&mut self, text: &str) {
+        if !self.line.is_empty() {
+            self.line.push(' ');
+        }
+        self.line.push_str(text);
+    }
+
+    fn int(&mut self, v: i32) -> std::io::Result<()> {
+        if self.binary {
+            self.out.write_all(&v.to_le_bytes())
+        } else {
+            self.token(&v.to_string());
+            Ok(())
+        }
+    }
+
+    fn size(&mut self, v: usize) -> std::io::Result<()> {
+        if self.binary {
+            self.out.write_all(&(v as u64).to_le_bytes())
+        } else {
+            self.token(&v.to_string());
+            Ok(())
+        }
+    }
+
+    fn real(&mut self, v: f64) -> std::io::Result<()> {
+        if self.binary {
+            self.out.write_all(&v.to_le_bytes())
+        } else {
+            self.token(&fmt_num(v));
+            Ok(())
+        }
+    }
+
+    fn end_line(&mut self) -> std::io::Result<()> {
+        if !self.binary {
+            self.line.push('\n');
+            self.out.write_all(self.line.as_bytes())?;
+            self.line.clear();
+        }
+        Ok(())
+    }
+
+    fn text(&mut self, s: &str) -> std::io::Result<()> {
+        self.out.write_all(s.as_bytes())
+    }
+
+    /// Ends a section; binary data is followed by a newline before `$End…`.
+    fn end_section(&mut self, name: &str) -> std::io::Result<()> {
+        if self.binary {
+            self.text("\n")?;
+        }
+        self.text(&format!("$End{name}\n"))
+    }
+}
+
+fn write_all(
+    model: &Model,
+    mesh: &Mesh,
+    binary: bool,
+    out: &mut dyn Write,
+) -> Result<(), WriteError> {
+    let mut s = Sink {
+        out,
+        binary,
+        line: String::new(),
+    };
+    s.text("$MeshFormat\n")?;
+    if binary {
+        s.text("4.1 1 8\n")?;
+        s.out.write_all(&1i32.to_le_bytes())?;
+        s.text("\n")?;
+    } else {
+        s.text("4.1 0 8\n")?;
+    }
+    s.text("$EndMeshFormat\n")?;
+
+    // Always ASCII, in both encodings.
+    if !model.physical_names.is_empty() {
+        s.text("$PhysicalNames\n")?;
+        s.text(&format!("{}\n", model.physical_names.len()))?;
+        for (dim, tag, name) in &model.physical_names {
+            s.text(&format!("{dim} {tag} \"{name}\"\n"))?;
+        }
+        s.text("$EndPhysicalNames\n")?;
+    }
+
+    write_entities(&mut s, model, mesh)?;
+    write_nodes(&mut s, model, mesh)?;
+    write_elements(&mut s, model)?;
+    Ok(())
+}
+
+fn write_entities(s: &mut Sink, model: &Model, mesh: &Mesh) -> std::io::Result<()> {
+    s.text("$Entities\n")?;
+    for list in &model.entities {
+        s.size(list.len())?;
+    }
+    s.end_line()?;
+    for (dim, list) in model.entities.iter().enumerate() {
+        for e in list {
+            s.int(e.tag)?;
+            if dim == 0 {
+                let p = e.used.first().map_or([0.0; 3], |&n| mesh.nodes[n as usize]);
+                for c in p {
+                    s.real(c)?;
+                }
+            } else {
+                let (lo, hi) =
+                    groups::bounds(mesh, e.used.iter().copied()).unwrap_or(([0.0; 3], [0.0; 3]));
+                for c in lo.into_iter().chain(hi) {
+                    s.real(c)?;
+                }
+            }
+            s.size(e.physicals.len())?;
+            for &p in &e.physicals {
+                s.int(p)?;
+            }
+            if dim > 0 {
+                s.size(e.bounding.len())?;
+                for &b in &e.bounding {
+                    s.int(b)?;
+                }
+            }
+            s.end_line()?;
+        }
+    }
+    s.end_section("Entities")
+}
+
+fn write_nodes(s: &mut Sink, model: &Model, mesh: &Mesh) -> std::io::Result<()> {
+    // Owned nodes per entity, in node order.
+    let mut blocks: BTreeMap<(u8, usize), Vec<u32>> = BTreeMap::new();
+    for (n, o) in model.owner.iter().enumerate() {
+        if let Some(key) = o {
+            blocks.entry(*key).or_default().push(n as u32);
+        }
+    }
+    let total: usize = blocks.values().map(Vec::len).sum();
+    let min = blocks
+        .values()
+        .flatten()
+        .min()
+        .map_or(0, |n| *n as usize + 1);
+    let max = blocks
+        .values()
+        .flatten()
+        .max()
+        .map_or(0, |n| *n as usize + 1);
+    s.text("$Nodes\n")?;
+    s.size(blocks.len())?;
+    s.size(total)?;
+    s.size(min)?;
+    s.size(max)?;
+    s.end_line()?;
+    for ((dim, index), nodes) in &blocks {
+        s.int(i32::from(*dim))?;
+        s.int(model.entities[*dim as usize][*index].tag)?;
+        s.int(0)?; // no parametric coordinates
+        s.size(nodes.len())?;
+        s.end_line()?;
+        for &n in nodes {
+            s.size(n as usize + 1)?;
+            s.end_line()?;
+        }
+        for &n in nodes {
+            for c in mesh.nodes[n as usize] {
+                s.real(c)?;
+            }
+            s.end_line()?;
+        }
+    }
+    s.end_section("Nodes")
+}
+
+fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
+    let blocks: Vec<(usize, &Entity)> = model
+        .entities
+        .iter()
+        .enumerate()
+        .flat_map(|(dim, list)| list.iter().map(move |e| (dim, e)))
+        .filter(|(_, e)| !e.elements.is_empty())
+        .collect();
+    let total: usize = blocks.iter().map(|(_, e)| e.elements.len()).sum();
+    s.text("$Elements\n")?;
+    s.size(blocks.len())?;
+    s.size(total)?;
+    s.size(usize::from(total > 0))?;
+    s.size(total)?;
+    s.end_line()?;
+    let mut tag = 0usize;
+    for (dim, e) in blocks {
+        let kind = match dim {
+            0 => 15,
+            1 => 1,
+            _ => 2,
+        };
+        s.int(dim as i32)?;
+        s.int(e.tag)?;
+        s.int(kind)?;
+        s.size(e.elements.len())?;
+        s.end_line()?;
+        for element in &e.elements {
+            tag += 1;
+            s.size(tag)?;
+            for &n in element {
+                s.size(n as usize + 1)?;
+            }
+            s.end_line()?;
+        }
+    }
+    s.end_section("Elements")
+}

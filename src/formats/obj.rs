@@ -1,0 +1,137 @@
+//! Wavefront OBJ: every mesh node once as `v`, then one object (`o`) per
+//! surface group (fragment in 3D, region in 2D, else face) with a `g` per face
+//! inside it, triangles as `f v//vn` with normals smooth within a face; line
+//! groups (2D fragments, edges, poly_lines) as `o` + `l`; point sets as `o` +
+//! `p`. OBJ has no volumes: 3D subdomains are carried only by the fragment
+//! names, which a warning says.
+
+use super::groups::{self, Source};
+use super::{MeshWriter, Warning, WriteError, WriteOptions, count, fmt_num, warning};
+use crate::mesh::Mesh;
+use std::io::Write;
+
+pub(crate) struct Obj;
+
+impl MeshWriter for Obj {
+    fn name(&self) -> &'static str {
+        "obj"
+    }
+
+    fn extensions(&self) -> &'static [&'static str] {
+        &["obj"]
+    }
+
+    fn write(
+        &self,
+        mesh: &Mesh,
+        options: &WriteOptions,
+        out: &mut dyn Write,
+    ) -> Result<Vec<Warning>, WriteError> {
+        groups::check(mesh)?;
+        let mut warnings = Vec::new();
+        if options.encoding.is_some() {
+            warnings.push(warning(
+                "obj",
+                "OBJ is text only: the encoding option is ignored",
+            ));
+        }
+        if mesh.dimension == 3 && !mesh.subdomains.is_empty() {
+            warnings.push(warning(
+                "obj",
+                format!(
+                    "OBJ has no volumes: {} carried only as the sides of the fragment objects",
+                    count(mesh.subdomains.len(), "subdomain")
+                ),
+            ));
+        }
+
+        writeln!(out, "# geomc mesh: {} nodes", mesh.nodes.len())?;
+        for p in &mesh.nodes {
+            writeln!(
+                out,
+                "v {} {} {}",
+                fmt_num(p[0]),
+                fmt_num(p[1]),
+                fmt_num(p[2])
+            )?;
+        }
+
+        // Normals are numbered across the whole file, in the order written.
+        let mut next_normal = 1usize;
+        for g in groups::surface_groups(mesh) {
+            writeln!(out, "o {}", obj_name(g.name))?;
+            for &(face, flip) in &g.faces {
+                let ex = groups::expand(mesh, &[(face, flip)]);
+                if ex.triangles.is_empty() {
+                    continue;
+                }
+                if !matches!(g.source, Source::Face(_)) {
+                    writeln!(out, "g {}", obj_name(&mesh.faces[face as usize].name))?;
+                }
+                for n in &ex.normals {
+                    writeln!(
+                        out,
+                        "vn {} {} {}",
+                        fmt_num(n[0]),
+                        fmt_num(n[1]),
+                        fmt_num(n[2])
+                    )?;
+                }
+                for t in &ex.triangles {
+                    let corner = |k: usize| {
+                        let local = t[k] as usize;
+                        format!("{}//{}", ex.nodes[local] + 1, next_normal + local)
+                    };
+                    writeln!(out, "f {} {} {}", corner(0), corner(1), corner(2))?;
+                }
+                next_normal += ex.normals.len();
+            }
+        }
+        for g in groups::line_groups(mesh) {
+            if g.segments.is_empty() {
+                continue;
+            }
+            writeln!(out, "o {}", obj_name(g.name))?;
+            // One `l` per polyline run: consecutive segments that share a node.
+            let mut run: Vec<u32> = Vec::new();
+            for [a, b] in g.segments {
+                if run.last() != Some(&a) {
+                    flush_line(out, &run)?;
+                    run = vec![a];
+                }
+                run.push(b);
+            }
+            flush_line(out, &run)?;
+        }
+        for p in &mesh.point_sets {
+            if p.nodes.is_empty() {
+                continue;
+            }
+            writeln!(out, "o {}", obj_name(&p.name))?;
+            let list: Vec<String> = p.nodes.iter().map(|n| (n + 1).to_string()).collect();
+            writeln!(out, "p {}", list.join(" "))?;
+        }
+        Ok(warnings)
+    }
+}
+
+fn flush_line(out: &mut dyn Write, run: &[u32]) -> Result<(), WriteError> {
+    if run.len() >= 2 {
+        let list: Vec<String> = run.iter().map(|n| (n + 1).to_string()).collect();
+        writeln!(out, "l {}", list.join(" "))?;
+    }
+    Ok(())
+}
+
+/// OBJ names end at whitespace: it becomes `_`.
+fn obj_name(name: &str) -> String {
+    let s: String = name
+        .chars()
+        .map(|c| if c.is_whitespace() { '_' } else { c })
+        .collect();
+    if s.is_empty() {
+        "unnamed".to_string()
+    } else {
+        s
+    }
+}
