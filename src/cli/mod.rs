@@ -1,6 +1,7 @@
 //! The command line: the only code that prints, reads files for the user, and
 //! decides exit codes. Each subcommand has its own file.
 
+mod compile;
 mod explain;
 mod inspect;
 mod validate;
@@ -32,6 +33,8 @@ struct Cli {
 enum Command {
     /// Check files (or folders, recursively) and report every problem.
     Validate(validate::Args),
+    /// Mesh domains and write glTF/GLB, OBJ, STL, Gmsh MSH, VTU and fragment descriptions.
+    Compile(compile::Args),
     /// Summarise a model: counts, subdomains, fragments, bounding box, parameters.
     Inspect(inspect::Args),
     /// Explain a diagnostic code, e.g. `geomc explain E201`.
@@ -103,6 +106,7 @@ pub fn run() -> i32 {
     };
     let result = std::panic::catch_unwind(|| match cli.command {
         Command::Validate(args) => validate::run(&args),
+        Command::Compile(args) => compile::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Explain(args) => explain::run(&args),
     });

@@ -326,7 +326,9 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
     let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
     let mut big = Vec::new();
     for (i, b) in boxes.iter().enumerate() {
-        let finite = [b.min, b.max].iter().all(|p| p.iter().all(|c| c.is_finite()));
+        let finite = [b.min, b.max]
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()));
         if b.is_empty() || !finite {
             // Nothing, or nothing placeable: it cannot overlap anything.
             continue;

@@ -1,0 +1,305 @@
+//! `geomc compile INPUT… -o OUTPUT…`: validate, mesh, and write every output
+//! format; several inputs compile in parallel into a folder.
+
+use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, InputOptions, report_usage};
+use geomc::diag::render_human;
+use geomc::driver::{Options, check_file};
+use geomc::formats::{self, Encoding, WriteOptions};
+use geomc::meshing::{MeshOptions, Tolerance, mesh_model};
+use rayon::prelude::*;
+use std::io::IsTerminal;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// Domain files (XML).
+    #[arg(required = true, value_name = "INPUT")]
+    inputs: Vec<PathBuf>,
+    /// Output file (format from its extension; repeatable), or a folder ending
+    /// in '/' when compiling several inputs.
+    #[arg(short, long = "output", required = true, value_name = "OUTPUT")]
+    outputs: Vec<PathBuf>,
+    /// Output format when writing into a folder (repeatable): gltf, glb, obj, stl, msh, vtu, frag.xml.
+    #[arg(long = "to", value_name = "FORMAT")]
+    to: Vec<String>,
+    /// Chordal tolerance: a length (0.01), or a percentage of the model's
+    /// bounding-box diagonal (0.1%).
+    #[arg(long, default_value = "0.1%", value_name = "TOL")]
+    tolerance: String,
+    /// Longest triangle edge allowed.
+    #[arg(long, value_name = "LENGTH")]
+    max_edge: Option<f64>,
+    /// Smallest triangle angle refinement aims for, in degrees (at most 33).
+    #[arg(long, default_value_t = 25.0, value_name = "DEGREES")]
+    min_angle: f64,
+    /// Text output where the format has both (STL, MSH, VTU).
+    #[arg(long, conflicts_with = "binary")]
+    ascii: bool,
+    /// Binary output where the format has both.
+    #[arg(long)]
+    binary: bool,
+    /// Threads for compiling several inputs (default: all cores).
+    #[arg(short = 'j', long, value_name = "N")]
+    jobs: Option<usize>,
+    /// Print nothing but errors.
+    #[arg(short, long)]
+    quiet: bool,
+    #[command(flatten)]
+    input: InputOptions,
+}
+
+/// What one input produced, collected so output is printed in input order.
+struct Outcome {
+    input: PathBuf,
+    messages: String,
+    ok: bool,
+}
+
+pub fn run(args: &Args) -> i32 {
+    let options = match args.input.to_options() {
+        Ok(o) => o,
+        Err(diagnostics) => {
+            report_usage(&diagnostics);
+            return EXIT_INVALID;
+        }
+    };
+    let mesh_options = match mesh_options(args) {
+        Ok(m) => m,
+        Err(message) => {
+            eprintln!("geomc: {message}");
+            return EXIT_USAGE;
+        }
+    };
+    let plans = match plan_outputs(args) {
+        Ok(p) => p,
+        Err(message) => {
+            eprintln!("geomc: {message}");
+            return EXIT_USAGE;
+        }
+    };
+    let encoding = if args.ascii {
+        Some(Encoding::Ascii)
+    } else if args.binary {
+        Some(Encoding::Binary)
+    } else {
+        None
+    };
+    let pool = match rayon::ThreadPoolBuilder::new()
+        .num_threads(args.jobs.unwrap_or(0))
+        .build()
+    {
+        Ok(pool) => pool,
+        Err(e) => {
+            eprintln!("geomc: cannot start threads: {e}");
+            return EXIT_USAGE;
+        }
+    };
+    let progress = (!args.quiet && args.inputs.len() > 1 && std::io::stderr().is_terminal())
+        .then(|| indicatif::ProgressBar::new(args.inputs.len() as u64));
+    let outcomes: Vec<Outcome> = pool.install(|| {
+        plans
+            .par_iter()
+            .map(|(input, outputs)| {
+                let outcome = compile_one(
+                    input,
+                    outputs,
+                    &options,
+                    &mesh_options,
+                    encoding,
+                    args.quiet,
+                );
+                if let Some(bar) = &progress {
+                    bar.inc(1);
+                }
+                outcome
+            })
+            .collect()
+    });
+    if let Some(bar) = progress {
+        bar.finish_and_clear();
+    }
+    let failed = outcomes.iter().filter(|o| !o.ok).count();
+    for outcome in &outcomes {
+        eprint!("{}", outcome.messages);
+    }
+    if !args.quiet || failed > 0 {
+        if outcomes.len() > 1 || failed > 0 {
+            eprintln!(
+                "compiled {} of {} input{}{}",
+                outcomes.len() - failed,
+                outcomes.len(),
+                if outcomes.len() == 1 { "" } else { "s" },
+                if failed > 0 {
+                    format!(
+                        "; failed: {}",
+                        outcomes
+                            .iter()
+                            .filter(|o| !o.ok)
+                            .map(|o| o.input.display().to_string())
+                            .collect::<Vec<_>>()
+                            .join(", ")
+                    )
+                } else {
+                    String::new()
+                }
+            );
+        }
+    }
+    if failed > 0 { EXIT_INVALID } else { EXIT_OK }
+}
+
+fn mesh_options(args: &Args) -> Result<MeshOptions, String> {
+    let text = args.tolerance.trim();
+    let tolerance = match text.strip_suffix('%') {
+        Some(percent) => percent
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(|v| v.is_finite() && *v > 0.0)
+            .map(|v| Tolerance::Relative(v / 100.0)),
+        None => text.parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0).map(Tolerance::Absolute),
+    }
+    .ok_or_else(|| format!("--tolerance {text}: give a positive length (0.01) or a percentage of the model's size (0.1%)"))?;
+    if let Some(max_edge) = args.max_edge {
+        if !(max_edge.is_finite() && max_edge > 0.0) {
+            return Err(format!("--max-edge {max_edge}: give a positive length"));
+        }
+    }
+    if !(args.min_angle > 0.0 && args.min_angle <= 33.0) {
+        return Err(format!(
+            "--min-angle {}: give an angle above 0 and at most 33 degrees",
+            args.min_angle
+        ));
+    }
+    Ok(MeshOptions {
+        tolerance,
+        max_edge: args.max_edge,
+        min_angle_degrees: args.min_angle,
+    })
+}
+
+/// The output files of each input: the -o files for one input, or
+/// DIR/STEM.EXT for every --to format when -o names a folder.
+fn plan_outputs(args: &Args) -> Result<Vec<(PathBuf, Vec<PathBuf>)>, String> {
+    let into_folder = args.outputs.len() == 1
+        && (args.outputs[0].is_dir() || args.outputs[0].to_string_lossy().ends_with('/'));
+    if !into_folder {
+        if args.inputs.len() > 1 {
+            return Err(
+                "several inputs compile into a folder: give -o DIR/ and --to FORMAT".into(),
+            );
+        }
+        for output in &args.outputs {
+            if formats::writer_for_path(output).is_none() {
+                return Err(format!(
+                    "{}: unknown output format; use one of .gltf .glb .obj .stl .msh .vtu .frag.xml",
+                    output.display()
+                ));
+            }
+        }
+        return Ok(vec![(args.inputs[0].clone(), args.outputs.clone())]);
+    }
+    let folder = &args.outputs[0];
+    let formats: Vec<String> = if args.to.is_empty() {
+        vec!["msh".to_string()]
+    } else {
+        args.to
+            .iter()
+            .map(|f| f.trim_start_matches('.').to_ascii_lowercase())
+            .collect()
+    };
+    for f in &formats {
+        if formats::writer_for_path(Path::new(&format!("x.{f}"))).is_none() {
+            return Err(format!(
+                "--to {f}: unknown format; use gltf, glb, obj, stl, msh, vtu or frag.xml"
+            ));
+        }
+    }
+    std::fs::create_dir_all(folder)
+        .map_err(|e| format!("cannot create {}: {e}", folder.display()))?;
+    Ok(args
+        .inputs
+        .iter()
+        .map(|input| {
+            let stem = input
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("model");
+            (
+                input.clone(),
+                formats
+                    .iter()
+                    .map(|f| folder.join(format!("{stem}.{f}")))
+                    .collect(),
+            )
+        })
+        .collect())
+}
+
+fn compile_one(
+    input: &Path,
+    outputs: &[PathBuf],
+    options: &Options,
+    mesh_options: &MeshOptions,
+    encoding: Option<Encoding>,
+    quiet: bool,
+) -> Outcome {
+    let mut messages = String::new();
+    let fail = |messages: String| Outcome {
+        input: input.to_path_buf(),
+        messages,
+        ok: false,
+    };
+    let checked = match check_file(input, options) {
+        Ok(c) => c,
+        Err(e) => return fail(format!("geomc: cannot read {}: {e}\n", input.display())),
+    };
+    for d in &checked.diagnostics.items {
+        if d.is_error() || !quiet {
+            messages.push_str(&render_human(&checked.source, d));
+        }
+    }
+    let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
+        return fail(messages);
+    };
+    let mesh = match mesh_model(&lowered.model, mesh_options) {
+        Ok(mesh) => mesh,
+        Err(e) => {
+            messages.push_str(&format!("{}: error: {e}\n", input.display()));
+            return fail(messages);
+        }
+    };
+    // A fragment description refers to the MSH written beside it, if any.
+    let mesh_file = outputs
+        .iter()
+        .find(|p| formats::writer_for_path(p).is_some_and(|w| w.name() == "msh"))
+        .and_then(|p| p.file_name())
+        .map(|n| n.to_string_lossy().into_owned());
+    let mut ok = true;
+    for output in outputs {
+        let write_options = WriteOptions {
+            encoding,
+            file_name: None,
+            mesh_file: mesh_file.clone(),
+        };
+        match formats::write_mesh_file(output, &mesh, &write_options) {
+            Ok(warnings) => {
+                if !quiet {
+                    for w in warnings {
+                        messages.push_str(&format!("{}: warning: {w}\n", output.display()));
+                    }
+                    messages.push_str(&format!("wrote {}\n", output.display()));
+                }
+            }
+            Err(e) => {
+                ok = false;
+                messages.push_str(&format!("geomc: {}: {e}\n", output.display()));
+            }
+        }
+    }
+    Outcome {
+        input: input.to_path_buf(),
+        messages,
+        ok,
+    }
+}
