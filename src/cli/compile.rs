@@ -122,28 +122,26 @@ pub fn run(args: &Args) -> i32 {
     for outcome in &outcomes {
         eprint!("{}", outcome.messages);
     }
-    if !args.quiet || failed > 0 {
-        if outcomes.len() > 1 || failed > 0 {
-            eprintln!(
-                "compiled {} of {} input{}{}",
-                outcomes.len() - failed,
-                outcomes.len(),
-                if outcomes.len() == 1 { "" } else { "s" },
-                if failed > 0 {
-                    format!(
-                        "; failed: {}",
-                        outcomes
-                            .iter()
-                            .filter(|o| !o.ok)
-                            .map(|o| o.input.display().to_string())
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )
-                } else {
-                    String::new()
-                }
-            );
-        }
+    if (!args.quiet && outcomes.len() > 1) || failed > 0 {
+        eprintln!(
+            "compiled {} of {} input{}{}",
+            outcomes.len() - failed,
+            outcomes.len(),
+            if outcomes.len() == 1 { "" } else { "s" },
+            if failed > 0 {
+                format!(
+                    "; failed: {}",
+                    outcomes
+                        .iter()
+                        .filter(|o| !o.ok)
+                        .map(|o| o.input.display().to_string())
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )
+            } else {
+                String::new()
+            }
+        );
     }
     if failed > 0 { EXIT_INVALID } else { EXIT_OK }
 }
