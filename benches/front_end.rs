@@ -66,8 +66,16 @@ fn best_of(runs: usize, mut f: impl FnMut()) -> Duration {
 }
 
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
-    let count = if quick { 10_000 } else { 100_000 };
+    // `cargo bench` passes --bench; under `cargo test --all-targets` this runs as a
+    // smoke test of the harness on a small model, so CI time stays bounded.
+    let args: Vec<String> = std::env::args().collect();
+    let smoke = !args.iter().any(|a| a == "--bench");
+    let quick = args.iter().any(|a| a == "--quick");
+    let count = match (smoke, quick) {
+        (true, _) => 1_000,
+        (false, true) => 10_000,
+        (false, false) => 100_000,
+    };
     let xml = generate(count);
     let mb = xml.len() as f64 / 1e6;
     println!("front end: {count} primitives as subdomains, {mb:.1} MB");
