@@ -4,6 +4,7 @@
 mod compile;
 mod explain;
 mod inspect;
+mod rfs;
 mod validate;
 
 use clap::{Parser, Subcommand};
