@@ -113,14 +113,15 @@ pub fn sample_grid(tape: &Tape, grid: &Grid) -> Vec<f64> {
     let [xs, ys, zs] = [grid.coords(0), grid.coords(1), grid.coords(2)];
     let plane = xs.len() * ys.len();
     let mut values = vec![0.0; plane * zs.len()];
+    // Whole planes per call, so batches are full (a 257-point row would leave
+    // its last batch nearly empty).
+    let px: Vec<f64> = (0..plane).map(|m| xs[m % xs.len()]).collect();
+    let py: Vec<f64> = (0..plane).map(|m| ys[m / xs.len()]).collect();
     values.par_chunks_mut(plane).enumerate().for_each_init(
-        || (tape.workspace(), vec![0.0; xs.len()], vec![0.0; xs.len()]),
-        |(ws, yrow, zrow), (k, out)| {
-            zrow.fill(zs[k]);
-            for (j, row) in out.chunks_mut(xs.len()).enumerate() {
-                yrow.fill(ys[j]);
-                tape.eval(ws, &xs, yrow, zrow, row);
-            }
+        || (tape.workspace(), vec![0.0; plane]),
+        |(ws, pz), (k, out)| {
+            pz.fill(zs[k]);
+            tape.eval(ws, &px, &py, pz, out);
         },
     );
     values
