@@ -48,7 +48,12 @@ pub fn load(path: &Path, bytes: &[u8]) -> Result<Loaded, Vec<Diagnostic>> {
         )]);
     }
     let mut loaded = load_mesh_as(&mesh_path, format)?;
-    apply(&mut loaded, &doc, &file).map_err(|d| vec![d])?;
+    if let Err(by_face) = apply(&mut loaded, &doc, &file) {
+        // Formats that group by fragment (MSH, STL solids) match fragment-wise.
+        if !apply_by_fragment(&mut loaded, &doc) {
+            return Err(vec![by_face]);
+        }
+    }
     Ok(loaded)
 }
 
@@ -124,7 +129,68 @@ fn apply(loaded: &mut Loaded, doc: &FragDocument, file: &str) -> Result<(), Diag
                 .collect(),
             edges: Vec::new(),
         })
-        .filter(|fr| (fr.subdomain as usize) < doc.subdomains.len())
+        .filter(|fr| {
+            let n = doc.subdomains.len();
+            (fr.subdomain as usize) < n && fr.other.is_none_or(|o| (o as usize) < n)
+        })
         .collect();
     Ok(())
+}
+
+/// Matches each fragment of a 3D description to the mesh face of its name
+/// with its triangle count; the faces become the fragments' faces.
+fn apply_by_fragment(loaded: &mut Loaded, doc: &FragDocument) -> bool {
+    let mesh = &mut loaded.mesh;
+    if doc.dimension != 3 {
+        return false;
+    }
+    let by_name: FastMap<&str, usize> = mesh
+        .faces
+        .iter()
+        .enumerate()
+        .map(|(i, f)| (f.name.as_str(), i))
+        .collect();
+    let mut faces = Vec::new();
+    for fr in &doc.fragments {
+        match by_name.get(fr.name.as_str()) {
+            Some(&m) if mesh.faces[m].triangles.len() == fr.elements => faces.push(Some(m as u32)),
+            None if fr.elements == 0 => faces.push(None),
+            _ => return false,
+        }
+    }
+    let n_sub = doc.subdomains.len();
+    if doc
+        .fragments
+        .iter()
+        .any(|fr| fr.subdomain as usize >= n_sub || fr.other.is_some_and(|o| o as usize >= n_sub))
+    {
+        return false;
+    }
+    mesh.subdomains = doc
+        .subdomains
+        .iter()
+        .map(|s| MeshSubdomain {
+            name: s.name.clone(),
+            material: s.material.clone(),
+            faces: Vec::new(),
+        })
+        .collect();
+    mesh.fragments.clear();
+    for (fr, face) in doc.fragments.iter().zip(faces) {
+        let Some(face) = face else { continue };
+        mesh.subdomains[fr.subdomain as usize]
+            .faces
+            .push((face, true));
+        if let Some(o) = fr.other {
+            mesh.subdomains[o as usize].faces.push((face, false));
+        }
+        mesh.fragments.push(MeshFragment {
+            name: fr.name.clone(),
+            subdomain: fr.subdomain,
+            other: fr.other,
+            faces: vec![face],
+            edges: Vec::new(),
+        });
+    }
+    true
 }

@@ -12,7 +12,7 @@
 //! size justifies.
 
 mod base64;
-mod build;
+pub mod build;
 pub mod clean;
 mod frag;
 mod gltf;

@@ -340,12 +340,6 @@ impl Reader<'_> {
                 format!("{split} strips, polygons or quads split into triangles"),
             );
         }
-        // Names of subdomains and fragments, when geomc wrote them.
-        if let Some(names) = field_names.get(&1) {
-            for name in names.values() {
-                b.subdomains.push((name.clone(), None));
-            }
-        }
         let binary = Some(piece_binary(piece));
         Ok((b, binary))
     }
