@@ -1,6 +1,6 @@
 //! Wavefront OBJ: `v` positions, `f` faces (polygons split into fans), `l`
-//! polylines, `p` points, grouped by the latest `o` or `g` name (`unnamed`
-//! before any). Texture coordinates, input normals and materials are not
+//! polylines, `p` points. Objects (`o`) are the groups; in a file without
+//! objects `g` groups are (`unnamed` before the first). Texture coordinates, input normals and materials are not
 //! kept (normals are recomputed by every writer), which a warning says.
 //! Hand-written rather than tobj so that every error has a line and column.
 
@@ -29,6 +29,7 @@ fn read_inner(bytes: &[u8]) -> Result<Builder, Diagnostic> {
     let mut group: Option<usize> = None;
     let mut ignored = Ignored::default();
     let mut corners: Vec<u32> = Vec::new();
+    let has_objects = bytes.starts_with(b"o ") || bytes.windows(3).any(|w| w == b"\no ");
     while let Some(t) = s.next_token() {
         if t.text.first() == Some(&b'#') {
             s.skip_line();
@@ -87,6 +88,7 @@ fn read_inner(bytes: &[u8]) -> Result<Builder, Diagnostic> {
                     _ => target.points.extend_from_slice(&corners),
                 }
             }
+            b"g" if has_objects => s.skip_line(),
             b"o" | b"g" => {
                 let name = s.rest_of_line().lossy().trim().to_string();
                 let name = if name.is_empty() {

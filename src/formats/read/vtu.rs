@@ -1,7 +1,7 @@
 //! VTK XML unstructured grids (`.vtu`): data arrays in ASCII, or inline
 //! base64 binary with UInt32 or UInt64 headers, zlib-compressed or not.
-//! Groups come from cell data: geomc's own `face_id`/`edge_id`/
-//! `polyline_id`/`point_set_id` (named by its FieldData), meshio's
+//! Groups come from cell data: geomc's own `fragment_id`, else `face_id`,
+//! `edge_id`, `polyline_id`, `point_set_id` (named by its FieldData), meshio's
 //! `gmsh:physical`, or the first integer cell array; cells without one are
 //! group `vtu`. Vertices, lines, poly-lines, triangles, strips, polygons and
 //! quads are kept (the last three split into triangles); volume cells are
@@ -25,12 +25,14 @@ const GROUP_ARRAYS: [&str; 6] = [
     "material",
 ];
 
-/// geomc's own arrays, in the order a cell's group is looked for.
-const GEOMC_ARRAYS: [(&str, &str); 4] = [
-    ("face_id", "face"),
-    ("edge_id", "edge"),
-    ("polyline_id", "poly_line"),
-    ("point_set_id", "point set"),
+/// geomc's own arrays, in the order a cell's group is looked for: (array,
+/// label of unnamed groups, index of the array in the writer's FieldData).
+const GEOMC_ARRAYS: [(&str, &str, i64); 5] = [
+    ("fragment_id", "fragment", 0),
+    ("face_id", "face", 3),
+    ("edge_id", "edge", 4),
+    ("polyline_id", "poly_line", 5),
+    ("point_set_id", "point set", 6),
 ];
 
 pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
@@ -243,7 +245,7 @@ impl Reader<'_> {
                 GEOMC_ARRAYS
                     .iter()
                     .enumerate()
-                    .find_map(|(k, (name, _))| {
+                    .find_map(|(k, (name, _, _))| {
                         cell_data
                             .get(*name)
                             .map(|v| v[i])
@@ -487,12 +489,11 @@ fn group_name(
         return "vtu".to_string();
     }
     if geomc {
-        // geomc's FieldData kinds are the writer's field indices: face_id is 3.
-        let kind = 3 + key.0 as i64;
+        let (_, label, kind) = GEOMC_ARRAYS[key.0];
         if let Some(name) = names.get(&kind).and_then(|m| m.get(&key.1)) {
             return name.clone();
         }
-        return format!("{} {}", GEOMC_ARRAYS[key.0].1, key.1);
+        return format!("{label} {}", key.1);
     }
     let array = generic.unwrap_or("group");
     if array == "gmsh:physical" {
