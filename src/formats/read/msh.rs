@@ -25,6 +25,7 @@ pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
         kinds: BTreeMap::new(),
         multi_physical: 0,
         group_of: FastMap::default(),
+        section_closed: true,
     };
     r.read().map_err(|d| vec![d])?;
     let binary = r.binary;
@@ -124,6 +125,9 @@ struct Reader<'a> {
     multi_physical: usize,
     /// (dim, physical or −entity) → group index, filled lazily.
     group_of: FastMap<(i32, i64), usize>,
+    /// Whether the current section's `$End…` line is in the file: when it
+    /// is not, a count the data cannot satisfy means the file was cut short.
+    section_closed: bool,
 }
 
 impl<'a> Reader<'a> {
@@ -135,6 +139,10 @@ impl<'a> Reader<'a> {
                 return Err(syntax(t, "a section such as `$Nodes`"));
             }
             let name = t.lossy()[1..].to_string();
+            let end = format!("$End{name}");
+            self.section_closed = self.s.bytes[self.s.pos..]
+                .windows(end.len())
+                .any(|w| w == end.as_bytes());
             self.section_start();
             match name.as_str() {
                 "PhysicalNames" => self.physical_names()?,
@@ -350,14 +358,19 @@ impl<'a> Reader<'a> {
     ) -> Result<usize, Diagnostic> {
         let left = (self.s.bytes.len() - self.s.pos.min(self.s.bytes.len())) as u64;
         if n.saturating_mul(min_bytes) > left + 1 {
-            return Err(self.err(
-                Code::MeshCountMismatch,
-                at,
-                1,
+            let code = if self.section_closed {
+                Code::MeshCountMismatch
+            } else {
+                Code::MeshTruncated
+            };
+            let message = if self.section_closed {
                 format!(
                     "the file says {n} {what}, but only {left} bytes follow: the count does not match the data"
-                ),
-            ));
+                )
+            } else {
+                format!("the file says {n} {what}, but ends {left} bytes later: it is truncated")
+            };
+            return Err(self.err(code, at, 1, message));
         }
         Ok(n as usize)
     }
