@@ -88,6 +88,9 @@ fn m3() -> Ssa {
     Ssa::from_ctx(&ctx, f.expect("1000 balls"))
 }
 
+/// A model's name, its builder and the plain-Rust anchor in seconds.
+type Model = (&'static str, fn() -> Ssa, f64);
+
 fn median(mut runs: Vec<Duration>) -> Duration {
     runs.sort();
     runs[runs.len() / 2]
@@ -109,7 +112,7 @@ fn main() {
         max: [1.0; 3],
         cells: [n; 3],
     };
-    let models: [(&str, fn() -> Ssa, f64); 3] = [
+    let models: [Model; 3] = [
         ("M1 seven balls", m1, 0.45),
         ("M2 gyroid in ball", m2, 0.55),
         ("M3 1,000 balls", m3, 31.0),
