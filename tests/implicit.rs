@@ -496,6 +496,10 @@ fn rfs_errors_have_codes_and_positions() {
             ("E603", 1, 11),
         ),
         (
+            "Geom.ny = 5000;\nfunction r_main(x, y, z) { return x; }",
+            ("E603", 1, 11),
+        ),
+        (
             "Geom.name = \"body\";\nfunction r_main(x, y, z) { return x; }",
             ("E604", 1, 13),
         ),

@@ -55,9 +55,9 @@ pub fn compile(
         return (messages, false);
     };
     if let Some(n) = cells {
-        if !(1..=4096).contains(&n) {
+        if !(1..=1024).contains(&n) {
             messages.push_str(&format!(
-                "geomc: --cells {n}: give a whole number from 1 to 4096\n"
+                "geomc: --cells {n}: give a whole number from 1 to 1024 (the grid holds (n + 1)³ samples of 8 bytes)\n"
             ));
             return (messages, false);
         }

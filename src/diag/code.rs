@@ -180,7 +180,7 @@ codes! {
     RfsArity = "E602", Error, "wrong number of arguments",
         "A function or library function is called with a different number of arguments than it takes. Arguments are positional, coordinates first: Ball(x, y, z, r, x0, y0, z0). The message shows the expected signature.";
     RfsGeomValue = "E603", Error, "bad Geom setting",
-        "A Geom field has a value it cannot take: dimension must be 3, x_min < x_max (likewise y, z), nx, ny, nz whole numbers from 1 to 4096, optiterations a whole number ≥ 0, name a string, rsystem one of \"rvachev\", \"minmax\", \"alpha\" and alpha in (−1, 1]. Fix the value shown.";
+        "A Geom field has a value it cannot take: dimension must be 3, x_min < x_max (likewise y, z), nx, ny, nz whole numbers from 1 to 1024 (the grid holds (nx + 1)(ny + 1)(nz + 1) samples of 8 bytes), optiterations a whole number ≥ 0, name a string, rsystem one of \"rvachev\", \"minmax\", \"alpha\" and alpha in (−1, 1]. Fix the value shown.";
     RfsNoResult = "E604", Error, "no result function",
         "The function that defines the solid is the one Geom.name names, else the one called r_main. Define one of them, or set Geom.name = \"…\" to the function's name.";
     RfsRecursion = "E605", Error, "recursive or too deeply nested function calls",

@@ -123,12 +123,12 @@ pub fn read_geom(program: &Program, diags: &mut Diagnostics) -> Geom {
                 }
                 "nx" | "ny" | "nz" => {
                     let v = number(&ex, &value)?;
-                    if !whole(v, 1.0, 4096.0) {
+                    if !whole(v, 1.0, 1024.0) {
                         return Err(err(
                             Code::RfsGeomValue,
                             expr.span(),
                             format!(
-                                "Geom.{field} = {v}: give a whole number of cells from 1 to 4096"
+                                "Geom.{field} = {v}: give a whole number of cells from 1 to 1024"
                             ),
                         ));
                     }
