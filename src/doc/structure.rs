@@ -123,7 +123,7 @@ fn check_children<'e>(
     element: &'e Element,
     rule: &'static Rule,
     diags: &mut Diagnostics,
-) -> Vec<&'e Element> {
+) -> Vec<&'e Element<'e>> {
     let allowed = rule.child_rules();
     let mut known = Vec::new();
     for child in &element.children {
