@@ -98,8 +98,8 @@ fn parallelepiped(frame: &Frame) -> Brep {
     for axis in 0..3 {
         let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
         let (lo, hi) = (p.min(q), p.max(q));
-        for s in 0..2 {
-            for t in 0..2 {
+        for (s, names) in EDGE_NAMES[axis].iter().enumerate() {
+            for (t, &name) in names.iter().enumerate() {
                 let mut at = [0usize; 3];
                 at[lo] = s;
                 at[hi] = t;
@@ -107,7 +107,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
                 at[axis] = 1;
                 let end = corner(at[0], at[1], at[2]);
                 edges.push(BrepEdge {
-                    name: EDGE_NAMES[axis][s][t],
+                    name,
                     curve: Curve::Segment {
                         a: vertices[begin].position,
                         b: vertices[end].position,

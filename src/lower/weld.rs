@@ -9,7 +9,7 @@
 use crate::geom::{Curve, Point3};
 use crate::ir::{Edge, EdgeId, Face, FaceId, Model, OrientedEdge, Vertex, VertexId};
 use std::collections::HashMap;
-use std::hash::{BuildHasher, Hash, Hasher};
+use std::hash::{BuildHasher, Hash};
 
 type FastMap<K, V> = HashMap<K, V, foldhash::fast::FixedState>;
 
@@ -196,9 +196,8 @@ impl Welder {
     /// The existing face with the same edges and the same interior point, or a new one.
     pub fn face(&mut self, model: &mut Model, face: Face, sample: Point3) -> (FaceId, bool) {
         sorted_edges(&face, &mut self.scratch);
-        let mut hasher = foldhash::fast::FixedState::default().build_hasher();
-        self.scratch.hash(&mut hasher);
-        let key = hasher.finish();
+
+        let key = foldhash::fast::FixedState::default().hash_one(&self.scratch);
         let mut theirs = Vec::new();
         for id in self.faces_by_edges.iter(&key) {
             sorted_edges(&model.faces[id as usize], &mut theirs);
