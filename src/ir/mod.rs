@@ -122,10 +122,14 @@ pub struct PointSet {
     pub points: Vec<Point3>,
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Polyline {
     pub name: String,
     pub points: Vec<Point3>,
+    /// The exact curve when the line is one (paper 003's curves): meshing
+    /// samples it to the chordal tolerance instead of using `points`, which
+    /// then hold a coarse sample for bounding boxes.
+    pub curve: Option<Curve>,
 }
 
 /// A user-named set of faces (3D) or edges (2D) where boundary conditions go.

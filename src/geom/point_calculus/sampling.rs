@@ -20,7 +20,7 @@ pub fn adaptive_samples(
     max_chord: f64,
     min_segments: usize,
 ) -> Option<(Vec<f64>, Vec<Point3>)> {
-    if !(tolerance > 0.0) || max_chord.is_nan() || max_chord <= 0.0 {
+    if tolerance.is_nan() || tolerance <= 0.0 || max_chord.is_nan() || max_chord <= 0.0 {
         return None;
     }
     let n0 = min_segments.max(1);
