@@ -114,7 +114,7 @@ pub(super) fn lower_topology(
             .and_then(|o| o.geometry.as_ref())
         {
             Some(Geometry::Surface(s)) => s.clone(),
-            Some(Geometry::Patch(patch)) => Surface::Patch9(Box::new(patch.clone())),
+            Some(Geometry::Patch(patch)) => Surface::Patch9(patch.clone()),
             Some(Geometry::Solid(SolidShape::Ball { frame })) => {
                 Surface::Ellipsoid { frame: *frame }
             }

@@ -61,7 +61,7 @@ pub enum Geometry {
     /// A curve of paper 003 (segment, conic_arc, desargues_arc).
     PointCurve(PcCurve),
     /// Paper 003's 9-point patch.
-    Patch(Patch9),
+    Patch(Box<Patch9>),
     /// Members of a replicate: `name[1]` … `name[n]`.
     Group(Vec<Geometry>),
 }
@@ -125,7 +125,7 @@ impl Geometry {
             }),
             // Point equations are affine combinations: map the defining points.
             Geometry::PointCurve(c) => Geometry::PointCurve(c.mapped(|p| map.to_global(p))),
-            Geometry::Patch(patch) => Geometry::Patch(patch.mapped(|p| map.to_global(p))),
+            Geometry::Patch(patch) => Geometry::Patch(Box::new(patch.mapped(|p| map.to_global(p)))),
             Geometry::Group(members) => Geometry::Group(
                 members
                     .iter()

@@ -147,7 +147,7 @@ pub(super) fn patch(
             let (u, v) = (j as f64 / n as f64, i as f64 / n as f64);
             let (mu, mv) = patch.derivatives(u, v);
             let area = mu.cross(&mv).norm();
-            if !(area > REL * scale * scale) {
+            if area.is_nan() || area <= REL * scale * scale {
                 r.diags.push(
                     Diagnostic::new(
                         Code::DegeneratePatch,
@@ -167,5 +167,5 @@ pub(super) fn patch(
             }
         }
     }
-    Some(Geometry::Patch(patch))
+    Some(Geometry::Patch(Box::new(patch)))
 }

@@ -220,6 +220,18 @@ impl PcCurve {
         }
     }
 
+    /// "conic_arc k = 0.25: hyperbola", "desargues_arc", … for reports.
+    pub fn describe(&self) -> String {
+        match self {
+            PcCurve::Conic { k, .. } => format!(
+                "conic_arc k = {}: {}",
+                crate::resolve_fmt(*k),
+                ConicKind::of(*k).map_or("no conic", ConicKind::name)
+            ),
+            _ => self.element().to_string(),
+        }
+    }
+
     /// `n + 1` points at u = 0, 1/n, …, 1 (n ≥ 1).
     pub fn samples(&self, n: usize) -> Vec<Point3> {
         let n = n.max(1);
