@@ -170,3 +170,50 @@ fn point_equation_parallelepiped_equals_base_point_form() {
     assert_eq!(a.vertices, b.vertices);
     assert_eq!(a.faces, b.faces);
 }
+
+#[test]
+fn curves_compile_to_line_elements_in_obj_gltf_and_msh() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let input = format!(
+        "{}/fixtures/valid/pointcalc_curves.xml",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let out = |ext: &str| dir.path().join(format!("curves.{ext}"));
+    let status = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
+        .args(["compile", &input, "-o"])
+        .arg(out("obj"))
+        .arg("-o")
+        .arg(out("gltf"))
+        .arg("-o")
+        .arg(out("msh"))
+        .output()
+        .expect("run geomc");
+    assert!(
+        status.status.success(),
+        "{}",
+        String::from_utf8_lossy(&status.stderr)
+    );
+    let obj = std::fs::read_to_string(out("obj")).expect("obj");
+    assert_eq!(obj.lines().filter(|l| l.starts_with("l ")).count(), 5);
+    for name in ["base", "hyperbola", "parabola", "ellipse", "cubic"] {
+        assert!(obj.lines().any(|l| l == format!("o {name}")), "{name}");
+    }
+    let gltf: serde_json::Value =
+        serde_json::from_str(&std::fs::read_to_string(out("gltf")).expect("gltf")).expect("json");
+    let lines = gltf["meshes"]
+        .as_array()
+        .expect("meshes")
+        .iter()
+        .flat_map(|m| m["primitives"].as_array().cloned().unwrap_or_default())
+        .filter(|p| p["mode"] == 1)
+        .count();
+    assert_eq!(lines, 5, "one LINES primitive per curve");
+    let msh = std::fs::read_to_string(out("msh")).expect("msh");
+    // MSH: one physical group of line elements (dimension 1) per curve, by name.
+    for (tag, name) in ["base", "hyperbola", "parabola", "ellipse", "cubic"]
+        .iter()
+        .enumerate()
+    {
+        assert!(msh.contains(&format!("1 {} \"{name}\"", tag + 1)), "{name}");
+    }
+}
