@@ -191,7 +191,7 @@ impl Model {
         &self.subdomains[id.index()]
     }
 
-    /// The bounding box of every vertex, point, polyline and solid.
+    /// The bounding box of every vertex, point, polyline, solid and patch face.
     pub fn bbox(&self) -> Aabb {
         let mut bbox = Aabb::empty();
         for v in &self.vertices {
@@ -205,6 +205,12 @@ impl Model {
         }
         for solid in &self.solids {
             bbox = bbox.union(&solid.shape.bbox());
+        }
+        // A patch face bulges beyond its vertices: include its nine points.
+        for face in &self.faces {
+            if let crate::geom::Surface::Patch9(patch) = &face.surface {
+                patch.rows.iter().flatten().for_each(|p| bbox.include(p));
+            }
         }
         bbox
     }
