@@ -172,6 +172,16 @@ codes! {
         "A point value with two coordinates is a line parallel to the missing axis, and one with one coordinate is a plane perpendicular to its axis (paper 000). Where a single point is needed, the missing coordinates are taken as 0.";
     EmptySubdomainList = "W009", Warning, "model has no subdomains",
         "The file defines geometry but no <subdomain>, so it describes no computational domain: no boundary fragments are derived and compile meshes each solid on its own. Add <subdomain> elements to describe the domain.";
+
+    // ---- compile (issue 3) ----
+    InternalMeshingFailure = "E500", Error, "internal meshing failure",
+        "The mesher failed inside on the edge or face named (for example a loss of floating-point precision in the constrained Delaunay refinement). This is a bug in geomc, not in your file: please report it with the input. Meanwhile a slightly different --tolerance, --max-edge or --min-angle often avoids it; the other inputs of the run are compiled as usual.";
+    InvalidMeshOption = "E501", Error, "invalid meshing option",
+        "A meshing option has a value the mesher cannot use: --tolerance must be a positive finite length (0.01) or a positive percentage of the model's bounding-box diagonal (0.1%); --max-edge a positive finite length; --min-angle an angle above 0 and at most 33 degrees (refinement may not terminate above about 33°).";
+    FaceNotMeshable = "E502", Error, "face cannot be meshed",
+        "geomc could not triangulate this face: its loops cross or enclose no area in the face's chart, a loop is not closed, or it needs more nodes than the limit for the tolerance. Check the face's edges (`geomc inspect --matrices`), or loosen --tolerance.";
+    EdgeNotDiscretisable = "E503", Error, "edge cannot be discretised",
+        "geomc could not split this edge into chords within the tolerance: its curve has points that are not finite, or it needs more than 65,536 segments for --tolerance or --max-edge. Loosen the tolerance or the edge length limit.";
 }
 
 impl Code {
