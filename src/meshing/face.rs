@@ -24,7 +24,7 @@
 use super::MeshError;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
-use crate::geom::{Point3, Vec3};
+use crate::geom::{Point3, Surface, Vec3};
 use crate::ir::{Face, Model};
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
@@ -395,24 +395,68 @@ fn boundary_splits(
 }
 
 /// True when a triangle is longer than `max_edge` or strays from the surface
-/// by more than the tolerance at its centroid or an edge midpoint.
+/// by more than the tolerance. The deviation is measured at the centroid and
+/// the edge midpoints, and its largest value inside the triangle is
+/// estimated from the quadratic that vanishes at the corners and matches the
+/// midpoints (on a sphere the deviation peaks at the circumcentre, which the
+/// centroid misses on skewed triangles).
 fn too_coarse(face: &Face, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
     let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
     if longest > settings.max_edge {
         return true;
     }
-    if matches!(face.surface, crate::geom::Surface::Plane { .. }) {
+    if matches!(face.surface, Surface::Plane { .. }) {
         return false;
     }
-    let probes = [
-        Point3::from((a.coords + b.coords + c.coords) / 3.0),
-        Point3::from((a.coords + b.coords) / 2.0),
-        Point3::from((b.coords + c.coords) / 2.0),
-        Point3::from((c.coords + a.coords) / 2.0),
-    ];
-    probes
+    let mid = |p: &Point3, q: &Point3| Point3::from((p.coords + q.coords) / 2.0);
+    let deviation = |p: &Point3| signed_distance(&face.surface, p);
+    let (ab, bc, ca) = (
+        deviation(&mid(a, b)),
+        deviation(&mid(b, c)),
+        deviation(&mid(c, a)),
+    );
+    let centroid = deviation(&Point3::from((a.coords + b.coords + c.coords) / 3.0));
+    let tolerance = settings.tolerance;
+    [ab, bc, ca, centroid, quadratic_peak(ab, bc, ca)]
         .iter()
-        .any(|p| face.surface.distance(p) > settings.tolerance)
+        .any(|d| d.abs() > tolerance)
+}
+
+/// The interior extremum of q = 4(m_ab λa λb + m_bc λb λc + m_ca λc λa) over
+/// the triangle (barycentric λ), or 0 when it has none inside.
+fn quadratic_peak(m_ab: f64, m_bc: f64, m_ca: f64) -> f64 {
+    // With λc = 1 − λa − λb, ∇q = 0 is a 2×2 linear system.
+    let k = m_ab - m_bc - m_ca;
+    let det = 4.0 * m_bc * m_ca - k * k;
+    if det.is_nan() || det.abs() <= 1e-300 {
+        return 0.0;
+    }
+    let la = (2.0 * m_bc * m_ca + k * m_bc) / det;
+    let lb = (2.0 * m_bc * m_ca + k * m_ca) / det;
+    let lc = 1.0 - la - lb;
+    if la < 0.0 || lb < 0.0 || lc < 0.0 {
+        return 0.0;
+    }
+    4.0 * (m_ab * la * lb + m_bc * lb * lc + m_ca * lc * la)
+}
+
+/// Signed distance from the surface: exact for spheres, value / |gradient|
+/// otherwise; infinite where the gradient vanishes off the surface.
+fn signed_distance(surface: &Surface, p: &Point3) -> f64 {
+    if let Surface::Ellipsoid { frame } = surface
+        && let Some(radius) = frame.similarity_scale()
+    {
+        return (p - frame.origin).norm() - radius;
+    }
+    let (value, gradient) = surface.value_and_gradient(p);
+    let norm = gradient.norm();
+    if value == 0.0 {
+        0.0
+    } else if value.is_finite() && norm.is_finite() && norm > 0.0 {
+        value / norm
+    } else {
+        f64::INFINITY
+    }
 }
 
 /// Twice the signed area of a closed polygon.
@@ -430,4 +474,24 @@ fn shoelace(points: &[[f64; 2]]) -> f64 {
 fn point2([u, v]: [f64; 2]) -> Point2<f64> {
     let snap = |x: f64| if x.abs() < 1e-30 { 0.0 } else { x };
     Point2::new(snap(u), snap(v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadratic_peak_finds_the_interior_extremum() {
+        // Equal midpoint deviations m: the peak is 4m/3 at the centroid.
+        assert!((quadratic_peak(0.3, 0.3, 0.3) - 0.4).abs() < 1e-15);
+        // The deviation of a chord plane under a unit sphere, q = ¼(R² − |x − c|²)·…:
+        // for a right triangle the circumcentre is the hypotenuse midpoint, so
+        // no interior extremum exceeds it.
+        let peak = quadratic_peak(1.0, 0.5, 0.5);
+        assert!(peak <= 1.0 + 1e-12, "{peak}");
+        // One large midpoint value: the peak lies inside and above the others.
+        let peak = quadratic_peak(1.0, 0.8, 0.8);
+        assert!(peak > 1.0, "{peak}");
+        assert_eq!(quadratic_peak(0.0, 0.0, 0.0), 0.0);
+    }
 }
