@@ -29,7 +29,7 @@ use crate::ir::{Face, Model};
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -158,6 +158,10 @@ pub(crate) fn mesh_face(
         parameters = parameters.keep_constraint_edges();
     }
     let mut inner = Vec::new();
+    // Triangles (by their corner nodes, which never move) already found
+    // fine: later passes only check the triangles insertions created.
+    let mut fine: HashSet<[usize; 3]> = HashSet::new();
+    let deviation = Deviation::of(&face.surface);
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if !settings.keep_boundary {
@@ -193,8 +197,13 @@ pub(crate) fn mesh_face(
             }
             let [a, b, c] = f.vertices().map(|v| v.fix().index());
             inner.push([a, b, c]);
+            let mut key = [a, b, c];
+            key.sort_unstable();
+            if fine.contains(&key) {
+                continue;
+            }
             if too_coarse(
-                face,
+                &deviation,
                 [&positions[a], &positions[b], &positions[c]],
                 settings,
             ) {
@@ -203,6 +212,8 @@ pub(crate) fn mesh_face(
                     (pa.x + pb.x + pc.x) / 3.0,
                     (pa.y + pb.y + pc.y) / 3.0,
                 ]));
+            } else {
+                fine.insert(key);
             }
         }
         if bad.is_empty() {
@@ -400,16 +411,16 @@ fn boundary_splits(
 /// estimated from the quadratic that vanishes at the corners and matches the
 /// midpoints (on a sphere the deviation peaks at the circumcentre, which the
 /// centroid misses on skewed triangles).
-fn too_coarse(face: &Face, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
+fn too_coarse(surface: &Deviation, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
     let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
     if longest > settings.max_edge {
         return true;
     }
-    if matches!(face.surface, Surface::Plane { .. }) {
+    if matches!(surface, Deviation::Plane) {
         return false;
     }
     let mid = |p: &Point3, q: &Point3| Point3::from((p.coords + q.coords) / 2.0);
-    let deviation = |p: &Point3| signed_distance(&face.surface, p);
+    let deviation = |p: &Point3| surface.signed_distance(p);
     let (ab, bc, ca) = (
         deviation(&mid(a, b)),
         deviation(&mid(b, c)),
@@ -440,22 +451,48 @@ fn quadratic_peak(m_ab: f64, m_bc: f64, m_ca: f64) -> f64 {
     4.0 * (m_ab * la * lb + m_bc * lb * lc + m_ca * lc * la)
 }
 
-/// Signed distance from the surface: exact for spheres, value / |gradient|
-/// otherwise; infinite where the gradient vanishes off the surface.
-fn signed_distance(surface: &Surface, p: &Point3) -> f64 {
-    if let Surface::Ellipsoid { frame } = surface
-        && let Some(radius) = frame.similarity_scale()
-    {
-        return (p - frame.origin).norm() - radius;
+/// A face's surface, prepared once for the many distance queries of
+/// refinement.
+enum Deviation<'a> {
+    Plane,
+    Sphere { centre: Point3, radius: f64 },
+    General(&'a Surface),
+}
+
+impl Deviation<'_> {
+    fn of(surface: &Surface) -> Deviation<'_> {
+        match surface {
+            Surface::Plane { .. } => Deviation::Plane,
+            Surface::Ellipsoid { frame } => match frame.similarity_scale() {
+                Some(radius) => Deviation::Sphere {
+                    centre: frame.origin,
+                    radius,
+                },
+                None => Deviation::General(surface),
+            },
+            _ => Deviation::General(surface),
+        }
     }
-    let (value, gradient) = surface.value_and_gradient(p);
-    let norm = gradient.norm();
-    if value == 0.0 {
-        0.0
-    } else if value.is_finite() && norm.is_finite() && norm > 0.0 {
-        value / norm
-    } else {
-        f64::INFINITY
+
+    /// Signed distance from the surface: exact for planes and spheres,
+    /// value / |gradient| otherwise; infinite where the gradient vanishes off
+    /// the surface.
+    fn signed_distance(&self, p: &Point3) -> f64 {
+        match self {
+            Deviation::Plane => 0.0,
+            Deviation::Sphere { centre, radius } => (p - centre).norm() - radius,
+            Deviation::General(surface) => {
+                let (value, gradient) = surface.value_and_gradient(p);
+                let norm = gradient.norm();
+                if value == 0.0 {
+                    0.0
+                } else if value.is_finite() && norm.is_finite() && norm > 0.0 {
+                    value / norm
+                } else {
+                    f64::INFINITY
+                }
+            }
+        }
     }
 }
 
