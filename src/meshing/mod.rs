@@ -40,6 +40,7 @@ use crate::mesh::{
 };
 use edges::EdgeNodes;
 use face::{FaceMesh, FacePoint, Outcome, Settings};
+use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Rounds of "mesh faces, add the boundary points they asked for" before
@@ -191,13 +192,23 @@ fn mesh_faces(
             keep_boundary: round == MAX_ROUNDS,
         };
         let mut splits: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
-        for &f in &todo {
-            let face = &model.faces[f];
-            let outcome = guard::guarded(
-                || format!("face `{}`", face.name),
-                || face::mesh_face(model, face, edge_nodes, &settings),
-            )?;
-            match outcome {
+        // Faces mesh independently against the shared edge nodes: in
+        // parallel, with results taken in face order (deterministic, and the
+        // first error in face order wins as it would sequentially).
+        let edges_now: &[EdgeNodes] = edge_nodes;
+        let outcomes: Vec<(usize, Result<Outcome, MeshError>)> = todo
+            .par_iter()
+            .map(|&f| {
+                let face = &model.faces[f];
+                let outcome = guard::guarded(
+                    || format!("face `{}`", face.name),
+                    || face::mesh_face(model, face, edges_now, &settings),
+                );
+                (f, outcome)
+            })
+            .collect();
+        for (f, outcome) in outcomes {
+            match outcome? {
                 Outcome::Meshed(mesh) => meshes[f] = Some(mesh),
                 Outcome::Split(points) => {
                     for (edge, s) in points {
