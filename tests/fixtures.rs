@@ -25,6 +25,28 @@ const NOT_COVERED_BY_FIXTURES: &[&str] = &[
     "E501", // invalid --tolerance / --max-edge / --min-angle values
     "E502", // a face the mesher cannot triangulate
     "E503", // an edge that needs too many segments
+    // ---- convert (issue 4): codes of mesh files, not of XML models ----
+    "E520", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E521", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E522", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E523", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E524", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E525", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E526", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E527", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E528", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E529", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E530", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E531", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E532", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E533", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W110", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W111", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W112", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W113", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W114", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W115", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W116", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
 ];
 
 /// Command-line options an `args:` header may name, and whether each takes a value.
@@ -361,7 +383,9 @@ fn every_code_has_a_fixture() {
             Severity::Error => {
                 NOT_COVERED_BY_FIXTURES.contains(&text) || expected_errors.contains(text)
             }
-            Severity::Warning => listed_warnings.contains(text),
+            Severity::Warning => {
+                NOT_COVERED_BY_FIXTURES.contains(&text) || listed_warnings.contains(text)
+            }
         };
         if !covered {
             missing.push(format!("{text} ({})", code.title()));
