@@ -30,6 +30,7 @@ use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
 use std::collections::{BTreeMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -160,7 +161,7 @@ pub(crate) fn mesh_face(
     let mut inner = Vec::new();
     // Triangles (by their corner nodes, which never move) already found
     // fine: later passes only check the triangles insertions created.
-    let mut fine: HashSet<[usize; 3]> = HashSet::new();
+    let mut fine: FineSet = FineSet::default();
     let deviation = Deviation::of(&face.surface);
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
@@ -197,9 +198,8 @@ pub(crate) fn mesh_face(
             }
             let [a, b, c] = f.vertices().map(|v| v.fix().index());
             inner.push([a, b, c]);
-            let mut key = [a, b, c];
-            key.sort_unstable();
-            if fine.contains(&key) {
+            let key = triangle_key(a, b, c);
+            if key.is_some_and(|k| fine.contains(&k)) {
                 continue;
             }
             if too_coarse(
@@ -208,11 +208,10 @@ pub(crate) fn mesh_face(
                 settings,
             ) {
                 let [pa, pb, pc] = f.positions();
-                bad.push(point2([
-                    (pa.x + pb.x + pc.x) / 3.0,
-                    (pa.y + pb.y + pc.y) / 3.0,
-                ]));
-            } else {
+                let centroid = point2([(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0]);
+                // A corner of the triangle is a good start for locating it.
+                bad.push((centroid, f.vertices()[0].fix()));
+            } else if let Some(key) = key {
                 fine.insert(key);
             }
         }
@@ -224,8 +223,8 @@ pub(crate) fn mesh_face(
                 "it needs more than {MAX_FACE_VERTICES} nodes for the tolerance"
             )));
         }
-        for point in bad {
-            cdt.insert(point)
+        for (point, hint) in bad {
+            cdt.insert_with_hint(point, hint)
                 .map_err(|e| failed(format!("a refinement point cannot be inserted: {e:?}")))?;
         }
     }
@@ -449,6 +448,37 @@ fn quadratic_peak(m_ab: f64, m_bc: f64, m_ca: f64) -> f64 {
         return 0.0;
     }
     4.0 * (m_ab * la * lb + m_bc * lb * lc + m_ca * lc * la)
+}
+
+/// Triangles known to be fine, by [`triangle_key`]; the keys are the
+/// mesher's own, so a fast multiplicative hash replaces SipHash.
+type FineSet = HashSet<u64, BuildHasherDefault<KeyHasher>>;
+
+/// The sorted corner nodes of a triangle packed into 64 bits, 21 bits each
+/// (`None`, so not cached, for the rare node index beyond that).
+fn triangle_key(a: usize, b: usize, c: usize) -> Option<u64> {
+    let mut key = [a as u64, b as u64, c as u64];
+    key.sort_unstable();
+    (key[2] < 1 << 21).then(|| key[0] | (key[1] << 21) | (key[2] << 42))
+}
+
+#[derive(Default)]
+struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
 }
 
 /// A face's surface, prepared once for the many distance queries of
