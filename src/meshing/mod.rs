@@ -140,9 +140,19 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         })
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
     let face_meshes = mesh_faces(model, &mut edge_nodes, tolerance, max_edge, min_angle)?;
+    let lines = model
+        .polylines
+        .iter()
+        .map(|l| {
+            guard::guarded(
+                || format!("poly_line `{}`", l.name),
+                || edges::polyline_points(l, tolerance, max_edge),
+            )
+        })
+        .collect::<Result<Vec<_>, MeshError>>()?;
     guard::guarded(
         || "the assembly of the mesh".to_string(),
-        || Ok(assemble(model, &edge_nodes, &face_meshes)),
+        || Ok(assemble(model, &edge_nodes, &face_meshes, &lines)),
     )
 }
 
@@ -240,7 +250,12 @@ fn mesh_faces(
 
 /// Numbers the nodes (vertices, then edge interiors, then face interiors,
 /// then points and poly_lines) and fills the mesh IR.
-fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceMesh>]) -> Mesh {
+fn assemble(
+    model: &Model,
+    edge_nodes: &[EdgeNodes],
+    face_meshes: &[Option<FaceMesh>],
+    lines: &[Vec<crate::geom::Point3>],
+) -> Mesh {
     let mut nodes: Vec<[f64; 3]> = model
         .vertices
         .iter()
@@ -339,8 +354,8 @@ fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceM
         });
     }
     let mut polylines = Vec::new();
-    for line in &model.polylines {
-        let ids = line.points.iter().map(|p| push(&mut nodes, p)).collect();
+    for (line, points) in model.polylines.iter().zip(lines) {
+        let ids = points.iter().map(|p| push(&mut nodes, p)).collect();
         polylines.push(MeshPolyline {
             name: line.name.clone(),
             nodes: ids,
