@@ -5,7 +5,7 @@ use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, InputOptions, report_usage};
 use geomc::diag::render_human;
 use geomc::driver::{Options, check_file};
 use geomc::formats::{self, Encoding, WriteOptions};
-use geomc::meshing::{MeshOptions, Tolerance, mesh_model};
+use geomc::meshing::{MeshOptions, mesh_model};
 use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
@@ -24,13 +24,23 @@ pub struct Args {
     to: Vec<String>,
     /// Chordal tolerance: a length (0.01), or a percentage of the model's
     /// bounding-box diagonal (0.1%).
-    #[arg(long, default_value = "0.1%", value_name = "TOL")]
+    #[arg(
+        long,
+        default_value = "0.1%",
+        value_name = "TOL",
+        allow_hyphen_values = true
+    )]
     tolerance: String,
     /// Longest triangle edge allowed.
-    #[arg(long, value_name = "LENGTH")]
+    #[arg(long, value_name = "LENGTH", allow_hyphen_values = true)]
     max_edge: Option<f64>,
     /// Smallest triangle angle refinement aims for, in degrees (at most 33).
-    #[arg(long, default_value_t = 25.0, value_name = "DEGREES")]
+    #[arg(
+        long,
+        default_value_t = 25.0,
+        value_name = "DEGREES",
+        allow_hyphen_values = true
+    )]
     min_angle: f64,
     /// Text output where the format has both (STL, MSH, VTU).
     #[arg(long, conflicts_with = "binary")]
@@ -68,8 +78,8 @@ pub fn run(args: &Args) -> i32 {
     };
     let mesh_options = match mesh_options(args) {
         Ok(m) => m,
-        Err(message) => {
-            eprintln!("geomc: {message}");
+        Err(diagnostic) => {
+            report_usage(&[diagnostic]);
             return EXIT_USAGE;
         }
     };
@@ -150,34 +160,8 @@ pub fn run(args: &Args) -> i32 {
     if failed > 0 { EXIT_INVALID } else { EXIT_OK }
 }
 
-fn mesh_options(args: &Args) -> Result<MeshOptions, String> {
-    let text = args.tolerance.trim();
-    let tolerance = match text.strip_suffix('%') {
-        Some(percent) => percent
-            .trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .map(|v| Tolerance::Relative(v / 100.0)),
-        None => text.parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0).map(Tolerance::Absolute),
-    }
-    .ok_or_else(|| format!("--tolerance {text}: give a positive length (0.01) or a percentage of the model's size (0.1%)"))?;
-    if let Some(max_edge) = args.max_edge {
-        if !(max_edge.is_finite() && max_edge > 0.0) {
-            return Err(format!("--max-edge {max_edge}: give a positive length"));
-        }
-    }
-    if !(args.min_angle > 0.0 && args.min_angle <= 33.0) {
-        return Err(format!(
-            "--min-angle {}: give an angle above 0 and at most 33 degrees",
-            args.min_angle
-        ));
-    }
-    Ok(MeshOptions {
-        tolerance,
-        max_edge: args.max_edge,
-        min_angle_degrees: args.min_angle,
-    })
+fn mesh_options(args: &Args) -> Result<MeshOptions, geomc::diag::Diagnostic> {
+    super::mesh_args::parse_mesh_options(&args.tolerance, args.max_edge, args.min_angle)
 }
 
 /// The output files of each input: the -o files for one input, or
@@ -276,7 +260,8 @@ fn compile_one(
     let mesh = match mesh_model(&lowered.model, mesh_options) {
         Ok(mesh) => mesh,
         Err(e) => {
-            messages.push_str(&format!("{}: error: {e}\n", input.display()));
+            let diagnostic = e.to_diagnostic(&lowered.model, &lowered.source_map);
+            messages.push_str(&render_human(&checked.source, &diagnostic));
             return fail(messages);
         }
     };

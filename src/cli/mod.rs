@@ -5,6 +5,8 @@ mod compile;
 mod convert;
 mod explain;
 mod inspect;
+mod inspect_mesh;
+mod mesh_args;
 mod rfs;
 mod validate;
 
@@ -97,6 +99,10 @@ pub enum Format {
 pub fn run() -> i32 {
     // A panic is a bug: say so, and exit with its own code.
     std::panic::set_hook(Box::new(|info| {
+        // The mesher turns its own panics into E500 diagnostics.
+        if geomc::meshing::panics_are_caught() {
+            return;
+        }
         eprintln!("geomc: internal error: {info}");
         eprintln!("this is a bug in geomc; please report it with the input that caused it");
     }));

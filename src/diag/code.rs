@@ -201,6 +201,17 @@ codes! {
         "This Geom field is not one geomc uses (dimension, x_min, x_max, y_min, y_max, z_min, z_max, nx, ny, nz, name, optiterations, rsystem, alpha); it is ignored. Check the spelling.";
     RfsOptimizeIgnored = "W131", Warning, "mesh optimisation iterations not applied",
         "Geom.optiterations asks for mesh optimisation (edge flips and smoothing); this geomc does not implement it yet, so the marching-cubes triangles are written as they are.";
+
+    // ---- compile (issue 3) ----
+    InternalMeshingFailure = "E500", Error, "internal meshing failure",
+        "The mesher failed inside on the edge or face named (for example a loss of floating-point precision in the constrained Delaunay refinement). This is a bug in geomc, not in your file: please report it with the input. Meanwhile a slightly different --tolerance, --max-edge or --min-angle often avoids it; the other inputs of the run are compiled as usual.";
+    InvalidMeshOption = "E501", Error, "invalid meshing option",
+        "A meshing option has a value the mesher cannot use: --tolerance must be a positive finite length (0.01) or a positive percentage of the model's bounding-box diagonal (0.1%); --max-edge a positive finite length; --min-angle an angle above 0 and at most 33 degrees (refinement may not terminate above about 33°).";
+    FaceNotMeshable = "E502", Error, "face cannot be meshed",
+        "geomc could not triangulate this face: its loops cross or enclose no area in the face's chart, a loop is not closed, or it needs more nodes than the limit for the tolerance. Check the face's edges (`geomc inspect --matrices`), or loosen --tolerance.";
+    EdgeNotDiscretisable = "E503", Error, "edge cannot be discretised",
+        "geomc could not split this edge into chords within the tolerance: its curve has points that are not finite, or it needs more than 65,536 segments for --tolerance or --max-edge. Loosen the tolerance or the edge length limit.";
+
     // ---- convert: mesh readers and `geomc convert` (issue 4) ----
     MeshReadFailed = "E520", Error, "cannot read the mesh file",
         "The mesh file (or a file it refers to, such as a .gltf's buffer or the mesh a .frag.xml names) could not be opened or read. Check the path and its permissions.";

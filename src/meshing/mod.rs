@@ -16,16 +16,23 @@
 //! # Limitations
 //! - Faces without loops (unbounded surfaces) get no triangles; one that
 //!   bounds a subdomain is an error.
-//! - Spade's refinement can panic on loss of precision (its own `expect`);
-//!   that is not caught here.
+//! - Spade's refinement can panic on loss of precision (its own `expect`):
+//!   every edge and face is meshed under `catch_unwind`, so such a failure
+//!   becomes [`MeshError::Internal`] naming the entity instead of a crash.
 //! - See the module docs of [`chart`] and [`face`] for per-surface limits.
 
 mod chart;
 mod check;
+mod diagnostic;
 mod edges;
+pub mod exact;
 mod face;
+mod guard;
+mod report;
 
 pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
+pub use guard::panics_are_caught;
+pub use report::{MeshReport, SubdomainReport};
 
 use crate::ir::{self, Dimension, Model, Side, SubdomainCells};
 use crate::mesh::{
@@ -33,6 +40,7 @@ use crate::mesh::{
 };
 use edges::EdgeNodes;
 use face::{FaceMesh, FacePoint, Outcome, Settings};
+use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Rounds of "mesh faces, add the boundary points they asked for" before
@@ -82,14 +90,25 @@ pub enum MeshError {
     Edge { edge: String, reason: String },
     #[error("cannot mesh face `{face}`: {reason}")]
     Face { face: String, reason: String },
+    /// A panic inside the mesher (a bug), caught and attributed to the edge
+    /// or face being meshed.
+    #[error("internal meshing failure on {entity}: {message}")]
+    Internal { entity: String, message: String },
+}
+
+impl Tolerance {
+    /// The tolerance as a length for `model`.
+    pub fn absolute(self, model: &Model) -> f64 {
+        match self {
+            Tolerance::Absolute(t) => t,
+            Tolerance::Relative(r) => r * model.bbox().diagonal(),
+        }
+    }
 }
 
 /// Meshes every edge and face of `model` and copies its groups.
 pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshError> {
-    let tolerance = match options.tolerance {
-        Tolerance::Absolute(t) => t,
-        Tolerance::Relative(r) => r * model.bbox().diagonal(),
-    };
+    let tolerance = options.tolerance.absolute(model);
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(MeshError::Options(format!(
             "the tolerance must be positive and finite (got {tolerance})"
@@ -97,7 +116,9 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
     }
     let max_edge = options.max_edge.unwrap_or(f64::INFINITY);
     if max_edge.is_nan() || max_edge <= 0.0 {
-        return Err(MeshError::Options("max_edge must be positive".into()));
+        return Err(MeshError::Options(format!(
+            "max_edge must be positive (got {max_edge})"
+        )));
     }
     // Spade's refinement may not terminate above about 30°.
     let min_angle = options.min_angle_degrees;
@@ -111,15 +132,28 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
     let mut edge_nodes = model
         .edges
         .iter()
-        .map(|e| edges::discretise(model, e, 0.5 * tolerance, max_edge))
+        .map(|e| {
+            guard::guarded(
+                || format!("edge `{}`", e.name),
+                || edges::discretise(model, e, 0.5 * tolerance, max_edge),
+            )
+        })
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
     let face_meshes = mesh_faces(model, &mut edge_nodes, tolerance, max_edge, min_angle)?;
     let lines = model
         .polylines
         .iter()
-        .map(|l| edges::polyline_points(l, tolerance, max_edge))
+        .map(|l| {
+            guard::guarded(
+                || format!("poly_line `{}`", l.name),
+                || edges::polyline_points(l, tolerance, max_edge),
+            )
+        })
         .collect::<Result<Vec<_>, MeshError>>()?;
-    Ok(assemble(model, &edge_nodes, &face_meshes, &lines))
+    guard::guarded(
+        || "the assembly of the mesh".to_string(),
+        || Ok(assemble(model, &edge_nodes, &face_meshes, &lines)),
+    )
 }
 
 /// Meshes the faces in rounds until no face asks for new boundary points.
@@ -168,8 +202,23 @@ fn mesh_faces(
             keep_boundary: round == MAX_ROUNDS,
         };
         let mut splits: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
-        for &f in &todo {
-            match face::mesh_face(model, &model.faces[f], edge_nodes, &settings)? {
+        // Faces mesh independently against the shared edge nodes: in
+        // parallel, with results taken in face order (deterministic, and the
+        // first error in face order wins as it would sequentially).
+        let edges_now: &[EdgeNodes] = edge_nodes;
+        let outcomes: Vec<(usize, Result<Outcome, MeshError>)> = todo
+            .par_iter()
+            .map(|&f| {
+                let face = &model.faces[f];
+                let outcome = guard::guarded(
+                    || format!("face `{}`", face.name),
+                    || face::mesh_face(model, face, edges_now, &settings),
+                );
+                (f, outcome)
+            })
+            .collect();
+        for (f, outcome) in outcomes {
+            match outcome? {
                 Outcome::Meshed(mesh) => meshes[f] = Some(mesh),
                 Outcome::Split(points) => {
                     for (edge, s) in points {
