@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Domain files (XML).
+    /// Domain files (XML), or implicit solids in paper 001's language (.rfs).
     #[arg(required = true, value_name = "INPUT")]
     inputs: Vec<PathBuf>,
     /// Output file (format from its extension; repeatable), or a folder ending
@@ -46,6 +46,9 @@ pub struct Args {
     quiet: bool,
     #[command(flatten)]
     input: InputOptions,
+    /// Grid cells per axis for implicit (.rfs) inputs, overriding Geom.nx/ny/nz.
+    #[arg(long, value_name = "N")]
+    cells: Option<usize>,
 }
 
 /// What one input produced, collected so output is printed in input order.
@@ -107,6 +110,7 @@ pub fn run(args: &Args) -> i32 {
                     &mesh_options,
                     encoding,
                     args.quiet,
+                    args.cells,
                 );
                 if let Some(bar) = &progress {
                     bar.inc(1);
@@ -241,7 +245,16 @@ fn compile_one(
     mesh_options: &MeshOptions,
     encoding: Option<Encoding>,
     quiet: bool,
+    cells: Option<usize>,
 ) -> Outcome {
+    if super::rfs::is_rfs(input) {
+        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells);
+        return Outcome {
+            input: input.to_path_buf(),
+            messages,
+            ok,
+        };
+    }
     let mut messages = String::new();
     let fail = |messages: String| Outcome {
         input: input.to_path_buf(),

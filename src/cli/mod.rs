@@ -5,6 +5,7 @@ mod compile;
 mod convert;
 mod explain;
 mod inspect;
+mod rfs;
 mod validate;
 
 use clap::{Parser, Subcommand};
