@@ -46,6 +46,10 @@ pub struct Args {
     quiet: bool,
     #[command(flatten)]
     input: InputOptions,
+    /// Also draw the mesh: a PNG (or SVG) picture, written in the same run
+    /// (into a folder: one STEM.png per input when it ends in '/').
+    #[arg(long, value_name = "OUT.png")]
+    preview: Option<PathBuf>,
 }
 
 /// What one input produced, collected so output is printed in input order.
@@ -100,6 +104,7 @@ pub fn run(args: &Args) -> i32 {
         plans
             .par_iter()
             .map(|(input, outputs)| {
+                let preview = super::render::preview_path(args.preview.as_deref(), input);
                 let outcome = compile_one(
                     input,
                     outputs,
@@ -107,6 +112,7 @@ pub fn run(args: &Args) -> i32 {
                     &mesh_options,
                     encoding,
                     args.quiet,
+                    preview.as_deref(),
                 );
                 if let Some(bar) = &progress {
                     bar.inc(1);
@@ -241,6 +247,7 @@ fn compile_one(
     mesh_options: &MeshOptions,
     encoding: Option<Encoding>,
     quiet: bool,
+    preview: Option<&Path>,
 ) -> Outcome {
     let mut messages = String::new();
     let fail = |messages: String| Outcome {
@@ -292,6 +299,15 @@ fn compile_one(
             Err(e) => {
                 ok = false;
                 messages.push_str(&format!("geomc: {}: {e}\n", output.display()));
+            }
+        }
+    }
+    if let Some(path) = preview {
+        match super::render::preview(&mesh, path) {
+            Ok(text) => messages.push_str(if quiet { "" } else { &text }),
+            Err(text) => {
+                ok = false;
+                messages.push_str(&text);
             }
         }
     }

@@ -4,6 +4,7 @@
 mod compile;
 mod explain;
 mod inspect;
+mod render;
 mod validate;
 
 use clap::{Parser, Subcommand};
@@ -39,6 +40,8 @@ enum Command {
     Inspect(inspect::Args),
     /// Explain a diagnostic code, e.g. `geomc explain E201`.
     Explain(explain::Args),
+    /// Draw a domain or mesh: a shaded PNG or a hidden-line SVG.
+    Render(render::Args),
 }
 
 /// Options shared by every subcommand that reads XML.
@@ -109,6 +112,7 @@ pub fn run() -> i32 {
         Command::Compile(args) => compile::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Explain(args) => explain::run(&args),
+        Command::Render(args) => render::run(&args),
     });
     result.unwrap_or(EXIT_INTERNAL)
 }

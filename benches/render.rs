@@ -1,0 +1,2 @@
+//! Render benchmark (issue 8); filled in below.
+fn main() {}
