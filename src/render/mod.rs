@@ -310,42 +310,44 @@ fn sample_point(proj: &raster::Projected, node: u32) -> [f32; 3] {
     [p[0], p[1], proj.z[node as usize]]
 }
 
+/// A node's sample-space position before snapping, and its depth.
+type Unsnapped = ([f32; 2], f32);
+
 /// Node positions in sample space, depths normalised to [0, 1].
 fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projected {
     use rayon::prelude::*;
-    let p: Vec<[f64; 3]> = scene
+    let (lo, hi) = scene
         .points
         .par_iter()
-        .map(|&q| camera.project(q))
-        .collect();
-    let (lo, hi) = p
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
-            (l.min(q[2]), h.max(q[2]))
-        });
+        .map(|&q| camera.project(q)[2])
+        .fold(
+            || (f64::INFINITY, f64::NEG_INFINITY),
+            |(l, h), z| (l.min(z), h.max(z)),
+        )
+        .reduce(
+            || (f64::INFINITY, f64::NEG_INFINITY),
+            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+        );
     let range = if hi > lo { hi - lo } else { 1.0 };
     let s = ss as f64;
     // Far outside the picture only the clamped bounding box matters.
     let limit = 1e6;
-    let xy_f: Vec<[f32; 2]> = p
+    let (xy, rest): (Vec<[i64; 2]>, Vec<Unsnapped>) = scene
+        .points
         .par_iter()
-        .map(|q| {
-            [
-                (q[0] * s).clamp(-limit, limit) as f32,
-                (q[1] * s).clamp(-limit, limit) as f32,
-            ]
+        .map(|&q| {
+            let p = camera.project(q);
+            let (x, y) = (
+                (p[0] * s).clamp(-limit, limit),
+                (p[1] * s).clamp(-limit, limit),
+            );
+            (
+                [(x * 16.0).round() as i64, (y * 16.0).round() as i64],
+                ([x as f32, y as f32], ((p[2] - lo) / range) as f32),
+            )
         })
-        .collect();
-    let xy = p
-        .par_iter()
-        .map(|q| {
-            [
-                ((q[0] * s).clamp(-limit, limit) * 16.0).round() as i64,
-                ((q[1] * s).clamp(-limit, limit) * 16.0).round() as i64,
-            ]
-        })
-        .collect();
-    let z = p.par_iter().map(|q| ((q[2] - lo) / range) as f32).collect();
+        .unzip();
+    let (xy_f, z) = rest.into_iter().unzip();
     raster::Projected { xy, xy_f, z }
 }
 

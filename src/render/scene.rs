@@ -6,6 +6,7 @@
 use super::camera::{Camera, cross, dot};
 use super::{ColorBy, RenderOptions, Section, Shading};
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 
 /// A side that is never seen (inside a closed subdomain, no section).
 pub const HIDDEN: u32 = u32::MAX;
@@ -260,6 +261,12 @@ fn shade(scene: &mut Scene, mesh: &Mesh, shading: Shading, camera: &Camera) {
             scene.corner_slots = (0..scene.tris.len() as u32).map(|i| [i, i, i]).collect();
         }
         Shading::Smooth => {
+            // Normals in parallel; the sums per node are a cheap serial scatter.
+            let normals: Vec<[f64; 3]> = scene
+                .tris
+                .par_iter()
+                .map(|&t| tri_normal(&scene.points, t))
+                .collect();
             let mut slot_of = vec![u32::MAX; mesh.nodes.len()];
             let mut sums: Vec<[f64; 3]> = Vec::new();
             scene.corner_slots = Vec::with_capacity(scene.tris.len());
@@ -270,8 +277,7 @@ fn shade(scene: &mut Scene, mesh: &Mesh, shading: Shading, camera: &Camera) {
                 while end < scene.tris.len() && scene.tri_face[end] == face {
                     end += 1;
                 }
-                for &t in &scene.tris[start..end] {
-                    let n = tri_normal(&scene.points, t);
+                for (&t, &n) in scene.tris[start..end].iter().zip(&normals[start..end]) {
                     let mut slots = [0u32; 3];
                     for (k, &node) in t.iter().enumerate() {
                         let s = &mut slot_of[node as usize];
@@ -294,7 +300,7 @@ fn shade(scene: &mut Scene, mesh: &Mesh, shading: Shading, camera: &Camera) {
                 }
                 start = end;
             }
-            scene.light = sums.iter().map(|&n| intensity(n, light)).collect();
+            scene.light = sums.par_iter().map(|&n| intensity(n, light)).collect();
         }
     }
 }
