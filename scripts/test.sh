@@ -33,6 +33,13 @@ if ! python3 -c "import gmsh, meshio" >/dev/null 2>&1; then
         || python3 -m pip install -q --break-system-packages gmsh==4.15.2 meshio==5.3.5
 fi
 
+# tests/tools/make_meshes.py (tests/convert_external.rs): meshes made by trimesh.
+if ! python3 -c "import trimesh" >/dev/null 2>&1; then
+    echo "installing: trimesh (pip)" >&2
+    python3 -m pip install -q trimesh==5.2.0 \
+        || python3 -m pip install -q --break-system-packages trimesh==5.2.0
+fi
+
 # tests/tools/validate_gltf.js: the validator pinned by tests/tools/package-lock.json.
 if [ ! -f tests/tools/node_modules/gltf-validator/package.json ]; then
     echo "installing: gltf-validator (npm, tests/tools/node_modules)" >&2

@@ -410,12 +410,56 @@ fn cli_renders_png_and_svg_and_refuses_bad_input() {
     ]);
     assert_eq!(out.status.code(), Some(2));
     assert!(String::from_utf8_lossy(&out.stderr).contains("error[E724]"));
-    let stl = dir.path().join("model.stl");
-    std::fs::write(&stl, "solid x\nendsolid x\n").expect("write");
-    let out = geomc(&["render", stl.to_str().unwrap(), "-o", bad.to_str().unwrap()]);
+    let rfs = dir.path().join("model.rfs");
+    std::fs::write(&rfs, "Geom.dimension = 3;\n").expect("write");
+    let out = geomc(&["render", rfs.to_str().unwrap(), "-o", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
     assert!(String::from_utf8_lossy(&out.stderr).contains("error[E720]"));
+    // A broken mesh file: the reader's own code, and no picture.
+    let stl = dir.path().join("model.stl");
+    std::fs::write(&stl, "solid x\nfacet normal 0 0 1\nouter loop\n").expect("write");
+    let out = geomc(&["render", stl.to_str().unwrap(), "-o", bad.to_str().unwrap()]);
+    assert_eq!(
+        out.status.code(),
+        Some(1),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    assert!(String::from_utf8_lossy(&out.stderr).contains("error[E5"));
     assert!(!bad.exists(), "no partial output");
+}
+
+#[test]
+fn renders_a_mesh_file_like_the_domain_it_came_from() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let glb = dir.path().join("ball.glb");
+    let out = geomc(&[
+        "compile",
+        "examples/ball_in_box.xml",
+        "-o",
+        glb.to_str().unwrap(),
+    ]);
+    assert!(out.status.success());
+    let from_mesh = dir.path().join("from_mesh.png");
+    let out = geomc(&[
+        "render",
+        glb.to_str().unwrap(),
+        "-o",
+        from_mesh.to_str().unwrap(),
+        "--size",
+        "160x120",
+        "--no-legend",
+    ]);
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let image = decode_png(&std::fs::read(&from_mesh).expect("written")).expect("a PNG");
+    assert_eq!((image.width, image.height), (160, 120));
+    // The box covers the middle of the picture; the corner is background.
+    assert_ne!(image.pixel(80, 60), [255, 255, 255, 255]);
+    assert_eq!(image.pixel(1, 1), [255, 255, 255, 255]);
 }
 
 #[test]

@@ -4,10 +4,12 @@
 use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, InputOptions, report_usage};
 use geomc::diag::{Code, Diagnostic, render_human};
 use geomc::driver::check_file;
+use geomc::formats::read::load_mesh;
 use geomc::formats::{WriteError, write_atomic};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, Tolerance, mesh_model};
 use geomc::render::{self, ColorBy, Edges, RenderOptions, Section, Shading, View};
+use geomc::span::SourceFile;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -33,7 +35,7 @@ pub enum EdgesArg {
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// A domain file (.xml, compiled on the fly).
+    /// A domain file (.xml, compiled on the fly) or a mesh file (.stl .obj .gltf .glb .msh .vtu .frag.xml).
     #[arg(value_name = "INPUT")]
     input: PathBuf,
     /// The picture: .png (shaded raster) or .svg (hidden-line drawing).
@@ -230,15 +232,18 @@ fn load_input(
         .and_then(|n| n.to_str())
         .unwrap_or("")
         .to_ascii_lowercase();
-    if !name.ends_with(".xml") || name.ends_with(".frag.xml") {
+    if name.ends_with(".rfs") {
         return Err(fail(Failure {
             code: Code::RenderUnsupportedInput,
             message: format!(
-                "{}: geomc render reads domain files (.xml) in this build; meshes and .rfs models are not readable here yet",
+                "{}: .rfs models are not readable by this build of geomc render; draw a domain file (.xml) or a mesh file",
                 path.display()
             ),
             exit: EXIT_INVALID,
         }));
+    }
+    if !name.ends_with(".xml") || name.ends_with(".frag.xml") {
+        return load_mesh_file(path, quiet);
     }
     let checked = match check_file(path, options) {
         Ok(c) => c,
@@ -262,6 +267,38 @@ fn load_input(
             exit: EXIT_INVALID,
         })
     })
+}
+
+/// A mesh file in any format geomc reads (its own codes on failure).
+fn load_mesh_file(path: &Path, quiet: bool) -> Result<Mesh, i32> {
+    match load_mesh(path) {
+        Ok(loaded) => {
+            if !quiet {
+                let source = SourceFile::new(path.display().to_string(), "");
+                for d in &loaded.warnings {
+                    eprint!("{}", render_human(&source, d));
+                }
+            }
+            Ok(loaded.mesh)
+        }
+        Err(diagnostics) => {
+            // Positions in a text mesh need its text to show the line.
+            let text = std::fs::read(path)
+                .map(|b| String::from_utf8_lossy(&b).into_owned())
+                .unwrap_or_default();
+            let source = SourceFile::new(path.display().to_string(), text);
+            for d in &diagnostics {
+                eprint!("{}", render_human(&source, d));
+            }
+            Err(
+                if diagnostics.iter().any(|d| d.code == Code::MeshReadFailed) {
+                    EXIT_USAGE
+                } else {
+                    EXIT_INVALID
+                },
+            )
+        }
+    }
 }
 
 fn write_picture(
