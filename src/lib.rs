@@ -13,6 +13,7 @@ pub mod driver;
 pub mod expr;
 pub mod formats;
 pub mod geom;
+pub mod implicit;
 pub mod inspect;
 pub mod ir;
 pub mod lower;

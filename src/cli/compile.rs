@@ -12,7 +12,7 @@ use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Domain files (XML).
+    /// Domain files (XML), or implicit solids in paper 001's language (.rfs).
     #[arg(required = true, value_name = "INPUT")]
     inputs: Vec<PathBuf>,
     /// Output file (format from its extension; repeatable), or a folder ending
@@ -46,6 +46,9 @@ pub struct Args {
     quiet: bool,
     #[command(flatten)]
     input: InputOptions,
+    /// Grid cells per axis for implicit (.rfs) inputs, overriding Geom.nx/ny/nz.
+    #[arg(long, value_name = "N")]
+    cells: Option<usize>,
     /// Also draw the mesh: a PNG (or SVG) picture, written in the same run
     /// (into a folder: one STEM.png per input when it ends in '/').
     #[arg(long, value_name = "OUT.png")]
@@ -112,6 +115,7 @@ pub fn run(args: &Args) -> i32 {
                     &mesh_options,
                     encoding,
                     args.quiet,
+                    args.cells,
                     preview.as_deref(),
                 );
                 if let Some(bar) = &progress {
@@ -240,6 +244,7 @@ fn plan_outputs(args: &Args) -> Result<Vec<(PathBuf, Vec<PathBuf>)>, String> {
         .collect())
 }
 
+#[allow(clippy::too_many_arguments)] // one more option per feature; a struct would be the next step
 fn compile_one(
     input: &Path,
     outputs: &[PathBuf],
@@ -247,8 +252,17 @@ fn compile_one(
     mesh_options: &MeshOptions,
     encoding: Option<Encoding>,
     quiet: bool,
+    cells: Option<usize>,
     preview: Option<&Path>,
 ) -> Outcome {
+    if super::rfs::is_rfs(input) {
+        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells);
+        return Outcome {
+            input: input.to_path_buf(),
+            messages,
+            ok,
+        };
+    }
     let mut messages = String::new();
     let fail = |messages: String| Outcome {
         input: input.to_path_buf(),

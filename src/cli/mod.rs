@@ -6,6 +6,7 @@ mod convert;
 mod explain;
 mod inspect;
 mod render;
+mod rfs;
 mod validate;
 
 use clap::{Parser, Subcommand};

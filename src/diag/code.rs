@@ -172,6 +172,35 @@ codes! {
         "A point value with two coordinates is a line parallel to the missing axis, and one with one coordinate is a plane perpendicular to its axis (paper 000). Where a single point is needed, the missing coordinates are taken as 0.";
     EmptySubdomainList = "W009", Warning, "model has no subdomains",
         "The file defines geometry but no <subdomain>, so it describes no computational domain: no boundary fragments are derived and compile meshes each solid on its own. Add <subdomain> elements to describe the domain.";
+    // ---- implicit solids and the .rfs language (issue 5) ----
+    RfsSyntax = "E600", Error, "syntax error in an .rfs program",
+        "The .rfs file (paper 001's modelling language) could not be read at this position. A program is a list of `Geom.<field> = value;` settings and `function name(a, b) { var v = …; return …; }` definitions; expressions use + - * / %, parentheses, numbers, names, library calls such as Ball(x, y, z, r, x0, y0, z0) and Math.<name>(…). Fix the text at the position shown.";
+    RfsUnknownName = "E601", Error, "unknown name in an .rfs program",
+        "A variable, function, library function or Math member is used but not defined. Check the spelling (the message suggests the nearest known name); variables must be declared with `var` or be parameters of the function. The library is listed in docs/implicit.md.";
+    RfsArity = "E602", Error, "wrong number of arguments",
+        "A function or library function is called with a different number of arguments than it takes. Arguments are positional, coordinates first: Ball(x, y, z, r, x0, y0, z0). The message shows the expected signature.";
+    RfsGeomValue = "E603", Error, "bad Geom setting",
+        "A Geom field has a value it cannot take: dimension must be 3, x_min < x_max (likewise y, z), nx, ny, nz whole numbers from 1 to 1024 (the grid holds (nx + 1)(ny + 1)(nz + 1) samples of 8 bytes), optiterations a whole number ≥ 0, name a string, rsystem one of \"rvachev\", \"minmax\", \"alpha\" and alpha in (−1, 1]. Fix the value shown.";
+    RfsNoResult = "E604", Error, "no result function",
+        "The function that defines the solid is the one Geom.name names, else the one called r_main. Define one of them, or set Geom.name = \"…\" to the function's name.";
+    RfsRecursion = "E605", Error, "recursive or too deeply nested function calls",
+        "Functions are expanded at compile time into one expression, so a function may not call itself, directly or through others, and calls may nest at most 64 deep. Rewrite the recursion as explicit calls.";
+    RfsLibraryArgument = "E606", Error, "invalid library argument",
+        "A library function got an argument it cannot use, such as a number of polygon sides that is not a constant whole number, or an odd number of polygon coordinates. The message names the argument and what it must be.";
+    RfsDuplicate = "E607", Error, "duplicate definition",
+        "A function, parameter or variable is defined twice in the same scope. Rename one of them.";
+    RfsResultSignature = "E608", Error, "result function must take three arguments",
+        "The solid's function is called with the coordinates (x, y, z) as its three positional arguments (their names do not matter). Give it exactly three parameters.";
+    RfsTooLarge = "E609", Error, "program expands to too large an expression",
+        "Functions are expanded into one expression; this program's expression exceeds the node limit (2 million nodes), or a nesting limit. Simplify the model (fewer primitives, shared variables instead of repeated calls).";
+    RfsType = "E610", Error, "string used as a number",
+        "A string (such as a Geom.name value) appears where a number or function value is needed, or a number where a string is needed. Only Geom.name and Geom.rsystem take strings.";
+    RfsNoReturn = "E611", Error, "function ends without return",
+        "Every function must end with `return <expression>;`. Add the return statement.";
+    RfsUnknownGeomField = "W130", Warning, "unknown Geom field",
+        "This Geom field is not one geomc uses (dimension, x_min, x_max, y_min, y_max, z_min, z_max, nx, ny, nz, name, optiterations, rsystem, alpha); it is ignored. Check the spelling.";
+    RfsOptimizeIgnored = "W131", Warning, "mesh optimisation iterations not applied",
+        "Geom.optiterations asks for mesh optimisation (edge flips and smoothing); this geomc does not implement it yet, so the marching-cubes triangles are written as they are.";
     // ---- convert: mesh readers and `geomc convert` (issue 4) ----
     MeshReadFailed = "E520", Error, "cannot read the mesh file",
         "The mesh file (or a file it refers to, such as a .gltf's buffer or the mesh a .frag.xml names) could not be opened or read. Check the path and its permissions.";
@@ -215,6 +244,22 @@ codes! {
         "Some triangles repeat a node or have no area. They carry no surface and break normals and quality measures. --weld EPS removes triangles that collapse when nearby nodes merge.";
     TargetNotCarried = "W116", Warning, "output format cannot carry everything",
         "The output format has no place for some of the mesh's data (binary STL has no groups, OBJ has no volumes, VTU keeps names only in its field data). The message names what was merged or left out and how many; choose a format that holds it to keep it.";
+
+    // ---- point calculus (issue 7) ----
+    DiscriminantOutOfRange = "E690", Error, "conic discriminant outside (0, 1)",
+        "A conic_arc's discriminant k = CK/CT places the arc's shoulder K between the tangent point C (k = 0) and the chord's midpoint T (k = 1); 0 < k < 0.5 gives a hyperbola, 0.5 a parabola, 0.5 < k < 1 an ellipse. Values at or beyond the ends give no arc. Give <discriminant value=\"…\"/> strictly between 0 and 1.";
+    DegenerateConic = "E691", Error, "conic arc's tangent point on its chord",
+        "A conic_arc runs from A to B with its end tangents meeting at C, so C must lie off the line AB (and differ from A and B); otherwise the tangents do not meet and the arc is not defined. Move point_c off the line through point_a and point_b, or use a <segment> for a straight piece.";
+    CurveEndsCoincide = "E692", Error, "point-calculus curve begins where it ends",
+        "A segment, conic_arc or desargues_arc joins two distinct end points (A and B; A and D for the Desargues arc). Give distinct end points; a closed contour is made of several arcs.";
+    DegeneratePatch = "E693", Error, "9-point patch is singular",
+        "The patch's tangent vectors ∂M/∂u and ∂M/∂v are parallel or zero somewhere on [0, 1]², for example because a row repeats one point or all nine points lie on a line; such a patch has no normal there and cannot carry a face. Spread the nine points out over the surface, rows A, B, C across and columns along.";
+    EdgeNotAtCurveEnds = "E694", Error, "edge's vertices are not its curve's end points",
+        "An edge whose line is a segment, conic_arc or desargues_arc runs along that whole curve, so its begin and end vertices must be the curve's two end points (in either order). Move the vertices onto the curve's ends, or change the curve's end points.";
+    EdgeNotOnPatchSide = "E695", Error, "edge's vertices are not adjacent patch corners",
+        "An edge whose line is a patch9 runs along one side of the patch, so its vertices must be two corners of the patch joined by a side: the ends of the first or last row, or of the first or last column. Use two adjacent corners; an edge across the patch needs a curve of its own.";
+    UnusedPatch = "W180", Warning, "patch9 is not the surface of any face",
+        "A patch9 is a surface: it is meshed as the carrier of the faces that name it with surface=\"…\" and bounded by edges along its sides. No face names this patch, so it produces no output. Add a face on it, or remove it.";
     // ---- render (issue 8) ----
     RenderUnsupportedInput = "E720", Error, "input cannot be rendered",
         "geomc render draws a domain file (.xml), which it compiles on the fly, or a mesh file geomc can read. The input's extension names neither. Compile the model to a mesh format geomc reads first, or give the domain XML itself.";

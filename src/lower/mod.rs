@@ -6,6 +6,7 @@
 mod booleans;
 mod brep;
 mod explicit;
+mod point_calculus;
 mod prune;
 mod weld;
 mod winding;
@@ -42,6 +43,54 @@ pub(crate) struct Entities {
     pub failed: std::collections::HashSet<String>,
 }
 
+impl Entities {
+    /// Adds the documented names of every lowered solid's entities
+    /// ("box.xmin" → its welded face). Explicit entities keep their names: an
+    /// explicit entity of the same name wins, and among solids the first does.
+    fn add_solid_entities(&mut self, model: &Model) {
+        fn add<T: Copy>(
+            table: &mut HashMap<String, T>,
+            solid: &str,
+            names: impl Iterator<Item = &'static str>,
+            ids: impl Iterator<Item = T>,
+        ) {
+            for (local, id) in names.zip(ids) {
+                table.entry(format!("{solid}.{local}")).or_insert(id);
+            }
+        }
+        let explicit = (
+            std::mem::take(&mut self.vertices),
+            std::mem::take(&mut self.edges),
+            std::mem::take(&mut self.faces),
+        );
+        for solid in &model.solids {
+            let brep = brep::of(&solid.shape);
+            let name = solid.name.as_str();
+            add(
+                &mut self.vertices,
+                name,
+                brep.vertices.iter().map(|v| v.name),
+                solid.vertices.iter().copied(),
+            );
+            add(
+                &mut self.edges,
+                name,
+                brep.edges.iter().map(|e| e.name),
+                solid.edges.iter().copied(),
+            );
+            add(
+                &mut self.faces,
+                name,
+                brep.faces.iter().map(|f| f.name),
+                solid.faces.iter().map(|f| f.face),
+            );
+        }
+        self.vertices.extend(explicit.0);
+        self.edges.extend(explicit.1);
+        self.faces.extend(explicit.2);
+    }
+}
+
 pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
@@ -54,12 +103,18 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
     let mut source_map = SourceMap::default();
     let mut entities = Entities::default();
     let mut welder = weld::Welder::new(model.tolerance);
+    // Curves that carry edges are part of the topology, not standalone lines.
+    let edge_lines = point_calculus::edge_lines(resolved);
+    point_calculus::report_unused_patches(resolved, diags);
 
     for object in &resolved.objects {
         let Some(geometry) = &object.geometry else {
             entities.failed.insert(object.name.clone());
             continue;
         };
+        if edge_lines.contains(object.name.as_str()) {
+            continue;
+        }
         match geometry {
             Geometry::Group(members) => {
                 for (k, member) in members.iter().enumerate() {
@@ -94,6 +149,11 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
         &mut entities,
         diags,
     );
+    let named_lists =
+        !doc.boundaries.is_empty() || doc.subdomains.iter().any(|s| s.faces.is_some());
+    if named_lists {
+        entities.add_solid_entities(&model);
+    }
     let face_samples = welder.face_samples;
     booleans::lower_subdomains(
         doc,
@@ -119,6 +179,8 @@ fn tolerance(resolved: &Resolved) -> f64 {
                 points.iter().for_each(|p| bbox.include(p))
             }
             Geometry::Vertex(p) => bbox.include(p),
+            Geometry::PointCurve(c) => c.samples(32).iter().for_each(|p| bbox.include(p)),
+            Geometry::Patch(patch) => patch.rows.iter().flatten().for_each(|p| bbox.include(p)),
             Geometry::Group(members) => members.iter().for_each(|m| visit(m, bbox)),
             _ => {}
         }
@@ -148,9 +210,13 @@ fn lower_free(
         Geometry::Polyline { points } => model.polylines.push(Polyline {
             name: name.to_string(),
             points: points.clone(),
+            ..Polyline::default()
         }),
+        Geometry::PointCurve(curve) => model
+            .polylines
+            .push(point_calculus::standalone(name, curve)),
         Geometry::Solid(shape) => {
-            let id = lower_solid(model, source_map, entities, welder, name, shape, span);
+            let id = lower_solid(model, source_map, welder, name, shape, span);
             entities
                 .solids
                 .entry(name.to_string())
@@ -164,7 +230,6 @@ fn lower_free(
 fn lower_solid(
     model: &mut Model,
     source_map: &mut SourceMap,
-    entities: &mut Entities,
     welder: &mut weld::Welder,
     name: &str,
     shape: &SolidShape,
@@ -172,18 +237,16 @@ fn lower_solid(
 ) -> SolidId {
     let origin = Origin { span };
     let brep = brep::of(shape);
+    // Entity names are made only for new entities; the name tables for
+    // faces= and edges= lists are built later, and only when a file has such lists.
     let vertex_ids: Vec<_> = brep
         .vertices
         .iter()
         .map(|v| {
-            let (id, new) = welder.vertex(model, format!("{name}.{}", v.name), v.position);
+            let (id, new) = welder.vertex(model, || format!("{name}.{}", v.name), v.position);
             if new {
                 source_map.vertices.insert(id, origin);
             }
-            entities
-                .vertices
-                .entry(format!("{name}.{}", v.name))
-                .or_insert(id);
             id
         })
         .collect();
@@ -191,10 +254,9 @@ fn lower_solid(
         .edges
         .into_iter()
         .map(|e| {
-            let entity = format!("{name}.{}", e.name);
             let (id, flipped, new) = welder.edge(
                 model,
-                entity.clone(),
+                || format!("{name}.{}", e.name),
                 e.curve,
                 vertex_ids[e.begin],
                 vertex_ids[e.end],
@@ -202,7 +264,6 @@ fn lower_solid(
             if new {
                 source_map.edges.insert(id, origin);
             }
-            entities.edges.entry(entity).or_insert(id);
             (id, flipped)
         })
         .collect();
@@ -213,7 +274,7 @@ fn lower_solid(
             forward: forward != flipped,
         }
     };
-    let mut faces = Vec::new();
+    let mut faces = Vec::with_capacity(brep.faces.len());
     for f in brep.faces {
         let loops: Vec<Vec<OrientedEdge>> = f
             .loops
@@ -221,9 +282,8 @@ fn lower_solid(
             .map(|l| l.iter().copied().map(orient).collect())
             .collect();
         let first = loops.first().and_then(|l| l.first()).copied();
-        let entity = format!("{name}.{}", f.name);
         let face = Face {
-            name: entity.clone(),
+            name: format!("{name}.{}", f.name),
             surface: f.surface,
             reversed: false,
             loops,
@@ -232,7 +292,6 @@ fn lower_solid(
         if new {
             source_map.faces.insert(id, origin);
         }
-        entities.faces.entry(entity).or_insert(id);
         // A welded face keeps the first solid's orientation; this solid's
         // outward side agrees when its loop runs the same way.
         let outward = new || first.is_none_or(|probe| same_direction(model.face(id), probe));

@@ -114,7 +114,12 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         .map(|e| edges::discretise(model, e, 0.5 * tolerance, max_edge))
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
     let face_meshes = mesh_faces(model, &mut edge_nodes, tolerance, max_edge, min_angle)?;
-    Ok(assemble(model, &edge_nodes, &face_meshes))
+    let lines = model
+        .polylines
+        .iter()
+        .map(|l| edges::polyline_points(l, tolerance, max_edge))
+        .collect::<Result<Vec<_>, MeshError>>()?;
+    Ok(assemble(model, &edge_nodes, &face_meshes, &lines))
 }
 
 /// Meshes the faces in rounds until no face asks for new boundary points.
@@ -196,7 +201,12 @@ fn mesh_faces(
 
 /// Numbers the nodes (vertices, then edge interiors, then face interiors,
 /// then points and poly_lines) and fills the mesh IR.
-fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceMesh>]) -> Mesh {
+fn assemble(
+    model: &Model,
+    edge_nodes: &[EdgeNodes],
+    face_meshes: &[Option<FaceMesh>],
+    lines: &[Vec<crate::geom::Point3>],
+) -> Mesh {
     let mut nodes: Vec<[f64; 3]> = model
         .vertices
         .iter()
@@ -295,8 +305,8 @@ fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceM
         });
     }
     let mut polylines = Vec::new();
-    for line in &model.polylines {
-        let ids = line.points.iter().map(|p| push(&mut nodes, p)).collect();
+    for (line, points) in model.polylines.iter().zip(lines) {
+        let ids = points.iter().map(|p| push(&mut nodes, p)).collect();
         polylines.push(MeshPolyline {
             name: line.name.clone(),
             nodes: ids,
