@@ -18,6 +18,7 @@ pub mod inspect;
 pub mod ir;
 pub mod lower;
 pub mod meshing;
+pub mod render;
 pub mod resolve;
 pub mod span;
 pub mod syntax;

@@ -63,6 +63,19 @@ const NOT_COVERED_BY_FIXTURES: &[&str] = &[
     "W114", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
     "W115", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
     "W116", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    // ---- render (issue 8): options and inputs of geomc render, not XML content ----
+    "E720", // an input that is not a domain file
+    "E721", // --size
+    "E722", // --view
+    "E723", // --section
+    "E724", // the picture's extension
+    "E725", // --background
+    "E726", // --antialias
+    "E727", // a mesh without triangles (tests/render.rs)
+    "E728", // --size × --antialias too large
+    "E729", // meshing failed while rendering
+    "W170", // the legend does not fit the picture's height
+    "W171", // --section below the whole model (tests/render.rs)
 ];
 
 /// Command-line options an `args:` header may name, and whether each takes a value.

@@ -59,6 +59,10 @@ pub struct Args {
     /// Grid cells per axis for implicit (.rfs) inputs, overriding Geom.nx/ny/nz.
     #[arg(long, value_name = "N")]
     cells: Option<usize>,
+    /// Also draw the mesh: a PNG (or SVG) picture, written in the same run
+    /// (into a folder: one STEM.png per input when it ends in '/').
+    #[arg(long, value_name = "OUT.png")]
+    preview: Option<PathBuf>,
 }
 
 /// What one input produced, collected so output is printed in input order.
@@ -113,6 +117,7 @@ pub fn run(args: &Args) -> i32 {
         plans
             .par_iter()
             .map(|(input, outputs)| {
+                let preview = super::render::preview_path(args.preview.as_deref(), input);
                 let outcome = compile_one(
                     input,
                     outputs,
@@ -121,6 +126,7 @@ pub fn run(args: &Args) -> i32 {
                     encoding,
                     args.quiet,
                     args.cells,
+                    preview.as_deref(),
                 );
                 if let Some(bar) = &progress {
                     bar.inc(1);
@@ -222,6 +228,7 @@ fn plan_outputs(args: &Args) -> Result<Vec<(PathBuf, Vec<PathBuf>)>, String> {
         .collect())
 }
 
+#[allow(clippy::too_many_arguments)] // one more option per feature; a struct would be the next step
 fn compile_one(
     input: &Path,
     outputs: &[PathBuf],
@@ -230,6 +237,7 @@ fn compile_one(
     encoding: Option<Encoding>,
     quiet: bool,
     cells: Option<usize>,
+    preview: Option<&Path>,
 ) -> Outcome {
     if super::rfs::is_rfs(input) {
         let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells);
@@ -290,6 +298,15 @@ fn compile_one(
             Err(e) => {
                 ok = false;
                 messages.push_str(&format!("geomc: {}: {e}\n", output.display()));
+            }
+        }
+    }
+    if let Some(path) = preview {
+        match super::render::preview(&mesh, path) {
+            Ok(text) => messages.push_str(if quiet { "" } else { &text }),
+            Err(text) => {
+                ok = false;
+                messages.push_str(&text);
             }
         }
     }

@@ -7,6 +7,7 @@ mod explain;
 mod inspect;
 mod inspect_mesh;
 mod mesh_args;
+mod render;
 mod rfs;
 mod validate;
 
@@ -45,6 +46,8 @@ enum Command {
     Explain(explain::Args),
     /// Convert a mesh between STL, OBJ, glTF/GLB, Gmsh MSH, VTU and .frag.xml, keeping its groups.
     Convert(convert::Args),
+    /// Draw a domain or mesh: a shaded PNG or a hidden-line SVG.
+    Render(render::Args),
 }
 
 /// Options shared by every subcommand that reads XML.
@@ -120,6 +123,7 @@ pub fn run() -> i32 {
         Command::Inspect(args) => inspect::run(&args),
         Command::Explain(args) => explain::run(&args),
         Command::Convert(args) => convert::run(&args),
+        Command::Render(args) => render::run(&args),
     });
     result.unwrap_or(EXIT_INTERNAL)
 }

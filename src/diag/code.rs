@@ -271,6 +271,31 @@ codes! {
         "An edge whose line is a patch9 runs along one side of the patch, so its vertices must be two corners of the patch joined by a side: the ends of the first or last row, or of the first or last column. Use two adjacent corners; an edge across the patch needs a curve of its own.";
     UnusedPatch = "W180", Warning, "patch9 is not the surface of any face",
         "A patch9 is a surface: it is meshed as the carrier of the faces that name it with surface=\"…\" and bounded by edges along its sides. No face names this patch, so it produces no output. Add a face on it, or remove it.";
+    // ---- render (issue 8) ----
+    RenderUnsupportedInput = "E720", Error, "input cannot be rendered",
+        "geomc render draws a domain file (.xml), which it compiles on the fly, or a mesh file geomc can read. The input's extension names neither. Compile the model to a mesh format geomc reads first, or give the domain XML itself.";
+    RenderBadSize = "E721", Error, "invalid picture size",
+        "--size takes WIDTHxHEIGHT in pixels, each between 1 and 16384, for example --size 1024x768.";
+    RenderBadView = "E722", Error, "invalid view",
+        "--view takes a named view (front, top, iso) or AZIMUTH,ELEVATION in degrees, for example --view 30,20. Azimuth 0 and elevation 0 look along +y with z up; elevation 90 looks down from +z. The elevation must lie in [-90, 90].";
+    RenderBadSection = "E723", Error, "invalid section plane",
+        "--section takes AXIS=VALUE, for example --section z=0: the part of the model with a larger coordinate is cut away and the cut is drawn hatched.";
+    RenderBadOutput = "E724", Error, "unknown picture format",
+        "geomc render writes a PNG (.png) or an SVG (.svg), chosen by the output's extension; --preview of geomc compile writes a .png. Name the output file with one of these extensions.";
+    RenderBadBackground = "E725", Error, "invalid background colour",
+        "--background takes white, black, transparent, or a colour as #rrggbb (or #rrggbbaa with opacity).";
+    RenderBadAntialias = "E726", Error, "invalid anti-aliasing level",
+        "--antialias takes 1 (no anti-aliasing) to 4: the number of samples per pixel along each axis.";
+    RenderNothingToDraw = "E727", Error, "nothing to draw",
+        "The mesh has no triangles (for example a model with only points and poly_lines). geomc render draws surfaces; give a model with faces or subdomains.";
+    RenderTooLarge = "E728", Error, "picture too large",
+        "The picture would need more than 134 million samples (width x height x antialias squared). Lower --size or --antialias.";
+    RenderInputFailed = "E729", Error, "input could not be meshed for rendering",
+        "The domain file is valid but meshing it failed, so there is nothing to draw. The message names the edge or face; geomc compile reports the same problem with the same options.";
+    RenderLegendTruncated = "W170", Warning, "legend does not fit",
+        "The picture is too short to name every colour group, so the legend ends with '... and N more'. Make the picture taller with --size, or colour by subdomain (--color-by subdomain) to have fewer groups.";
+    RenderSectionEmpty = "W171", Warning, "section leaves nothing to draw",
+        "The section plane lies below the whole model, so everything was cut away and the picture is empty. Pick a value inside the model's extent (geomc inspect prints the bounding box).";
 }
 
 impl Code {
