@@ -414,7 +414,28 @@ fn cli_renders_png_and_svg_and_refuses_bad_input() {
     std::fs::write(&rfs, "Geom.dimension = 3;\n").expect("write");
     let out = geomc(&["render", rfs.to_str().unwrap(), "-o", bad.to_str().unwrap()]);
     assert_eq!(out.status.code(), Some(1));
-    assert!(String::from_utf8_lossy(&out.stderr).contains("error[E720]"));
+    // An .rfs program without a result function: the language's own code, at 1:1.
+    assert!(String::from_utf8_lossy(&out.stderr).contains("error[E604]"));
+    // A good .rfs model is polygonized and drawn: same bytes twice.
+    let balls = dir.path().join("balls.png");
+    let again = dir.path().join("balls2.png");
+    for target in [&balls, &again] {
+        let out = geomc(&[
+            "render",
+            "fixtures/rfs/seven_balls.rfs",
+            "-o",
+            target.to_str().unwrap(),
+        ]);
+        assert_eq!(
+            out.status.code(),
+            Some(0),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+    }
+    let bytes = std::fs::read(&balls).expect("picture written");
+    assert_eq!(&bytes[..8], b"\x89PNG\r\n\x1a\n");
+    assert_eq!(bytes, std::fs::read(&again).expect("second picture"));
     // A broken mesh file: the reader's own code, and no picture.
     let stl = dir.path().join("model.stl");
     std::fs::write(&stl, "solid x\nfacet normal 0 0 1\nouter loop\n").expect("write");

@@ -233,14 +233,9 @@ fn load_input(
         .unwrap_or("")
         .to_ascii_lowercase();
     if name.ends_with(".rfs") {
-        return Err(fail(Failure {
-            code: Code::RenderUnsupportedInput,
-            message: format!(
-                "{}: .rfs models are not readable by this build of geomc render; draw a domain file (.xml) or a mesh file",
-                path.display()
-            ),
-            exit: EXIT_INVALID,
-        }));
+        let (messages, loaded) = super::rfs::load(path, quiet, None);
+        eprint!("{messages}");
+        return loaded.map(|(mesh, _)| mesh);
     }
     if !name.ends_with(".xml") || name.ends_with(".frag.xml") {
         return load_mesh_file(path, quiet);

@@ -2,9 +2,11 @@
 //! 001's language, polygonized on its Geom grid (or `--cells N` per axis) and
 //! written in every requested format.
 
+use super::{EXIT_INVALID, EXIT_USAGE};
 use geomc::diag::render_human;
 use geomc::formats::{self, Encoding, WriteOptions};
 use geomc::implicit::{lang, surface_to_mesh};
+use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use std::path::{Path, PathBuf};
 
@@ -14,14 +16,14 @@ pub fn is_rfs(path: &Path) -> bool {
         .is_some_and(|e| e.eq_ignore_ascii_case("rfs"))
 }
 
-/// Compiles one `.rfs` input; returns the messages to print and success.
-pub fn compile(
+/// Reads one `.rfs` program and polygonizes it: the messages to print
+/// (diagnostics with line:column) and the mesh with its triangle count, or
+/// the exit code (2 when the file cannot be read, 1 when the program is bad).
+pub fn load(
     input: &Path,
-    outputs: &[PathBuf],
-    encoding: Option<Encoding>,
     quiet: bool,
     cells: Option<usize>,
-) -> (String, bool) {
+) -> (String, Result<(Mesh, usize), i32>) {
     let mut messages = String::new();
     let text = match std::fs::read(input) {
         Ok(bytes) => match String::from_utf8(bytes) {
@@ -33,14 +35,14 @@ pub fn compile(
                         input.display(),
                         e.utf8_error().valid_up_to()
                     ),
-                    false,
+                    Err(EXIT_INVALID),
                 );
             }
         },
         Err(e) => {
             return (
                 format!("geomc: cannot read {}: {e}\n", input.display()),
-                false,
+                Err(EXIT_USAGE),
             );
         }
     };
@@ -52,18 +54,33 @@ pub fn compile(
         }
     }
     let Some(model) = model.filter(|_| !diagnostics.has_errors()) else {
-        return (messages, false);
+        return (messages, Err(EXIT_INVALID));
     };
     if let Some(n) = cells {
         if !(1..=1024).contains(&n) {
             messages.push_str(&format!(
                 "geomc: --cells {n}: give a whole number from 1 to 1024 (the grid holds (n + 1)³ samples of 8 bytes)\n"
             ));
-            return (messages, false);
+            return (messages, Err(EXIT_USAGE));
         }
     }
     let surface = model.polygonize(cells.map(|n| [n; 3]));
     let mesh = surface_to_mesh(&surface, model.name());
+    (messages, Ok((mesh, surface.triangles.len())))
+}
+
+/// Compiles one `.rfs` input; returns the messages to print and success.
+pub fn compile(
+    input: &Path,
+    outputs: &[PathBuf],
+    encoding: Option<Encoding>,
+    quiet: bool,
+    cells: Option<usize>,
+) -> (String, bool) {
+    let (mut messages, loaded) = load(input, quiet, cells);
+    let Ok((mesh, triangles)) = loaded else {
+        return (messages, false);
+    };
     let mut ok = true;
     for output in outputs {
         let write_options = WriteOptions {
@@ -80,7 +97,7 @@ pub fn compile(
                     messages.push_str(&format!(
                         "wrote {} ({} triangles)\n",
                         output.display(),
-                        surface.triangles.len()
+                        triangles
                     ));
                 }
             }
