@@ -172,6 +172,12 @@ codes! {
         "A point value with two coordinates is a line parallel to the missing axis, and one with one coordinate is a plane perpendicular to its axis (paper 000). Where a single point is needed, the missing coordinates are taken as 0.";
     EmptySubdomainList = "W009", Warning, "model has no subdomains",
         "The file defines geometry but no <subdomain>, so it describes no computational domain: no boundary fragments are derived and compile meshes each solid on its own. Add <subdomain> elements to describe the domain.";
+
+    // ---- 2D domains (issue 6) ----
+    PolygonEdgesCross = "E660", Error, "polygon edges cross",
+        "A <polygon> must be simple: its edges may meet only where consecutive edges share a vertex. Two of its edges cross, touch, or fold back along one line. Reorder or move the vertices so that the boundary does not meet itself.";
+    AreaIn3d = "W150", Warning, "area limit ignored in a 3D model",
+        "The area= attribute of a <subdomain> limits triangle areas in 2D meshes only; in a 3D model it is ignored. Remove it, or use compile --max-edge to limit the size of surface triangles.";
 }
 
 impl Code {

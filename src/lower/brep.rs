@@ -6,7 +6,7 @@ use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
 use std::f64::consts::TAU;
 
 pub struct BrepVertex {
-    pub name: &'static str,
+    pub name: std::borrow::Cow<'static, str>,
     pub position: Point3,
 }
 
@@ -77,7 +77,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
     let corner = |i: usize, j: usize, k: usize| i + 2 * j + 4 * k;
     let vertices = (0..8)
         .map(|n| BrepVertex {
-            name: VERTEX_NAMES[n],
+            name: VERTEX_NAMES[n].into(),
             position: frame.to_global(&Point3::new(
                 (n & 1) as f64,
                 ((n >> 1) & 1) as f64,
@@ -170,7 +170,7 @@ fn ball(frame: &Frame) -> Brep {
     let surface = Surface::Ellipsoid { frame: *frame };
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam",
+            name: "seam".into(),
             position: seam,
         }],
         edges: vec![BrepEdge {
@@ -213,7 +213,7 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
         }
         let v = vertices.len();
         vertices.push(BrepVertex {
-            name: vertex,
+            name: vertex.into(),
             position: frame.to_global(&Point3::new(r, 0.0, z)),
         });
         let e = edges.len();
@@ -268,7 +268,7 @@ fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
     }
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam",
+            name: "seam".into(),
             position: frame.to_global(&Point3::new(outer, 0.0, 0.0)),
         }],
         edges: vec![
@@ -317,7 +317,7 @@ fn disk(frame: &Frame) -> Brep {
     let center = frame.origin;
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam",
+            name: "seam".into(),
             position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)),
         }],
         edges: vec![BrepEdge {
@@ -339,13 +339,14 @@ fn disk(frame: &Frame) -> Brep {
     }
 }
 
-const POLYGON_VERTICES: [&str; 4] = ["v1", "v2", "v3", "v4"];
-
+/// A polygon's boundary: vertices v1…vn in the given order, edge ei from vi
+/// to the next vertex, the loop counter-clockwise in local coordinates
+/// (a clockwise vertex list is walked backwards).
 fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
-    let n = local.len().min(POLYGON_VERTICES.len());
+    let n = local.len();
     let vertices: Vec<BrepVertex> = (0..n)
         .map(|i| BrepVertex {
-            name: POLYGON_VERTICES[i],
+            name: format!("v{}", i + 1).into(),
             position: frame.to_global(&local[i]),
         })
         .collect();
@@ -363,20 +364,33 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
             }
         })
         .collect();
-    let centroid =
-        Point3::from(vertices.iter().map(|v| v.position.coords).sum::<Vec3>() / n.max(1) as f64);
-    let ring: Vec<(usize, bool)> = (0..n).map(|i| (i, true)).collect();
+    let twice_area: f64 = (0..n)
+        .map(|i| {
+            let (v, w) = (local[i], local[(i + 1) % n]);
+            v.x * w.y - w.x * v.y
+        })
+        .sum();
+    let ring: Vec<(usize, bool)> = if twice_area >= 0.0 {
+        (0..n).map(|i| (i, true)).collect()
+    } else {
+        (0..n).rev().map(|i| (i, false)).collect()
+    };
+    let shape = SolidShape::Polygon {
+        frame: *frame,
+        vertices: local.to_vec(),
+    };
+    let sample = shape.interior_point();
     Brep {
         vertices,
         edges,
         faces: vec![BrepFace {
             name: "region",
             surface: Surface::Plane {
-                origin: centroid,
+                origin: sample,
                 normal: region_normal(frame),
             },
             loops: vec![ring.clone()],
-            sample: centroid,
+            sample,
         }],
         boundary: ring,
     }
