@@ -46,6 +46,8 @@ pub struct Args {
     quiet: bool,
     #[command(flatten)]
     input: InputOptions,
+    #[command(flatten)]
+    solver_mesh: super::mesh_args::MeshArgs,
 }
 
 /// What one input produced, collected so output is printed in input order.
@@ -169,11 +171,14 @@ fn mesh_options(args: &Args) -> Result<MeshOptions, String> {
             args.min_angle
         ));
     }
-    Ok(MeshOptions {
+    let mut options = MeshOptions {
         tolerance,
         max_edge: args.max_edge,
         min_angle_degrees: args.min_angle,
-    })
+        ..MeshOptions::default()
+    };
+    args.solver_mesh.apply(&mut options)?;
+    Ok(options)
 }
 
 /// The output files of each input: the -o files for one input, or

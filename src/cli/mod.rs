@@ -4,6 +4,7 @@
 mod compile;
 mod explain;
 mod inspect;
+mod mesh_args;
 mod validate;
 
 use clap::{Parser, Subcommand};

@@ -24,6 +24,7 @@
 use super::MeshError;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
+use super::size::Sizing;
 use crate::geom::{Point3, Vec3};
 use crate::ir::{Face, Model};
 use spade::{
@@ -55,6 +56,9 @@ pub(crate) enum FacePoint {
 pub(crate) struct FaceMesh {
     pub points: Vec<FacePoint>,
     pub triangles: Vec<[usize; 3]>,
+    /// Constrained poly_lines: (poly_line index, its points in order, as
+    /// indices into `points`, refinement points included).
+    pub polylines: Vec<(usize, Vec<usize>)>,
 }
 
 pub(crate) enum Outcome {
@@ -63,12 +67,14 @@ pub(crate) enum Outcome {
     Split(Vec<(usize, f64)>),
 }
 
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Settings {
+#[derive(Clone, Copy)]
+pub(crate) struct Settings<'a> {
     pub tolerance: f64,
-    pub max_edge: f64,
+    pub sizing: &'a Sizing,
     pub min_angle: f64,
     pub keep_boundary: bool,
+    /// Largest triangle area (2D subdomains' `area=` and `--max-area`).
+    pub max_area: f64,
 }
 
 /// One point of a loop: its node, position, and the segment to the next point.
@@ -89,6 +95,7 @@ pub(crate) fn mesh_face(
     face: &Face,
     edges: &[EdgeNodes],
     settings: &Settings,
+    constraints: &[(usize, Vec<Point3>)],
 ) -> Result<Outcome, MeshError> {
     let failed = |reason: String| MeshError::Face {
         face: face.name.clone(),
@@ -148,20 +155,69 @@ pub(crate) fn mesh_face(
             positions.push(p);
         }
     }
+    // Poly_lines inside the face: constraint chains the mesh must follow.
+    let mut polyline_handles: Vec<(usize, Vec<usize>)> = Vec::new();
+    for (index, points) in constraints {
+        let mut handles = Vec::with_capacity(points.len());
+        for p in points {
+            let uv = chart
+                .to_param(p)
+                .ok_or_else(|| failed("a poly_line point has no parameters".into()))?;
+            let handle = cdt
+                .insert(point2(uv))
+                .map_err(|e| failed(format!("a poly_line point cannot be triangulated: {e:?}")))?;
+            if handle.index() == keys.len() {
+                keys.push(FacePoint::Interior(*p));
+                positions.push(*p);
+            } else if handles.last() != Some(&handle.index()) {
+                return Err(failed(format!(
+                    "a point of poly_line #{} coincides with another node",
+                    index + 1
+                )));
+            }
+            if handles.last() != Some(&handle.index()) {
+                handles.push(handle.index());
+            }
+        }
+        for w in handles.windows(2) {
+            let (a, b) = (
+                spade::handles::FixedVertexHandle::from_index(w[0]),
+                spade::handles::FixedVertexHandle::from_index(w[1]),
+            );
+            if !cdt.can_add_constraint(a, b) {
+                return Err(failed(format!(
+                    "poly_line #{} crosses its boundary or another poly_line",
+                    index + 1
+                )));
+            }
+            cdt.add_constraint(a, b);
+        }
+        polyline_handles.push((*index, handles));
+    }
+    let polyline_segments: Vec<(usize, usize)> = polyline_handles
+        .iter()
+        .flat_map(|(_, h)| h.windows(2).map(|w| (w[0], w[1])))
+        .collect();
     let fixed = cdt.num_vertices();
 
     let mut parameters = RefinementParameters::<f64>::new()
-        .exclude_outer_faces(true)
+        // Spade's peeling takes an open poly_line for a loop: with poly_lines
+        // the outside is found here instead (`outside_faces`).
+        .exclude_outer_faces(polyline_segments.is_empty())
         .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
         .with_max_additional_vertices(200_000);
     if settings.keep_boundary {
         parameters = parameters.keep_constraint_edges();
     }
+    if settings.max_area.is_finite() {
+        parameters = parameters.with_max_allowed_area(settings.max_area);
+    }
     let mut inner = Vec::new();
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if !settings.keep_boundary {
-            let splits = boundary_splits(&cdt, fixed, &segments).map_err(failed)?;
+            let splits =
+                boundary_splits(&cdt, fixed, &segments, &polyline_segments).map_err(failed)?;
             if !splits.is_empty() {
                 return Ok(Outcome::Split(splits));
             }
@@ -180,10 +236,14 @@ pub(crate) fn mesh_face(
             positions.push(p);
         }
         let mut excluded = vec![false; cdt.num_all_faces()];
-        for f in &result.excluded_faces {
-            if let Some(slot) = excluded.get_mut(f.index()) {
-                *slot = true;
+        if polyline_segments.is_empty() {
+            for f in &result.excluded_faces {
+                if let Some(slot) = excluded.get_mut(f.index()) {
+                    *slot = true;
+                }
             }
+        } else {
+            excluded = outside_faces(&cdt, &polyline_segments);
         }
         inner.clear();
         let mut bad = Vec::new();
@@ -231,9 +291,14 @@ pub(crate) fn mesh_face(
             t.swap(1, 2);
         }
     }
+    let polylines = polyline_handles
+        .iter()
+        .map(|(index, handles)| (*index, polyline_chain(&cdt, fixed, handles)))
+        .collect();
     Ok(Outcome::Meshed(FaceMesh {
         points: keys,
         triangles: inner,
+        polylines,
     }))
 }
 
@@ -368,6 +433,7 @@ fn boundary_splits(
     cdt: &Cdt,
     fixed: usize,
     segments: &Segments,
+    polyline_segments: &[(usize, usize)],
 ) -> Result<Vec<(usize, f64)>, String> {
     let mut splits = Vec::new();
     for v in fixed..cdt.num_vertices() {
@@ -376,6 +442,12 @@ fn boundary_splits(
             continue;
         }
         let p = vertex.position();
+        if polyline_segments
+            .iter()
+            .any(|&(a, b)| on_segment(cdt, a, b, p).is_some())
+        {
+            continue;
+        }
         let found = segments.iter().find_map(|(&(a, b), &(edge, sa, sb))| {
             let pa = cdt
                 .vertex(spade::handles::FixedVertexHandle::from_index(a))
@@ -394,11 +466,119 @@ fn boundary_splits(
     Ok(splits)
 }
 
+/// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and
+/// `b`, when it lies on it.
+fn on_segment(cdt: &Cdt, a: usize, b: usize, p: Point2<f64>) -> Option<f64> {
+    let pa = cdt
+        .vertex(spade::handles::FixedVertexHandle::from_index(a))
+        .position();
+    let pb = cdt
+        .vertex(spade::handles::FixedVertexHandle::from_index(b))
+        .position();
+    let (dx, dy) = (pb.x - pa.x, pb.y - pa.y);
+    let len2 = dx * dx + dy * dy;
+    let t = ((p.x - pa.x) * dx + (p.y - pa.y) * dy) / len2;
+    let off = ((p.x - pa.x) * dy - (p.y - pa.y) * dx).abs() / len2.sqrt();
+    (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some(t)
+}
+
+/// Faces outside the loops (indexed by face index): a flood fill from the
+/// convex hull that flips inside/outside when it crosses a loop segment but
+/// not a poly_line.
+fn outside_faces(cdt: &Cdt, polyline_segments: &[(usize, usize)]) -> Vec<bool> {
+    let mut outside: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+    let crosses_loop = |constraint: bool, ia: usize, ib: usize| {
+        if !constraint {
+            return false;
+        }
+        let (a, b) = (
+            cdt.vertex(spade::handles::FixedVertexHandle::from_index(ia))
+                .position(),
+            cdt.vertex(spade::handles::FixedVertexHandle::from_index(ib))
+                .position(),
+        );
+        let mid = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
+        !polyline_segments.iter().any(|&(p, q)| {
+            (p == ia && q == ib) || (p == ib && q == ia) || on_segment(cdt, p, q, mid).is_some()
+        })
+    };
+    let mut stack = Vec::new();
+    for e in cdt.convex_hull() {
+        let inner = e.rev();
+        if let Some(face) = inner.face().as_inner() {
+            let state = !crosses_loop(
+                inner.is_constraint_edge(),
+                inner.from().fix().index(),
+                inner.to().fix().index(),
+            );
+            if outside[face.fix().index()].is_none() {
+                outside[face.fix().index()] = Some(state);
+                stack.push(face.fix());
+            }
+        }
+    }
+    while let Some(f) = stack.pop() {
+        let face = cdt.face(f);
+        let state = outside[f.index()].unwrap_or(true);
+        for e in face.adjacent_edges() {
+            let twin = e.rev();
+            if let Some(next) = twin.face().as_inner() {
+                let slot = &mut outside[next.fix().index()];
+                if slot.is_none() {
+                    *slot = Some(
+                        state
+                            != crosses_loop(
+                                e.is_constraint_edge(),
+                                e.from().fix().index(),
+                                e.to().fix().index(),
+                            ),
+                    );
+                    stack.push(next.fix());
+                }
+            }
+        }
+    }
+    outside.into_iter().map(|s| s.unwrap_or(true)).collect()
+}
+
+/// A constrained poly_line's vertices in order: its own points with the
+/// points refinement added on each segment, sorted along it.
+fn polyline_chain(cdt: &Cdt, fixed: usize, handles: &[usize]) -> Vec<usize> {
+    let added: Vec<(usize, Point2<f64>)> = (fixed..cdt.num_vertices())
+        .filter_map(|v| {
+            let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(v));
+            vertex
+                .out_edges()
+                .any(|e| e.is_constraint_edge())
+                .then(|| (v, vertex.position()))
+        })
+        .collect();
+    let mut chain = Vec::new();
+    for w in handles.windows(2) {
+        chain.push(w[0]);
+        let mut on: Vec<(f64, usize)> = added
+            .iter()
+            .filter_map(|&(v, p)| on_segment(cdt, w[0], w[1], p).map(|t| (t, v)))
+            .collect();
+        on.sort_by(|x, y| x.0.total_cmp(&y.0));
+        chain.extend(on.into_iter().map(|(_, v)| v));
+    }
+    chain.extend(handles.last().copied());
+    chain
+}
+
 /// True when a triangle is longer than `max_edge` or strays from the surface
 /// by more than the tolerance at its centroid or an edge midpoint.
 fn too_coarse(face: &Face, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
     let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-    if longest > settings.max_edge {
+    let size = if settings.sizing.is_uniform() {
+        settings.sizing.at(a)
+    } else {
+        settings
+            .sizing
+            .at(&Point3::from((a.coords + b.coords + c.coords) / 3.0))
+    };
+    if longest > size {
         return true;
     }
     if matches!(face.surface, crate::geom::Surface::Plane { .. }) {

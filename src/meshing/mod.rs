@@ -22,10 +22,14 @@
 
 mod chart;
 mod check;
+mod constraints;
 mod edges;
 mod face;
+mod quadratic;
+mod size;
 
 pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
+pub use size::SizeField;
 
 use crate::ir::{self, Dimension, Model, Side, SubdomainCells};
 use crate::mesh::{
@@ -62,6 +66,14 @@ pub struct MeshOptions {
     /// The smallest triangle angle refinement aims for (planar faces exactly,
     /// curved faces in their chart).
     pub min_angle_degrees: f64,
+    /// 2D: the largest triangle area anywhere (a subdomain's `area=` may
+    /// lower it there).
+    pub max_area: Option<f64>,
+    /// A size field h(x, y, z[, d]): no triangle edge longer than h.
+    pub size_field: Option<SizeField>,
+    /// 1: linear elements; 2: quadratic (mid-edge nodes, on the curve for
+    /// boundary edges).
+    pub order: u8,
 }
 
 impl Default for MeshOptions {
@@ -70,6 +82,9 @@ impl Default for MeshOptions {
             tolerance: Tolerance::default(),
             max_edge: None,
             min_angle_degrees: 25.0,
+            max_area: None,
+            size_field: None,
+            order: 1,
         }
     }
 }
@@ -107,23 +122,69 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         )));
     }
 
+    let max_area = options.max_area.unwrap_or(f64::INFINITY);
+    if max_area.is_nan() || max_area <= 0.0 {
+        return Err(MeshError::Options("max_area must be positive".into()));
+    }
+    if !(1..=2).contains(&options.order) {
+        return Err(MeshError::Options(format!(
+            "the element order must be 1 or 2 (got {})",
+            options.order
+        )));
+    }
+
     // Half the tolerance on edges leaves room for the triangles beside them.
     let mut edge_nodes = model
         .edges
         .iter()
         .map(|e| edges::discretise(model, e, 0.5 * tolerance, max_edge))
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
-    let face_meshes = mesh_faces(model, &mut edge_nodes, tolerance, max_edge, min_angle)?;
-    Ok(assemble(model, &edge_nodes, &face_meshes))
+    let edge_points: Vec<Vec<crate::geom::Point3>> =
+        edge_nodes.iter().map(|n| n.points.clone()).collect();
+    let sizing = size::Sizing::new(model, options.size_field.as_ref(), max_edge, &edge_points)?;
+    for (nodes, edge) in edge_nodes.iter_mut().zip(&model.edges) {
+        nodes.refine_to_size(&edge.curve, &sizing);
+    }
+    let constraints = constraints::assign(model, &edge_nodes)?;
+    let face_areas = face_area_limits(model, max_area);
+    let settings = Settings {
+        tolerance,
+        sizing: &sizing,
+        min_angle,
+        keep_boundary: false,
+        max_area,
+    };
+    let face_meshes = mesh_faces(model, &mut edge_nodes, settings, &face_areas, &constraints)?;
+    let mut mesh = assemble(model, &edge_nodes, &face_meshes);
+    if options.order == 2 {
+        quadratic::elevate(model, &edge_nodes, &mut mesh);
+    }
+    Ok(mesh)
+}
+
+/// Each face's area limit: the smallest of `max_area` and the `area=` of
+/// the 2D subdomains it belongs to.
+fn face_area_limits(model: &Model, max_area: f64) -> Vec<f64> {
+    let mut limits = vec![max_area; model.faces.len()];
+    for sub in &model.subdomains {
+        if let (SubdomainCells::Region { faces }, Some(area)) = (&sub.cells, sub.max_area) {
+            for f in faces {
+                if let Some(limit) = limits.get_mut(f.index()) {
+                    *limit = limit.min(area);
+                }
+            }
+        }
+    }
+    limits
 }
 
 /// Meshes the faces in rounds until no face asks for new boundary points.
 fn mesh_faces(
     model: &Model,
     edge_nodes: &mut [EdgeNodes],
-    tolerance: f64,
-    max_edge: f64,
-    min_angle: f64,
+    base: Settings,
+    face_areas: &[f64],
+    constraints: &constraints::Constraints,
 ) -> Result<Vec<Option<FaceMesh>>, MeshError> {
     let mut faces_of_edge: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for (f, face) in model.faces.iter().enumerate() {
@@ -156,15 +217,21 @@ fn mesh_faces(
         .filter(|&f| !model.faces[f].loops.is_empty())
         .collect();
     for round in 0..=MAX_ROUNDS {
-        let settings = Settings {
-            tolerance,
-            max_edge,
-            min_angle,
-            keep_boundary: round == MAX_ROUNDS,
-        };
         let mut splits: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
         for &f in &todo {
-            match face::mesh_face(model, &model.faces[f], edge_nodes, &settings)? {
+            let settings = Settings {
+                keep_boundary: round == MAX_ROUNDS,
+                max_area: face_areas.get(f).copied().unwrap_or(base.max_area),
+                ..base
+            };
+            let face_constraints = constraints.get(&f).map_or(&[][..], |c| c.as_slice());
+            match face::mesh_face(
+                model,
+                &model.faces[f],
+                edge_nodes,
+                &settings,
+                face_constraints,
+            )? {
                 Outcome::Meshed(mesh) => meshes[f] = Some(mesh),
                 Outcome::Split(points) => {
                     for (edge, s) in points {
@@ -225,6 +292,7 @@ fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceM
         edge_ids.push(ids);
     }
     let mut faces = Vec::with_capacity(model.faces.len());
+    let mut constrained: BTreeMap<usize, Vec<u32>> = BTreeMap::new();
     for (face, mesh) in model.faces.iter().zip(face_meshes) {
         let mut triangles = Vec::new();
         if let Some(mesh) = mesh {
@@ -246,6 +314,10 @@ fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceM
                     *slot = id;
                 }
                 triangles.push(tri);
+            }
+            for (index, chain) in &mesh.polylines {
+                let nodes = chain.iter().filter_map(|&i| ids.get(i).copied().flatten());
+                constrained.insert(*index, nodes.collect());
             }
         }
         faces.push(MeshFace {
@@ -295,8 +367,11 @@ fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceM
         });
     }
     let mut polylines = Vec::new();
-    for line in &model.polylines {
-        let ids = line.points.iter().map(|p| push(&mut nodes, p)).collect();
+    for (index, line) in model.polylines.iter().enumerate() {
+        let ids = match constrained.remove(&index) {
+            Some(chain) => chain,
+            None => line.points.iter().map(|p| push(&mut nodes, p)).collect(),
+        };
         polylines.push(MeshPolyline {
             name: line.name.clone(),
             nodes: ids,
@@ -323,5 +398,6 @@ fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceM
         fragments,
         point_sets,
         polylines,
+        ..Mesh::default()
     }
 }
