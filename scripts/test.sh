@@ -33,6 +33,13 @@ if ! python3 -c "import gmsh, meshio" >/dev/null 2>&1; then
         || python3 -m pip install -q --break-system-packages gmsh==4.15.2 meshio==5.3.5
 fi
 
+# tests/tools/make_meshes.py (tests/convert_external.rs): meshes made by trimesh.
+if ! python3 -c "import trimesh" >/dev/null 2>&1; then
+    echo "installing: trimesh (pip)" >&2
+    python3 -m pip install -q trimesh==5.2.0 \
+        || python3 -m pip install -q --break-system-packages trimesh==5.2.0
+fi
+
 # tests/tools/fem_poisson.py (tests/fem_2d.rs) and benches/mesh2d.rs' peer
 # (benches/mesh2d_triangle.py): scikit-fem solves on geomc's meshes, Triangle
 # is the 2D meshing peer.

@@ -33,4 +33,5 @@ pub(crate) fn resolve_fmt(v: f64) -> String {
         format!("{rounded}")
     }
 }
+pub mod convert;
 pub mod mesh;

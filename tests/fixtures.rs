@@ -16,7 +16,31 @@ use std::process::Command;
 const UNPOSITIONED: &[&str] = &["E103", "E106", "E204", "E207"];
 
 /// Error codes that no fixture can express in a small file; they are tested elsewhere.
-const NOT_COVERED_BY_FIXTURES: &[&str] = &["E103", "E106"];
+const NOT_COVERED_BY_FIXTURES: &[&str] = &[
+    "E103", "E106",
+    // ---- convert (issue 4): codes of mesh files, not of XML models ----
+    "E520", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E521", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E522", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E523", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E524", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E525", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E526", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E527", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E528", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E529", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E530", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E531", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E532", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "E533", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W110", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W111", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W112", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W113", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W114", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W115", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+    "W116", // mesh files (geomc convert/inspect): tests/convert_bad_input.rs, tests/convert_cli.rs
+];
 
 /// Command-line options an `args:` header may name, and whether each takes a value.
 /// XML comments cannot contain `--`, so the header writes `set r=2` for `--set r=2`.
@@ -352,7 +376,9 @@ fn every_code_has_a_fixture() {
             Severity::Error => {
                 NOT_COVERED_BY_FIXTURES.contains(&text) || expected_errors.contains(text)
             }
-            Severity::Warning => listed_warnings.contains(text),
+            Severity::Warning => {
+                NOT_COVERED_BY_FIXTURES.contains(&text) || listed_warnings.contains(text)
+            }
         };
         if !covered {
             missing.push(format!("{text} ({})", code.title()));

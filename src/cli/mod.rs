@@ -2,6 +2,7 @@
 //! decides exit codes. Each subcommand has its own file.
 
 mod compile;
+mod convert;
 mod explain;
 mod inspect;
 mod mesh_args;
@@ -40,6 +41,8 @@ enum Command {
     Inspect(inspect::Args),
     /// Explain a diagnostic code, e.g. `geomc explain E201`.
     Explain(explain::Args),
+    /// Convert a mesh between STL, OBJ, glTF/GLB, Gmsh MSH, VTU and .frag.xml, keeping its groups.
+    Convert(convert::Args),
 }
 
 /// Options shared by every subcommand that reads XML.
@@ -110,6 +113,7 @@ pub fn run() -> i32 {
         Command::Compile(args) => compile::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Explain(args) => explain::run(&args),
+        Command::Convert(args) => convert::run(&args),
     });
     result.unwrap_or(EXIT_INTERNAL)
 }

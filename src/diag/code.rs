@@ -172,6 +172,49 @@ codes! {
         "A point value with two coordinates is a line parallel to the missing axis, and one with one coordinate is a plane perpendicular to its axis (paper 000). Where a single point is needed, the missing coordinates are taken as 0.";
     EmptySubdomainList = "W009", Warning, "model has no subdomains",
         "The file defines geometry but no <subdomain>, so it describes no computational domain: no boundary fragments are derived and compile meshes each solid on its own. Add <subdomain> elements to describe the domain.";
+    // ---- convert: mesh readers and `geomc convert` (issue 4) ----
+    MeshReadFailed = "E520", Error, "cannot read the mesh file",
+        "The mesh file (or a file it refers to, such as a .gltf's buffer or the mesh a .frag.xml names) could not be opened or read. Check the path and its permissions.";
+    UnknownMeshFormat = "E521", Error, "unknown mesh format",
+        "geomc tells a mesh's format from its content (GLB, MSH, VTU, ASCII and binary STL) or else its ending (.stl .obj .gltf .glb .msh .vtu .frag.xml). Rename the file or name the format with --from.";
+    MeshTruncated = "E522", Error, "mesh file ends early",
+        "The file ends (or a section, chunk or buffer ends) before the data its own header announces. The file was cut short while copying or writing: write it again from the tool that made it.";
+    MeshCountMismatch = "E523", Error, "counts do not match the data",
+        "A count in the file (nodes, elements, values in an array, an element's vertices) disagrees with the data that follows, or is larger than the rest of the file could hold. The file is corrupt or was edited by hand: write it again from the tool that made it.";
+    MeshIndexOutOfRange = "E524", Error, "index out of range",
+        "An element refers to a node (vertex, point) that the file does not define. Check the indexing convention of the writer (OBJ counts from 1, VTU from 0, MSH by node tag) and write the file again.";
+    MeshNonFinite = "E525", Error, "coordinate is not a finite number",
+        "A coordinate is NaN or infinite. No mesh can hold it: fix the geometry in the tool that wrote the file, or remove the elements that use it.";
+    MeshUnsupportedElement = "E526", Error, "unknown element type",
+        "The file uses an element or cell type geomc does not know (Gmsh types 1-21 and 26-29; VTK points, lines, triangles, strips, polygons, quads and the volume cells), or an STL facet with more than three vertices. Save the mesh with standard linear or quadratic elements.";
+    StlSizeMismatch = "E527", Error, "binary STL size contradicts its triangle count",
+        "A binary STL is an 80-byte header, a 4-byte triangle count n, and 50 bytes per triangle: its size must be 84 + 50n. The file is truncated or has extra data after the triangles; write it again.";
+    MeshSyntax = "E528", Error, "malformed mesh file",
+        "A keyword, number or structure is not what the format expects at this place (a missing `endloop` in STL, a section out of order in MSH, malformed JSON in glTF, a VTU without its <Cells>). Fix the file at the position shown, or write it again.";
+    MeshUnsupportedVersion = "E529", Error, "unsupported variant of a mesh format",
+        "The file uses a version or encoding geomc does not read: MSH other than 2.2 and 4.1 or big-endian binary MSH, GLB other than 2.0, appended or big-endian VTU data. Save it from its tool as MSH 4.1 or 2.2, glTF 2.0, or VTU with inline data.";
+    GltfInvalid = "E530", Error, "invalid glTF structure",
+        "The glTF JSON parses but breaks the specification: an accessor, buffer view, buffer, mesh or node index points nowhere, a type is wrong, or the node hierarchy has a cycle. The message names the JSON path; check the file with the Khronos glTF validator.";
+    FragMeshMismatch = "E531", Error, ".frag.xml and its mesh file disagree",
+        "A .frag.xml describes the faces, subdomains and fragments of one mesh file. The mesh file it names is missing, or its faces do not have the triangle counts the description says. Write both files in one `geomc compile` or `geomc convert` run.";
+    UnknownGroup = "E532", Error, "no group of that name",
+        "--group keeps only the named groups (faces, physical groups, solids, objects), but the mesh has no group of this name. `geomc inspect MESHFILE` lists the groups; the message suggests the nearest name.";
+    TargetCannotHold = "E533", Error, "the output format cannot hold this mesh",
+        "The output format has a hard limit the mesh exceeds (binary STL holds at most 2^32-1 triangles, GLB files at most 4 GiB). Write another format, such as MSH or VTU.";
+    InputNotCarried = "W110", Warning, "input data not kept",
+        "The input holds data that geomc's mesh does not (volume cells, texture coordinates, materials, STL attribute bytes, elements in several physical groups). The message counts what was left out; convert with a tool that keeps it if you need it.";
+    ElementsConverted = "W111", Warning, "elements converted",
+        "Elements were turned into the triangles, lines and points geomc's mesh holds: polygons and quadrangles split into triangles, strips and fans unrolled, higher-order elements reduced to their corner nodes. The surface is the same; the element count differs.";
+    OpenEdges = "W112", Warning, "open edges",
+        "Some edges are used by only one triangle: the surface has holes or boundaries, so it does not enclose a volume. Solvers that need a closed boundary will reject it. `geomc inspect` shows which groups are open; --weld EPS merges nodes that should coincide.";
+    NonManifoldEdges = "W113", Warning, "non-manifold edges",
+        "Some edges are used by three or more triangles (surfaces meeting along a line, or duplicated triangles). Many solvers and boolean tools need a 2-manifold: separate the surfaces or remove the duplicates.";
+    MeshInconsistentOrientation = "W114", Warning, "inconsistent orientation",
+        "Across some edges the two triangles run the same way, so their normals disagree (part of the surface is inside out). --normals orients each connected surface consistently, outward when it is closed.";
+    DegenerateTriangles = "W115", Warning, "degenerate triangles",
+        "Some triangles repeat a node or have no area. They carry no surface and break normals and quality measures. --weld EPS removes triangles that collapse when nearby nodes merge.";
+    TargetNotCarried = "W116", Warning, "output format cannot carry everything",
+        "The output format has no place for some of the mesh's data (binary STL has no groups, OBJ has no volumes, VTU keeps names only in its field data). The message names what was merged or left out and how many; choose a format that holds it to keep it.";
 
     // ---- 2D domains (issue 6) ----
     PolygonEdgesCross = "E660", Error, "polygon edges cross",

@@ -16,6 +16,7 @@ mod gltf;
 mod groups;
 mod msh;
 mod obj;
+pub mod read;
 mod stl;
 mod vtu;
 

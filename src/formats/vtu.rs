@@ -4,8 +4,9 @@
 //! (Int32, −1 where it does not apply): `fragment_id`, `subdomain_id`,
 //! `other_subdomain_id`, `face_id`, `edge_id`, `polyline_id`, `point_set_id`.
 //! In 3D a triangle's `subdomain_id` / `other_subdomain_id` are its fragment's
-//! pair; in 2D a triangle's `subdomain_id` is its region. VTK keeps numbers,
-//! not names: the `.frag.xml` names them, which a warning says.
+//! pair; in 2D a triangle's `subdomain_id` is its region. FieldData arrays
+//! name the ids (`Name="inlet"` holding `[id, field index]`); many readers
+//! ignore them, so a warning points to the `.frag.xml` for the names.
 
 use super::groups;
 use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, base64, fmt_num, warning};
@@ -189,6 +190,41 @@ fn data_array(
     writeln!(out, "        </DataArray>")
 }
 
+/// The names behind the cell data's ids, as FieldData arrays named by the
+/// entity and holding `[id, k]`, k the index of its cell-data array in
+/// `FIELDS` (meshio reads these as its `field_data`).
+fn write_names(mesh: &Mesh, out: &mut dyn Write) -> std::io::Result<()> {
+    let lists: [(usize, Vec<&str>); 6] = [
+        (0, mesh.fragments.iter().map(|f| f.name.as_str()).collect()),
+        (1, mesh.subdomains.iter().map(|s| s.name.as_str()).collect()),
+        (3, mesh.faces.iter().map(|f| f.name.as_str()).collect()),
+        (4, mesh.edges.iter().map(|e| e.name.as_str()).collect()),
+        (5, mesh.polylines.iter().map(|p| p.name.as_str()).collect()),
+        (6, mesh.point_sets.iter().map(|p| p.name.as_str()).collect()),
+    ];
+    if lists.iter().all(|(_, names)| names.is_empty()) {
+        return Ok(());
+    }
+    writeln!(out, "    <FieldData>")?;
+    for (k, names) in &lists {
+        for (id, name) in names.iter().enumerate() {
+            writeln!(
+                out,
+                "      <DataArray type=\"Int32\" Name=\"{}\" NumberOfTuples=\"2\" format=\"ascii\">{id} {k}</DataArray>",
+                escape(name)
+            )?;
+        }
+    }
+    writeln!(out, "    </FieldData>")
+}
+
+fn escape(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+        .replace('"', "&quot;")
+}
+
 fn write_grid(
     mesh: &Mesh,
     cells: &[Cell],
@@ -201,6 +237,7 @@ fn write_grid(
         "<VTKFile type=\"UnstructuredGrid\" version=\"1.0\" byte_order=\"LittleEndian\" header_type=\"UInt64\">"
     )?;
     writeln!(out, "  <UnstructuredGrid>")?;
+    write_names(mesh, out)?;
     writeln!(
         out,
         "    <Piece NumberOfPoints=\"{}\" NumberOfCells=\"{}\">",

@@ -1,0 +1,287 @@
+//! `geomc convert INPUT OUTPUT`: read a mesh file, apply the mesh options,
+//! write it in another format; and `geomc inspect MESHFILE` for mesh files.
+//! Warnings name everything the input or the output format could not hold.
+
+use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, Format, out};
+use geomc::convert::{ConvertOptions, apply, inspect::MeshReport};
+use geomc::diag::{Code, Diagnostic, render_human};
+use geomc::formats::read::{ReadFormat, load_mesh_as};
+use geomc::formats::{
+    Encoding, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic, writer_for_path,
+};
+use geomc::span::SourceFile;
+use std::path::{Path, PathBuf};
+
+#[derive(clap::Args)]
+pub struct Args {
+    /// The mesh to read: .stl .obj .gltf .glb .msh .vtu .frag.xml.
+    input: PathBuf,
+    /// The file to write: .gltf .glb .obj .stl .msh .vtu .frag.xml.
+    output: PathBuf,
+    /// The input format, when its ending or content does not tell.
+    #[arg(long, value_name = "FORMAT")]
+    from: Option<String>,
+    /// The output format, when the output's ending does not tell.
+    #[arg(long, value_name = "FORMAT")]
+    to: Option<String>,
+    /// Text output for STL, MSH and VTU.
+    #[arg(long, conflicts_with = "binary")]
+    ascii: bool,
+    /// Binary output for STL, MSH and VTU.
+    #[arg(long)]
+    binary: bool,
+    /// Merge nodes closer than EPS (STL and glTF give triangle soup).
+    #[arg(long, value_name = "EPS", value_parser = non_negative)]
+    weld: Option<f64>,
+    /// Orient each connected surface's triangles consistently (outward when
+    /// closed), so the recomputed vertex normals agree.
+    #[arg(long)]
+    normals: bool,
+    /// Scale: one factor, or SX,SY,SZ.
+    #[arg(long, value_name = "S|SX,SY,SZ", value_parser = scale, allow_hyphen_values = true)]
+    scale: Option<[f64; 3]>,
+    /// Translate by X,Y,Z (after scaling and rotating).
+    #[arg(long, value_name = "X,Y,Z", value_parser = triple, allow_hyphen_values = true)]
+    translate: Option<[f64; 3]>,
+    /// Rotate by AX,AY,AZ degrees about the x, then y, then z axis.
+    #[arg(long, value_name = "AX,AY,AZ", value_parser = triple, allow_hyphen_values = true)]
+    rotate: Option<[f64; 3]>,
+    /// Keep only this group (repeatable): a face, physical group, solid or object name.
+    #[arg(long = "group", value_name = "NAME")]
+    groups: Vec<String>,
+}
+
+fn non_negative(s: &str) -> Result<f64, String> {
+    match s.parse::<f64>() {
+        Ok(v) if v >= 0.0 && v.is_finite() => Ok(v),
+        _ => Err(format!("`{s}` is not a non-negative number")),
+    }
+}
+
+fn triple(s: &str) -> Result<[f64; 3], String> {
+    let parts: Vec<f64> = s
+        .split(',')
+        .map(|p| p.trim().parse::<f64>())
+        .collect::<Result<_, _>>()
+        .map_err(|_| format!("`{s}` is not three numbers X,Y,Z"))?;
+    match parts[..] {
+        [x, y, z] if parts.iter().all(|v| v.is_finite()) => Ok([x, y, z]),
+        _ => Err(format!("`{s}` is not three finite numbers X,Y,Z")),
+    }
+}
+
+fn scale(s: &str) -> Result<[f64; 3], String> {
+    if let Ok(v) = s.parse::<f64>() {
+        if v.is_finite() && v != 0.0 {
+            return Ok([v; 3]);
+        }
+        return Err(format!("`{s}` is not a finite, non-zero scale"));
+    }
+    let t = triple(s)?;
+    if t.contains(&0.0) {
+        return Err(format!("`{s}` has a zero factor: the mesh would collapse"));
+    }
+    Ok(t)
+}
+
+/// Prints diagnostics of a file, with its source line where they have a span.
+fn report(path: &Path, diagnostics: &[Diagnostic]) {
+    let name = path.display().to_string();
+    let needs_text = diagnostics.iter().any(|d| d.span.is_some());
+    let text = if needs_text {
+        std::fs::read(path)
+            .map(|b| String::from_utf8_lossy(&b).into_owned())
+            .unwrap_or_default()
+    } else {
+        String::new()
+    };
+    let source = SourceFile::new(name, text);
+    for d in diagnostics {
+        eprint!("{}", render_human(&source, d));
+    }
+}
+
+fn read_format(name: Option<&str>) -> Result<Option<ReadFormat>, i32> {
+    match name {
+        None => Ok(None),
+        Some(n) => match ReadFormat::parse(n) {
+            Some(f) => Ok(Some(f)),
+            None => {
+                eprintln!(
+                    "geomc: --from {n}: unknown format; use one of stl obj gltf glb msh vtu frag.xml"
+                );
+                Err(EXIT_USAGE)
+            }
+        },
+    }
+}
+
+fn load(path: &Path, from: Option<ReadFormat>) -> Result<geomc::formats::read::Loaded, i32> {
+    load_mesh_as(path, from).map_err(|diagnostics| {
+        report(path, &diagnostics);
+        if diagnostics.iter().any(|d| d.code == Code::MeshReadFailed) {
+            EXIT_USAGE
+        } else {
+            EXIT_INVALID
+        }
+    })
+}
+
+pub fn run(args: &Args) -> i32 {
+    let from = match read_format(args.from.as_deref()) {
+        Ok(f) => f,
+        Err(code) => return code,
+    };
+    let writer: &'static dyn MeshWriter = match &args.to {
+        Some(name) => {
+            let name = name.trim_start_matches('.').to_ascii_lowercase();
+            match WRITERS
+                .iter()
+                .find(|w| w.name() == name || w.extensions().contains(&name.as_str()))
+            {
+                Some(w) => *w,
+                None => {
+                    eprintln!(
+                        "geomc: --to {name}: unknown format; use one of gltf glb obj stl msh vtu frag.xml"
+                    );
+                    return EXIT_USAGE;
+                }
+            }
+        }
+        None => match writer_for_path(&args.output) {
+            Some(w) => w,
+            None => {
+                eprintln!(
+                    "geomc: cannot tell the output format of {} from its ending; name it with --to",
+                    args.output.display()
+                );
+                return EXIT_USAGE;
+            }
+        },
+    };
+    let mut loaded = match load(&args.input, from) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    report(&args.input, &loaded.warnings);
+    let options = ConvertOptions {
+        groups: args.groups.clone(),
+        scale: args.scale,
+        rotate: args.rotate,
+        translate: args.translate,
+        weld: args.weld,
+        normals: args.normals,
+    };
+    match apply(&mut loaded.mesh, &options) {
+        Ok(applied) => {
+            for note in applied.notes {
+                eprintln!("geomc: {note}");
+            }
+        }
+        Err(diagnostics) => {
+            report(&args.input, &diagnostics);
+            return EXIT_INVALID;
+        }
+    }
+    if options.weld.is_some() || options.normals {
+        // The checks again, on the mesh as written.
+        let checks = geomc::formats::read::clean::check(&loaded.mesh);
+        for d in checks.warnings() {
+            eprint!(
+                "{}",
+                render_human(&SourceFile::new(args.output.display().to_string(), ""), &d)
+            );
+        }
+    }
+    let encoding = if args.ascii {
+        Some(Encoding::Ascii)
+    } else if args.binary {
+        Some(Encoding::Binary)
+    } else {
+        None
+    };
+    let write_options = WriteOptions {
+        encoding,
+        file_name: args
+            .output
+            .file_name()
+            .and_then(|n| n.to_str())
+            .map(String::from),
+        mesh_file: None,
+    };
+    match write(&args.output, writer, &loaded.mesh, &write_options) {
+        Ok(warnings) => {
+            let source = SourceFile::new(args.output.display().to_string(), "");
+            for w in warnings {
+                let d = Diagnostic::new(Code::TargetNotCarried, None, w.to_string());
+                eprint!("{}", render_human(&source, &d));
+            }
+            let mesh = &loaded.mesh;
+            eprintln!(
+                "geomc: wrote {} ({} nodes, {} triangles, {} groups)",
+                args.output.display(),
+                mesh.nodes.len(),
+                mesh.faces.iter().map(|f| f.triangles.len()).sum::<usize>(),
+                mesh.faces.len() + mesh.polylines.len() + mesh.point_sets.len()
+            );
+            EXIT_OK
+        }
+        Err(WriteError::Unsupported(message)) => {
+            let d = Diagnostic::new(Code::TargetCannotHold, None, message);
+            report(&args.output, &[d]);
+            EXIT_INVALID
+        }
+        Err(e) => {
+            eprintln!("geomc: cannot write {}: {e}", args.output.display());
+            EXIT_USAGE
+        }
+    }
+}
+
+/// Like `formats::write_mesh_file`, with the writer chosen by the caller.
+fn write(
+    path: &Path,
+    writer: &dyn MeshWriter,
+    mesh: &geomc::mesh::Mesh,
+    options: &WriteOptions,
+) -> Result<Vec<geomc::formats::Warning>, WriteError> {
+    let folder = path.parent().unwrap_or(Path::new(""));
+    let mut written = Vec::new();
+    let result = (|| {
+        for side in writer.side_files(mesh, options)? {
+            let side_path = folder.join(&side.name);
+            write_atomic(&side_path, |w| Ok(w.write_all(&side.bytes)?))?;
+            written.push(side_path);
+        }
+        write_atomic(path, |w| writer.write(mesh, options, w))
+    })();
+    if result.is_err() {
+        for side_path in written {
+            let _ = std::fs::remove_file(side_path);
+        }
+    }
+    result
+}
+
+/// Whether `inspect` should read `path` as a mesh file (by its ending).
+pub fn is_mesh_file(path: &Path) -> bool {
+    ReadFormat::from_path(path).is_some()
+}
+
+/// `geomc inspect MESHFILE`.
+pub fn inspect(path: &Path, format: Format) -> i32 {
+    let loaded = match load(path, None) {
+        Ok(l) => l,
+        Err(code) => return code,
+    };
+    let name = std::fs::read(path)
+        .ok()
+        .and_then(|b| geomc::formats::read::detect(path, &b))
+        .map_or("mesh", ReadFormat::name);
+    let report = MeshReport::of(&loaded, name);
+    match format {
+        Format::Human => out(&report.render_text()),
+        Format::Json => out(&format!("{}\n", report.render_json())),
+    }
+    EXIT_OK
+}

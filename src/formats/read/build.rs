@@ -1,0 +1,242 @@
+//! What every reader fills: nodes and named groups of triangles, line
+//! segments and points, then [`Builder::finish`] turns them into the mesh IR
+//! (one face per triangle group, poly_lines for line groups, point sets for
+//! point groups) and runs the surface checks.
+
+use super::Loaded;
+use super::clean;
+use crate::diag::{Code, Diagnostic};
+use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain};
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+/// Elements of one named group.
+#[derive(Debug, Clone, Default)]
+pub struct Group {
+    pub name: String,
+    pub triangles: Vec<[u32; 3]>,
+    pub lines: Vec<[u32; 2]>,
+    pub points: Vec<u32>,
+}
+
+/// A fragment recovered from a file that carries one (geomc's own glTF
+/// extras): group name, subdomain name, other subdomain name (`None`: exterior).
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct FragmentInfo {
+    pub group: String,
+    pub subdomain: String,
+    pub other: Option<String>,
+}
+
+#[derive(Debug, Default)]
+pub struct Builder {
+    pub nodes: Vec<[f64; 3]>,
+    pub groups: Vec<Group>,
+    index: HashMap<String, usize>,
+    pub warnings: Vec<Diagnostic>,
+    /// Subdomains by name, with their material, when the file names them.
+    pub subdomains: Vec<(String, Option<String>)>,
+    pub fragments: Vec<FragmentInfo>,
+}
+
+impl Builder {
+    pub fn new() -> Builder {
+        Builder::default()
+    }
+
+    /// The index of the group named `name`, created empty when new.
+    pub fn group(&mut self, name: &str) -> usize {
+        if let Some(&i) = self.index.get(name) {
+            return i;
+        }
+        self.groups.push(Group {
+            name: name.to_string(),
+            ..Group::default()
+        });
+        self.index.insert(name.to_string(), self.groups.len() - 1);
+        self.groups.len() - 1
+    }
+
+    pub fn warn(&mut self, code: Code, message: impl Into<String>) {
+        self.warnings.push(Diagnostic::new(code, None, message));
+    }
+
+    /// The mesh and its checks. Indices are the readers' to check; this
+    /// checks them again so that no reader bug can reach a writer.
+    pub fn finish(self) -> Result<Loaded, Vec<Diagnostic>> {
+        let n = self.nodes.len();
+        for g in &self.groups {
+            let bad = g.triangles.iter().flatten().any(|&v| v as usize >= n)
+                || g.lines.iter().flatten().any(|&v| v as usize >= n)
+                || g.points.iter().any(|&v| v as usize >= n);
+            if bad {
+                return Err(vec![Diagnostic::new(
+                    Code::MeshIndexOutOfRange,
+                    None,
+                    format!("group `{}` refers to a node beyond the {n} nodes", g.name),
+                )]);
+            }
+        }
+        if let Some(i) = self
+            .nodes
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
+        {
+            return Err(vec![Diagnostic::new(
+                Code::MeshNonFinite,
+                None,
+                format!("node {} has a coordinate that is not finite", i + 1),
+            )]);
+        }
+        let mut mesh = Mesh {
+            dimension: 3,
+            nodes: self.nodes,
+            ..Mesh::default()
+        };
+        let mut face_of_group = HashMap::new();
+        for g in self.groups {
+            if !g.triangles.is_empty() {
+                face_of_group.insert(g.name.clone(), mesh.faces.len() as u32);
+                mesh.faces.push(MeshFace {
+                    name: g.name.clone(),
+                    triangles: g.triangles,
+                    boundary: Vec::new(),
+                });
+            }
+            for chain in chains(&g.lines) {
+                mesh.polylines.push(MeshPolyline {
+                    name: g.name.clone(),
+                    nodes: chain,
+                });
+            }
+            if !g.points.is_empty() {
+                mesh.point_sets.push(MeshPolyline {
+                    name: g.name,
+                    nodes: g.points,
+                });
+            }
+        }
+        attach_fragments(&mut mesh, &self.subdomains, &self.fragments, &face_of_group);
+        let report = clean::check(&mesh);
+        let mut warnings = self.warnings;
+        warnings.extend(report.warnings());
+        Ok(Loaded {
+            mesh,
+            warnings,
+            report,
+            binary: None,
+        })
+    }
+}
+
+/// Subdomains and fragments named by the file: each fragment's face is
+/// outward for its subdomain and inward for the other one.
+fn attach_fragments(
+    mesh: &mut Mesh,
+    subdomains: &[(String, Option<String>)],
+    fragments: &[FragmentInfo],
+    face_of_group: &HashMap<String, u32>,
+) {
+    if subdomains.is_empty() {
+        return;
+    }
+    let index: HashMap<&str, u32> = subdomains
+        .iter()
+        .enumerate()
+        .map(|(i, (name, _))| (name.as_str(), i as u32))
+        .collect();
+    mesh.subdomains = subdomains
+        .iter()
+        .map(|(name, material)| MeshSubdomain {
+            name: name.clone(),
+            material: material.clone(),
+            faces: Vec::new(),
+        })
+        .collect();
+    for fr in fragments {
+        let (Some(&face), Some(&sub)) = (
+            face_of_group.get(&fr.group),
+            index.get(fr.subdomain.as_str()),
+        ) else {
+            continue;
+        };
+        let other = fr.other.as_deref().and_then(|o| index.get(o).copied());
+        mesh.subdomains[sub as usize].faces.push((face, true));
+        if let Some(o) = other {
+            mesh.subdomains[o as usize].faces.push((face, false));
+        }
+        mesh.fragments.push(MeshFragment {
+            name: fr.group.clone(),
+            subdomain: sub,
+            other,
+            faces: vec![face],
+            edges: Vec::new(),
+        });
+    }
+}
+
+/// Line segments as polylines: consecutive segments that share a node make
+/// one run (the way the writers emit them).
+pub fn chains(segments: &[[u32; 2]]) -> Vec<Vec<u32>> {
+    let mut out: Vec<Vec<u32>> = Vec::new();
+    for &[a, b] in segments {
+        match out.last_mut() {
+            Some(run) if run.last() == Some(&a) => run.push(b),
+            _ => out.push(vec![a, b]),
+        }
+    }
+    out
+}
+
+/// FxHash's multiply-rotate: the node maps hash millions of keys, where
+/// SipHash's protection against chosen keys is not needed (input files only
+/// choose coordinates, and a slow map is the worst they can cause).
+#[derive(Default, Clone, Copy)]
+pub struct FastHasher(u64);
+
+impl Hasher for FastHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for chunk in bytes.chunks(8) {
+            let mut word = [0u8; 8];
+            word[..chunk.len()].copy_from_slice(chunk);
+            self.write_u64(u64::from_le_bytes(word));
+        }
+    }
+
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+
+    fn write_u32(&mut self, v: u32) {
+        self.write_u64(u64::from(v));
+    }
+}
+
+pub type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<FastHasher>>;
+
+/// Merges nodes with bit-identical coordinates (−0 equals 0), for formats
+/// that repeat a vertex per triangle (STL).
+#[derive(Default)]
+pub struct NodeDedup {
+    map: FastMap<[u64; 3], u32>,
+}
+
+impl NodeDedup {
+    pub fn with_capacity(n: usize) -> NodeDedup {
+        let mut map = FastMap::default();
+        map.reserve(n);
+        NodeDedup { map }
+    }
+
+    pub fn node(&mut self, nodes: &mut Vec<[f64; 3]>, p: [f64; 3]) -> u32 {
+        let key = p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        *self.map.entry(key).or_insert_with(|| {
+            nodes.push(p);
+            (nodes.len() - 1) as u32
+        })
+    }
+}

@@ -1,0 +1,195 @@
+//! How clean a triangle surface is: open edges (one triangle), non-manifold
+//! edges (three or more), edges whose two triangles run the same way
+//! (inconsistent orientation), and degenerate triangles (a repeated node or no
+//! area). Counted for the whole mesh and per face (group), so `inspect` can
+//! say which groups are watertight.
+
+use crate::diag::{Code, Diagnostic};
+use crate::mesh::Mesh;
+
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct EdgeCounts {
+    pub edges: usize,
+    pub open: usize,
+    pub non_manifold: usize,
+    pub inconsistent: usize,
+    pub degenerate: usize,
+}
+
+impl EdgeCounts {
+    /// Closed and 2-manifold with consistent orientation.
+    pub fn watertight(&self) -> bool {
+        self.edges > 0 && self.open == 0 && self.non_manifold == 0 && self.inconsistent == 0
+    }
+}
+
+#[derive(Debug, Clone, Default, PartialEq, Eq)]
+pub struct CleanReport {
+    pub whole: EdgeCounts,
+    /// Per mesh face (group), in face order.
+    pub faces: Vec<EdgeCounts>,
+}
+
+impl CleanReport {
+    /// One warning per kind of problem, with its count.
+    pub fn warnings(&self) -> Vec<Diagnostic> {
+        let c = &self.whole;
+        let mut out = Vec::new();
+        let mut push = |code: Code, n: usize, what: &str, help: &str| {
+            if n > 0 {
+                out.push(Diagnostic::new(code, None, format!("{n} {what}")).with_help(help));
+            }
+        };
+        push(
+            Code::OpenEdges,
+            c.open,
+            "open edges (used by one triangle): the surface has holes or is not closed",
+            "`geomc inspect` lists which groups are open; --weld EPS merges nodes that only nearly coincide",
+        );
+        push(
+            Code::NonManifoldEdges,
+            c.non_manifold,
+            "non-manifold edges (used by three or more triangles)",
+            "solvers that need a closed 2-manifold reject these; separate the surfaces that meet there",
+        );
+        push(
+            Code::MeshInconsistentOrientation,
+            c.inconsistent,
+            "edges whose two triangles are oriented inconsistently",
+            "--normals orients every connected surface consistently (outward when closed)",
+        );
+        push(
+            Code::DegenerateTriangles,
+            c.degenerate,
+            "degenerate triangles (a repeated node or zero area)",
+            "--weld EPS removes triangles that collapse when nearby nodes merge",
+        );
+        out
+    }
+}
+
+/// The checks of a whole mesh and of each face.
+pub fn check(mesh: &Mesh) -> CleanReport {
+    let all: Vec<[u32; 3]> = mesh
+        .faces
+        .iter()
+        .flat_map(|f| f.triangles.iter().copied())
+        .collect();
+    let scale = diagonal(mesh);
+    let whole = counts(&mesh.nodes, &all, scale);
+    drop(all);
+    let faces = if mesh.faces.len() == 1 {
+        vec![whole.clone()]
+    } else {
+        mesh.faces
+            .iter()
+            .map(|f| counts(&mesh.nodes, &f.triangles, scale))
+            .collect()
+    };
+    CleanReport { whole, faces }
+}
+
+fn diagonal(mesh: &Mesh) -> f64 {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in &mesh.nodes {
+        for k in 0..3 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let d: f64 = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    if d.is_finite() { d } else { 0.0 }
+}
+
+/// Edge use counts by sorting packed half-edges: `min << 33 | max << 1 | dir`
+/// (nodes below 2³¹, which any mesh that fits in memory satisfies).
+pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCounts {
+    let mut out = EdgeCounts::default();
+    let area_floor = (scale * scale) * 1e-14;
+    let mut half: Vec<u64> = Vec::with_capacity(triangles.len() * 3);
+    for t in triangles {
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || twice_area(nodes, *t) <= area_floor {
+            out.degenerate += 1;
+        }
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            if a == b {
+                continue;
+            }
+            let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
+            half.push((u64::from(lo) << 33) | (u64::from(hi) << 1) | dir);
+        }
+    }
+    half.sort_unstable();
+    let mut i = 0;
+    while i < half.len() {
+        let key = half[i] >> 1;
+        let mut j = i;
+        let (mut forward, mut backward) = (0usize, 0usize);
+        while j < half.len() && half[j] >> 1 == key {
+            if half[j] & 1 == 0 {
+                forward += 1;
+            } else {
+                backward += 1;
+            }
+            j += 1;
+        }
+        out.edges += 1;
+        match forward + backward {
+            1 => out.open += 1,
+            2 => {
+                if forward != 1 {
+                    out.inconsistent += 1;
+                }
+            }
+            _ => out.non_manifold += 1,
+        }
+        i = j;
+    }
+    out
+}
+
+fn twice_area(nodes: &[[f64; 3]], [a, b, c]: [u32; 3]) -> f64 {
+    let (Some(p), Some(q), Some(r)) = (
+        nodes.get(a as usize),
+        nodes.get(b as usize),
+        nodes.get(c as usize),
+    ) else {
+        return 0.0;
+    };
+    let u = [q[0] - p[0], q[1] - p[1], q[2] - p[2]];
+    let v = [r[0] - p[0], r[1] - p[1], r[2] - p[2]];
+    let n = [
+        u[1] * v[2] - u[2] * v[1],
+        u[2] * v[0] - u[0] * v[2],
+        u[0] * v[1] - u[1] * v[0],
+    ];
+    (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tetrahedron_is_watertight_and_a_flipped_face_is_not_consistent() {
+        let nodes = [
+            [0.0, 0.0, 0.0],
+            [1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, 1.0],
+        ];
+        let mut tris = vec![[0, 2, 1], [0, 1, 3], [1, 2, 3], [0, 3, 2]];
+        let c = counts(&nodes, &tris, 1.7);
+        assert_eq!((c.edges, c.open, c.inconsistent), (6, 0, 0));
+        assert!(c.watertight());
+        tris[0] = [0, 1, 2];
+        let c = counts(&nodes, &tris, 1.7);
+        assert_eq!(c.inconsistent, 3);
+        let c = counts(&nodes, &tris[..3], 1.7);
+        assert_eq!(c.open, 3);
+        let c = counts(&nodes, &[[0, 1, 1], [0, 1, 2]], 1.7);
+        assert_eq!(c.degenerate, 1);
+    }
+}

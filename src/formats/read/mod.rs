@@ -1,0 +1,204 @@
+//! Mesh readers: STL (ASCII and binary, told apart by content), Wavefront OBJ,
+//! glTF 2.0 and GLB, Gmsh MSH 2.2 and 4.1 (ASCII and binary), VTK `.vtu` and
+//! geomc's `.frag.xml` (with the mesh file it names) into the mesh IR.
+//!
+//! [`load_mesh`] picks a reader from the file's content and extension and
+//! returns the mesh with warnings about what the IR could not hold (volume
+//! cells, quads split into triangles) and how clean the surface is (open and
+//! non-manifold edges, inconsistent orientation, degenerate triangles).
+//! Bad input is a list of error diagnostics: text formats carry a byte span
+//! (rendered as line:column), binary ones name the byte offset in the
+//! message. Readers never panic and never allocate more than the file's
+//! size justifies.
+
+mod base64;
+pub mod build;
+pub mod clean;
+mod frag;
+mod gltf;
+mod msh;
+mod obj;
+mod stl;
+mod text;
+mod vtu;
+
+pub use build::Builder;
+
+use crate::diag::{Code, Diagnostic};
+use crate::mesh::Mesh;
+use crate::span::Span;
+use std::path::Path;
+
+/// The formats [`load_mesh`] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord)]
+pub enum ReadFormat {
+    Stl,
+    Obj,
+    Gltf,
+    Glb,
+    Msh,
+    Vtu,
+    FragXml,
+}
+
+impl ReadFormat {
+    pub const ALL: [ReadFormat; 7] = [
+        ReadFormat::Stl,
+        ReadFormat::Obj,
+        ReadFormat::Gltf,
+        ReadFormat::Glb,
+        ReadFormat::Msh,
+        ReadFormat::Vtu,
+        ReadFormat::FragXml,
+    ];
+
+    /// The name used by `--from` and in messages (also the file ending).
+    pub fn name(self) -> &'static str {
+        match self {
+            ReadFormat::Stl => "stl",
+            ReadFormat::Obj => "obj",
+            ReadFormat::Gltf => "gltf",
+            ReadFormat::Glb => "glb",
+            ReadFormat::Msh => "msh",
+            ReadFormat::Vtu => "vtu",
+            ReadFormat::FragXml => "frag.xml",
+        }
+    }
+
+    pub fn parse(name: &str) -> Option<ReadFormat> {
+        let name = name.trim_start_matches('.').to_ascii_lowercase();
+        ReadFormat::ALL.into_iter().find(|f| f.name() == name)
+    }
+
+    /// The format a path's ending names (case-insensitive).
+    pub fn from_path(path: &Path) -> Option<ReadFormat> {
+        let name = path.file_name()?.to_str()?.to_ascii_lowercase();
+        if name.ends_with(".frag.xml") {
+            return Some(ReadFormat::FragXml);
+        }
+        let ext = name.rsplit_once('.')?.1;
+        ReadFormat::ALL
+            .into_iter()
+            .find(|f| f.name() == ext && *f != ReadFormat::FragXml)
+    }
+}
+
+/// A mesh read from a file.
+#[derive(Debug, Clone, Default)]
+pub struct Loaded {
+    pub mesh: Mesh,
+    /// Warnings (never errors): what the mesh IR could not hold, and how
+    /// clean the surface is.
+    pub warnings: Vec<Diagnostic>,
+    /// How the surface checks came out, for `inspect`.
+    pub report: clean::CleanReport,
+    /// Set for the formats that have two encodings: whether the file was binary.
+    pub binary: Option<bool>,
+}
+
+/// Reads a mesh file; the format comes from its content where that is
+/// unambiguous (GLB, binary and ASCII STL, MSH, VTU) and else from its ending.
+pub fn load_mesh(path: &Path) -> Result<Loaded, Vec<Diagnostic>> {
+    load_mesh_as(path, None)
+}
+
+/// [`load_mesh`] with the format forced (`--from`).
+pub fn load_mesh_as(path: &Path, format: Option<ReadFormat>) -> Result<Loaded, Vec<Diagnostic>> {
+    let bytes = std::fs::read(path).map_err(|e| {
+        vec![Diagnostic::new(
+            Code::MeshReadFailed,
+            None,
+            format!("cannot read {}: {e}", path.display()),
+        )]
+    })?;
+    let format = match format.or_else(|| detect(path, &bytes)) {
+        Some(f) => f,
+        None => {
+            return Err(vec![
+                Diagnostic::new(
+                    Code::UnknownMeshFormat,
+                    None,
+                    format!(
+                        "cannot tell the mesh format of {} from its ending or content",
+                        path.display()
+                    ),
+                )
+                .with_help("name the format with --from (stl, obj, gltf, glb, msh, vtu, frag.xml)"),
+            ]);
+        }
+    };
+    if format == ReadFormat::FragXml {
+        return frag::load(path, &bytes);
+    }
+    let folder = path.parent().unwrap_or(Path::new(""));
+    load_bytes(format, &bytes, folder)
+}
+
+/// Reads a mesh from bytes already in memory. `folder` is where relative
+/// references (a `.gltf`'s buffer files) are looked up.
+pub fn load_bytes(
+    format: ReadFormat,
+    bytes: &[u8],
+    folder: &Path,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    let (builder, binary) = match format {
+        ReadFormat::Stl => stl::read(bytes)?,
+        ReadFormat::Obj => (obj::read(bytes)?, None),
+        ReadFormat::Gltf | ReadFormat::Glb => (gltf::read(bytes, folder)?, None),
+        ReadFormat::Msh => msh::read(bytes)?,
+        ReadFormat::Vtu => vtu::read(bytes)?,
+        ReadFormat::FragXml => {
+            return Err(vec![Diagnostic::new(
+                Code::UnknownMeshFormat,
+                None,
+                "a .frag.xml describes a mesh file: read it from its path so the mesh file can be found",
+            )]);
+        }
+    };
+    let mut loaded = builder.finish()?;
+    loaded.binary = binary;
+    Ok(loaded)
+}
+
+/// The format by content first, then by ending.
+pub fn detect(path: &Path, bytes: &[u8]) -> Option<ReadFormat> {
+    if bytes.starts_with(b"glTF") {
+        return Some(ReadFormat::Glb);
+    }
+    let head = &bytes[..bytes.len().min(512)];
+    let head_text = String::from_utf8_lossy(head);
+    let trimmed = head_text.trim_start();
+    if trimmed.starts_with("$MeshFormat") {
+        return Some(ReadFormat::Msh);
+    }
+    let by_name = ReadFormat::from_path(path);
+    if by_name == Some(ReadFormat::FragXml) {
+        return by_name;
+    }
+    if trimmed.starts_with("<?xml") || trimmed.starts_with("<VTKFile") {
+        if head_text.contains("<VTKFile") {
+            return Some(ReadFormat::Vtu);
+        }
+        return by_name;
+    }
+    if stl::looks_like_stl(bytes) {
+        return Some(ReadFormat::Stl);
+    }
+    by_name
+}
+
+/// An error at a byte range of a text file.
+pub(crate) fn error_at(
+    code: Code,
+    start: usize,
+    end: usize,
+    message: impl Into<String>,
+) -> Diagnostic {
+    Diagnostic::new(code, Span::new(start, end), message)
+}
+
+/// An error at a byte offset of a binary file: no span (the renderer would
+/// look for lines), the offset in the message.
+pub(crate) fn error_at_byte(code: Code, offset: usize, message: impl Into<String>) -> Diagnostic {
+    Diagnostic::new(code, None, format!("at byte {offset}: {}", message.into()))
+}

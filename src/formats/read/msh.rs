@@ -1,0 +1,795 @@
+//! Gmsh MSH 2.2 and 4.1, ASCII or binary (little-endian, 8-byte sizes).
+//! Elements are grouped by physical name: in 4.1 through their entity's
+//! physical tags (`$Entities`), in 2.2 by their first tag; elements in no
+//! physical group are grouped by entity (`surface 3`). Triangles (also the
+//! corners of higher-order ones), lines and points are kept; quadrangles are
+//! split into two triangles and volume cells are not kept (the mesh IR holds
+//! surfaces), each with a warning and counts. Sections geomc does not use
+//! (`$NodeData`, `$Periodic`, …) are skipped.
+
+use super::build::{Builder, FastMap};
+use super::text::{Scanner, Token, syntax};
+use super::{error_at, error_at_byte};
+use crate::diag::{Code, Diagnostic};
+use std::collections::BTreeMap;
+
+pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
+    let mut r = Reader {
+        s: Scanner::new(bytes),
+        binary: false,
+        version: Version::V41,
+        physical_names: BTreeMap::new(),
+        entity_physicals: BTreeMap::new(),
+        nodes: NodeIndex::default(),
+        b: Builder::new(),
+        kinds: BTreeMap::new(),
+        multi_physical: 0,
+        group_of: FastMap::default(),
+        section_closed: true,
+    };
+    r.read().map_err(|d| vec![d])?;
+    let binary = r.binary;
+    Ok((r.finish(), Some(binary)))
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Version {
+    V22,
+    V41,
+}
+
+/// Node tags to node indices: a table when tags are dense, a map otherwise.
+#[derive(Default)]
+struct NodeIndex {
+    dense: Vec<u32>,
+    sparse: FastMap<u64, u32>,
+}
+
+const NONE: u32 = u32::MAX;
+
+impl NodeIndex {
+    fn insert(&mut self, tag: u64, index: u32, dense_limit: u64) -> bool {
+        if tag < dense_limit {
+            let t = tag as usize;
+            if t >= self.dense.len() {
+                self.dense.resize(t + 1, NONE);
+            }
+            let old = std::mem::replace(&mut self.dense[t], index);
+            old == NONE
+        } else {
+            self.sparse.insert(tag, index).is_none()
+        }
+    }
+
+    fn get(&self, tag: u64) -> Option<u32> {
+        match self.dense.get(tag as usize) {
+            Some(&i) if i != NONE => Some(i),
+            _ => self.sparse.get(&tag).copied(),
+        }
+    }
+}
+
+/// What an element type is, by Gmsh's numbering.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Kind {
+    Point,
+    Line,
+    Triangle,
+    Quad,
+    Volume(&'static str),
+}
+
+/// (number of nodes, kind, name) of a Gmsh element type.
+fn element_type(t: i64) -> Option<(usize, Kind, &'static str)> {
+    Some(match t {
+        1 => (2, Kind::Line, "line"),
+        2 => (3, Kind::Triangle, "triangle"),
+        3 => (4, Kind::Quad, "quadrangle"),
+        4 => (4, Kind::Volume("tetrahedra"), "tetrahedron"),
+        5 => (8, Kind::Volume("hexahedra"), "hexahedron"),
+        6 => (6, Kind::Volume("prisms"), "prism"),
+        7 => (5, Kind::Volume("pyramids"), "pyramid"),
+        8 => (3, Kind::Line, "3-node line"),
+        9 => (6, Kind::Triangle, "6-node triangle"),
+        10 => (9, Kind::Quad, "9-node quadrangle"),
+        11 => (10, Kind::Volume("tetrahedra"), "10-node tetrahedron"),
+        12 => (27, Kind::Volume("hexahedra"), "27-node hexahedron"),
+        13 => (18, Kind::Volume("prisms"), "18-node prism"),
+        14 => (14, Kind::Volume("pyramids"), "14-node pyramid"),
+        15 => (1, Kind::Point, "point"),
+        16 => (8, Kind::Quad, "8-node quadrangle"),
+        17 => (20, Kind::Volume("hexahedra"), "20-node hexahedron"),
+        18 => (15, Kind::Volume("prisms"), "15-node prism"),
+        19 => (13, Kind::Volume("pyramids"), "13-node pyramid"),
+        20 => (9, Kind::Triangle, "9-node triangle"),
+        21 => (10, Kind::Triangle, "10-node triangle"),
+        26 => (4, Kind::Line, "4-node line"),
+        27 => (5, Kind::Line, "5-node line"),
+        28 => (6, Kind::Line, "6-node line"),
+        29 => (20, Kind::Volume("tetrahedra"), "20-node tetrahedron"),
+        _ => return None,
+    })
+}
+
+struct Reader<'a> {
+    s: Scanner<'a>,
+    binary: bool,
+    version: Version,
+    physical_names: BTreeMap<(i32, i32), String>,
+    /// (dim, entity tag) → its physical tags.
+    entity_physicals: BTreeMap<(i32, i32), Vec<i32>>,
+    nodes: NodeIndex,
+    b: Builder,
+    /// Element counts by what happened to them: (kind name, count).
+    kinds: BTreeMap<&'static str, usize>,
+    multi_physical: usize,
+    /// (dim, physical or −entity) → group index, filled lazily.
+    group_of: FastMap<(i32, i64), usize>,
+    /// Whether the current section's `$End…` line is in the file: when it
+    /// is not, a count the data cannot satisfy means the file was cut short.
+    section_closed: bool,
+}
+
+impl<'a> Reader<'a> {
+    fn read(&mut self) -> Result<(), Diagnostic> {
+        self.header()?;
+        let mut seen_nodes = false;
+        while let Some(t) = self.s.next_token() {
+            if t.text.first() != Some(&b'$') {
+                return Err(syntax(t, "a section such as `$Nodes`"));
+            }
+            let name = t.lossy()[1..].to_string();
+            let end = format!("$End{name}");
+            self.section_closed = self.s.bytes[self.s.pos..]
+                .windows(end.len())
+                .any(|w| w == end.as_bytes());
+            self.section_start();
+            match name.as_str() {
+                "PhysicalNames" => self.physical_names()?,
+                "Entities" if self.version == Version::V41 => self.entities()?,
+                "Nodes" => {
+                    match self.version {
+                        Version::V41 => self.nodes41()?,
+                        Version::V22 => self.nodes22()?,
+                    }
+                    seen_nodes = true;
+                }
+                "Elements" => {
+                    if !seen_nodes {
+                        return Err(error_at(
+                            Code::MeshSyntax,
+                            t.start,
+                            t.end(),
+                            "`$Elements` comes before `$Nodes`",
+                        ));
+                    }
+                    match self.version {
+                        Version::V41 => self.elements41()?,
+                        Version::V22 => self.elements22()?,
+                    }
+                }
+                _ => {
+                    self.skip_section(&name, t)?;
+                    continue;
+                }
+            }
+            self.end(&name)?;
+        }
+        Ok(())
+    }
+
+    fn header(&mut self) -> Result<(), Diagnostic> {
+        self.s.keyword("$MeshFormat")?;
+        let v = self.s.expect("the MSH version")?;
+        self.version = match v.text {
+            b"4.1" => Version::V41,
+            b"2.2" | b"2.1" | b"2" | b"2.0" => Version::V22,
+            _ => {
+                return Err(error_at(
+                    Code::MeshUnsupportedVersion,
+                    v.start,
+                    v.end(),
+                    format!(
+                        "MSH version {} is not read: geomc reads 2.2 and 4.1",
+                        v.lossy()
+                    ),
+                )
+                .with_help("save the mesh from Gmsh as version 4.1 or 2.2 (Mesh.MshFileVersion)"));
+            }
+        };
+        let ft = self.s.expect("the file type (0 ASCII, 1 binary)")?;
+        self.binary = match ft.text {
+            b"0" => false,
+            b"1" => true,
+            _ => return Err(syntax(ft, "0 (ASCII) or 1 (binary)")),
+        };
+        let ds = self.s.expect("the data size")?;
+        if self.binary && ds.text != b"8" {
+            return Err(error_at(
+                Code::MeshUnsupportedVersion,
+                ds.start,
+                ds.end(),
+                format!(
+                    "binary MSH with {}-byte sizes: geomc reads 8-byte sizes",
+                    ds.lossy()
+                ),
+            ));
+        }
+        if self.binary {
+            self.section_start();
+            let at = self.here();
+            let one = self.raw_i32()?;
+            if one != 1 {
+                return Err(error_at_byte(
+                    Code::MeshUnsupportedVersion,
+                    at,
+                    "the binary MSH is big-endian (its check integer is not 1 in little-endian): geomc reads little-endian files",
+                ));
+            }
+        }
+        self.s.keyword("$EndMeshFormat")?;
+        Ok(())
+    }
+
+    /// After a section's name line: skips the one line end before binary data.
+    fn section_start(&mut self) {
+        let b = self.s.bytes;
+        while self.s.pos < b.len() && (b[self.s.pos] == b' ' || b[self.s.pos] == b'\r') {
+            self.s.pos += 1;
+        }
+        if self.s.pos < b.len() && b[self.s.pos] == b'\n' {
+            self.s.pos += 1;
+        }
+    }
+
+    fn end(&mut self, name: &str) -> Result<(), Diagnostic> {
+        self.s.keyword(&format!("$End{name}")).map(|_| ())
+    }
+
+    fn skip_section(&mut self, name: &str, start: Token) -> Result<(), Diagnostic> {
+        let end = format!("$End{name}");
+        let rest = &self.s.bytes[self.s.pos..];
+        match rest.windows(end.len()).position(|w| w == end.as_bytes()) {
+            Some(i) => {
+                self.s.pos += i + end.len();
+                Ok(())
+            }
+            None => Err(error_at(
+                Code::MeshTruncated,
+                start.start,
+                start.end(),
+                format!("section `${name}` has no `{end}`"),
+            )),
+        }
+    }
+
+    // ---- values: ASCII tokens or little-endian binary ----
+
+    fn err(&self, code: Code, at: usize, len: usize, message: String) -> Diagnostic {
+        if self.binary {
+            error_at_byte(code, at, message)
+        } else {
+            error_at(code, at, at + len, message)
+        }
+    }
+
+    fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], Diagnostic> {
+        let b = self.s.bytes;
+        if self.s.pos + n > b.len() {
+            return Err(error_at_byte(
+                Code::MeshTruncated,
+                b.len(),
+                format!("the file ends where {what} was expected"),
+            )
+            .with_help(
+                "the file is truncated: write it again, or check that the copy is complete",
+            ));
+        }
+        let out = &b[self.s.pos..self.s.pos + n];
+        self.s.pos += n;
+        Ok(out)
+    }
+
+    /// The offset of the next value (in ASCII, past the whitespace before it).
+    fn here(&mut self) -> usize {
+        if !self.binary {
+            let b = self.s.bytes;
+            while self.s.pos < b.len() && b[self.s.pos].is_ascii_whitespace() {
+                self.s.pos += 1;
+            }
+        }
+        self.s.pos
+    }
+
+    fn raw_i32(&mut self) -> Result<i32, Diagnostic> {
+        let b = self.take(4, "a 4-byte integer")?;
+        Ok(i32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+    }
+
+    /// An `int` (tags, dimensions, types).
+    fn int(&mut self, what: &str) -> Result<i64, Diagnostic> {
+        if self.binary {
+            Ok(i64::from(self.raw_i32()?))
+        } else {
+            self.s.integer(what)
+        }
+    }
+
+    /// A `size_t` in 4.1 (counts, node and element tags).
+    fn size(&mut self, what: &str) -> Result<u64, Diagnostic> {
+        if self.binary {
+            let b = self.take(8, what)?;
+            let mut a = [0u8; 8];
+            a.copy_from_slice(b);
+            Ok(u64::from_le_bytes(a))
+        } else {
+            self.s.unsigned(what)
+        }
+    }
+
+    fn real(&mut self, what: &str) -> Result<f64, Diagnostic> {
+        if self.binary {
+            let at = self.here();
+            let b = self.take(8, what)?;
+            let mut a = [0u8; 8];
+            a.copy_from_slice(b);
+            let v = f64::from_le_bytes(a);
+            if !v.is_finite() {
+                return Err(error_at_byte(
+                    Code::MeshNonFinite,
+                    at,
+                    format!("{what} is {v}, not a finite number"),
+                ));
+            }
+            Ok(v)
+        } else {
+            self.s.real(what)
+        }
+    }
+
+    /// Refuses a count that the rest of the file cannot hold, before any
+    /// allocation: each item takes at least `min_bytes`.
+    fn plausible(
+        &self,
+        n: u64,
+        min_bytes: u64,
+        what: &str,
+        at: usize,
+    ) -> Result<usize, Diagnostic> {
+        let left = (self.s.bytes.len() - self.s.pos.min(self.s.bytes.len())) as u64;
+        if n.saturating_mul(min_bytes) > left + 1 {
+            let code = if self.section_closed {
+                Code::MeshCountMismatch
+            } else {
+                Code::MeshTruncated
+            };
+            let message = if self.section_closed {
+                format!(
+                    "the file says {n} {what}, but only {left} bytes follow: the count does not match the data"
+                )
+            } else {
+                format!("the file says {n} {what}, but ends {left} bytes later: it is truncated")
+            };
+            return Err(self.err(code, at, 1, message));
+        }
+        Ok(n as usize)
+    }
+
+    // ---- sections ----
+
+    fn physical_names(&mut self) -> Result<(), Diagnostic> {
+        let at = self.here();
+        let n = self.s.unsigned("the number of physical names")?;
+        let n = self.plausible(n, 6, "physical names", at)?;
+        for _ in 0..n {
+            let dim = self.s.integer("a physical group's dimension")? as i32;
+            let tag = self.s.integer("a physical group's tag")? as i32;
+            let name = self.s.rest_of_line().lossy();
+            let name = name.trim().trim_matches('"').to_string();
+            self.physical_names.insert((dim, tag), name);
+        }
+        Ok(())
+    }
+
+    fn entities(&mut self) -> Result<(), Diagnostic> {
+        let mut counts = [0u64; 4];
+        for c in &mut counts {
+            *c = self.size("an entity count")?;
+        }
+        for (dim, &n) in counts.iter().enumerate() {
+            let at = self.here();
+            let n = self.plausible(n, 8, "entities", at)?;
+            for _ in 0..n {
+                let tag = self.int("an entity tag")? as i32;
+                let reals = if dim == 0 { 3 } else { 6 };
+                for _ in 0..reals {
+                    self.real("an entity bounding-box coordinate")?;
+                }
+                let at = self.here();
+                let np = self.size("the number of physical tags")?;
+                let np = self.plausible(np, 1, "physical tags", at)?;
+                let mut physicals = Vec::with_capacity(np);
+                for _ in 0..np {
+                    physicals.push(self.int("a physical tag")? as i32);
+                }
+                if dim > 0 {
+                    let at = self.here();
+                    let nb = self.size("the number of bounding entities")?;
+                    let nb = self.plausible(nb, 1, "bounding entities", at)?;
+                    for _ in 0..nb {
+                        self.int("a bounding entity tag")?;
+                    }
+                }
+                self.entity_physicals.insert((dim as i32, tag), physicals);
+            }
+        }
+        Ok(())
+    }
+
+    fn add_node(
+        &mut self,
+        tag: u64,
+        at: usize,
+        p: [f64; 3],
+        dense_limit: u64,
+    ) -> Result<(), Diagnostic> {
+        let index = self.b.nodes.len() as u32;
+        if !self.nodes.insert(tag, index, dense_limit) {
+            return Err(self.err(
+                Code::MeshCountMismatch,
+                at,
+                1,
+                format!("node tag {tag} is given twice"),
+            ));
+        }
+        self.b.nodes.push(p);
+        Ok(())
+    }
+
+    fn nodes41(&mut self) -> Result<(), Diagnostic> {
+        let blocks = self.size("the number of node blocks")?;
+        let at = self.here();
+        let total = self.size("the number of nodes")?;
+        let _min = self.size("the smallest node tag")?;
+        let max = self.size("the largest node tag")?;
+        let per_node = if self.binary { 32 } else { 8 };
+        let total = self.plausible(total, per_node, "nodes", at)?;
+        let dense_limit = max.min(4 * total as u64 + 1024) + 1;
+        self.b.nodes.reserve(total);
+        let at = self.here();
+        let blocks = self.plausible(blocks, 8, "node blocks", at)?;
+        let mut tags: Vec<(u64, usize)> = Vec::new();
+        let mut read = 0usize;
+        for _ in 0..blocks {
+            let _dim = self.int("a node block's entity dimension")?;
+            let _tag = self.int("a node block's entity tag")?;
+            let parametric = self.int("the parametric flag")?;
+            let at = self.here();
+            let n = self.size("the number of nodes in a block")?;
+            let n = self.plausible(n, per_node, "nodes in a block", at)?;
+            tags.clear();
+            for _ in 0..n {
+                let at = self.here();
+                tags.push((self.size("a node tag")?, at));
+            }
+            let extra = if parametric != 0 {
+                _dim.clamp(0, 3) as usize
+            } else {
+                0
+            };
+            for &(tag, at) in &tags {
+                let p = [
+                    self.real("a node coordinate")?,
+                    self.real("a node coordinate")?,
+                    self.real("a node coordinate")?,
+                ];
+                for _ in 0..extra {
+                    self.real("a parametric coordinate")?;
+                }
+                self.add_node(tag, at, p, dense_limit)?;
+            }
+            read += n;
+        }
+        if read != total {
+            return Err(self.err(
+                Code::MeshCountMismatch,
+                self.s.pos,
+                1,
+                format!("`$Nodes` says {total} nodes, its blocks hold {read}"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn nodes22(&mut self) -> Result<(), Diagnostic> {
+        let at = self.here();
+        let n = self.s.unsigned("the number of nodes")?;
+        let per_node = if self.binary { 28 } else { 8 };
+        let n = self.plausible(n, per_node, "nodes", at)?;
+        self.b.nodes.reserve(n);
+        let dense_limit = 4 * n as u64 + 1024;
+        if self.binary {
+            self.section_start();
+        }
+        for _ in 0..n {
+            let at = self.here();
+            let tag = self.int("a node tag")?;
+            if tag < 0 {
+                return Err(self.err(
+                    Code::MeshIndexOutOfRange,
+                    at,
+                    1,
+                    format!("node tag {tag} is negative"),
+                ));
+            }
+            let p = [
+                self.real("a node coordinate")?,
+                self.real("a node coordinate")?,
+                self.real("a node coordinate")?,
+            ];
+            self.add_node(tag as u64, at, p, dense_limit)?;
+        }
+        Ok(())
+    }
+
+    fn node(&self, tag: u64, at: usize) -> Result<u32, Diagnostic> {
+        self.nodes.get(tag).ok_or_else(|| {
+            self.err(
+                Code::MeshIndexOutOfRange,
+                at,
+                1,
+                format!("an element refers to node {tag}, which `$Nodes` does not define"),
+            )
+        })
+    }
+
+    fn element_kind(&self, t: i64, at: usize) -> Result<(usize, Kind, &'static str), Diagnostic> {
+        element_type(t).ok_or_else(|| {
+            self.err(
+                Code::MeshUnsupportedElement,
+                at,
+                1,
+                format!("element type {t} is not one geomc knows (Gmsh types 1–21, 26–29)"),
+            )
+            .with_help("points, lines, triangles, quadrangles and the volume cells are read; save the mesh with those")
+        })
+    }
+
+    /// The group of an element: its physical group, else its entity.
+    fn group_for(&mut self, dim: i32, physical: Option<i32>, entity: i32) -> usize {
+        let key = match physical {
+            Some(p) => (dim, i64::from(p)),
+            None => (dim, -1 - i64::from(entity)),
+        };
+        if let Some(&g) = self.group_of.get(&key) {
+            return g;
+        }
+        let name = match physical {
+            Some(p) => self
+                .physical_names
+                .get(&(dim, p))
+                .cloned()
+                .unwrap_or_else(|| format!("physical {dim}:{p}")),
+            None => format!(
+                "{} {entity}",
+                ["point", "curve", "surface", "volume"][dim.clamp(0, 3) as usize]
+            ),
+        };
+        let g = self.b.group(&name);
+        self.group_of.insert(key, g);
+        g
+    }
+
+    fn add_element(&mut self, kind: Kind, name: &'static str, corners: &[u32], group: usize) {
+        let g = &mut self.b.groups[group];
+        match kind {
+            Kind::Point => g.points.push(corners[0]),
+            Kind::Line => g.lines.push([corners[0], corners[1]]),
+            Kind::Triangle => g.triangles.push([corners[0], corners[1], corners[2]]),
+            Kind::Quad => {
+                g.triangles.push([corners[0], corners[1], corners[2]]);
+                g.triangles.push([corners[0], corners[2], corners[3]]);
+            }
+            Kind::Volume(_) => {}
+        }
+        let high_order = matches!(
+            (kind, corners.len()),
+            (Kind::Line, 3..) | (Kind::Triangle, 4..) | (Kind::Quad, 5..)
+        );
+        if matches!(kind, Kind::Volume(_) | Kind::Quad) || high_order {
+            *self.kinds.entry(name).or_default() += 1;
+        }
+    }
+
+    fn elements41(&mut self) -> Result<(), Diagnostic> {
+        let blocks = self.size("the number of element blocks")?;
+        let at = self.here();
+        let total = self.size("the number of elements")?;
+        self.size("the smallest element tag")?;
+        self.size("the largest element tag")?;
+        let per = if self.binary { 16 } else { 4 };
+        let total = self.plausible(total, per, "elements", at)?;
+        let at = self.here();
+        let blocks = self.plausible(blocks, 8, "element blocks", at)?;
+        let mut read = 0usize;
+        let mut corners: Vec<u32> = Vec::new();
+        for _ in 0..blocks {
+            let dim = self.int("an element block's dimension")? as i32;
+            let entity = self.int("an element block's entity tag")? as i32;
+            let at = self.here();
+            let t = self.int("an element type")?;
+            let (k, kind, name) = self.element_kind(t, at)?;
+            let at = self.here();
+            let n = self.size("the number of elements in a block")?;
+            let n = self.plausible(n, per * k as u64 / 2, "elements in a block", at)?;
+            let physicals = self
+                .entity_physicals
+                .get(&(dim, entity))
+                .cloned()
+                .unwrap_or_default();
+            if physicals.len() > 1 {
+                self.multi_physical += n;
+            }
+            let group = self.group_for(dim, physicals.first().copied(), entity);
+            if let Kind::Triangle | Kind::Quad = kind {
+                self.b.groups[group]
+                    .triangles
+                    .reserve(n * if kind == Kind::Quad { 2 } else { 1 });
+            }
+            for _ in 0..n {
+                self.size("an element tag")?;
+                corners.clear();
+                for _ in 0..k {
+                    let at = self.here();
+                    let tag = self.size("an element's node tag")?;
+                    corners.push(self.node(tag, at)?);
+                }
+                self.add_element(kind, name, &corners, group);
+            }
+            read += n;
+        }
+        if read != total {
+            return Err(self.err(
+                Code::MeshCountMismatch,
+                self.s.pos,
+                1,
+                format!("`$Elements` says {total} elements, its blocks hold {read}"),
+            ));
+        }
+        Ok(())
+    }
+
+    fn elements22(&mut self) -> Result<(), Diagnostic> {
+        let at = self.here();
+        let total = self.s.unsigned("the number of elements")?;
+        let per = if self.binary { 12 } else { 6 };
+        let total = self.plausible(total, per, "elements", at)?;
+        let mut corners: Vec<u32> = Vec::new();
+        let mut tags: Vec<i64> = Vec::new();
+        if self.binary {
+            self.section_start();
+            let mut read = 0usize;
+            while read < total {
+                let at = self.here();
+                let t = self.int("an element type")?;
+                let (k, kind, name) = self.element_kind(t, at)?;
+                let at = self.here();
+                let n = self.int("the number of elements in a block")?;
+                let nt = self.int("the number of tags")?;
+                if n <= 0 || n as usize > total - read || !(0..=64).contains(&nt) {
+                    return Err(self.err(
+                        Code::MeshCountMismatch,
+                        at,
+                        1,
+                        format!("an element block of {n} elements with {nt} tags does not fit the {total} elements announced"),
+                    ));
+                }
+                for _ in 0..n {
+                    self.int("an element tag")?;
+                    tags.clear();
+                    for _ in 0..nt {
+                        tags.push(self.int("an element's tag")?);
+                    }
+                    corners.clear();
+                    for _ in 0..k {
+                        let at = self.here();
+                        let tag = self.int("an element's node")?;
+                        corners.push(self.node(tag.max(0) as u64, at)?);
+                    }
+                    self.element22(kind, name, &tags, &corners);
+                }
+                read += n as usize;
+            }
+            return Ok(());
+        }
+        for _ in 0..total {
+            self.s.integer("an element tag")?;
+            let tt = self.s.expect("an element type")?;
+            let t = super::text::integer(tt, "an element type")?;
+            let (k, kind, name) = self.element_kind(t, tt.start)?;
+            let nt = self.s.unsigned("the number of tags")?;
+            tags.clear();
+            for _ in 0..nt.min(64) {
+                tags.push(self.s.integer("an element's tag")?);
+            }
+            corners.clear();
+            for _ in 0..k {
+                let tok = self.s.expect("an element's node")?;
+                let tag = super::text::unsigned(tok, "an element's node")?;
+                corners.push(self.node(tag, tok.start)?);
+            }
+            self.element22(kind, name, &tags, &corners);
+        }
+        Ok(())
+    }
+
+    fn element22(&mut self, kind: Kind, name: &'static str, tags: &[i64], corners: &[u32]) {
+        let dim = match kind {
+            Kind::Point => 0,
+            Kind::Line => 1,
+            Kind::Triangle | Kind::Quad => 2,
+            Kind::Volume(_) => 3,
+        };
+        let physical = tags.first().copied().filter(|&p| p != 0).map(|p| p as i32);
+        let entity = tags.get(1).copied().unwrap_or(0) as i32;
+        let group = self.group_for(dim, physical, entity);
+        self.add_element(kind, name, corners, group);
+    }
+
+    fn finish(mut self) -> Builder {
+        let mut volumes: BTreeMap<&str, usize> = BTreeMap::new();
+        let mut quads = 0;
+        let mut high = Vec::new();
+        for (&name, &n) in &self.kinds {
+            let kind = (1..=29)
+                .filter_map(element_type)
+                .find(|e| e.2 == name)
+                .map(|e| e.1);
+            match kind {
+                Some(Kind::Volume(plural)) => *volumes.entry(plural).or_default() += n,
+                Some(Kind::Quad) => {
+                    quads += n;
+                    if name != "quadrangle" {
+                        high.push(format!("{n} {name}s"));
+                    }
+                }
+                _ => high.push(format!("{n} {name}s")),
+            }
+        }
+        if !volumes.is_empty() {
+            let list: Vec<String> = volumes.iter().map(|(k, n)| format!("{n} {k}")).collect();
+            self.b.warn(
+                Code::InputNotCarried,
+                format!(
+                    "volume cells are not kept (geomc converts surface meshes): {}",
+                    list.join(", ")
+                ),
+            );
+        }
+        if quads > 0 {
+            self.b.warn(
+                Code::ElementsConverted,
+                format!("{quads} quadrangles split into two triangles each"),
+            );
+        }
+        if !high.is_empty() {
+            self.b.warn(
+                Code::ElementsConverted,
+                format!(
+                    "higher-order elements reduced to their corner nodes: {}",
+                    high.join(", ")
+                ),
+            );
+        }
+        if self.multi_physical > 0 {
+            self.b.warn(
+                Code::InputNotCarried,
+                format!(
+                    "{} elements belong to several physical groups: each is kept in its first group only",
+                    self.multi_physical
+                ),
+            );
+        }
+        self.b
+    }
+}

@@ -1,0 +1,576 @@
+//! VTK XML unstructured grids (`.vtu`): data arrays in ASCII, or inline
+//! base64 binary with UInt32 or UInt64 headers, zlib-compressed or not.
+//! Groups come from cell data: geomc's own `fragment_id`, else `face_id`,
+//! `edge_id`, `polyline_id`, `point_set_id` (named by its FieldData), meshio's
+//! `gmsh:physical`, or the first integer cell array; cells without one are
+//! group `vtu`. Vertices, lines, poly-lines, triangles, strips, polygons and
+//! quads are kept (the last three split into triangles); volume cells are
+//! not kept, with a warning and counts.
+
+use super::build::Builder;
+use super::{base64, error_at};
+use crate::diag::{Code, Diagnostic};
+use crate::span::{SourceFile, Span};
+use crate::syntax::{self, Element, Limits};
+use std::collections::BTreeMap;
+use std::io::Read;
+
+/// Cell data arrays that name groups, best first.
+const GROUP_ARRAYS: [&str; 6] = [
+    "gmsh:physical",
+    "group",
+    "region",
+    "CellEntityIds",
+    "MaterialIds",
+    "material",
+];
+
+/// geomc's own arrays, in the order a cell's group is looked for: (array,
+/// label of unnamed groups, index of the array in the writer's FieldData).
+const GEOMC_ARRAYS: [(&str, &str, i64); 5] = [
+    ("fragment_id", "fragment", 0),
+    ("face_id", "face", 3),
+    ("edge_id", "edge", 4),
+    ("polyline_id", "poly_line", 5),
+    ("point_set_id", "point set", 6),
+];
+
+pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
+    let text = std::str::from_utf8(bytes).map_err(|e| {
+        vec![
+            error_at(
+                Code::MeshSyntax,
+                e.valid_up_to(),
+                e.valid_up_to() + 1,
+                "the file is not UTF-8 text: raw appended VTU data is not read",
+            )
+            .with_help("save the .vtu with inline (base64) or ASCII data arrays"),
+        ]
+    })?;
+    let source = SourceFile::new("", text);
+    let root = syntax::parse(&source, &Limits::default()).map_err(|d| vec![d])?;
+    let r = Reader { source: &source };
+    r.grid(&root).map_err(|d| vec![d])
+}
+
+struct Reader<'a> {
+    source: &'a SourceFile,
+}
+
+/// A decoded data array.
+enum Values {
+    Real(Vec<f64>),
+    Int(Vec<i64>),
+}
+
+fn err(e: &Element, code: Code, message: impl Into<String>) -> Diagnostic {
+    Diagnostic::new(code, e.name_span, message)
+}
+
+fn child<'e>(e: &'e Element, name: &'e str) -> Result<&'e Element, Diagnostic> {
+    e.children_named(name)
+        .next()
+        .ok_or_else(|| err(e, Code::MeshSyntax, format!("<{}> has no <{name}>", e.name)))
+}
+
+fn attr<'e>(e: &'e Element, name: &str) -> Option<&'e str> {
+    e.attribute(name).map(|a| a.value.as_str())
+}
+
+impl Reader<'_> {
+    fn grid(&self, root: &Element) -> Result<(Builder, Option<bool>), Diagnostic> {
+        if root.name != "VTKFile" || attr(root, "type") != Some("UnstructuredGrid") {
+            return Err(err(
+                root,
+                Code::MeshSyntax,
+                "not a VTK unstructured grid (<VTKFile type=\"UnstructuredGrid\">)",
+            ));
+        }
+        if attr(root, "byte_order").is_some_and(|o| o != "LittleEndian") {
+            return Err(err(
+                root,
+                Code::MeshUnsupportedVersion,
+                "big-endian VTU data is not read",
+            ));
+        }
+        let header64 = attr(root, "header_type") == Some("UInt64");
+        let compressed = match attr(root, "compressor") {
+            None | Some("") => false,
+            Some("vtkZLibDataCompressor") => true,
+            Some(other) => {
+                return Err(err(
+                    root,
+                    Code::MeshUnsupportedVersion,
+                    format!("VTU compressor `{other}` is not read (zlib is)"),
+                ));
+            }
+        };
+        let grid = child(root, "UnstructuredGrid")?;
+        let field_names = self.field_names(grid);
+        let piece = child(grid, "Piece")?;
+        let count = |name: &str| -> Result<usize, Diagnostic> {
+            attr(piece, name)
+                .and_then(|v| v.trim().parse().ok())
+                .ok_or_else(|| err(piece, Code::MeshSyntax, format!("<Piece> needs a {name}")))
+        };
+        let n_points = count("NumberOfPoints")?;
+        let n_cells = count("NumberOfCells")?;
+        let ctx = Ctx {
+            header64,
+            compressed,
+        };
+        let points = child(piece, "Points")?;
+        let pa = child(points, "DataArray")?;
+        let coords = self.array(pa, &ctx)?;
+        let Values::Real(coords) = to_real(coords) else {
+            unreachable!()
+        };
+        if coords.len() != 3 * n_points {
+            return Err(err(
+                pa,
+                Code::MeshCountMismatch,
+                format!(
+                    "the points array holds {} values, {} points need {}",
+                    coords.len(),
+                    n_points,
+                    3 * n_points
+                ),
+            ));
+        }
+        if let Some(i) = coords.iter().position(|c| !c.is_finite()) {
+            return Err(err(
+                pa,
+                Code::MeshNonFinite,
+                format!("point {} has a coordinate that is not finite", i / 3),
+            ));
+        }
+        let cells = child(piece, "Cells")?;
+        let mut connectivity = None;
+        let mut offsets = None;
+        let mut types = None;
+        for a in cells.children_named("DataArray") {
+            let slot = match attr(a, "Name") {
+                Some("connectivity") => &mut connectivity,
+                Some("offsets") => &mut offsets,
+                Some("types") => &mut types,
+                _ => continue,
+            };
+            *slot = Some((a, ints(self.array(a, &ctx)?)));
+        }
+        let missing = |what: &str| {
+            err(
+                cells,
+                Code::MeshSyntax,
+                format!("<Cells> has no `{what}` array"),
+            )
+        };
+        let (ca, connectivity) = connectivity.ok_or_else(|| missing("connectivity"))?;
+        let (oa, offsets) = offsets.ok_or_else(|| missing("offsets"))?;
+        let (ta, types) = types.ok_or_else(|| missing("types"))?;
+        if offsets.len() != n_cells || types.len() != n_cells {
+            return Err(err(
+                oa,
+                Code::MeshCountMismatch,
+                format!(
+                    "{} offsets and {} types for {n_cells} cells",
+                    offsets.len(),
+                    types.len()
+                ),
+            ));
+        }
+        // Cell data that names groups.
+        let mut cell_data: BTreeMap<String, Vec<i64>> = BTreeMap::new();
+        if let Some(cd) = piece.children_named("CellData").next() {
+            for a in cd.children_named("DataArray") {
+                let name = attr(a, "Name").unwrap_or("").to_string();
+                let ty = attr(a, "type").unwrap_or("");
+                if !ty.contains("Int") || attr(a, "NumberOfComponents").is_some_and(|c| c != "1") {
+                    continue;
+                }
+                let v = ints(self.array(a, &ctx)?);
+                if v.len() != n_cells {
+                    return Err(err(
+                        a,
+                        Code::MeshCountMismatch,
+                        format!(
+                            "cell data `{name}` has {} values for {n_cells} cells",
+                            v.len()
+                        ),
+                    ));
+                }
+                cell_data.insert(name, v);
+            }
+        }
+        let geomc = cell_data.contains_key("face_id");
+        let generic = GROUP_ARRAYS
+            .iter()
+            .find(|n| cell_data.contains_key(**n))
+            .map(|n| n.to_string())
+            .or_else(|| cell_data.keys().next().cloned());
+
+        let mut b = Builder::new();
+        b.nodes = coords.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        let mut groups: BTreeMap<(usize, i64), usize> = BTreeMap::new();
+        let mut dropped: BTreeMap<&str, usize> = BTreeMap::new();
+        let mut split = 0usize;
+        let mut start = 0usize;
+        for i in 0..n_cells {
+            let end = offsets[i];
+            if end < start as i64 || end as usize > connectivity.len() {
+                return Err(err(
+                    oa,
+                    Code::MeshCountMismatch,
+                    format!(
+                        "cell {i}'s offset {end} is outside the {} connectivity entries",
+                        connectivity.len()
+                    ),
+                ));
+            }
+            let end = end as usize;
+            let ids = &connectivity[start..end];
+            start = end;
+            let mut nodes = Vec::with_capacity(ids.len());
+            for &v in ids {
+                if v < 0 || v as usize >= n_points {
+                    return Err(err(
+                        ca,
+                        Code::MeshIndexOutOfRange,
+                        format!("cell {i} refers to point {v}, outside the {n_points} points"),
+                    ));
+                }
+                nodes.push(v as u32);
+            }
+            // The group key: (which array, value).
+            let key = if geomc {
+                GEOMC_ARRAYS
+                    .iter()
+                    .enumerate()
+                    .find_map(|(k, (name, _, _))| {
+                        cell_data
+                            .get(*name)
+                            .map(|v| v[i])
+                            .filter(|&v| v >= 0)
+                            .map(|v| (k, v))
+                    })
+                    .unwrap_or((usize::MAX, 0))
+            } else {
+                match &generic {
+                    Some(name) => (0, cell_data[name][i]),
+                    None => (usize::MAX, 0),
+                }
+            };
+            let g = match groups.get(&key) {
+                Some(&g) => g,
+                None => {
+                    let name = group_name(key, geomc, generic.as_deref(), &field_names);
+                    let g = b.group(&name);
+                    groups.insert(key, g);
+                    g
+                }
+            };
+            let t = types[i];
+            let need = match t {
+                1 => Some(1),
+                3 | 21 => Some(2),
+                5 | 22 => Some(3),
+                9 | 23 | 28 => Some(4),
+                _ => None,
+            };
+            if let Some(k) = need {
+                if nodes.len() < k {
+                    return Err(err(
+                        ca,
+                        Code::MeshCountMismatch,
+                        format!(
+                            "cell {i} of type {t} has {} points, it needs {k}",
+                            nodes.len()
+                        ),
+                    ));
+                }
+            }
+            let group = &mut b.groups[g];
+            match t {
+                1 | 2 => group.points.extend_from_slice(&nodes),
+                3 | 4 | 21 => {
+                    let corners = if t == 21 { &nodes[..2] } else { &nodes[..] };
+                    group.lines.extend(corners.windows(2).map(|w| [w[0], w[1]]));
+                }
+                5 | 22 => group.triangles.push([nodes[0], nodes[1], nodes[2]]),
+                6 => {
+                    split += 1;
+                    for k in 0..nodes.len().saturating_sub(2) {
+                        let (a, c) = if k % 2 == 0 { (k, k + 1) } else { (k + 1, k) };
+                        group.triangles.push([nodes[a], nodes[c], nodes[k + 2]]);
+                    }
+                }
+                7 | 9 | 23 | 28 => {
+                    split += 1;
+                    let corners = if t == 7 { &nodes[..] } else { &nodes[..4] };
+                    for k in 1..corners.len().saturating_sub(1) {
+                        group
+                            .triangles
+                            .push([corners[0], corners[k], corners[k + 1]]);
+                    }
+                }
+                10 | 24 => *dropped.entry("tetrahedra").or_default() += 1,
+                12 | 25 | 29 => *dropped.entry("hexahedra").or_default() += 1,
+                13 | 26 => *dropped.entry("wedges").or_default() += 1,
+                14 | 27 => *dropped.entry("pyramids").or_default() += 1,
+                42 => *dropped.entry("polyhedra").or_default() += 1,
+                _ => {
+                    return Err(err(
+                        ta,
+                        Code::MeshUnsupportedElement,
+                        format!("cell {i} has VTK cell type {t}, which geomc does not read"),
+                    ));
+                }
+            }
+        }
+        if !dropped.is_empty() {
+            let list: Vec<String> = dropped.iter().map(|(k, n)| format!("{n} {k}")).collect();
+            b.warn(
+                Code::InputNotCarried,
+                format!(
+                    "volume cells are not kept (geomc converts surface meshes): {}",
+                    list.join(", ")
+                ),
+            );
+        }
+        if split > 0 {
+            b.warn(
+                Code::ElementsConverted,
+                format!("{split} strips, polygons or quads split into triangles"),
+            );
+        }
+        let binary = Some(piece_binary(piece));
+        Ok((b, binary))
+    }
+
+    /// FieldData arrays `Name="group name"` holding `[id, kind]`: kind is the
+    /// index of the cell-data array the id belongs to (geomc's writer), or
+    /// meshio's `[tag, dim]` for Gmsh physical names.
+    fn field_names(&self, grid: &Element) -> BTreeMap<i64, BTreeMap<i64, String>> {
+        let mut out: BTreeMap<i64, BTreeMap<i64, String>> = BTreeMap::new();
+        let Some(fd) = grid.children_named("FieldData").next() else {
+            return out;
+        };
+        for a in fd.children_named("DataArray") {
+            let Some(name) = attr(a, "Name") else {
+                continue;
+            };
+            let values: Vec<i64> = a
+                .text
+                .iter()
+                .flat_map(|(t, _)| t.split_whitespace().map(str::to_string).collect::<Vec<_>>())
+                .filter_map(|t| t.parse::<f64>().ok().map(|v| v as i64))
+                .collect();
+            if let [id, kind] = values[..] {
+                out.entry(kind).or_default().insert(id, name.to_string());
+            }
+        }
+        out
+    }
+
+    fn array(&self, a: &Element, ctx: &Ctx) -> Result<Values, Diagnostic> {
+        let ty = attr(a, "type").unwrap_or("");
+        let format = attr(a, "format").unwrap_or("ascii");
+        let real = ty.starts_with("Float");
+        let Some((text, span)) = a.text.first() else {
+            return Ok(if real {
+                Values::Real(Vec::new())
+            } else {
+                Values::Int(Vec::new())
+            });
+        };
+        match format {
+            "ascii" => self.ascii(text, *span, real),
+            "binary" => {
+                let bytes = decode_binary(text.as_bytes(), ctx)
+                    .ok_or_else(|| err(a, Code::MeshSyntax, "the binary data array is not valid base64 or its block headers do not match its data"))?;
+                from_bytes(&bytes, ty).ok_or_else(|| {
+                    err(
+                        a,
+                        Code::MeshUnsupportedVersion,
+                        format!("data array type `{ty}` is not read"),
+                    )
+                })
+            }
+            _ => Err(err(
+                a,
+                Code::MeshUnsupportedVersion,
+                format!("data array format `{format}` is not read (ascii and inline binary are)"),
+            )
+            .with_help("save the .vtu with inline data arrays (meshio: binary=True, the default)")),
+        }
+    }
+
+    fn ascii(&self, text: &str, span: Span, real: bool) -> Result<Values, Diagnostic> {
+        // Positions: the text is trimmed; find it in the source for offsets.
+        let raw = self.source.text.get(span.range()).unwrap_or("");
+        let base = span.start as usize + raw.find(|c: char| !c.is_whitespace()).unwrap_or(0);
+        let mut offset = 0usize;
+        let mut reals = Vec::new();
+        let mut ints_out = Vec::new();
+        for token in text.split_ascii_whitespace() {
+            let at = base + text[offset..].find(token).map_or(0, |i| i + offset);
+            offset = at - base + token.len();
+            if real {
+                let v: f64 = token.parse().map_err(|_| {
+                    error_at(
+                        Code::MeshSyntax,
+                        at,
+                        at + token.len(),
+                        format!("expected a number, found `{token}`"),
+                    )
+                })?;
+                if !v.is_finite() {
+                    return Err(error_at(
+                        Code::MeshNonFinite,
+                        at,
+                        at + token.len(),
+                        format!("`{token}` is not a finite number"),
+                    ));
+                }
+                reals.push(v);
+            } else {
+                let v: i64 = token.parse().map_err(|_| {
+                    error_at(
+                        Code::MeshSyntax,
+                        at,
+                        at + token.len(),
+                        format!("expected an integer, found `{token}`"),
+                    )
+                })?;
+                ints_out.push(v);
+            }
+        }
+        Ok(if real {
+            Values::Real(reals)
+        } else {
+            Values::Int(ints_out)
+        })
+    }
+}
+
+struct Ctx {
+    header64: bool,
+    compressed: bool,
+}
+
+fn piece_binary(piece: &Element) -> bool {
+    piece
+        .children
+        .iter()
+        .flat_map(|c| c.children_named("DataArray"))
+        .any(|a| attr(a, "format") == Some("binary"))
+}
+
+fn to_real(v: Values) -> Values {
+    match v {
+        Values::Int(i) => Values::Real(i.into_iter().map(|x| x as f64).collect()),
+        r => r,
+    }
+}
+
+fn ints(v: Values) -> Vec<i64> {
+    match v {
+        Values::Int(i) => i,
+        Values::Real(r) => r.into_iter().map(|x| x as i64).collect(),
+    }
+}
+
+fn group_name(
+    key: (usize, i64),
+    geomc: bool,
+    generic: Option<&str>,
+    names: &BTreeMap<i64, BTreeMap<i64, String>>,
+) -> String {
+    if key.0 == usize::MAX {
+        return "vtu".to_string();
+    }
+    if geomc {
+        let (_, label, kind) = GEOMC_ARRAYS[key.0];
+        if let Some(name) = names.get(&kind).and_then(|m| m.get(&key.1)) {
+            return name.clone();
+        }
+        return format!("{label} {}", key.1);
+    }
+    let array = generic.unwrap_or("group");
+    if array == "gmsh:physical" {
+        // meshio keeps Gmsh physical names as [tag, dim].
+        for dim in [2, 1, 0, 3] {
+            if let Some(name) = names.get(&dim).and_then(|m| m.get(&key.1)) {
+                return name.clone();
+            }
+        }
+    }
+    format!("{array} {}", key.1)
+}
+
+/// Inline binary: base64 of (header, data), or with a compressor base64 of
+/// the block header followed by base64 of the compressed blocks.
+fn decode_binary(text: &[u8], ctx: &Ctx) -> Option<Vec<u8>> {
+    let word = if ctx.header64 { 8 } else { 4 };
+    let read_word = |b: &[u8], i: usize| -> Option<usize> {
+        let s = b.get(i * word..(i + 1) * word)?;
+        Some(if word == 8 {
+            u64::from_le_bytes(s.try_into().ok()?) as usize
+        } else {
+            u32::from_le_bytes(s.try_into().ok()?) as usize
+        })
+    };
+    if !ctx.compressed {
+        let all = base64::decode(text)?;
+        let n = read_word(&all, 0)?;
+        return all.get(word..word + n).map(<[u8]>::to_vec);
+    }
+    // The header is its own base64 run: decode just enough of it.
+    let clean: Vec<u8> = text
+        .iter()
+        .copied()
+        .filter(|c| !c.is_ascii_whitespace())
+        .collect();
+    let first = base64::decode(clean.get(..clean.len().min(64))?)?;
+    let blocks = read_word(&first, 0)?;
+    let header_bytes = (3 + blocks) * word;
+    let header_chars = header_bytes.div_ceil(3) * 4;
+    let header = base64::decode(clean.get(..header_chars)?)?;
+    let sizes: Vec<usize> = (0..blocks)
+        .map(|i| read_word(&header, 3 + i))
+        .collect::<Option<_>>()?;
+    let data = base64::decode(clean.get(header_chars..)?)?;
+    let mut out = Vec::new();
+    let mut at = 0usize;
+    for size in sizes {
+        let block = data.get(at..at + size)?;
+        at += size;
+        let mut z = flate2::read::ZlibDecoder::new(block);
+        z.read_to_end(&mut out).ok()?;
+    }
+    Some(out)
+}
+
+fn from_bytes(b: &[u8], ty: &str) -> Option<Values> {
+    macro_rules! conv {
+        ($t:ty, $n:literal, $wrap:ident, $to:ty) => {
+            Values::$wrap(
+                b.chunks_exact($n)
+                    .map(|c| <$t>::from_le_bytes(c.try_into().unwrap_or([0; $n])) as $to)
+                    .collect(),
+            )
+        };
+    }
+    Some(match ty {
+        "Float32" => conv!(f32, 4, Real, f64),
+        "Float64" => conv!(f64, 8, Real, f64),
+        "Int8" => conv!(i8, 1, Int, i64),
+        "UInt8" => conv!(u8, 1, Int, i64),
+        "Int16" => conv!(i16, 2, Int, i64),
+        "UInt16" => conv!(u16, 2, Int, i64),
+        "Int32" => conv!(i32, 4, Int, i64),
+        "UInt32" => conv!(u32, 4, Int, i64),
+        "Int64" => conv!(i64, 8, Int, i64),
+        "UInt64" => conv!(u64, 8, Int, i64),
+        _ => return None,
+    })
+}
