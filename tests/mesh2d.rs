@@ -276,3 +276,46 @@ fn second_order_mid_nodes_lie_on_the_circle_and_are_shared() {
     let boundary_segments: usize = q.edges.iter().map(Vec::len).sum::<usize>() - rim_mids.len();
     assert_eq!(distinct.len(), (3 * triangles + boundary_segments) / 2);
 }
+
+#[test]
+fn inspect_mesh_reports_angles_and_areas_per_subdomain() {
+    let out = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
+        .args(["inspect", "--mesh", "--min-angle", "30", "--format", "json"])
+        .arg(concat!(
+            env!("CARGO_MANIFEST_DIR"),
+            "/fixtures/valid/2d_rectangles_interface.xml"
+        ))
+        .output()
+        .expect("run geomc");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("one JSON object");
+    let mesh = &json["mesh"];
+    assert!(mesh["min_angle"].as_f64().unwrap() >= 30.0, "{mesh}");
+    let histogram: Vec<u64> = mesh["angle_histogram"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_u64().unwrap())
+        .collect();
+    assert_eq!(histogram[..6].iter().sum::<u64>(), 0);
+    assert_eq!(
+        histogram.iter().sum::<u64>(),
+        mesh["triangles"].as_u64().unwrap()
+    );
+    // The fixture's limits: soft area ≤ 0.02, hard area ≤ 0.005.
+    for (name, limit) in [("soft", 0.02), ("hard", 0.005)] {
+        let s = mesh["subdomains"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .find(|s| s["name"] == name)
+            .unwrap();
+        let max = s["max_area"].as_f64().unwrap();
+        assert!(max <= limit && max > 0.3 * limit, "{name}: {max}");
+    }
+    assert_eq!(json["model"]["dimension"], 2, "{}", json["model"]);
+}

@@ -16,6 +16,8 @@ pub struct Args {
     matrices: bool,
     #[command(flatten)]
     input: InputOptions,
+    #[command(flatten)]
+    mesh_quality: super::mesh_args::InspectMeshArgs,
 }
 
 pub fn run(args: &Args) -> i32 {
@@ -47,11 +49,31 @@ pub fn run(args: &Args) -> i32 {
         return EXIT_INVALID;
     };
     let report = geomc::inspect::Report::of(&lowered.model);
-    match args.format {
-        Format::Human => out(&report.render_text(&lowered.model, args.matrices)),
-        Format::Json => out(&format!(
+    // --mesh: the mesh-quality section after the model's facts (JSON: both
+    // in one object, {"model": …, "mesh": …}).
+    let mesh_section = if args.mesh_quality.mesh {
+        match args.mesh_quality.report(&lowered.model) {
+            Ok(r) => Some(r),
+            Err(code) => return code,
+        }
+    } else {
+        None
+    };
+    match (args.format, mesh_section) {
+        (Format::Human, section) => {
+            out(&report.render_text(&lowered.model, args.matrices));
+            if let Some(r) = section {
+                out(&r.render_text());
+            }
+        }
+        (Format::Json, None) => out(&format!(
             "{}\n",
             report.render_json(&lowered.model, args.matrices)
+        )),
+        (Format::Json, Some(r)) => out(&format!(
+            "{{\"model\": {}, \"mesh\": {}}}\n",
+            report.render_json(&lowered.model, args.matrices),
+            serde_json::to_string_pretty(&r).unwrap_or_default()
         )),
     }
     EXIT_OK

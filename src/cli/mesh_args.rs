@@ -1,7 +1,8 @@
 //! Size, quality and order options of `geomc compile` for solver meshes
 //! (issue 6), kept apart from compile's own arguments.
 
-use geomc::meshing::{MeshOptions, SizeField};
+use super::{EXIT_INVALID, EXIT_USAGE};
+use geomc::meshing::{MeshOptions, MeshReport, SizeField, mesh_model, mesh_report};
 
 #[derive(clap::Args, Debug, Clone, Default)]
 pub struct MeshArgs {
@@ -45,5 +46,46 @@ impl MeshArgs {
             (None, None) => None,
         };
         Ok(())
+    }
+}
+
+/// `geomc inspect --mesh`: mesh the model as compile would and report the
+/// achieved quality.
+#[derive(clap::Args, Debug, Clone)]
+pub struct InspectMeshArgs {
+    /// Also mesh the model and report the minimum angle, the angle
+    /// histogram and the area range per subdomain.
+    #[arg(long)]
+    pub mesh: bool,
+    /// With --mesh: the smallest angle refinement aims for, degrees.
+    #[arg(
+        long,
+        default_value_t = 25.0,
+        value_name = "DEGREES",
+        requires = "mesh"
+    )]
+    pub min_angle: f64,
+    #[command(flatten)]
+    pub solver: MeshArgs,
+}
+
+impl InspectMeshArgs {
+    /// Meshes `model` as compile would; on failure prints why and gives the exit code.
+    pub fn report(&self, model: &geomc::ir::Model) -> Result<MeshReport, i32> {
+        let mut options = MeshOptions {
+            min_angle_degrees: self.min_angle,
+            ..MeshOptions::default()
+        };
+        if let Err(message) = self.solver.apply(&mut options) {
+            eprintln!("geomc: {message}");
+            return Err(EXIT_USAGE);
+        }
+        match mesh_model(model, &options) {
+            Ok(mesh) => Ok(mesh_report(&mesh)),
+            Err(e) => {
+                eprintln!("geomc: {e}");
+                Err(EXIT_INVALID)
+            }
+        }
     }
 }

@@ -26,9 +26,11 @@ mod constraints;
 mod edges;
 mod face;
 mod quadratic;
+mod report;
 mod size;
 
 pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
+pub use report::{MeshReport, SubdomainQuality, mesh_report};
 pub use size::SizeField;
 
 use crate::ir::{self, Dimension, Model, Side, SubdomainCells};
