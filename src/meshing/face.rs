@@ -205,7 +205,7 @@ pub(crate) fn mesh_face(
         // the outside is found here instead (`outside_faces`).
         .exclude_outer_faces(polyline_segments.is_empty())
         .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
-        .with_max_additional_vertices(200_000);
+        .with_max_additional_vertices(vertex_budget(&uv_loops, settings.max_area));
     if settings.keep_boundary {
         parameters = parameters.keep_constraint_edges();
     }
@@ -253,11 +253,19 @@ pub(crate) fn mesh_face(
             }
             let [a, b, c] = f.vertices().map(|v| v.fix().index());
             inner.push([a, b, c]);
-            if too_coarse(
-                face,
-                [&positions[a], &positions[b], &positions[c]],
-                settings,
-            ) {
+            let [pa, pb, pc] = f.positions();
+            let uv_area =
+                0.5 * ((pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x)).abs();
+            let over_area = settings.max_area.is_finite()
+                && matches!(face.surface, crate::geom::Surface::Plane { .. })
+                && uv_area > settings.max_area;
+            if over_area
+                || too_coarse(
+                    face,
+                    [&positions[a], &positions[b], &positions[c]],
+                    settings,
+                )
+            {
                 let [pa, pb, pc] = f.positions();
                 bad.push(point2([
                     (pa.x + pb.x + pc.x) / 3.0,
@@ -464,6 +472,19 @@ fn boundary_splits(
         splits.push(found.ok_or("refinement put a node on its boundary away from every edge")?);
     }
     Ok(splits)
+}
+
+/// Points one refinement call may add: enough for the area limit (about two
+/// triangles per vertex, with room for grading), at least 200,000 (spade's
+/// guard against non-termination), at most the face's node limit.
+fn vertex_budget(uv_loops: &[Vec<[f64; 2]>], max_area: f64) -> usize {
+    let area = uv_loops.iter().map(|lp| shoelace(lp)).sum::<f64>().abs() / 2.0;
+    let wanted = if max_area.is_finite() {
+        (2.0 * area / max_area).min(MAX_FACE_VERTICES as f64) as usize
+    } else {
+        0
+    };
+    wanted.clamp(200_000, MAX_FACE_VERTICES)
 }
 
 /// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and

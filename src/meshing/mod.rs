@@ -136,10 +136,26 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
     }
 
     // Half the tolerance on edges leaves room for the triangles beside them.
+    // Under an area limit, edges start at the side of an equilateral triangle
+    // of that area, so refinement rarely has to send splits back (each round
+    // re-meshes the faces).
+    let face_areas = face_area_limits(model, max_area);
+    let mut edge_area = vec![f64::INFINITY; model.edges.len()];
+    for (face, &area) in model.faces.iter().zip(&face_areas) {
+        for oe in face.loops.iter().flatten() {
+            if let Some(slot) = edge_area.get_mut(oe.edge.index()) {
+                *slot = slot.min(area);
+            }
+        }
+    }
     let mut edge_nodes = model
         .edges
         .iter()
-        .map(|e| edges::discretise(model, e, 0.5 * tolerance, max_edge))
+        .zip(&edge_area)
+        .map(|(e, &area)| {
+            let side = (4.0 * area / 3f64.sqrt()).sqrt();
+            edges::discretise(model, e, 0.5 * tolerance, max_edge.min(side))
+        })
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
     let edge_points: Vec<Vec<crate::geom::Point3>> =
         edge_nodes.iter().map(|n| n.points.clone()).collect();
@@ -148,7 +164,6 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         nodes.refine_to_size(&edge.curve, &sizing);
     }
     let constraints = constraints::assign(model, &edge_nodes)?;
-    let face_areas = face_area_limits(model, max_area);
     let settings = Settings {
         tolerance,
         sizing: &sizing,
