@@ -39,6 +39,9 @@ pub struct Report {
     pub parameters: Vec<(String, f64)>,
     pub point_sets: usize,
     pub polylines: usize,
+    /// Paper 003's curves (standalone lines and edge curves): "name: what".
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub curves: Vec<String>,
 }
 
 impl Report {
@@ -86,6 +89,7 @@ impl Report {
             parameters: model.parameters.clone(),
             point_sets: model.point_sets.len(),
             polylines: model.polylines.len(),
+            curves: point_curves(model),
         }
     }
 
@@ -107,6 +111,12 @@ impl Report {
                 "point sets: {}  poly_lines: {}",
                 self.point_sets, self.polylines
             );
+        }
+        if !self.curves.is_empty() {
+            let _ = writeln!(s, "curves:");
+            for c in &self.curves {
+                let _ = writeln!(s, "  {c}");
+            }
         }
         if let (Some(min), Some(max)) = (self.bbox_min, self.bbox_max) {
             let _ = writeln!(s, "bounding box: ({}) .. ({})", join(&min), join(&max));
@@ -221,4 +231,22 @@ fn join(v: &[f64; 3]) -> String {
 
 fn plural(n: usize) -> &'static str {
     if n == 1 { "" } else { "s" }
+}
+
+/// Each point-calculus curve of the model with its kind (and a conic's type
+/// by its discriminant): standalone lines first, then edges, in model order.
+fn point_curves(model: &Model) -> Vec<String> {
+    use crate::geom::Curve;
+    let lines = model.polylines.iter().map(|l| (&l.name, &l.curve, "line"));
+    let edges = model.edges.iter().map(|e| (&e.name, &e.curve, "edge"));
+    let mut out = Vec::new();
+    for (name, curve, role) in lines
+        .map(|(n, c, r)| (n, c.as_ref(), r))
+        .chain(edges.map(|(n, c, r)| (n, Some(c), r)))
+    {
+        if let Some(Curve::PointCalculus(c)) = curve {
+            out.push(format!("{name} ({role}): {}", c.describe()));
+        }
+    }
+    out
 }

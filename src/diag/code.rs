@@ -216,6 +216,22 @@ codes! {
     TargetNotCarried = "W116", Warning, "output format cannot carry everything",
         "The output format has no place for some of the mesh's data (binary STL has no groups, OBJ has no volumes, VTU keeps names only in its field data). The message names what was merged or left out and how many; choose a format that holds it to keep it.";
 
+    // ---- point calculus (issue 7) ----
+    DiscriminantOutOfRange = "E690", Error, "conic discriminant outside (0, 1)",
+        "A conic_arc's discriminant k = CK/CT places the arc's shoulder K between the tangent point C (k = 0) and the chord's midpoint T (k = 1); 0 < k < 0.5 gives a hyperbola, 0.5 a parabola, 0.5 < k < 1 an ellipse. Values at or beyond the ends give no arc. Give <discriminant value=\"…\"/> strictly between 0 and 1.";
+    DegenerateConic = "E691", Error, "conic arc's tangent point on its chord",
+        "A conic_arc runs from A to B with its end tangents meeting at C, so C must lie off the line AB (and differ from A and B); otherwise the tangents do not meet and the arc is not defined. Move point_c off the line through point_a and point_b, or use a <segment> for a straight piece.";
+    CurveEndsCoincide = "E692", Error, "point-calculus curve begins where it ends",
+        "A segment, conic_arc or desargues_arc joins two distinct end points (A and B; A and D for the Desargues arc). Give distinct end points; a closed contour is made of several arcs.";
+    DegeneratePatch = "E693", Error, "9-point patch is singular",
+        "The patch's tangent vectors ∂M/∂u and ∂M/∂v are parallel or zero somewhere on [0, 1]², for example because a row repeats one point or all nine points lie on a line; such a patch has no normal there and cannot carry a face. Spread the nine points out over the surface, rows A, B, C across and columns along.";
+    EdgeNotAtCurveEnds = "E694", Error, "edge's vertices are not its curve's end points",
+        "An edge whose line is a segment, conic_arc or desargues_arc runs along that whole curve, so its begin and end vertices must be the curve's two end points (in either order). Move the vertices onto the curve's ends, or change the curve's end points.";
+    EdgeNotOnPatchSide = "E695", Error, "edge's vertices are not adjacent patch corners",
+        "An edge whose line is a patch9 runs along one side of the patch, so its vertices must be two corners of the patch joined by a side: the ends of the first or last row, or of the first or last column. Use two adjacent corners; an edge across the patch needs a curve of its own.";
+    UnusedPatch = "W180", Warning, "patch9 is not the surface of any face",
+        "A patch9 is a surface: it is meshed as the carrier of the faces that name it with surface=\"…\" and bounded by edges along its sides. No face names this patch, so it produces no output. Add a face on it, or remove it.";
+
     // ---- 2D domains (issue 6) ----
     PolygonEdgesCross = "E660", Error, "polygon edges cross",
         "A <polygon> must be simple: its edges may meet only where consecutive edges share a vertex. Two of its edges cross, touch, or fold back along one line. Reorder or move the vertices so that the boundary does not meet itself.";

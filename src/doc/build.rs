@@ -166,6 +166,13 @@ impl Builder<'_> {
                         base,
                         vertices: self.points_named(e, "vertex"),
                     }))
+                } else if e.children_named("point_a").next().is_some() {
+                    let points: Vec<PointSpec> = ["point_a", "point_b", "point_c", "point_d"]
+                        .iter()
+                        .filter_map(|n| self.point_child(e, n))
+                        .collect();
+                    (points.len() == 4)
+                        .then(|| Box::new(ParallelepipedForm::PointEquation { points }))
                 } else {
                     match (
                         self.point_child(e, "first_point"),
@@ -195,6 +202,27 @@ impl Builder<'_> {
             "plane" => ObjectKind::Plane {
                 base: self.point_child(e, "base_point"),
                 normal: self.vector_child(e, "normal"),
+            },
+            "segment" | "conic_arc" | "desargues_arc" => {
+                let (kind, names): (PcCurveKind, &[&str]) = match e.name.as_str() {
+                    "segment" => (PcCurveKind::Segment, &["point_a", "point_b"]),
+                    "conic_arc" => (PcCurveKind::Conic, &["point_a", "point_b", "point_c"]),
+                    _ => (
+                        PcCurveKind::Desargues,
+                        &["point_a", "point_b", "point_c", "point_d"],
+                    ),
+                };
+                ObjectKind::PcCurve {
+                    kind,
+                    points: names.iter().map(|n| self.point_child(e, n)).collect(),
+                    discriminant: self.value_child(e, "discriminant"),
+                }
+            }
+            "patch9" => ObjectKind::Patch9 {
+                rows: e
+                    .children_named("row")
+                    .map(|r| self.points_named(r, "node"))
+                    .collect(),
             },
             "transform" => ObjectKind::Transform {
                 target: self.reference(e, "ref"),

@@ -175,6 +175,10 @@ pub static RADIUS_VERTEX: Rule = leaf("radius_vertex", POINT_ATTRS);
 pub static ORIGIN: Rule = leaf("origin", POINT_ATTRS);
 pub static APEX: Rule = leaf("apex", POINT_ATTRS);
 pub static NEAR: Rule = leaf("near", POINT_ATTRS);
+pub static POINT_A: Rule = leaf("point_a", POINT_ATTRS);
+pub static POINT_B: Rule = leaf("point_b", POINT_ATTRS);
+pub static POINT_C: Rule = leaf("point_c", POINT_ATTRS);
+pub static POINT_D: Rule = leaf("point_d", POINT_ATTRS);
 
 pub static NORMAL: Rule = leaf("normal", VECTOR_ATTRS);
 pub static AXIS: Rule = leaf("axis", VECTOR_ATTRS);
@@ -319,6 +323,8 @@ pub static PARALLELEPIPED: Rule = Rule {
     content: Content::Forms(&[
         &[one(&BASE_POINT), exactly(&VERTEX_POINT, 3)],
         &[one(&FIRST_POINT), one(&SECOND_POINT)],
+        // Paper 003's point equation M = Au + Bv + Cw + D(1 − u − v − w).
+        &[one(&POINT_A), one(&POINT_B), one(&POINT_C), one(&POINT_D)],
     ]),
 };
 pub static SPHERE: Rule = Rule {
@@ -349,6 +355,51 @@ pub static PLANE: Rule = Rule {
     attrs: NAMED,
     any_attrs: false,
     content: Content::All(&[one(&BASE_POINT), one(&NORMAL)]),
+};
+
+// ---- point calculus (paper 003) ----
+
+/// The straight segment M = A·ū + B·u.
+pub static SEGMENT: Rule = Rule {
+    name: "segment",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[one(&POINT_A), one(&POINT_B)]),
+};
+/// The conic arc's "engineering discriminant" k = CK/CT, 0 < k < 1.
+pub static DISCRIMINANT: Rule = leaf("discriminant", VALUE_ATTRS);
+/// The arc from A to B whose end tangents meet at C, shaped by k.
+pub static CONIC_ARC: Rule = Rule {
+    name: "conic_arc",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[
+        one(&POINT_A),
+        one(&POINT_B),
+        one(&POINT_C),
+        one(&DISCRIMINANT),
+    ]),
+};
+/// The cubic arc of the Desargues configuration, from A to D.
+pub static DESARGUES_ARC: Rule = Rule {
+    name: "desargues_arc",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[one(&POINT_A), one(&POINT_B), one(&POINT_C), one(&POINT_D)]),
+};
+pub static PATCH_NODE: Rule = leaf("node", POINT_ATTRS);
+pub static PATCH_ROW: Rule = Rule {
+    name: "row",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Sequence(&[exactly(&PATCH_NODE, 3)]),
+};
+/// The 9-point parabolic patch: rows A, B, C of three points each.
+pub static PATCH9: Rule = Rule {
+    name: "patch9",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[exactly(&PATCH_ROW, 3)]),
 };
 
 // ---- transforms and replication ----
@@ -614,6 +665,10 @@ pub static GEOMETRY: Rule = Rule {
             &ELLIPSOID,
             &TORUS,
             &PLANE,
+            &SEGMENT,
+            &CONIC_ARC,
+            &DESARGUES_ARC,
+            &PATCH9,
             &TRANSFORM,
             &REPLICATE,
             &SURFACE,

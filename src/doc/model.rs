@@ -112,6 +112,19 @@ pub enum ParallelepipedForm {
     },
     /// Two opposite corners of an axis-aligned box.
     Corners { first: PointSpec, second: PointSpec },
+    /// Paper 003's M = Au + Bv + Cw + D(1 − u − v − w): `points` are A, B, C, D.
+    PointEquation { points: Vec<PointSpec> },
+}
+
+/// Which of paper 003's curves an element defines.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PcCurveKind {
+    /// `segment`: A, B.
+    Segment,
+    /// `conic_arc`: A, B, C and the discriminant.
+    Conic,
+    /// `desargues_arc`: A, B, C, D.
+    Desargues,
 }
 
 #[derive(Debug, Clone, PartialEq)]
@@ -269,6 +282,17 @@ pub enum ObjectKind {
         begin: Option<Ref>,
         end: Option<Ref>,
     },
+    /// Paper 003's curves; `points` holds A, B, … in order (missing ones
+    /// already reported by the structural check).
+    PcCurve {
+        kind: PcCurveKind,
+        points: Vec<Option<PointSpec>>,
+        discriminant: Option<Number>,
+    },
+    /// Paper 003's 9-point patch: three rows of three points.
+    Patch9 {
+        rows: Vec<Vec<PointSpec>>,
+    },
     /// Loops of edge references; the first is the outer loop.
     Face {
         surface: Option<Ref>,
@@ -303,6 +327,12 @@ impl ObjectKind {
             ObjectKind::Vertex(_) => "vertex",
             ObjectKind::Edge { .. } => "edge",
             ObjectKind::Face { .. } => "face",
+            ObjectKind::PcCurve { kind, .. } => match kind {
+                PcCurveKind::Segment => "segment",
+                PcCurveKind::Conic => "conic_arc",
+                PcCurveKind::Desargues => "desargues_arc",
+            },
+            ObjectKind::Patch9 { .. } => "patch9",
         }
     }
 }

@@ -2,6 +2,7 @@
 //! the edge's begin vertex to its end vertex.
 
 use super::newton::project_onto_pair;
+use super::point_calculus::PcCurve;
 use super::trace::{polyline_at, trace};
 use super::{Point3, Surface, Vec3};
 use std::f64::consts::TAU;
@@ -25,6 +26,9 @@ pub enum Curve {
         a: Point3,
         b: Point3,
     },
+    /// A curve of paper 003's point calculus (segment, conic, Desargues or
+    /// parabolic arc), over its own u = s.
+    PointCalculus(Box<PcCurve>),
 }
 
 impl Curve {
@@ -51,6 +55,7 @@ impl Curve {
                     self.on_curve(polyline_at(&line, s).0)
                 }
             }
+            Curve::PointCalculus(c) => c.point(s),
         }
     }
 
@@ -100,6 +105,7 @@ impl Curve {
                 let t = unit(oriented);
                 if t.norm() > 0.0 { t } else { unit(direction) }
             }
+            Curve::PointCalculus(c) => c.tangent(s),
         }
     }
 
@@ -108,6 +114,7 @@ impl Curve {
             Curve::Segment { .. } => false,
             Curve::Ellipse { t0, t1, .. } => (t1 - t0).abs() >= TAU * (1.0 - 1e-12),
             Curve::Intersection { a, b, .. } => same_point(a, b),
+            Curve::PointCalculus(c) => same_point(&c.begin(), &c.end()),
         }
     }
 
@@ -167,6 +174,7 @@ impl Curve {
                 let points = self.samples(512);
                 points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
             }
+            Curve::PointCalculus(c) => c.length(),
         }
     }
 
@@ -195,6 +203,11 @@ impl Curve {
             Curve::Intersection { surfaces, .. } => {
                 let q = project_onto_pair([&surfaces[0], &surfaces[1]], p)?;
                 let t = unit(surfaces[0].gradient(&q).cross(&surfaces[1].gradient(&q)));
+                (t.norm() > 0.0).then_some((q, t))
+            }
+            Curve::PointCalculus(c) => {
+                let (u, q) = c.project(p)?;
+                let t = c.tangent(u);
                 (t.norm() > 0.0).then_some((q, t))
             }
         }

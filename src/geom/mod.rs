@@ -11,6 +11,7 @@ mod curve;
 mod frame;
 mod intersect;
 mod newton;
+pub mod point_calculus;
 pub mod polygon;
 mod sampling;
 mod shape_eval;

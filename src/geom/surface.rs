@@ -1,5 +1,6 @@
 //! Analytic surfaces that carry faces.
 
+use super::point_calculus::Patch9;
 use super::{Frame, Point3, Vec3};
 use crate::expr::{Expr, eval};
 use crate::span::Span;
@@ -28,6 +29,9 @@ pub enum Surface {
     Quadric { coefficients: [f64; 10] },
     /// An expression in the free variables x, y, z (parameters already folded in).
     Implicit { expr: Expr },
+    /// Paper 003's 9-point parabolic patch. Its value is the signed distance
+    /// along the patch normal ∂M/∂u × ∂M/∂v from the nearest patch point.
+    Patch9(Box<Patch9>),
 }
 
 impl Surface {
@@ -82,6 +86,7 @@ impl Surface {
                 }
                 None => self.newton_project(p),
             },
+            Surface::Patch9(patch) => patch.project(p).map(|(_, q)| q),
             _ => self.newton_project(p),
         }
     }
@@ -124,6 +129,13 @@ impl Surface {
                 }
                 (v, g)
             }
+            Surface::Patch9(patch) => match patch.project(p) {
+                Some((uv, q)) => {
+                    let n = patch.normal(uv[0], uv[1]);
+                    (n.dot(&(p - q)), n)
+                }
+                None => nan,
+            },
         }
     }
 

@@ -130,10 +130,14 @@ pub struct PointSet {
     pub points: Vec<Point3>,
 }
 
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Polyline {
     pub name: String,
     pub points: Vec<Point3>,
+    /// The exact curve when the line is one (paper 003's curves): meshing
+    /// samples it to the chordal tolerance instead of using `points`, which
+    /// then hold a coarse sample for bounding boxes.
+    pub curve: Option<Curve>,
 }
 
 /// A user-named set of faces (3D) or edges (2D) where boundary conditions go.
@@ -195,7 +199,7 @@ impl Model {
         &self.subdomains[id.index()]
     }
 
-    /// The bounding box of every vertex, point, polyline and solid.
+    /// The bounding box of every vertex, point, polyline, solid and patch face.
     pub fn bbox(&self) -> Aabb {
         let mut bbox = Aabb::empty();
         for v in &self.vertices {
@@ -209,6 +213,12 @@ impl Model {
         }
         for solid in &self.solids {
             bbox = bbox.union(&solid.shape.bbox());
+        }
+        // A patch face bulges beyond its vertices: include its nine points.
+        for face in &self.faces {
+            if let crate::geom::Surface::Patch9(patch) = &face.surface {
+                patch.rows.iter().flatten().for_each(|p| bbox.include(p));
+            }
         }
         bbox
     }

@@ -46,32 +46,63 @@ pub(super) fn lower_topology(
         else {
             continue;
         };
+        let a = model.vertex(b).position;
+        let z = model.vertex(e).position;
         let carrier = match line {
             Some(link) => match resolved
                 .objects
                 .get(link.object)
                 .and_then(|o| o.geometry.as_ref())
             {
-                Some(Geometry::Line(c)) => c.clone(),
-                _ => continue,
+                Some(Geometry::Line(c)) => Some(c.clone()),
+                Some(g @ (Geometry::PointCurve(_) | Geometry::Patch(_))) => {
+                    match super::point_calculus::edge_curve(
+                        g,
+                        a,
+                        z,
+                        tol,
+                        &object.name,
+                        object.span,
+                        diags,
+                    ) {
+                        Some(curve) => {
+                            push_edge(
+                                model,
+                                source_map,
+                                entities,
+                                &mut edge_of,
+                                i,
+                                object,
+                                curve,
+                                b,
+                                e,
+                            );
+                            None
+                        }
+                        None => None,
+                    }
+                }
+                _ => None,
             },
-            None => LineCarrier::Straight,
+            None => Some(LineCarrier::Straight),
         };
-        let a = model.vertex(b).position;
-        let z = model.vertex(e).position;
+        let Some(carrier) = carrier else {
+            continue;
+        };
         let Some(curve) = edge_curve(&carrier, a, z, tol, &object.name, object.span, diags) else {
             continue;
         };
-        let id = EdgeId(model.edges.len() as u32);
-        model.edges.push(Edge {
-            name: object.name.clone(),
+        push_edge(
+            model,
+            source_map,
+            entities,
+            &mut edge_of,
+            i,
+            object,
             curve,
-            begin: b,
-            end: e,
-        });
-        source_map.edges.insert(id, Origin { span: object.span });
-        entities.edges.insert(object.name.clone(), id);
-        edge_of.insert(i, id);
+            b,
+            e,
+        );
     }
     for (i, object) in resolved.objects.iter().enumerate() {
         let Some(Geometry::Face { surface, loops }) = &object.geometry else {
@@ -83,6 +114,7 @@ pub(super) fn lower_topology(
             .and_then(|o| o.geometry.as_ref())
         {
             Some(Geometry::Surface(s)) => s.clone(),
+            Some(Geometry::Patch(patch)) => Surface::Patch9(patch.clone()),
             Some(Geometry::Solid(SolidShape::Ball { frame })) => {
                 Surface::Ellipsoid { frame: *frame }
             }
@@ -141,6 +173,30 @@ pub(super) fn lower_topology(
         source_map.faces.insert(id, Origin { span: object.span });
         entities.faces.insert(object.name.clone(), id);
     }
+}
+
+#[allow(clippy::too_many_arguments)]
+fn push_edge(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    entities: &mut Entities,
+    edge_of: &mut HashMap<usize, EdgeId>,
+    i: usize,
+    object: &crate::resolve::ResolvedObject,
+    curve: Curve,
+    begin: VertexId,
+    end: VertexId,
+) {
+    let id = EdgeId(model.edges.len() as u32);
+    model.edges.push(Edge {
+        name: object.name.clone(),
+        curve,
+        begin,
+        end,
+    });
+    source_map.edges.insert(id, Origin { span: object.span });
+    entities.edges.insert(object.name.clone(), id);
+    edge_of.insert(i, id);
 }
 
 /// The curve of an explicit edge from its carrier and end points; reports

@@ -6,6 +6,7 @@
 mod booleans;
 mod brep;
 mod explicit;
+mod point_calculus;
 mod prune;
 mod weld;
 mod winding;
@@ -54,12 +55,18 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
     let mut source_map = SourceMap::default();
     let mut entities = Entities::default();
     let mut welder = weld::Welder::new(model.tolerance);
+    // Curves that carry edges are part of the topology, not standalone lines.
+    let edge_lines = point_calculus::edge_lines(resolved);
+    point_calculus::report_unused_patches(resolved, diags);
 
     for object in &resolved.objects {
         let Some(geometry) = &object.geometry else {
             entities.failed.insert(object.name.clone());
             continue;
         };
+        if edge_lines.contains(object.name.as_str()) {
+            continue;
+        }
         match geometry {
             Geometry::Group(members) => {
                 for (k, member) in members.iter().enumerate() {
@@ -119,6 +126,8 @@ fn tolerance(resolved: &Resolved) -> f64 {
                 points.iter().for_each(|p| bbox.include(p))
             }
             Geometry::Vertex(p) => bbox.include(p),
+            Geometry::PointCurve(c) => c.samples(32).iter().for_each(|p| bbox.include(p)),
+            Geometry::Patch(patch) => patch.rows.iter().flatten().for_each(|p| bbox.include(p)),
             Geometry::Group(members) => members.iter().for_each(|m| visit(m, bbox)),
             _ => {}
         }
@@ -148,7 +157,11 @@ fn lower_free(
         Geometry::Polyline { points } => model.polylines.push(Polyline {
             name: name.to_string(),
             points: points.clone(),
+            ..Polyline::default()
         }),
+        Geometry::PointCurve(curve) => model
+            .polylines
+            .push(point_calculus::standalone(name, curve)),
         Geometry::Solid(shape) => {
             let id = lower_solid(model, source_map, entities, welder, name, shape, span);
             entities

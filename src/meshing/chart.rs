@@ -21,6 +21,7 @@
 //! - The projection fallback needs faces that are graphs over the plane
 //!   perpendicular to their mean normal.
 
+use crate::geom::point_calculus::Patch9;
 use crate::geom::{Frame, Mat3, Point3, Surface, Vec3};
 use std::f64::consts::{PI, TAU};
 
@@ -59,6 +60,13 @@ pub(crate) enum Chart {
         e1: Vec3,
         e2: Vec3,
         normal: Vec3,
+    },
+    /// A 9-point patch's own (u, v), scaled by its mean tangent lengths so
+    /// that lengths in the chart approximate lengths on the surface.
+    Patch {
+        patch: Box<Patch9>,
+        scale_u: f64,
+        scale_v: f64,
     },
 }
 
@@ -118,6 +126,24 @@ impl Chart {
                     major: *major,
                     minor: *minor,
                     root,
+                })
+            }
+            Surface::Patch9(patch) => {
+                let (mut su, mut sv) = (0.0, 0.0);
+                for v in [0.0, 0.5, 1.0] {
+                    for u in [0.0, 0.5, 1.0] {
+                        let (mu, mv) = patch.derivatives(u, v);
+                        su += mu.norm() / 9.0;
+                        sv += mv.norm() / 9.0;
+                    }
+                }
+                if !(su > 0.0 && sv > 0.0 && su.is_finite() && sv.is_finite()) {
+                    return Err("the patch has no extent along u or v".into());
+                }
+                Ok(Chart::Patch {
+                    patch: patch.clone(),
+                    scale_u: su,
+                    scale_v: sv,
                 })
             }
             Surface::Quadric { .. } | Surface::Implicit { .. } => {
@@ -218,6 +244,14 @@ impl Chart {
                 let phi = q.z.atan2(q.x.hypot(q.y) - major);
                 [theta, torus_psi(phi, major / minor, *root)]
             }
+            Chart::Patch {
+                patch,
+                scale_u,
+                scale_v,
+            } => {
+                let ([u, v], _) = patch.project(p)?;
+                [u * scale_u, v * scale_v]
+            }
         };
         uv.iter().all(|x| x.is_finite()).then_some(uv)
     }
@@ -275,6 +309,11 @@ impl Chart {
                 e2,
                 normal,
             } => lift_along(surface, origin + e1 * u + e2 * v, normal)?,
+            Chart::Patch {
+                patch,
+                scale_u,
+                scale_v,
+            } => patch.point(u / scale_u, v / scale_v),
         };
         p.coords.iter().all(|x| x.is_finite()).then_some(p)
     }

@@ -18,7 +18,12 @@ use std::collections::BTreeMap;
 /// Poly_lines per face index: (poly_line index, its points).
 pub(crate) type Constraints = BTreeMap<usize, Vec<(usize, Vec<Point3>)>>;
 
-pub(crate) fn assign(model: &Model, edge_nodes: &[EdgeNodes]) -> Result<Constraints, MeshError> {
+/// `lines[i]`: poly_line i's points as meshing samples them.
+pub(crate) fn assign(
+    model: &Model,
+    edge_nodes: &[EdgeNodes],
+    lines: &[Vec<Point3>],
+) -> Result<Constraints, MeshError> {
     let mut out = Constraints::new();
     if model.dimension != Dimension::Two || model.polylines.is_empty() {
         return Ok(out);
@@ -33,10 +38,10 @@ pub(crate) fn assign(model: &Model, edge_nodes: &[EdgeNodes]) -> Result<Constrai
             }
         }
     }
-    for (index, line) in model.polylines.iter().enumerate() {
-        let mut probes: Vec<Point3> = line.points.clone();
+    for ((index, line), points) in model.polylines.iter().enumerate().zip(lines) {
+        let mut probes: Vec<Point3> = points.clone();
         probes.extend(
-            line.points
+            points
                 .windows(2)
                 .map(|w| Point3::from((w[0].coords + w[1].coords) / 2.0)),
         );
@@ -60,7 +65,7 @@ pub(crate) fn assign(model: &Model, edge_nodes: &[EdgeNodes]) -> Result<Constrai
         if let Some(face) = home {
             out.entry(face)
                 .or_default()
-                .push((index, line.points.clone()));
+                .push((index, points.clone()));
         }
     }
     Ok(out)

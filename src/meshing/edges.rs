@@ -16,6 +16,7 @@
 //!   curves of quadrics).
 
 use super::MeshError;
+use crate::geom::point_calculus::adaptive_samples;
 use crate::geom::{Curve, Point3};
 use crate::ir::{Edge, Model};
 
@@ -56,6 +57,18 @@ pub(crate) fn discretise(
         Curve::Segment { .. } => 1,
         _ => 2,
     };
+    if let Curve::PointCalculus(curve) = &edge.curve {
+        // Point-calculus curves are sampled adaptively (denser where they bend).
+        let (params, points) = adaptive_samples(curve, tolerance, max_edge, n)
+            .ok_or_else(|| failed("its curve has points that are not finite"))?;
+        if params.len() > MAX_SEGMENTS + 1 {
+            return Err(failed("its discretisation did not reach the tolerance"));
+        }
+        let n = params.len() - 1;
+        let mut nodes = finish(points, n, begin, end);
+        nodes.params = params;
+        return Ok(nodes);
+    }
     if let Curve::Segment { a, b } = &edge.curve {
         // A straight edge only needs the length limit.
         let length = (b - a).norm();
@@ -166,4 +179,23 @@ pub(crate) fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
     }
     let t = ((p - a).dot(&d) / len2).clamp(0.0, 1.0);
     (p - (a + d * t)).norm()
+}
+
+/// The points of a standalone line: its exact curve sampled to the
+/// tolerance when it has one, else its own points.
+pub(crate) fn polyline_points(
+    line: &crate::ir::Polyline,
+    tolerance: f64,
+    max_edge: f64,
+) -> Result<Vec<Point3>, MeshError> {
+    match &line.curve {
+        Some(Curve::PointCalculus(curve)) => adaptive_samples(curve, tolerance, max_edge, 2)
+            .map(|(_, points)| points)
+            .ok_or_else(|| MeshError::Edge {
+                edge: line.name.clone(),
+                reason: "its curve has points that are not finite".into(),
+            }),
+        Some(curve) => Ok(curve.samples(64)),
+        None => Ok(line.points.clone()),
+    }
 }

@@ -163,7 +163,12 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
     for (nodes, edge) in edge_nodes.iter_mut().zip(&model.edges) {
         nodes.refine_to_size(&edge.curve, &sizing);
     }
-    let constraints = constraints::assign(model, &edge_nodes)?;
+    let lines = model
+        .polylines
+        .iter()
+        .map(|l| edges::polyline_points(l, tolerance, max_edge))
+        .collect::<Result<Vec<_>, MeshError>>()?;
+    let constraints = constraints::assign(model, &edge_nodes, &lines)?;
     let settings = Settings {
         tolerance,
         sizing: &sizing,
@@ -172,7 +177,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         max_area,
     };
     let face_meshes = mesh_faces(model, &mut edge_nodes, settings, &face_areas, &constraints)?;
-    let mut mesh = assemble(model, &edge_nodes, &face_meshes);
+    let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
     if options.order == 2 {
         quadratic::elevate(model, &edge_nodes, &mut mesh);
     }
@@ -280,7 +285,12 @@ fn mesh_faces(
 
 /// Numbers the nodes (vertices, then edge interiors, then face interiors,
 /// then points and poly_lines) and fills the mesh IR.
-fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceMesh>]) -> Mesh {
+fn assemble(
+    model: &Model,
+    edge_nodes: &[EdgeNodes],
+    face_meshes: &[Option<FaceMesh>],
+    lines: &[Vec<crate::geom::Point3>],
+) -> Mesh {
     let mut nodes: Vec<[f64; 3]> = model
         .vertices
         .iter()
@@ -384,10 +394,10 @@ fn assemble(model: &Model, edge_nodes: &[EdgeNodes], face_meshes: &[Option<FaceM
         });
     }
     let mut polylines = Vec::new();
-    for (index, line) in model.polylines.iter().enumerate() {
+    for (index, (line, points)) in model.polylines.iter().zip(lines).enumerate() {
         let ids = match constrained.remove(&index) {
             Some(chain) => chain,
-            None => line.points.iter().map(|p| push(&mut nodes, p)).collect(),
+            None => points.iter().map(|p| push(&mut nodes, p)).collect(),
         };
         polylines.push(MeshPolyline {
             name: line.name.clone(),

@@ -1,5 +1,6 @@
 //! Resolved geometry of named objects, in global coordinates.
 
+use crate::geom::point_calculus::{Patch9, PcCurve};
 use crate::geom::{Frame, Point3, SolidShape, Surface, Vec3};
 use crate::span::Span;
 
@@ -57,6 +58,10 @@ pub enum Geometry {
         surface: Link,
         loops: Vec<Vec<(Link, Option<String>)>>,
     },
+    /// A curve of paper 003 (segment, conic_arc, desargues_arc).
+    PointCurve(PcCurve),
+    /// Paper 003's 9-point patch.
+    Patch(Box<Patch9>),
     /// Members of a replicate: `name[1]` … `name[n]`.
     Group(Vec<Geometry>),
 }
@@ -73,6 +78,8 @@ impl Geometry {
             Geometry::Vertex(_) => "vertex",
             Geometry::Edge { .. } => "edge",
             Geometry::Face { .. } => "face",
+            Geometry::PointCurve(c) => c.element(),
+            Geometry::Patch(_) => "patch9",
             Geometry::Group(_) => "replicated group",
         }
     }
@@ -116,6 +123,9 @@ impl Geometry {
                 major: *major,
                 minor: *minor,
             }),
+            // Point equations are affine combinations: map the defining points.
+            Geometry::PointCurve(c) => Geometry::PointCurve(c.mapped(|p| map.to_global(p))),
+            Geometry::Patch(patch) => Geometry::Patch(Box::new(patch.mapped(|p| map.to_global(p)))),
             Geometry::Group(members) => Geometry::Group(
                 members
                     .iter()

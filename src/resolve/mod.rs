@@ -5,6 +5,7 @@
 mod geometry;
 mod names;
 mod objects;
+mod point_calculus;
 mod polygons;
 mod shapes;
 mod values;

@@ -394,12 +394,21 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             }
             Some(Geometry::Group(members))
         }
+        ObjectKind::PcCurve {
+            kind,
+            points,
+            discriminant,
+        } => super::point_calculus::curve(r, object, *kind, points, discriminant.as_ref(), frame),
+        ObjectKind::Patch9 { rows } => super::point_calculus::patch(r, object, rows, frame),
         ObjectKind::Surface(spec) => surface(r, spec.as_ref()?, object, frame),
         ObjectKind::Line(spec) => line(r, spec.as_ref()?, object, frame),
         ObjectKind::Vertex(spec) => vertex(r, spec.as_ref()?, object, frame),
         ObjectKind::Edge { line, begin, end } => {
             let line = match line {
-                Some(l) => Some(r.link(l, &["line"])?),
+                Some(l) => Some(r.link(
+                    l,
+                    &["line", "segment", "conic_arc", "desargues_arc", "patch9"],
+                )?),
                 None => None,
             };
             let begin = r.link(begin.as_ref()?, &["vertex"])?;
@@ -416,6 +425,7 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
                     "ellipsoid",
                     "truncated_cone",
                     "torus",
+                    "patch9",
                 ],
             )?;
             let mut out = Vec::new();
@@ -483,6 +493,21 @@ fn parallelepiped(
             ];
             (o, cols)
         }
+        ParallelepipedForm::PointEquation { points } => {
+            // M = Au + Bv + Cw + D(1 − u − v − w) = D + (A − D)u + (B − D)v +
+            // (C − D)w: paper 000's base point D with vertices A, B, C, and the
+            // same arithmetic, so both forms give the identical solid.
+            let [a, b, c, d] = points.as_slice() else {
+                return None;
+            };
+            let o = r.point(d, frame, need3)?;
+            let edges = [
+                r.point(a, frame, need3)? - o,
+                r.point(b, frame, need3)? - o,
+                r.point(c, frame, need3)? - o,
+            ];
+            (o, edges)
+        }
     };
     let lengths = edges.map(|e| e.norm());
     let det = Mat3::from_columns(&edges).determinant();
@@ -493,6 +518,9 @@ fn parallelepiped(
             }
             ParallelepipedForm::Edges { .. } => {
                 "its three edge vectors are coplanar, so it has no volume".to_string()
+            }
+            ParallelepipedForm::PointEquation { .. } => {
+                "A − D, B − D and C − D are coplanar, so it has no volume".to_string()
             }
         };
         r.diags.push(

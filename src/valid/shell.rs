@@ -54,6 +54,7 @@ fn curve_is_closed(curve: &Curve, tolerance: f64) -> bool {
             ((t1 - t0) - std::f64::consts::TAU).abs() <= ANGLE_TOLERANCE
         }
         Curve::Intersection { a, b, .. } => (a - b).norm() <= tolerance,
+        Curve::PointCalculus(c) => (c.begin() - c.end()).norm() <= tolerance,
     }
 }
 
@@ -62,6 +63,7 @@ fn curve_description(curve: &Curve) -> String {
         Curve::Segment { .. } => "a straight segment".to_string(),
         Curve::Ellipse { t0, t1, .. } => format!("an arc spanning {:.6} rad, not 2π", t1 - t0),
         Curve::Intersection { .. } => "an intersection curve with distinct ends".to_string(),
+        Curve::PointCalculus(c) => format!("a {} with distinct ends", c.element()),
     }
 }
 
