@@ -63,9 +63,7 @@ pub(crate) fn assign(
             }
         }
         if let Some(face) = home {
-            out.entry(face)
-                .or_default()
-                .push((index, points.clone()));
+            out.entry(face).or_default().push((index, points.clone()));
         }
     }
     Ok(out)
