@@ -138,8 +138,12 @@ fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Optio
     }
     doc::structure::check(&root, &grammar::GEOMETRY, diags);
     let document = doc::build(source, &root, diags);
+    // Each stage's input is dropped as soon as the next no longer needs it,
+    // which keeps the peak memory of large files down.
+    drop(root);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     let lowered = lower::lower(&document, &resolved, diags);
+    drop(resolved);
     diags.extend(crate::valid::check_topology(
         &lowered.model,
         &lowered.source_map,

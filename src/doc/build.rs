@@ -17,7 +17,7 @@ pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Do
             Some("2") => 2,
             _ => 3,
         },
-        title: root.attribute("name").map(|a| a.value.clone()),
+        title: root.attribute("name").map(|a| a.value.to_string()),
         ..Document::default()
     };
     for element in &root.children {
@@ -33,7 +33,7 @@ struct Builder<'a> {
 
 impl Builder<'_> {
     fn top_level(&mut self, e: &Element, doc: &mut Document) {
-        match e.name.as_str() {
+        match e.name {
             "parameters" => {
                 for p in e.children_named("parameter") {
                     if let (Some(name), Some(value)) = (self.name(p), self.number(p, "value")) {
@@ -55,7 +55,7 @@ impl Builder<'_> {
                             doc.basis.push(BasisCoordinate {
                                 axis,
                                 name: Name {
-                                    text: attr.name.clone(),
+                                    text: attr.name.to_string(),
                                     span: attr.name_span,
                                 },
                                 value,
@@ -78,7 +78,7 @@ impl Builder<'_> {
                 if let Some(name) = self.name(e) {
                     doc.subdomains.push(SubdomainDef {
                         name,
-                        material: e.attribute("material").map(|a| a.value.clone()),
+                        material: e.attribute("material").map(|a| a.value.to_string()),
                         faces: self.ref_list(e, "faces"),
                         tree: e.children.first().and_then(|c| self.solid_tree(c)),
                         area: self.number(e, "area"),
@@ -112,7 +112,7 @@ impl Builder<'_> {
     }
 
     fn object_kind(&mut self, e: &Element) -> Option<ObjectKind> {
-        Some(match e.name.as_str() {
+        Some(match e.name {
             "point" => ObjectKind::Point {
                 values: e.children_named("value").map(|v| self.vector(v)).collect(),
             },
@@ -204,7 +204,7 @@ impl Builder<'_> {
                 normal: self.vector_child(e, "normal"),
             },
             "segment" | "conic_arc" | "desargues_arc" => {
-                let (kind, names): (PcCurveKind, &[&str]) = match e.name.as_str() {
+                let (kind, names): (PcCurveKind, &[&str]) = match e.name {
                     "segment" => (PcCurveKind::Segment, &["point_a", "point_b"]),
                     "conic_arc" => (PcCurveKind::Conic, &["point_a", "point_b", "point_c"]),
                     _ => (
@@ -267,7 +267,7 @@ impl Builder<'_> {
     fn steps(&mut self, e: &Element) -> Vec<Step> {
         let mut steps = Vec::new();
         for c in &e.children {
-            match c.name.as_str() {
+            match c.name {
                 "shift" => steps.push(Step::Shift(self.vector(c))),
                 "rotate" => steps.push(Step::Rotate {
                     angles: self.vector(c),
@@ -284,7 +284,7 @@ impl Builder<'_> {
     }
 
     fn surface(&mut self, c: &Element) -> Option<SurfaceSpec> {
-        Some(match c.name.as_str() {
+        Some(match c.name {
             "plane" => SurfaceSpec::Plane {
                 base: self.point_child(c, "base_point"),
                 normal: self.vector_child(c, "normal"),
@@ -322,7 +322,7 @@ impl Builder<'_> {
     }
 
     fn line(&mut self, c: &Element) -> Option<LineSpec> {
-        Some(match c.name.as_str() {
+        Some(match c.name {
             "straight" => LineSpec::Straight,
             "circle_arc" => LineSpec::CircleArc {
                 center: self.point_child(c, "center"),
@@ -377,7 +377,7 @@ impl Builder<'_> {
         let operands = |b: &mut Self| -> Vec<SolidTree> {
             e.children.iter().filter_map(|c| b.solid_tree(c)).collect()
         };
-        Some(match e.name.as_str() {
+        Some(match e.name {
             "solid" => SolidTree::Solid(self.reference(e, "ref")?),
             "union" => SolidTree::Union(operands(self), e.name_span),
             "intersection" => SolidTree::Intersection(operands(self), e.name_span),
@@ -508,7 +508,7 @@ impl Builder<'_> {
             y: self.number(e, "y"),
             z: self.number(e, "z"),
             point: self.reference(e, "point"),
-            tag: e.name.clone(),
+            tag: e.name.to_string(),
             span: e.name_span,
         }
     }

@@ -27,7 +27,7 @@ pub fn check(root: &Element, rule: &'static Rule, diags: &mut Diagnostics) {
         }
         let known: Vec<&Element> = check_children(element, rule, diags);
         for child in known.into_iter().rev() {
-            if let Some(child_rule) = rule.child_rule(&child.name) {
+            if let Some(child_rule) = rule.child_rule(child.name) {
                 stack.push((child, child_rule));
             }
         }
@@ -44,7 +44,7 @@ fn abbreviate(text: &str) -> String {
 
 fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
     for attr in &element.attributes {
-        match rule.attr(&attr.name) {
+        match rule.attr(attr.name) {
             Some(spec) => {
                 if let AttrKind::Enum(values) = spec.kind {
                     if !values.contains(&attr.value.trim()) {
@@ -85,7 +85,7 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
                     attr.name_span,
                     format!("unknown attribute '{}' on <{}>", attr.name, element.name),
                 );
-                d.help = Some(match did_you_mean(&attr.name, names) {
+                d.help = Some(match did_you_mean(attr.name, names) {
                     Some(best) => format!("did you mean '{best}'?"),
                     None if rule.attrs.is_empty() => {
                         format!("<{}> takes no attributes", element.name)
@@ -123,7 +123,7 @@ fn check_children<'e>(
     element: &'e Element,
     rule: &'static Rule,
     diags: &mut Diagnostics,
-) -> Vec<&'e Element> {
+) -> Vec<&'e Element<'e>> {
     let allowed = rule.child_rules();
     let mut known = Vec::new();
     for child in &element.children {
@@ -136,7 +136,7 @@ fn check_children<'e>(
                 format!("unknown element <{}> inside <{}>", child.name, element.name),
             );
             d.help = Some(
-                match did_you_mean(&child.name, allowed.iter().map(|r| r.name)) {
+                match did_you_mean(child.name, allowed.iter().map(|r| r.name)) {
                     Some(best) => format!("did you mean <{best}>?"),
                     None if allowed.is_empty() => {
                         format!("<{}> has no child elements", element.name)
@@ -272,7 +272,7 @@ fn check_order(element: &Element, known: &[&Element], children: &[Child], diags:
     let position = |name: &str| children.iter().position(|c| c.rule.name == name);
     let mut latest: Option<(usize, &Element)> = None;
     for child in known {
-        let Some(p) = position(&child.name) else {
+        let Some(p) = position(child.name) else {
             continue;
         };
         if let Some((q, previous)) = latest {
@@ -328,11 +328,11 @@ fn check_forms(element: &Element, known: &[&Element], forms: &[&[Child]], diags:
         );
         return;
     };
-    let Some(form) = forms.iter().find(|f| in_form(f, &first.name)) else {
+    let Some(form) = forms.iter().find(|f| in_form(f, first.name)) else {
         return;
     };
     let mut conflict = false;
-    for child in known.iter().filter(|c| !in_form(form, &c.name)) {
+    for child in known.iter().filter(|c| !in_form(form, c.name)) {
         conflict = true;
         diags.push(
             Diagnostic::new(

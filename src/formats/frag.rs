@@ -485,7 +485,7 @@ impl Reader<'_> {
         root: &'e Element,
         list: &'e str,
         item: &str,
-    ) -> Result<Vec<&'e Element>, FragReadError> {
+    ) -> Result<Vec<&'e Element<'e>>, FragReadError> {
         let Some(parent) = root.children_named(list).next() else {
             return self.error(root, format!("<{}> has no <{list}>", root.name));
         };
@@ -588,7 +588,7 @@ impl Reader<'_> {
             .map(|e| {
                 Ok(FragSubdomain {
                     name: name(e)?,
-                    material: e.attribute("material").map(|a| a.value.clone()),
+                    material: e.attribute("material").map(|a| a.value.to_string()),
                 })
             })
             .collect::<Result<_, FragReadError>>()?;

@@ -5,6 +5,7 @@
 
 use super::Entities;
 use super::explicit::{lookup_entities, unknown_entity};
+use super::weld::FaceSamples;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::{Document, SolidTree};
 use crate::geom::{Point3, Surface, Vec3, boundary_relation};
@@ -51,7 +52,7 @@ pub(super) fn lower_subdomains(
     model: &mut Model,
     source_map: &mut SourceMap,
     entities: &Entities,
-    face_samples: &HashMap<FaceId, Point3>,
+    face_samples: &FaceSamples,
     diags: &mut Diagnostics,
 ) {
     let mut trees: Vec<(SubdomainId, Built)> = Vec::new();
@@ -324,7 +325,9 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
         .max(tol * 1e3)
         .max(f64::MIN_POSITIVE);
     let key = |v: f64| (v / cell).floor() as i64;
-    let mut grid: HashMap<[i64; 3], Vec<usize>> = HashMap::new();
+    // A sorted list of (cell, box) instead of a map of cells: boxes sharing a
+    // cell are adjacent after sorting, and nothing is allocated per cell.
+    let mut cells: Vec<([i64; 3], u32)> = Vec::with_capacity(boxes.len());
     let mut big = Vec::new();
     for (i, b) in boxes.iter().enumerate() {
         let finite = [b.min, b.max]
@@ -346,17 +349,19 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
-                    grid.entry([x, y, z]).or_default().push(i);
+                    cells.push(([x, y, z], i as u32));
                 }
             }
         }
     }
-    let mut pairs = BTreeSet::new();
-    for members in grid.values() {
-        for (k, &i) in members.iter().enumerate() {
-            for &j in &members[k + 1..] {
+    cells.sort_unstable();
+    let mut pairs = Vec::new();
+    for run in cells.chunk_by(|a, b| a.0 == b.0) {
+        for (k, &(_, i)) in run.iter().enumerate() {
+            for &(_, j) in &run[k + 1..] {
+                let (i, j) = (i as usize, j as usize);
                 if boxes[i].overlaps(&boxes[j], tol) {
-                    pairs.insert((i.min(j), i.max(j)));
+                    pairs.push((i.min(j), i.max(j)));
                 }
             }
         }
@@ -364,11 +369,13 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
     for &i in &big {
         for j in 0..boxes.len() {
             if i != j && boxes[i].overlaps(&boxes[j], tol) {
-                pairs.insert((i.min(j), i.max(j)));
+                pairs.push((i.min(j), i.max(j)));
             }
         }
     }
-    pairs.into_iter().collect()
+    pairs.sort_unstable();
+    pairs.dedup();
+    pairs
 }
 
 fn check_pair(
@@ -438,11 +445,7 @@ fn check_pair(
 }
 
 /// The faces of the subdomain's boundary, with `outward` set.
-fn classify_faces(
-    model: &Model,
-    built: &Built,
-    samples: &HashMap<FaceId, Point3>,
-) -> Vec<OrientedFace> {
+fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<OrientedFace> {
     let mut result: BTreeMap<FaceId, bool> = BTreeMap::new();
     for &leaf in &built.leaves {
         for of in &model.solids[leaf.index()].faces {
@@ -566,7 +569,7 @@ fn check_overlaps(
     model: &Model,
     source_map: &SourceMap,
     trees: &[(SubdomainId, Built)],
-    samples: &HashMap<FaceId, Point3>,
+    samples: &FaceSamples,
     diags: &mut Diagnostics,
 ) {
     let step = model.tolerance * 1000.0;
@@ -585,9 +588,13 @@ fn check_overlaps(
             interior_probes(model, *id, samples, step),
         ));
     }
+    let mut from_tree = vec![false; model.subdomains.len()];
+    for (t, _) in trees {
+        from_tree[t.index()] = true;
+    }
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         let id = SubdomainId(k as u32);
-        if trees.iter().any(|(t, _)| *t == id) {
+        if from_tree[k] {
             continue;
         }
         let SubdomainCells::Volume { boundary } = &subdomain.cells else {
@@ -595,7 +602,7 @@ fn check_overlaps(
         };
         let shell = super::winding::ShellTriangles::of(model, boundary);
         let mut bbox = crate::geom::Aabb::empty();
-        let mut face_points = HashMap::new();
+        let mut face_points = FaceSamples::default();
         for of in boundary {
             for e in model.face(of.face).loops.iter().flatten() {
                 let edge = model.edge(e.edge);
@@ -645,7 +652,7 @@ fn check_overlaps(
 fn interior_probes(
     model: &Model,
     id: SubdomainId,
-    samples: &HashMap<FaceId, Point3>,
+    samples: &FaceSamples,
     step: f64,
 ) -> Vec<Point3> {
     match &model.subdomain(id).cells {

@@ -11,7 +11,7 @@ pub struct BrepVertex {
 }
 
 pub struct BrepEdge {
-    pub name: String,
+    pub name: std::borrow::Cow<'static, str>,
     pub curve: Curve,
     pub begin: usize,
     pub end: usize,
@@ -69,6 +69,13 @@ fn ellipse(frame: &Frame, center: Vec3, a: Vec3, b: Vec3) -> Curve {
 }
 
 const FACE_NAMES: [[&str; 2]; 3] = [["xmin", "xmax"], ["ymin", "ymax"], ["zmin", "zmax"]];
+/// Edge names by axis the edge runs along, then the sides of the two other
+/// axes in ascending axis order ("xmin_ymax" runs along z).
+const EDGE_NAMES: [[[&str; 2]; 2]; 3] = [
+    [["ymin_zmin", "ymin_zmax"], ["ymax_zmin", "ymax_zmax"]],
+    [["xmin_zmin", "xmin_zmax"], ["xmax_zmin", "xmax_zmax"]],
+    [["xmin_ymin", "xmin_ymax"], ["xmax_ymin", "xmax_ymax"]],
+];
 const VERTEX_NAMES: [&str; 8] = [
     "v000", "v100", "v010", "v110", "v001", "v101", "v011", "v111",
 ];
@@ -86,22 +93,21 @@ fn parallelepiped(frame: &Frame) -> Brep {
         })
         .collect::<Vec<_>>();
     // Edges along axis `a` at fixed values of the other two axes.
-    let mut edges = Vec::new();
-    let mut edge_index = std::collections::HashMap::new();
+    // Edge (axis, s, t) is edges[4 * axis + 2 * s + t].
+    let mut edges = Vec::with_capacity(12);
     for axis in 0..3 {
         let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
         let (lo, hi) = (p.min(q), p.max(q));
-        for (s, lo_name) in FACE_NAMES[lo].iter().enumerate() {
-            for (t, hi_name) in FACE_NAMES[hi].iter().enumerate() {
+        for (s, names) in EDGE_NAMES[axis].iter().enumerate() {
+            for (t, &name) in names.iter().enumerate() {
                 let mut at = [0usize; 3];
                 at[lo] = s;
                 at[hi] = t;
                 let begin = corner(at[0], at[1], at[2]);
                 at[axis] = 1;
                 let end = corner(at[0], at[1], at[2]);
-                edge_index.insert((axis, lo, s, hi, t), edges.len());
                 edges.push(BrepEdge {
-                    name: format!("{lo_name}_{hi_name}"),
+                    name: name.into(),
                     curve: Curve::Segment {
                         a: vertices[begin].position,
                         b: vertices[end].position,
@@ -120,13 +126,13 @@ fn parallelepiped(frame: &Frame) -> Brep {
             // The four edges of the face axis = side, walked p-then-q, which is
             // counter-clockwise about +axis; reversed on the min side.
             let e = |along: usize, fixed_axis: usize, fixed: usize| {
-                let (lo, hi) = (axis.min(fixed_axis), axis.max(fixed_axis));
+                // s belongs to the lower of the two fixed axes, t to the higher.
                 let (s, t) = if axis < fixed_axis {
                     (side, fixed)
                 } else {
                     (fixed, side)
                 };
-                edge_index[&(along, lo, s, hi, t)]
+                4 * along + 2 * s + t
             };
             let mut ring = vec![
                 (e(p, q, 0), true),
@@ -354,7 +360,7 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
         .map(|i| {
             let j = (i + 1) % n;
             BrepEdge {
-                name: format!("e{}", i + 1),
+                name: format!("e{}", i + 1).into(),
                 curve: Curve::Segment {
                     a: vertices[i].position,
                     b: vertices[j].position,

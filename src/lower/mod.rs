@@ -43,6 +43,54 @@ pub(crate) struct Entities {
     pub failed: std::collections::HashSet<String>,
 }
 
+impl Entities {
+    /// Adds the documented names of every lowered solid's entities
+    /// ("box.xmin" → its welded face). Explicit entities keep their names: an
+    /// explicit entity of the same name wins, and among solids the first does.
+    fn add_solid_entities(&mut self, model: &Model) {
+        fn add<'n, T: Copy>(
+            table: &mut HashMap<String, T>,
+            solid: &str,
+            names: impl Iterator<Item = &'n str>,
+            ids: impl Iterator<Item = T>,
+        ) {
+            for (local, id) in names.zip(ids) {
+                table.entry(format!("{solid}.{local}")).or_insert(id);
+            }
+        }
+        let explicit = (
+            std::mem::take(&mut self.vertices),
+            std::mem::take(&mut self.edges),
+            std::mem::take(&mut self.faces),
+        );
+        for solid in &model.solids {
+            let brep = brep::of(&solid.shape);
+            let name = solid.name.as_str();
+            add(
+                &mut self.vertices,
+                name,
+                brep.vertices.iter().map(|v| v.name.as_ref()),
+                solid.vertices.iter().copied(),
+            );
+            add(
+                &mut self.edges,
+                name,
+                brep.edges.iter().map(|e| e.name.as_ref()),
+                solid.edges.iter().copied(),
+            );
+            add(
+                &mut self.faces,
+                name,
+                brep.faces.iter().map(|f| f.name),
+                solid.faces.iter().map(|f| f.face),
+            );
+        }
+        self.vertices.extend(explicit.0);
+        self.edges.extend(explicit.1);
+        self.faces.extend(explicit.2);
+    }
+}
+
 pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
@@ -101,6 +149,11 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
         &mut entities,
         diags,
     );
+    let named_lists =
+        !doc.boundaries.is_empty() || doc.subdomains.iter().any(|s| s.faces.is_some());
+    if named_lists {
+        entities.add_solid_entities(&model);
+    }
     let face_samples = welder.face_samples;
     booleans::lower_subdomains(
         doc,
@@ -163,7 +216,7 @@ fn lower_free(
             .polylines
             .push(point_calculus::standalone(name, curve)),
         Geometry::Solid(shape) => {
-            let id = lower_solid(model, source_map, entities, welder, name, shape, span);
+            let id = lower_solid(model, source_map, welder, name, shape, span);
             entities
                 .solids
                 .entry(name.to_string())
@@ -177,7 +230,6 @@ fn lower_free(
 fn lower_solid(
     model: &mut Model,
     source_map: &mut SourceMap,
-    entities: &mut Entities,
     welder: &mut weld::Welder,
     name: &str,
     shape: &SolidShape,
@@ -185,18 +237,16 @@ fn lower_solid(
 ) -> SolidId {
     let origin = Origin { span };
     let brep = brep::of(shape);
+    // Entity names are made only for new entities; the name tables for
+    // faces= and edges= lists are built later, and only when a file has such lists.
     let vertex_ids: Vec<_> = brep
         .vertices
         .iter()
         .map(|v| {
-            let (id, new) = welder.vertex(model, format!("{name}.{}", v.name), v.position);
+            let (id, new) = welder.vertex(model, || format!("{name}.{}", v.name), v.position);
             if new {
                 source_map.vertices.insert(id, origin);
             }
-            entities
-                .vertices
-                .entry(format!("{name}.{}", v.name))
-                .or_insert(id);
             id
         })
         .collect();
@@ -204,10 +254,9 @@ fn lower_solid(
         .edges
         .into_iter()
         .map(|e| {
-            let entity = format!("{name}.{}", e.name);
             let (id, flipped, new) = welder.edge(
                 model,
-                entity.clone(),
+                || format!("{name}.{}", e.name),
                 e.curve,
                 vertex_ids[e.begin],
                 vertex_ids[e.end],
@@ -215,7 +264,6 @@ fn lower_solid(
             if new {
                 source_map.edges.insert(id, origin);
             }
-            entities.edges.entry(entity).or_insert(id);
             (id, flipped)
         })
         .collect();
@@ -226,7 +274,7 @@ fn lower_solid(
             forward: forward != flipped,
         }
     };
-    let mut faces = Vec::new();
+    let mut faces = Vec::with_capacity(brep.faces.len());
     for f in brep.faces {
         let loops: Vec<Vec<OrientedEdge>> = f
             .loops
@@ -234,9 +282,8 @@ fn lower_solid(
             .map(|l| l.iter().copied().map(orient).collect())
             .collect();
         let first = loops.first().and_then(|l| l.first()).copied();
-        let entity = format!("{name}.{}", f.name);
         let face = Face {
-            name: entity.clone(),
+            name: format!("{name}.{}", f.name),
             surface: f.surface,
             reversed: false,
             loops,
@@ -245,7 +292,6 @@ fn lower_solid(
         if new {
             source_map.faces.insert(id, origin);
         }
-        entities.faces.entry(entity).or_insert(id);
         // A welded face keeps the first solid's orientation; this solid's
         // outward side agrees when its loop runs the same way.
         let outward = new || first.is_none_or(|probe| same_direction(model.face(id), probe));

@@ -2,17 +2,19 @@
 //! subdomains that bound no subdomain, and the edges and vertices only they used.
 
 use crate::ir::{EdgeId, FaceId, Model, SourceMap, SubdomainCells, VertexId};
-use std::collections::{BTreeSet, HashMap};
+use std::collections::HashMap;
 
 pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
-    let used_by_subdomains: BTreeSet<usize> = model
-        .subdomains
-        .iter()
-        .flat_map(|s| s.solids.iter().map(|id| id.index()))
-        .collect();
+    // Flag vectors, not sets: these run over every entity of the model.
+    let mut used_by_subdomains = vec![false; model.solids.len()];
+    for id in model.subdomains.iter().flat_map(|s| &s.solids) {
+        if let Some(flag) = used_by_subdomains.get_mut(id.index()) {
+            *flag = true;
+        }
+    }
     let mut keep_face = vec![true; model.faces.len()];
     for (k, solid) in model.solids.iter().enumerate() {
-        if used_by_subdomains.contains(&k) {
+        if used_by_subdomains[k] {
             for of in &solid.faces {
                 keep_face[of.face.index()] = false;
             }
@@ -20,7 +22,7 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
         }
     }
     for (k, solid) in model.solids.iter().enumerate() {
-        if !used_by_subdomains.contains(&k) {
+        if !used_by_subdomains[k] {
             solid
                 .faces
                 .iter()
@@ -51,19 +53,20 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
                 .for_each(|e| keep_edge[e.edge.index()] = true);
         }
     }
-    let primitive_edges: BTreeSet<usize> = model
-        .solids
-        .iter()
-        .flat_map(|s| s.edges.iter().map(|e| e.index()))
-        .collect();
+    let mut primitive_edges = vec![false; model.edges.len()];
+    for e in model.solids.iter().flat_map(|s| &s.edges) {
+        if let Some(flag) = primitive_edges.get_mut(e.index()) {
+            *flag = true;
+        }
+    }
     for (k, keep) in keep_edge.iter_mut().enumerate() {
         // Explicit edges and edges of free-standing solids always stay.
-        if !primitive_edges.contains(&k) {
+        if !primitive_edges[k] {
             *keep = true;
         }
     }
     for (k, solid) in model.solids.iter().enumerate() {
-        if !used_by_subdomains.contains(&k) {
+        if !used_by_subdomains[k] {
             solid.edges.iter().for_each(|e| keep_edge[e.index()] = true);
         }
     }
@@ -78,13 +81,14 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
             keep_vertex[edge.end.index()] = true;
         }
     }
-    let primitive_vertices: BTreeSet<usize> = model
-        .solids
-        .iter()
-        .flat_map(|s| s.vertices.iter().map(|v| v.index()))
-        .collect();
+    let mut primitive_vertices = vec![false; model.vertices.len()];
+    for v in model.solids.iter().flat_map(|s| &s.vertices) {
+        if let Some(flag) = primitive_vertices.get_mut(v.index()) {
+            *flag = true;
+        }
+    }
     for (k, keep) in keep_vertex.iter_mut().enumerate() {
-        if !primitive_vertices.contains(&k) {
+        if !primitive_vertices[k] {
             *keep = true;
         }
     }

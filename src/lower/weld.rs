@@ -1,19 +1,94 @@
 //! Welding: entities of different primitives that coincide within the
 //! tolerance become one entity, so solids that share a face share one `Face`
 //! and the meshes built on it conform.
+//!
+//! Candidates are kept in hash maps (foldhash, fixed seed) whose values are
+//! chains through per-entity `next` links, so a lookup allocates nothing and
+//! candidates are visited in creation order.
 
 use crate::geom::{Curve, Point3};
 use crate::ir::{Edge, EdgeId, Face, FaceId, Model, OrientedEdge, Vertex, VertexId};
 use std::collections::HashMap;
+use std::hash::{BuildHasher, Hash};
+
+type FastMap<K, V> = HashMap<K, V, foldhash::fast::FixedState>;
+
+/// No entity: the end of a chain.
+const NONE: u32 = u32::MAX;
+
+/// Canonical interior points of faces, indexed by face id.
+#[derive(Debug, Default, Clone)]
+pub struct FaceSamples(Vec<Option<Point3>>);
+
+impl FaceSamples {
+    pub fn get(&self, face: &FaceId) -> Option<&Point3> {
+        self.0.get(face.index()).and_then(Option::as_ref)
+    }
+
+    pub fn insert(&mut self, face: FaceId, point: Point3) {
+        if self.0.len() <= face.index() {
+            self.0.resize(face.index() + 1, None);
+        }
+        self.0[face.index()] = Some(point);
+    }
+}
+
+/// Chains of entity ids sharing a key: the map holds (first, last) of each
+/// chain, `next` links an id to the following one.
+struct Chains<K> {
+    heads: FastMap<K, (u32, u32)>,
+    next: Vec<u32>,
+}
+
+impl<K> Default for Chains<K> {
+    fn default() -> Self {
+        Chains {
+            heads: FastMap::default(),
+            next: Vec::new(),
+        }
+    }
+}
+
+impl<K: Hash + Eq> Chains<K> {
+    fn push(&mut self, key: K, id: u32) {
+        if self.next.len() <= id as usize {
+            self.next.resize(id as usize + 1, NONE);
+        }
+        match self.heads.get_mut(&key) {
+            Some((_, last)) => {
+                self.next[*last as usize] = id;
+                *last = id;
+            }
+            None => {
+                self.heads.insert(key, (id, id));
+            }
+        }
+    }
+
+    /// The ids under `key`, in the order they were pushed.
+    fn iter(&self, key: &K) -> impl Iterator<Item = u32> + '_ {
+        let mut at = self.heads.get(key).map_or(NONE, |&(first, _)| first);
+        std::iter::from_fn(move || {
+            if at == NONE {
+                return None;
+            }
+            let id = at;
+            at = self.next.get(id as usize).copied().unwrap_or(NONE);
+            Some(id)
+        })
+    }
+}
 
 pub struct Welder {
     tol: f64,
     cell: f64,
-    vertex_grid: HashMap<[i64; 3], Vec<VertexId>>,
-    edges_by_ends: HashMap<(VertexId, VertexId), Vec<EdgeId>>,
-    faces_by_edges: HashMap<Vec<EdgeId>, Vec<FaceId>>,
+    vertex_grid: Chains<[i64; 3]>,
+    edges_by_ends: Chains<(VertexId, VertexId)>,
+    /// Faces by a hash of their sorted edge list (compared exactly on a hit).
+    faces_by_edges: Chains<u64>,
     /// Canonical interior point of every face (welded faces: the first's).
-    pub face_samples: HashMap<FaceId, Point3>,
+    pub face_samples: FaceSamples,
+    scratch: Vec<EdgeId>,
 }
 
 impl Welder {
@@ -21,10 +96,11 @@ impl Welder {
         Welder {
             tol,
             cell: (tol * 4.0).max(f64::MIN_POSITIVE),
-            vertex_grid: HashMap::new(),
-            edges_by_ends: HashMap::new(),
-            faces_by_edges: HashMap::new(),
-            face_samples: HashMap::new(),
+            vertex_grid: Chains::default(),
+            edges_by_ends: Chains::default(),
+            faces_by_edges: Chains::default(),
+            face_samples: FaceSamples::default(),
+            scratch: Vec::new(),
         }
     }
 
@@ -32,40 +108,49 @@ impl Welder {
         [p.x, p.y, p.z].map(|c| (c / self.cell).floor() as i64)
     }
 
-    /// The existing vertex within the tolerance of `position`, or a new one.
+    /// The existing vertex within the tolerance of `position`, or a new one
+    /// named by `name()`.
     pub fn vertex(
         &mut self,
         model: &mut Model,
-        name: String,
+        name: impl FnOnce() -> String,
         position: Point3,
     ) -> (VertexId, bool) {
         let key = self.key(&position);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    let k = [key[0] + dx, key[1] + dy, key[2] + dz];
-                    if let Some(ids) = self.vertex_grid.get(&k) {
-                        for &id in ids {
-                            if (model.vertices[id.index()].position - position).norm() <= self.tol {
-                                return (id, false);
-                            }
+        // Only cells that the tolerance ball around `position` reaches can
+        // hold a match; they are visited in the same order as the full 3×3×3
+        // neighbourhood, so the first match is the same.
+        let lo = self.key(&(position - crate::geom::Vec3::repeat(self.tol)));
+        let hi = self.key(&(position + crate::geom::Vec3::repeat(self.tol)));
+        let range =
+            |k: usize| lo[k].max(key[k].saturating_sub(1))..=hi[k].min(key[k].saturating_add(1));
+        for x in range(0) {
+            for y in range(1) {
+                for z in range(2) {
+                    for id in self.vertex_grid.iter(&[x, y, z]) {
+                        if (model.vertices[id as usize].position - position).norm() <= self.tol {
+                            return (VertexId(id), false);
                         }
                     }
                 }
             }
         }
         let id = VertexId(model.vertices.len() as u32);
-        model.vertices.push(Vertex { name, position });
-        self.vertex_grid.entry(key).or_default().push(id);
+        model.vertices.push(Vertex {
+            name: name(),
+            position,
+        });
+        self.vertex_grid.push(key, id.0);
         (id, true)
     }
 
-    /// The existing edge with the same ends and the same curve, or a new one.
-    /// Returns the id and whether the existing edge runs the other way.
+    /// The existing edge with the same ends and the same curve, or a new one
+    /// named by `name()`. Returns the id, whether the existing edge runs the
+    /// other way, and whether the edge is new.
     pub fn edge(
         &mut self,
         model: &mut Model,
-        name: String,
+        name: impl FnOnce() -> String,
         curve: Curve,
         begin: VertexId,
         end: VertexId,
@@ -75,64 +160,69 @@ impl Welder {
         } else {
             (end, begin)
         };
-        let probes = probe_points(&curve);
-        if let Some(ids) = self.edges_by_ends.get(&key) {
-            for &id in ids {
-                let existing = &model.edges[id.index()];
-                let theirs = probe_points(&existing.curve);
-                let same = probes
-                    .iter()
-                    .zip(&theirs)
-                    .all(|(a, b)| (a - b).norm() <= self.tol);
-                let mut reversed_probes = probes;
-                reversed_probes.reverse();
-                let opposite = reversed_probes
-                    .iter()
-                    .zip(&theirs)
-                    .all(|(a, b)| (a - b).norm() <= self.tol);
-                if same && (existing.begin == begin || begin == end) {
-                    return (id, false, false);
-                }
-                if opposite && (existing.begin == end || begin == end) {
-                    return (id, true, false);
-                }
+        let mut probes = None;
+        for id in self.edges_by_ends.iter(&key) {
+            let probes = *probes.get_or_insert_with(|| probe_points(&curve));
+            let existing = &model.edges[id as usize];
+            let theirs = probe_points(&existing.curve);
+            let same = probes
+                .iter()
+                .zip(&theirs)
+                .all(|(a, b)| (a - b).norm() <= self.tol);
+            let mut reversed_probes = probes;
+            reversed_probes.reverse();
+            let opposite = reversed_probes
+                .iter()
+                .zip(&theirs)
+                .all(|(a, b)| (a - b).norm() <= self.tol);
+            if same && (existing.begin == begin || begin == end) {
+                return (EdgeId(id), false, false);
+            }
+            if opposite && (existing.begin == end || begin == end) {
+                return (EdgeId(id), true, false);
             }
         }
         let id = EdgeId(model.edges.len() as u32);
         model.edges.push(Edge {
-            name,
+            name: name(),
             curve,
             begin,
             end,
         });
-        self.edges_by_ends.entry(key).or_default().push(id);
+        self.edges_by_ends.push(key, id.0);
         (id, false, true)
     }
 
     /// The existing face with the same edges and the same interior point, or a new one.
     pub fn face(&mut self, model: &mut Model, face: Face, sample: Point3) -> (FaceId, bool) {
-        let mut key: Vec<EdgeId> = face
-            .loops
-            .iter()
-            .flatten()
-            .map(|e: &OrientedEdge| e.edge)
-            .collect();
-        key.sort();
-        if let Some(ids) = self.faces_by_edges.get(&key) {
-            for &id in ids {
-                if let Some(theirs) = self.face_samples.get(&id) {
-                    if (theirs - sample).norm() <= self.tol {
-                        return (id, false);
-                    }
+        sorted_edges(&face, &mut self.scratch);
+
+        let key = foldhash::fast::FixedState::default().hash_one(&self.scratch);
+        let mut theirs = Vec::new();
+        for id in self.faces_by_edges.iter(&key) {
+            sorted_edges(&model.faces[id as usize], &mut theirs);
+            if theirs != self.scratch {
+                continue;
+            }
+            if let Some(p) = self.face_samples.get(&FaceId(id)) {
+                if (p - sample).norm() <= self.tol {
+                    return (FaceId(id), false);
                 }
             }
         }
         let id = FaceId(model.faces.len() as u32);
         model.faces.push(face);
-        self.faces_by_edges.entry(key).or_default().push(id);
+        self.faces_by_edges.push(key, id.0);
         self.face_samples.insert(id, sample);
         (id, true)
     }
+}
+
+/// The edges of a face's loops, sorted (the welding key).
+fn sorted_edges(face: &Face, out: &mut Vec<EdgeId>) {
+    out.clear();
+    out.extend(face.loops.iter().flatten().map(|e: &OrientedEdge| e.edge));
+    out.sort_unstable();
 }
 
 /// Points at s = 1/4, 1/2, 3/4: two curves with the same ends are the same

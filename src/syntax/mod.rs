@@ -31,7 +31,7 @@ impl Default for Limits {
 }
 
 /// Parses `source` into an owned tree, or says why it cannot.
-pub fn parse(source: &SourceFile, limits: &Limits) -> Result<Element, Diagnostic> {
+pub fn parse<'s>(source: &'s SourceFile, limits: &Limits) -> Result<Element<'s>, Diagnostic> {
     let text = source.text.as_str();
     if text.len() > limits.max_file_size {
         return Err(Diagnostic::new(

@@ -1,41 +1,48 @@
-//! The owned element tree: names, attributes and children with byte spans.
+//! The element tree: names, attributes and children with byte spans. Names
+//! and attribute values borrow from the source text (a value is owned only
+//! when the parser had to expand an entity or normalise whitespace in it), so
+//! building the tree allocates little more than its vectors.
 
 use crate::span::Span;
+use std::borrow::Cow;
 
 #[derive(Debug, Clone, PartialEq)]
-pub struct Attribute {
-    pub name: String,
+pub struct Attribute<'s> {
+    pub name: &'s str,
     pub name_span: Span,
-    pub value: String,
+    pub value: Cow<'s, str>,
     pub value_span: Span,
 }
 
 #[derive(Debug, Clone, PartialEq)]
-pub struct Element {
-    pub name: String,
+pub struct Element<'s> {
+    pub name: &'s str,
     /// The whole element, from `<` to the end of its closing tag.
     pub span: Span,
     /// The element's name in its start tag.
     pub name_span: Span,
-    pub attributes: Vec<Attribute>,
-    pub children: Vec<Element>,
+    pub attributes: Vec<Attribute<'s>>,
+    pub children: Vec<Element<'s>>,
     /// Non-whitespace text directly inside the element, with its span.
     pub text: Vec<(String, Span)>,
 }
 
-impl Element {
-    pub fn attribute(&self, name: &str) -> Option<&Attribute> {
+impl<'s> Element<'s> {
+    pub fn attribute(&self, name: &str) -> Option<&Attribute<'s>> {
         self.attributes.iter().find(|a| a.name == name)
     }
 
-    pub fn children_named<'a>(&'a self, name: &'a str) -> impl Iterator<Item = &'a Element> + 'a {
+    pub fn children_named<'a>(
+        &'a self,
+        name: &'a str,
+    ) -> impl Iterator<Item = &'a Element<'s>> + 'a {
         self.children.iter().filter(move |c| c.name == name)
     }
 }
 
-/// Converts a parsed roxmltree node into the owned tree. Iterative, so depth
+/// Converts a parsed roxmltree node into the tree. Iterative, so depth
 /// is bounded only by memory (the caller has already checked the depth limit).
-pub(super) fn build(root: roxmltree::Node) -> Element {
+pub(super) fn build<'s>(root: roxmltree::Node<'_, 's>) -> Element<'s> {
     // Post-order assembly: each frame keeps its child iterator and collects its
     // finished children.
     let mut stack = vec![(root.children(), shell(root))];
@@ -55,9 +62,10 @@ pub(super) fn build(root: roxmltree::Node) -> Element {
             }
             Some(_) => {}
             None => {
-                let Some((_, finished)) = stack.pop() else {
+                let Some((_, mut finished)) = stack.pop() else {
                     unreachable!("the loop only pops a frame it has just seen")
                 };
+                finished.children.shrink_to_fit();
                 match stack.last_mut() {
                     Some(parent) => parent.1.children.push(finished),
                     None => return finished,
@@ -67,9 +75,9 @@ pub(super) fn build(root: roxmltree::Node) -> Element {
     }
 }
 
-fn shell(node: roxmltree::Node) -> Element {
+fn shell<'s>(node: roxmltree::Node<'_, 's>) -> Element<'s> {
     let range = node.range();
-    let name = node.tag_name().name().to_string();
+    let name = node.tag_name().name();
     let name_start = range.start + 1;
     Element {
         name_span: Span::new(name_start, name_start + name.len()),
@@ -81,9 +89,12 @@ fn shell(node: roxmltree::Node) -> Element {
             // the XML tooling, not to the format.
             .filter(|a| a.namespace().is_none())
             .map(|a| Attribute {
-                name: a.name().to_string(),
+                name: a.name(),
                 name_span: Span::from_range(a.range_qname()),
-                value: a.value().to_string(),
+                value: match a.value_storage() {
+                    roxmltree::StringStorage::Borrowed(text) => Cow::Borrowed(*text),
+                    other => Cow::Owned(other.as_str().to_string()),
+                },
                 value_span: Span::from_range(a.range_value()),
             })
             .collect(),

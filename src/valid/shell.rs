@@ -569,33 +569,54 @@ fn check_euler(
 /// explicit vertices, edges and faces that nothing uses. Entities of solids
 /// are generated, so only those in the source map and in no solid count.
 pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagnostics) {
-    let mut bounded: BTreeMap<FaceId, BTreeSet<SubdomainId>> = BTreeMap::new();
-    let mut used_faces: BTreeSet<FaceId> = BTreeSet::new();
+    // Flag and count vectors indexed by id, not sets: this runs over every
+    // entity of the model. Ids out of range are skipped (a malformed model).
+    let n_faces = model.faces.len();
+    let mut used_faces = vec![false; n_faces];
+    let mut bounding_count = vec![0u32; n_faces];
+    let mut last_subdomain = vec![u32::MAX; n_faces];
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         match &subdomain.cells {
             SubdomainCells::Volume { boundary } => {
                 for of in boundary {
-                    bounded
-                        .entry(of.face)
-                        .or_default()
-                        .insert(SubdomainId(k as u32));
-                    used_faces.insert(of.face);
+                    let f = of.face.index();
+                    if f >= n_faces {
+                        continue;
+                    }
+                    used_faces[f] = true;
+                    if last_subdomain[f] != k as u32 {
+                        last_subdomain[f] = k as u32;
+                        bounding_count[f] += 1;
+                    }
                 }
             }
-            SubdomainCells::Region { faces } => used_faces.extend(faces.iter().copied()),
+            SubdomainCells::Region { faces } => {
+                for f in faces {
+                    if let Some(u) = used_faces.get_mut(f.index()) {
+                        *u = true;
+                    }
+                }
+            }
         }
     }
-    used_faces.extend(
-        model
-            .boundaries
-            .iter()
-            .flat_map(|b| b.faces.iter().copied()),
-    );
-
-    for (&face, subdomains) in &bounded {
-        if subdomains.len() <= 2 || face.index() >= model.faces.len() {
-            continue;
+    for f in model.boundaries.iter().flat_map(|b| &b.faces) {
+        if let Some(u) = used_faces.get_mut(f.index()) {
+            *u = true;
         }
+    }
+
+    for (f, _) in bounding_count.iter().enumerate().filter(|(_, n)| **n > 2) {
+        let face = FaceId(f as u32);
+        let subdomains: BTreeSet<SubdomainId> = model
+            .subdomains
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| match &s.cells {
+                SubdomainCells::Volume { boundary } => boundary.iter().any(|of| of.face == face),
+                SubdomainCells::Region { .. } => false,
+            })
+            .map(|(k, _)| SubdomainId(k as u32))
+            .collect();
         let names: Vec<String> = subdomains
             .iter()
             .map(|&s| format!("'{}'", subdomain_name(model, s)))
@@ -618,36 +639,60 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
         );
     }
 
-    let in_solids_v: BTreeSet<VertexId> = model
-        .solids
-        .iter()
-        .flat_map(|s| s.vertices.iter().copied())
-        .collect();
-    let in_solids_e: BTreeSet<EdgeId> = model
-        .solids
-        .iter()
-        .flat_map(|s| s.edges.iter().copied())
-        .collect();
-    let in_solids_f: BTreeSet<FaceId> = model
-        .solids
-        .iter()
-        .flat_map(|s| s.faces.iter().map(|of| of.face))
-        .collect();
-
-    let used_vertices: BTreeSet<VertexId> =
-        model.edges.iter().flat_map(|e| [e.begin, e.end]).collect();
-    let used_edges: BTreeSet<EdgeId> = model
-        .faces
-        .iter()
-        .flat_map(|f| f.loops.iter().flatten().map(|oe| oe.edge))
-        .collect();
+    let flags = |len: usize, ids: &mut dyn Iterator<Item = usize>| {
+        let mut flags = vec![false; len];
+        for i in ids {
+            if let Some(flag) = flags.get_mut(i) {
+                *flag = true;
+            }
+        }
+        flags
+    };
+    let in_solids_v = flags(
+        model.vertices.len(),
+        &mut model
+            .solids
+            .iter()
+            .flat_map(|s| &s.vertices)
+            .map(|v| v.index()),
+    );
+    let in_solids_e = flags(
+        model.edges.len(),
+        &mut model
+            .solids
+            .iter()
+            .flat_map(|s| &s.edges)
+            .map(|e| e.index()),
+    );
+    let in_solids_f = flags(
+        n_faces,
+        &mut model
+            .solids
+            .iter()
+            .flat_map(|s| &s.faces)
+            .map(|of| of.face.index()),
+    );
+    let used_vertices = flags(
+        model.vertices.len(),
+        &mut model
+            .edges
+            .iter()
+            .flat_map(|e| [e.begin.index(), e.end.index()]),
+    );
+    let used_edges = flags(
+        model.edges.len(),
+        &mut model
+            .faces
+            .iter()
+            .flat_map(|f| f.loops.iter().flatten().map(|oe| oe.edge.index())),
+    );
 
     let mut unused = |span: Option<Span>, message: String, help: &str| {
         diags.push(Diagnostic::new(Code::Dangling, span, message).with_help(help));
     };
     for (i, vertex) in model.vertices.iter().enumerate() {
         let id = VertexId(i as u32);
-        let explicit_unused = !in_solids_v.contains(&id) && !used_vertices.contains(&id);
+        let explicit_unused = !in_solids_v[i] && !used_vertices[i];
         if let Some(span) = source_map.vertex(id).filter(|_| explicit_unused) {
             unused(
                 Some(span),
@@ -658,7 +703,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     }
     for (i, edge) in model.edges.iter().enumerate() {
         let id = EdgeId(i as u32);
-        let explicit_unused = !in_solids_e.contains(&id) && !used_edges.contains(&id);
+        let explicit_unused = !in_solids_e[i] && !used_edges[i];
         if let Some(span) = source_map.edge(id).filter(|_| explicit_unused) {
             unused(
                 Some(span),
@@ -669,7 +714,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     }
     for (i, face) in model.faces.iter().enumerate() {
         let id = FaceId(i as u32);
-        let explicit_unused = !in_solids_f.contains(&id) && !used_faces.contains(&id);
+        let explicit_unused = !in_solids_f[i] && !used_faces[i];
         if let Some(span) = source_map.face(id).filter(|_| explicit_unused) {
             unused(
                 Some(span),

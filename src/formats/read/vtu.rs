@@ -67,14 +67,14 @@ fn err(e: &Element, code: Code, message: impl Into<String>) -> Diagnostic {
     Diagnostic::new(code, e.name_span, message)
 }
 
-fn child<'e>(e: &'e Element, name: &'e str) -> Result<&'e Element, Diagnostic> {
+fn child<'e>(e: &'e Element<'e>, name: &'e str) -> Result<&'e Element<'e>, Diagnostic> {
     e.children_named(name)
         .next()
         .ok_or_else(|| err(e, Code::MeshSyntax, format!("<{}> has no <{name}>", e.name)))
 }
 
 fn attr<'e>(e: &'e Element, name: &str) -> Option<&'e str> {
-    e.attribute(name).map(|a| a.value.as_str())
+    e.attribute(name).map(|a| a.value.as_ref())
 }
 
 impl Reader<'_> {
