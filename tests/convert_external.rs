@@ -149,6 +149,23 @@ fn meshes_made_by_gmsh_meshio_and_trimesh_read_correctly() {
         .unwrap_or_default();
     assert_eq!(names, ["ball", "brick"]);
 
+    // gmsh's mesh as GLB passes the Khronos glTF validator.
+    let gm = load(&at("gmsh41.msh"));
+    let glb = dir.path().join("from_gmsh.glb");
+    write_mesh_file(&glb, &gm.mesh, &WriteOptions::default()).expect("write glb");
+    let report = run_json("node", "validate_gltf.js", &[&glb]);
+    assert_eq!(
+        (report["numErrors"].as_u64(), report["numWarnings"].as_u64()),
+        (Some(0), Some(0)),
+        "{:#}",
+        report["messages"]
+    );
+    let back = load(&glb);
+    assert_eq!(
+        groups(&back),
+        expected_groups(&facts["gmsh41.msh"]["groups"])
+    );
+
     let gm = load(&at("gmsh22_bin.msh"));
     let out = dir.path().join("from_gmsh.vtu");
     write_mesh_file(&out, &gm.mesh, &binary).expect("write vtu");

@@ -5,14 +5,14 @@ use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, InputOptions, report_usage};
 use geomc::diag::render_human;
 use geomc::driver::{Options, check_file};
 use geomc::formats::{self, Encoding, WriteOptions};
-use geomc::meshing::{MeshOptions, Tolerance, mesh_model};
+use geomc::meshing::{MeshOptions, mesh_model};
 use rayon::prelude::*;
 use std::io::IsTerminal;
 use std::path::{Path, PathBuf};
 
 #[derive(clap::Args)]
 pub struct Args {
-    /// Domain files (XML).
+    /// Domain files (XML), or implicit solids in paper 001's language (.rfs).
     #[arg(required = true, value_name = "INPUT")]
     inputs: Vec<PathBuf>,
     /// Output file (format from its extension; repeatable), or a folder ending
@@ -24,13 +24,23 @@ pub struct Args {
     to: Vec<String>,
     /// Chordal tolerance: a length (0.01), or a percentage of the model's
     /// bounding-box diagonal (0.1%).
-    #[arg(long, default_value = "0.1%", value_name = "TOL")]
+    #[arg(
+        long,
+        default_value = "0.1%",
+        value_name = "TOL",
+        allow_hyphen_values = true
+    )]
     tolerance: String,
     /// Longest triangle edge allowed.
-    #[arg(long, value_name = "LENGTH")]
+    #[arg(long, value_name = "LENGTH", allow_hyphen_values = true)]
     max_edge: Option<f64>,
     /// Smallest triangle angle refinement aims for, in degrees (at most 33).
-    #[arg(long, default_value_t = 25.0, value_name = "DEGREES")]
+    #[arg(
+        long,
+        default_value_t = 25.0,
+        value_name = "DEGREES",
+        allow_hyphen_values = true
+    )]
     min_angle: f64,
     /// Text output where the format has both (STL, MSH, VTU).
     #[arg(long, conflicts_with = "binary")]
@@ -47,7 +57,14 @@ pub struct Args {
     #[command(flatten)]
     input: InputOptions,
     #[command(flatten)]
-    solver_mesh: super::mesh_args::MeshArgs,
+    solver_mesh: super::solver_args::SolverMeshArgs,
+    /// Grid cells per axis for implicit (.rfs) inputs, overriding Geom.nx/ny/nz.
+    #[arg(long, value_name = "N")]
+    cells: Option<usize>,
+    /// Also draw the mesh: a PNG (or SVG) picture, written in the same run
+    /// (into a folder: one STEM.png per input when it ends in '/').
+    #[arg(long, value_name = "OUT.png")]
+    preview: Option<PathBuf>,
 }
 
 /// What one input produced, collected so output is printed in input order.
@@ -67,8 +84,8 @@ pub fn run(args: &Args) -> i32 {
     };
     let mesh_options = match mesh_options(args) {
         Ok(m) => m,
-        Err(message) => {
-            eprintln!("geomc: {message}");
+        Err(diagnostic) => {
+            report_usage(&[diagnostic]);
             return EXIT_USAGE;
         }
     };
@@ -102,6 +119,7 @@ pub fn run(args: &Args) -> i32 {
         plans
             .par_iter()
             .map(|(input, outputs)| {
+                let preview = super::render::preview_path(args.preview.as_deref(), input);
                 let outcome = compile_one(
                     input,
                     outputs,
@@ -109,6 +127,8 @@ pub fn run(args: &Args) -> i32 {
                     &mesh_options,
                     encoding,
                     args.quiet,
+                    args.cells,
+                    preview.as_deref(),
                 );
                 if let Some(bar) = &progress {
                     bar.inc(1);
@@ -148,35 +168,9 @@ pub fn run(args: &Args) -> i32 {
     if failed > 0 { EXIT_INVALID } else { EXIT_OK }
 }
 
-fn mesh_options(args: &Args) -> Result<MeshOptions, String> {
-    let text = args.tolerance.trim();
-    let tolerance = match text.strip_suffix('%') {
-        Some(percent) => percent
-            .trim()
-            .parse::<f64>()
-            .ok()
-            .filter(|v| v.is_finite() && *v > 0.0)
-            .map(|v| Tolerance::Relative(v / 100.0)),
-        None => text.parse::<f64>().ok().filter(|v| v.is_finite() && *v > 0.0).map(Tolerance::Absolute),
-    }
-    .ok_or_else(|| format!("--tolerance {text}: give a positive length (0.01) or a percentage of the model's size (0.1%)"))?;
-    if let Some(max_edge) = args.max_edge {
-        if !(max_edge.is_finite() && max_edge > 0.0) {
-            return Err(format!("--max-edge {max_edge}: give a positive length"));
-        }
-    }
-    if !(args.min_angle > 0.0 && args.min_angle <= 33.0) {
-        return Err(format!(
-            "--min-angle {}: give an angle above 0 and at most 33 degrees",
-            args.min_angle
-        ));
-    }
-    let mut options = MeshOptions {
-        tolerance,
-        max_edge: args.max_edge,
-        min_angle_degrees: args.min_angle,
-        ..MeshOptions::default()
-    };
+fn mesh_options(args: &Args) -> Result<MeshOptions, geomc::diag::Diagnostic> {
+    let mut options =
+        super::mesh_args::parse_mesh_options(&args.tolerance, args.max_edge, args.min_angle)?;
     args.solver_mesh.apply(&mut options)?;
     Ok(options)
 }
@@ -239,6 +233,7 @@ fn plan_outputs(args: &Args) -> Result<Vec<(PathBuf, Vec<PathBuf>)>, String> {
         .collect())
 }
 
+#[allow(clippy::too_many_arguments)] // one more option per feature; a struct would be the next step
 fn compile_one(
     input: &Path,
     outputs: &[PathBuf],
@@ -246,7 +241,17 @@ fn compile_one(
     mesh_options: &MeshOptions,
     encoding: Option<Encoding>,
     quiet: bool,
+    cells: Option<usize>,
+    preview: Option<&Path>,
 ) -> Outcome {
+    if super::rfs::is_rfs(input) {
+        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells);
+        return Outcome {
+            input: input.to_path_buf(),
+            messages,
+            ok,
+        };
+    }
     let mut messages = String::new();
     let fail = |messages: String| Outcome {
         input: input.to_path_buf(),
@@ -268,7 +273,8 @@ fn compile_one(
     let mesh = match mesh_model(&lowered.model, mesh_options) {
         Ok(mesh) => mesh,
         Err(e) => {
-            messages.push_str(&format!("{}: error: {e}\n", input.display()));
+            let diagnostic = e.to_diagnostic(&lowered.model, &lowered.source_map);
+            messages.push_str(&render_human(&checked.source, &diagnostic));
             return fail(messages);
         }
     };
@@ -297,6 +303,15 @@ fn compile_one(
             Err(e) => {
                 ok = false;
                 messages.push_str(&format!("geomc: {}: {e}\n", output.display()));
+            }
+        }
+    }
+    if let Some(path) = preview {
+        match super::render::preview(&mesh, path) {
+            Ok(text) => messages.push_str(if quiet { "" } else { &text }),
+            Err(text) => {
+                ok = false;
+                messages.push_str(&text);
             }
         }
     }

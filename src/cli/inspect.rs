@@ -14,10 +14,14 @@ pub struct Args {
     /// Print the incidence matrices M_VE, M_EF, M_FD and the derived V–F, E–D.
     #[arg(long)]
     matrices: bool,
+    /// Mesh the model (with the meshing options below, as compile does) and
+    /// report counts, triangle quality, and mesh vs exact volume and area.
+    #[arg(long)]
+    mesh: bool,
+    #[command(flatten)]
+    mesh_args: super::mesh_args::MeshArgs,
     #[command(flatten)]
     input: InputOptions,
-    #[command(flatten)]
-    mesh_quality: super::mesh_args::InspectMeshArgs,
 }
 
 pub fn run(args: &Args) -> i32 {
@@ -48,33 +52,31 @@ pub fn run(args: &Args) -> i32 {
         );
         return EXIT_INVALID;
     };
-    let report = geomc::inspect::Report::of(&lowered.model);
-    // --mesh: the mesh-quality section after the model's facts (JSON: both
-    // in one object, {"model": …, "mesh": …}).
-    let mesh_section = if args.mesh_quality.mesh {
-        match args.mesh_quality.report(&lowered.model) {
+    let mesh_report = if args.mesh {
+        match super::inspect_mesh::report(&checked, lowered, &args.mesh_args) {
             Ok(r) => Some(r),
             Err(code) => return code,
         }
     } else {
         None
     };
-    match (args.format, mesh_section) {
-        (Format::Human, section) => {
-            out(&report.render_text(&lowered.model, args.matrices));
-            if let Some(r) = section {
-                out(&r.render_text());
+    let report = geomc::inspect::Report::of(&lowered.model);
+    match args.format {
+        Format::Human => {
+            let mut text = report.render_text(&lowered.model, args.matrices);
+            if let Some(mesh) = &mesh_report {
+                text.push('\n');
+                text.push_str(&mesh.render_text());
             }
+            out(&text)
         }
-        (Format::Json, None) => out(&format!(
-            "{}\n",
-            report.render_json(&lowered.model, args.matrices)
-        )),
-        (Format::Json, Some(r)) => out(&format!(
-            "{{\"model\": {}, \"mesh\": {}}}\n",
-            report.render_json(&lowered.model, args.matrices),
-            serde_json::to_string_pretty(&r).unwrap_or_default()
-        )),
+        Format::Json => {
+            let mut json = report.render_json(&lowered.model, args.matrices);
+            if let Some(mesh) = &mesh_report {
+                json = super::inspect_mesh::with_mesh_json(&json, mesh);
+            }
+            out(&format!("{json}\n"))
+        }
     }
     EXIT_OK
 }

@@ -1,91 +1,95 @@
-//! Size, quality and order options of `geomc compile` for solver meshes
-//! (issue 6), kept apart from compile's own arguments.
+//! The meshing options shared by `geomc compile` and `geomc inspect --mesh`,
+//! checked into [`MeshOptions`] or an E501 diagnostic naming the bad value.
 
-use super::{EXIT_INVALID, EXIT_USAGE};
-use geomc::meshing::{MeshOptions, MeshReport, SizeField, mesh_model, mesh_report};
+use super::solver_args::SolverMeshArgs;
+use geomc::diag::{Code, Diagnostic};
+use geomc::meshing::{MeshOptions, Tolerance};
 
-#[derive(clap::Args, Debug, Clone, Default)]
+/// The options as `inspect` takes them (compile declares the same three and
+/// flattens the same [`SolverMeshArgs`]).
+#[derive(clap::Args, Clone, Debug)]
 pub struct MeshArgs {
-    /// 2D: largest triangle area anywhere (a subdomain's area= may lower it).
-    #[arg(long, value_name = "AREA")]
-    pub max_area: Option<f64>,
-    /// Size field: an expression in x, y, z (and d with --size-distance-to)
-    /// giving the longest triangle edge wanted there, e.g. "0.01 + 0.2*d".
-    #[arg(long, value_name = "EXPR")]
-    pub size_field: Option<String>,
-    /// Makes d in --size-field the distance to this boundary fragment or
-    /// <boundary> (default field without --size-field: 0.2% of the model's
-    /// size + 0.3 d).
-    #[arg(long, value_name = "FRAGMENT")]
-    pub size_distance_to: Option<String>,
-    /// Element order: 1 (3-node triangles) or 2 (6-node triangles with
-    /// mid-edge nodes on curved boundaries).
-    #[arg(long, default_value_t = 1, value_name = "N")]
-    pub order: u8,
-}
-
-impl MeshArgs {
-    /// Adds these options to `options`, or says what is wrong with them.
-    pub fn apply(&self, options: &mut MeshOptions) -> Result<(), String> {
-        if let Some(area) = self.max_area
-            && !(area.is_finite() && area > 0.0)
-        {
-            return Err(format!("--max-area {area}: give a positive area"));
-        }
-        if !(1..=2).contains(&self.order) {
-            return Err(format!("--order {}: give 1 or 2", self.order));
-        }
-        options.max_area = self.max_area;
-        options.order = self.order;
-        options.size_field = match (&self.size_field, &self.size_distance_to) {
-            (Some(text), target) => Some(SizeField::parse(text, target.clone())?),
-            (None, Some(target)) => Some(SizeField::parse(
-                "0.002*diagonal + 0.3*d",
-                Some(target.clone()),
-            )?),
-            (None, None) => None,
-        };
-        Ok(())
-    }
-}
-
-/// `geomc inspect --mesh`: mesh the model as compile would and report the
-/// achieved quality.
-#[derive(clap::Args, Debug, Clone)]
-pub struct InspectMeshArgs {
-    /// Also mesh the model and report the minimum angle, the angle
-    /// histogram and the area range per subdomain.
-    #[arg(long)]
-    pub mesh: bool,
-    /// With --mesh: the smallest angle refinement aims for, degrees.
+    /// Chordal tolerance: a length (0.01), or a percentage of the model's
+    /// bounding-box diagonal (0.1%).
+    #[arg(
+        long,
+        default_value = "0.1%",
+        value_name = "TOL",
+        allow_hyphen_values = true
+    )]
+    pub tolerance: String,
+    /// Longest triangle edge allowed.
+    #[arg(long, value_name = "LENGTH", allow_hyphen_values = true)]
+    pub max_edge: Option<f64>,
+    /// Smallest triangle angle refinement aims for, in degrees (at most 33).
     #[arg(
         long,
         default_value_t = 25.0,
         value_name = "DEGREES",
-        requires = "mesh"
+        allow_hyphen_values = true
     )]
     pub min_angle: f64,
     #[command(flatten)]
-    pub solver: MeshArgs,
+    pub solver: SolverMeshArgs,
 }
 
-impl InspectMeshArgs {
-    /// Meshes `model` as compile would; on failure prints why and gives the exit code.
-    pub fn report(&self, model: &geomc::ir::Model) -> Result<MeshReport, i32> {
-        let mut options = MeshOptions {
-            min_angle_degrees: self.min_angle,
-            ..MeshOptions::default()
-        };
-        if let Err(message) = self.solver.apply(&mut options) {
-            eprintln!("geomc: {message}");
-            return Err(EXIT_USAGE);
-        }
-        match mesh_model(model, &options) {
-            Ok(mesh) => Ok(mesh_report(&mesh)),
-            Err(e) => {
-                eprintln!("geomc: {e}");
-                Err(EXIT_INVALID)
-            }
-        }
+impl MeshArgs {
+    pub fn to_options(&self) -> Result<MeshOptions, Diagnostic> {
+        let mut options = parse_mesh_options(&self.tolerance, self.max_edge, self.min_angle)?;
+        self.solver.apply(&mut options)?;
+        Ok(options)
     }
+}
+
+/// Checks the three meshing options; the error names the offending value.
+pub fn parse_mesh_options(
+    tolerance: &str,
+    max_edge: Option<f64>,
+    min_angle: f64,
+) -> Result<MeshOptions, Diagnostic> {
+    let text = tolerance.trim();
+    let positive = |v: &f64| v.is_finite() && *v > 0.0;
+    let tolerance = match text.strip_suffix('%') {
+        Some(percent) => percent
+            .trim()
+            .parse::<f64>()
+            .ok()
+            .filter(positive)
+            .map(|v| Tolerance::Relative(v / 100.0)),
+        None => text
+            .parse::<f64>()
+            .ok()
+            .filter(positive)
+            .map(Tolerance::Absolute),
+    }
+    .ok_or_else(|| {
+        invalid(format!(
+            "--tolerance {text}: the chordal tolerance must be a positive finite length or percentage"
+        ))
+        .with_help("give a length such as 0.01, or a percentage of the model's size such as 0.1%")
+    })?;
+    if let Some(max_edge) = max_edge
+        && !positive(&max_edge)
+    {
+        return Err(invalid(format!(
+            "--max-edge {max_edge}: the longest edge must be a positive finite length"
+        ))
+        .with_help("give a length such as 0.2, or leave --max-edge out for no limit"));
+    }
+    if !(min_angle > 0.0 && min_angle <= 33.0) {
+        return Err(invalid(format!(
+            "--min-angle {min_angle}: the angle must lie above 0 and at most 33 degrees"
+        ))
+        .with_help("the default is 25; refinement may not terminate above about 33"));
+    }
+    Ok(MeshOptions {
+        tolerance,
+        max_edge,
+        min_angle_degrees: min_angle,
+        ..MeshOptions::default()
+    })
+}
+
+fn invalid(message: String) -> Diagnostic {
+    Diagnostic::new(Code::InvalidMeshOption, None, message)
 }

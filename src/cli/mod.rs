@@ -5,7 +5,11 @@ mod compile;
 mod convert;
 mod explain;
 mod inspect;
+mod inspect_mesh;
 mod mesh_args;
+mod render;
+mod rfs;
+mod solver_args;
 mod validate;
 
 use clap::{Parser, Subcommand};
@@ -43,6 +47,8 @@ enum Command {
     Explain(explain::Args),
     /// Convert a mesh between STL, OBJ, glTF/GLB, Gmsh MSH, VTU and .frag.xml, keeping its groups.
     Convert(convert::Args),
+    /// Draw a domain or mesh: a shaded PNG or a hidden-line SVG.
+    Render(render::Args),
 }
 
 /// Options shared by every subcommand that reads XML.
@@ -97,6 +103,10 @@ pub enum Format {
 pub fn run() -> i32 {
     // A panic is a bug: say so, and exit with its own code.
     std::panic::set_hook(Box::new(|info| {
+        // The mesher turns its own panics into E500 diagnostics.
+        if geomc::meshing::panics_are_caught() {
+            return;
+        }
         eprintln!("geomc: internal error: {info}");
         eprintln!("this is a bug in geomc; please report it with the input that caused it");
     }));
@@ -114,6 +124,7 @@ pub fn run() -> i32 {
         Command::Inspect(args) => inspect::run(&args),
         Command::Explain(args) => explain::run(&args),
         Command::Convert(args) => convert::run(&args),
+        Command::Render(args) => render::run(&args),
     });
     result.unwrap_or(EXIT_INTERNAL)
 }

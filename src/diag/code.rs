@@ -172,6 +172,46 @@ codes! {
         "A point value with two coordinates is a line parallel to the missing axis, and one with one coordinate is a plane perpendicular to its axis (paper 000). Where a single point is needed, the missing coordinates are taken as 0.";
     EmptySubdomainList = "W009", Warning, "model has no subdomains",
         "The file defines geometry but no <subdomain>, so it describes no computational domain: no boundary fragments are derived and compile meshes each solid on its own. Add <subdomain> elements to describe the domain.";
+    // ---- implicit solids and the .rfs language (issue 5) ----
+    RfsSyntax = "E600", Error, "syntax error in an .rfs program",
+        "The .rfs file (paper 001's modelling language) could not be read at this position. A program is a list of `Geom.<field> = value;` settings and `function name(a, b) { var v = …; return …; }` definitions; expressions use + - * / %, parentheses, numbers, names, library calls such as Ball(x, y, z, r, x0, y0, z0) and Math.<name>(…). Fix the text at the position shown.";
+    RfsUnknownName = "E601", Error, "unknown name in an .rfs program",
+        "A variable, function, library function or Math member is used but not defined. Check the spelling (the message suggests the nearest known name); variables must be declared with `var` or be parameters of the function. The library is listed in docs/implicit.md.";
+    RfsArity = "E602", Error, "wrong number of arguments",
+        "A function or library function is called with a different number of arguments than it takes. Arguments are positional, coordinates first: Ball(x, y, z, r, x0, y0, z0). The message shows the expected signature.";
+    RfsGeomValue = "E603", Error, "bad Geom setting",
+        "A Geom field has a value it cannot take: dimension must be 3, x_min < x_max (likewise y, z), nx, ny, nz whole numbers from 1 to 1024 (the grid holds (nx + 1)(ny + 1)(nz + 1) samples of 8 bytes), optiterations a whole number ≥ 0, name a string, rsystem one of \"rvachev\", \"minmax\", \"alpha\" and alpha in (−1, 1]. Fix the value shown.";
+    RfsNoResult = "E604", Error, "no result function",
+        "The function that defines the solid is the one Geom.name names, else the one called r_main. Define one of them, or set Geom.name = \"…\" to the function's name.";
+    RfsRecursion = "E605", Error, "recursive or too deeply nested function calls",
+        "Functions are expanded at compile time into one expression, so a function may not call itself, directly or through others, and calls may nest at most 64 deep. Rewrite the recursion as explicit calls.";
+    RfsLibraryArgument = "E606", Error, "invalid library argument",
+        "A library function got an argument it cannot use, such as a number of polygon sides that is not a constant whole number, or an odd number of polygon coordinates. The message names the argument and what it must be.";
+    RfsDuplicate = "E607", Error, "duplicate definition",
+        "A function, parameter or variable is defined twice in the same scope. Rename one of them.";
+    RfsResultSignature = "E608", Error, "result function must take three arguments",
+        "The solid's function is called with the coordinates (x, y, z) as its three positional arguments (their names do not matter). Give it exactly three parameters.";
+    RfsTooLarge = "E609", Error, "program expands to too large an expression",
+        "Functions are expanded into one expression; this program's expression exceeds the node limit (2 million nodes), or a nesting limit. Simplify the model (fewer primitives, shared variables instead of repeated calls).";
+    RfsType = "E610", Error, "string used as a number",
+        "A string (such as a Geom.name value) appears where a number or function value is needed, or a number where a string is needed. Only Geom.name and Geom.rsystem take strings.";
+    RfsNoReturn = "E611", Error, "function ends without return",
+        "Every function must end with `return <expression>;`. Add the return statement.";
+    RfsUnknownGeomField = "W130", Warning, "unknown Geom field",
+        "This Geom field is not one geomc uses (dimension, x_min, x_max, y_min, y_max, z_min, z_max, nx, ny, nz, name, optiterations, rsystem, alpha); it is ignored. Check the spelling.";
+    RfsOptimizeIgnored = "W131", Warning, "mesh optimisation iterations not applied",
+        "Geom.optiterations asks for mesh optimisation (edge flips and smoothing); this geomc does not implement it yet, so the marching-cubes triangles are written as they are.";
+
+    // ---- compile (issue 3) ----
+    InternalMeshingFailure = "E500", Error, "internal meshing failure",
+        "The mesher failed inside on the edge or face named (for example a loss of floating-point precision in the constrained Delaunay refinement). This is a bug in geomc, not in your file: please report it with the input. Meanwhile a slightly different --tolerance, --max-edge or --min-angle often avoids it; the other inputs of the run are compiled as usual.";
+    InvalidMeshOption = "E501", Error, "invalid meshing option",
+        "A meshing option has a value the mesher cannot use: --tolerance must be a positive finite length (0.01) or a positive percentage of the model's bounding-box diagonal (0.1%); --max-edge a positive finite length; --min-angle an angle above 0 and at most 33 degrees (refinement may not terminate above about 33°).";
+    FaceNotMeshable = "E502", Error, "face cannot be meshed",
+        "geomc could not triangulate this face: its loops cross or enclose no area in the face's chart, a loop is not closed, or it needs more nodes than the limit for the tolerance. Check the face's edges (`geomc inspect --matrices`), or loosen --tolerance.";
+    EdgeNotDiscretisable = "E503", Error, "edge cannot be discretised",
+        "geomc could not split this edge into chords within the tolerance: its curve has points that are not finite, or it needs more than 65,536 segments for --tolerance or --max-edge. Loosen the tolerance or the edge length limit.";
+
     // ---- convert: mesh readers and `geomc convert` (issue 4) ----
     MeshReadFailed = "E520", Error, "cannot read the mesh file",
         "The mesh file (or a file it refers to, such as a .gltf's buffer or the mesh a .frag.xml names) could not be opened or read. Check the path and its permissions.";
@@ -237,6 +277,32 @@ codes! {
         "A <polygon> must be simple: its edges may meet only where consecutive edges share a vertex. Two of its edges cross, touch, or fold back along one line. Reorder or move the vertices so that the boundary does not meet itself.";
     AreaIn3d = "W150", Warning, "area limit ignored in a 3D model",
         "The area= attribute of a <subdomain> limits triangle areas in 2D meshes only; in a 3D model it is ignored. Remove it, or use compile --max-edge to limit the size of surface triangles.";
+
+    // ---- render (issue 8) ----
+    RenderUnsupportedInput = "E720", Error, "input cannot be rendered",
+        "geomc render draws a domain file (.xml), which it compiles on the fly, or a mesh file geomc can read. The input's extension names neither. Compile the model to a mesh format geomc reads first, or give the domain XML itself.";
+    RenderBadSize = "E721", Error, "invalid picture size",
+        "--size takes WIDTHxHEIGHT in pixels, each between 1 and 16384, for example --size 1024x768.";
+    RenderBadView = "E722", Error, "invalid view",
+        "--view takes a named view (front, top, iso) or AZIMUTH,ELEVATION in degrees, for example --view 30,20. Azimuth 0 and elevation 0 look along +y with z up; elevation 90 looks down from +z. The elevation must lie in [-90, 90].";
+    RenderBadSection = "E723", Error, "invalid section plane",
+        "--section takes AXIS=VALUE, for example --section z=0: the part of the model with a larger coordinate is cut away and the cut is drawn hatched.";
+    RenderBadOutput = "E724", Error, "unknown picture format",
+        "geomc render writes a PNG (.png) or an SVG (.svg), chosen by the output's extension; --preview of geomc compile writes a .png. Name the output file with one of these extensions.";
+    RenderBadBackground = "E725", Error, "invalid background colour",
+        "--background takes white, black, transparent, or a colour as #rrggbb (or #rrggbbaa with opacity).";
+    RenderBadAntialias = "E726", Error, "invalid anti-aliasing level",
+        "--antialias takes 1 (no anti-aliasing) to 4: the number of samples per pixel along each axis.";
+    RenderNothingToDraw = "E727", Error, "nothing to draw",
+        "The mesh has no triangles (for example a model with only points and poly_lines). geomc render draws surfaces; give a model with faces or subdomains.";
+    RenderTooLarge = "E728", Error, "picture too large",
+        "The picture would need more than 134 million samples (width x height x antialias squared). Lower --size or --antialias.";
+    RenderInputFailed = "E729", Error, "input could not be meshed for rendering",
+        "The domain file is valid but meshing it failed, so there is nothing to draw. The message names the edge or face; geomc compile reports the same problem with the same options.";
+    RenderLegendTruncated = "W170", Warning, "legend does not fit",
+        "The picture is too short to name every colour group, so the legend ends with '... and N more'. Make the picture taller with --size, or colour by subdomain (--color-by subdomain) to have fewer groups.";
+    RenderSectionEmpty = "W171", Warning, "section leaves nothing to draw",
+        "The section plane lies below the whole model, so everything was cut away and the picture is empty. Pick a value inside the model's extent (geomc inspect prints the bounding box).";
 }
 
 impl Code {

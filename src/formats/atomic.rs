@@ -41,7 +41,8 @@ fn fill_and_sync<T>(
     file: File,
     fill: impl FnOnce(&mut dyn Write) -> Result<T, WriteError>,
 ) -> Result<T, WriteError> {
-    let mut out = BufWriter::new(file);
+    // Large writes: the writers' pieces reach the kernel in few system calls.
+    let mut out = BufWriter::with_capacity(1 << 20, file);
     let value = fill(&mut out)?;
     let file = out.into_inner().map_err(|e| e.into_error())?;
     file.sync_all()?;

@@ -348,7 +348,13 @@ struct Sink<'a> {
     out: &'a mut dyn Write,
     binary: bool,
     line: String,
+    /// Binary values gathered here and handed to `out` in large pieces: one
+    /// dynamic `write_all` per 8-byte value costs more than the copy itself.
+    bytes: Vec<u8>,
 }
+
+/// How many binary bytes [`Sink`] gathers before writing them out.
+const CHUNK: usize = 1 << 16;
 
 impl Sink<'_> {
     fn token(&mut self, text: &str) {
@@ -358,9 +364,23 @@ impl Sink<'_> {
         self.line.push_str(text);
     }
 
+    fn raw(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.bytes.extend_from_slice(bytes);
+        if self.bytes.len() >= CHUNK {
+            self.flush()?;
+        }
+        Ok(())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.out.write_all(&self.bytes)?;
+        self.bytes.clear();
+        Ok(())
+    }
+
     fn int(&mut self, v: i32) -> std::io::Result<()> {
         if self.binary {
-            self.out.write_all(&v.to_le_bytes())
+            self.raw(&v.to_le_bytes())
         } else {
             self.token(&v.to_string());
             Ok(())
@@ -369,7 +389,7 @@ impl Sink<'_> {
 
     fn size(&mut self, v: usize) -> std::io::Result<()> {
         if self.binary {
-            self.out.write_all(&(v as u64).to_le_bytes())
+            self.raw(&(v as u64).to_le_bytes())
         } else {
             self.token(&v.to_string());
             Ok(())
@@ -378,7 +398,7 @@ impl Sink<'_> {
 
     fn real(&mut self, v: f64) -> std::io::Result<()> {
         if self.binary {
-            self.out.write_all(&v.to_le_bytes())
+            self.raw(&v.to_le_bytes())
         } else {
             self.token(&fmt_num(v));
             Ok(())
@@ -395,6 +415,7 @@ impl Sink<'_> {
     }
 
     fn text(&mut self, s: &str) -> std::io::Result<()> {
+        self.flush()?;
         self.out.write_all(s.as_bytes())
     }
 
@@ -417,11 +438,12 @@ fn write_all(
         out,
         binary,
         line: String::new(),
+        bytes: Vec::with_capacity(if binary { CHUNK + 64 } else { 0 }),
     };
     s.text("$MeshFormat\n")?;
     if binary {
         s.text("4.1 1 8\n")?;
-        s.out.write_all(&1i32.to_le_bytes())?;
+        s.raw(&1i32.to_le_bytes())?;
         s.text("\n")?;
     } else {
         s.text("4.1 0 8\n")?;
@@ -441,6 +463,7 @@ fn write_all(
     write_entities(&mut s, model, mesh)?;
     write_nodes(&mut s, model, mesh)?;
     write_elements(&mut s, model)?;
+    s.flush()?;
     Ok(())
 }
 

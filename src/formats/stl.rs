@@ -137,17 +137,23 @@ fn write_binary(
     header[..text.len()].copy_from_slice(text);
     out.write_all(&header)?;
     out.write_all(&n.to_le_bytes())?;
-    let mut record = Vec::with_capacity(50);
+    // Records gathered into large pieces: one dynamic write per 50 bytes
+    // would cost more than building them.
+    const CHUNK: usize = 50 << 12;
+    let mut bytes = Vec::with_capacity(CHUNK);
     for g in groups {
         for (normal, points) in facets(mesh, g) {
-            record.clear();
             for c in normal.iter().chain(points.iter().flatten()) {
-                record.extend_from_slice(&c.to_le_bytes());
+                bytes.extend_from_slice(&c.to_le_bytes());
             }
-            record.extend_from_slice(&0u16.to_le_bytes());
-            out.write_all(&record)?;
+            bytes.extend_from_slice(&[0, 0]);
+            if bytes.len() >= CHUNK {
+                out.write_all(&bytes)?;
+                bytes.clear();
+            }
         }
     }
+    out.write_all(&bytes)?;
     Ok(())
 }
 

@@ -25,12 +25,13 @@ use super::MeshError;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
 use super::size::Sizing;
-use crate::geom::{Point3, Vec3};
+use crate::geom::{Point3, Surface, Vec3};
 use crate::ir::{Face, Model};
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
 
 type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -213,6 +214,10 @@ pub(crate) fn mesh_face(
         parameters = parameters.with_max_allowed_area(settings.max_area);
     }
     let mut inner = Vec::new();
+    // Triangles (by their corner nodes, which never move) already found
+    // fine: later passes only check the triangles insertions created.
+    let mut fine: FineSet = FineSet::default();
+    let deviation = Deviation::of(&face.surface);
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if !settings.keep_boundary {
@@ -253,24 +258,29 @@ pub(crate) fn mesh_face(
             }
             let [a, b, c] = f.vertices().map(|v| v.fix().index());
             inner.push([a, b, c]);
+            let key = triangle_key(a, b, c);
+            if key.is_some_and(|k| fine.contains(&k)) {
+                continue;
+            }
             let [pa, pb, pc] = f.positions();
             let uv_area =
                 0.5 * ((pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x)).abs();
             let over_area = settings.max_area.is_finite()
-                && matches!(face.surface, crate::geom::Surface::Plane { .. })
+                && matches!(face.surface, Surface::Plane { .. })
                 && uv_area > settings.max_area;
             if over_area
                 || too_coarse(
-                    face,
+                    &deviation,
                     [&positions[a], &positions[b], &positions[c]],
                     settings,
                 )
             {
                 let [pa, pb, pc] = f.positions();
-                bad.push(point2([
-                    (pa.x + pb.x + pc.x) / 3.0,
-                    (pa.y + pb.y + pc.y) / 3.0,
-                ]));
+                let centroid = point2([(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0]);
+                // A corner of the triangle is a good start for locating it.
+                bad.push((centroid, f.vertices()[0].fix()));
+            } else if let Some(key) = key {
+                fine.insert(key);
             }
         }
         if bad.is_empty() {
@@ -281,8 +291,8 @@ pub(crate) fn mesh_face(
                 "it needs more than {MAX_FACE_VERTICES} nodes for the tolerance"
             )));
         }
-        for point in bad {
-            cdt.insert(point)
+        for (point, hint) in bad {
+            cdt.insert_with_hint(point, hint)
                 .map_err(|e| failed(format!("a refinement point cannot be inserted: {e:?}")))?;
         }
     }
@@ -589,8 +599,12 @@ fn polyline_chain(cdt: &Cdt, fixed: usize, handles: &[usize]) -> Vec<usize> {
 }
 
 /// True when a triangle is longer than `max_edge` or strays from the surface
-/// by more than the tolerance at its centroid or an edge midpoint.
-fn too_coarse(face: &Face, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
+/// by more than the tolerance. The deviation is measured at the centroid and
+/// the edge midpoints, and its largest value inside the triangle is
+/// estimated from the quadratic that vanishes at the corners and matches the
+/// midpoints (on a sphere the deviation peaks at the circumcentre, which the
+/// centroid misses on skewed triangles).
+fn too_coarse(surface: &Deviation, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
     let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
     let size = if settings.sizing.is_uniform() {
         settings.sizing.at(a)
@@ -602,18 +616,115 @@ fn too_coarse(face: &Face, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool
     if longest > size {
         return true;
     }
-    if matches!(face.surface, crate::geom::Surface::Plane { .. }) {
+    if matches!(surface, Deviation::Plane) {
         return false;
     }
-    let probes = [
-        Point3::from((a.coords + b.coords + c.coords) / 3.0),
-        Point3::from((a.coords + b.coords) / 2.0),
-        Point3::from((b.coords + c.coords) / 2.0),
-        Point3::from((c.coords + a.coords) / 2.0),
-    ];
-    probes
+    let mid = |p: &Point3, q: &Point3| Point3::from((p.coords + q.coords) / 2.0);
+    let deviation = |p: &Point3| surface.signed_distance(p);
+    let (ab, bc, ca) = (
+        deviation(&mid(a, b)),
+        deviation(&mid(b, c)),
+        deviation(&mid(c, a)),
+    );
+    let centroid = deviation(&Point3::from((a.coords + b.coords + c.coords) / 3.0));
+    let tolerance = settings.tolerance;
+    [ab, bc, ca, centroid, quadratic_peak(ab, bc, ca)]
         .iter()
-        .any(|p| face.surface.distance(p) > settings.tolerance)
+        .any(|d| d.abs() > tolerance)
+}
+
+/// The interior extremum of q = 4(m_ab λa λb + m_bc λb λc + m_ca λc λa) over
+/// the triangle (barycentric λ), or 0 when it has none inside.
+fn quadratic_peak(m_ab: f64, m_bc: f64, m_ca: f64) -> f64 {
+    // With λc = 1 − λa − λb, ∇q = 0 is a 2×2 linear system.
+    let k = m_ab - m_bc - m_ca;
+    let det = 4.0 * m_bc * m_ca - k * k;
+    if det.is_nan() || det.abs() <= 1e-300 {
+        return 0.0;
+    }
+    let la = (2.0 * m_bc * m_ca + k * m_bc) / det;
+    let lb = (2.0 * m_bc * m_ca + k * m_ca) / det;
+    let lc = 1.0 - la - lb;
+    if la < 0.0 || lb < 0.0 || lc < 0.0 {
+        return 0.0;
+    }
+    4.0 * (m_ab * la * lb + m_bc * lb * lc + m_ca * lc * la)
+}
+
+/// Triangles known to be fine, by [`triangle_key`]; the keys are the
+/// mesher's own, so a fast multiplicative hash replaces SipHash.
+type FineSet = HashSet<u64, BuildHasherDefault<KeyHasher>>;
+
+/// The sorted corner nodes of a triangle packed into 64 bits, 21 bits each
+/// (`None`, so not cached, for the rare node index beyond that).
+fn triangle_key(a: usize, b: usize, c: usize) -> Option<u64> {
+    let mut key = [a as u64, b as u64, c as u64];
+    key.sort_unstable();
+    (key[2] < 1 << 21).then(|| key[0] | (key[1] << 21) | (key[2] << 42))
+}
+
+#[derive(Default)]
+struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+
+    fn write_u64(&mut self, n: u64) {
+        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+    }
+}
+
+/// A face's surface, prepared once for the many distance queries of
+/// refinement.
+enum Deviation<'a> {
+    Plane,
+    Sphere { centre: Point3, radius: f64 },
+    General(&'a Surface),
+}
+
+impl Deviation<'_> {
+    fn of(surface: &Surface) -> Deviation<'_> {
+        match surface {
+            Surface::Plane { .. } => Deviation::Plane,
+            Surface::Ellipsoid { frame } => match frame.similarity_scale() {
+                Some(radius) => Deviation::Sphere {
+                    centre: frame.origin,
+                    radius,
+                },
+                None => Deviation::General(surface),
+            },
+            _ => Deviation::General(surface),
+        }
+    }
+
+    /// Signed distance from the surface: exact for planes and spheres,
+    /// value / |gradient| otherwise; infinite where the gradient vanishes off
+    /// the surface.
+    fn signed_distance(&self, p: &Point3) -> f64 {
+        match self {
+            Deviation::Plane => 0.0,
+            Deviation::Sphere { centre, radius } => (p - centre).norm() - radius,
+            Deviation::General(surface) => {
+                let (value, gradient) = surface.value_and_gradient(p);
+                let norm = gradient.norm();
+                if value == 0.0 {
+                    0.0
+                } else if value.is_finite() && norm.is_finite() && norm > 0.0 {
+                    value / norm
+                } else {
+                    f64::INFINITY
+                }
+            }
+        }
+    }
 }
 
 /// Twice the signed area of a closed polygon.
@@ -631,4 +742,24 @@ fn shoelace(points: &[[f64; 2]]) -> f64 {
 fn point2([u, v]: [f64; 2]) -> Point2<f64> {
     let snap = |x: f64| if x.abs() < 1e-30 { 0.0 } else { x };
     Point2::new(snap(u), snap(v))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn quadratic_peak_finds_the_interior_extremum() {
+        // Equal midpoint deviations m: the peak is 4m/3 at the centroid.
+        assert!((quadratic_peak(0.3, 0.3, 0.3) - 0.4).abs() < 1e-15);
+        // The deviation of a chord plane under a unit sphere, q = ¼(R² − |x − c|²)·…:
+        // for a right triangle the circumcentre is the hypotenuse midpoint, so
+        // no interior extremum exceeds it.
+        let peak = quadratic_peak(1.0, 0.5, 0.5);
+        assert!(peak <= 1.0 + 1e-12, "{peak}");
+        // One large midpoint value: the peak lies inside and above the others.
+        let peak = quadratic_peak(1.0, 0.8, 0.8);
+        assert!(peak > 1.0, "{peak}");
+        assert_eq!(quadratic_peak(0.0, 0.0, 0.0), 0.0);
+    }
 }

@@ -16,21 +16,26 @@
 //! # Limitations
 //! - Faces without loops (unbounded surfaces) get no triangles; one that
 //!   bounds a subdomain is an error.
-//! - Spade's refinement can panic on loss of precision (its own `expect`);
-//!   that is not caught here.
+//! - Spade's refinement can panic on loss of precision (its own `expect`):
+//!   every edge and face is meshed under `catch_unwind`, so such a failure
+//!   becomes [`MeshError::Internal`] naming the entity instead of a crash.
 //! - See the module docs of [`chart`] and [`face`] for per-surface limits.
 
 mod chart;
 mod check;
 mod constraints;
+mod diagnostic;
 mod edges;
+pub mod exact;
 mod face;
+mod guard;
 mod quadratic;
 mod report;
 mod size;
 
 pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
-pub use report::{MeshReport, SubdomainQuality, mesh_report};
+pub use guard::panics_are_caught;
+pub use report::{MeshReport, SubdomainReport};
 pub use size::SizeField;
 
 use crate::ir::{self, Dimension, Model, Side, SubdomainCells};
@@ -39,6 +44,7 @@ use crate::mesh::{
 };
 use edges::EdgeNodes;
 use face::{FaceMesh, FacePoint, Outcome, Settings};
+use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Rounds of "mesh faces, add the boundary points they asked for" before
@@ -99,14 +105,25 @@ pub enum MeshError {
     Edge { edge: String, reason: String },
     #[error("cannot mesh face `{face}`: {reason}")]
     Face { face: String, reason: String },
+    /// A panic inside the mesher (a bug), caught and attributed to the edge
+    /// or face being meshed.
+    #[error("internal meshing failure on {entity}: {message}")]
+    Internal { entity: String, message: String },
+}
+
+impl Tolerance {
+    /// The tolerance as a length for `model`.
+    pub fn absolute(self, model: &Model) -> f64 {
+        match self {
+            Tolerance::Absolute(t) => t,
+            Tolerance::Relative(r) => r * model.bbox().diagonal(),
+        }
+    }
 }
 
 /// Meshes every edge and face of `model` and copies its groups.
 pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshError> {
-    let tolerance = match options.tolerance {
-        Tolerance::Absolute(t) => t,
-        Tolerance::Relative(r) => r * model.bbox().diagonal(),
-    };
+    let tolerance = options.tolerance.absolute(model);
     if !(tolerance.is_finite() && tolerance > 0.0) {
         return Err(MeshError::Options(format!(
             "the tolerance must be positive and finite (got {tolerance})"
@@ -114,7 +131,9 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
     }
     let max_edge = options.max_edge.unwrap_or(f64::INFINITY);
     if max_edge.is_nan() || max_edge <= 0.0 {
-        return Err(MeshError::Options("max_edge must be positive".into()));
+        return Err(MeshError::Options(format!(
+            "max_edge must be positive (got {max_edge})"
+        )));
     }
     // Spade's refinement may not terminate above about 30°.
     let min_angle = options.min_angle_degrees;
@@ -154,7 +173,10 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         .zip(&edge_area)
         .map(|(e, &area)| {
             let side = (4.0 * area / 3f64.sqrt()).sqrt();
-            edges::discretise(model, e, 0.5 * tolerance, max_edge.min(side))
+            guard::guarded(
+                || format!("edge `{}`", e.name),
+                || edges::discretise(model, e, 0.5 * tolerance, max_edge.min(side)),
+            )
         })
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
     let edge_points: Vec<Vec<crate::geom::Point3>> =
@@ -166,7 +188,12 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
     let lines = model
         .polylines
         .iter()
-        .map(|l| edges::polyline_points(l, tolerance, max_edge))
+        .map(|l| {
+            guard::guarded(
+                || format!("poly_line `{}`", l.name),
+                || edges::polyline_points(l, tolerance, max_edge),
+            )
+        })
         .collect::<Result<Vec<_>, MeshError>>()?;
     let constraints = constraints::assign(model, &edge_nodes, &lines)?;
     let settings = Settings {
@@ -177,11 +204,16 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         max_area,
     };
     let face_meshes = mesh_faces(model, &mut edge_nodes, settings, &face_areas, &constraints)?;
-    let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
-    if options.order == 2 {
-        quadratic::elevate(model, &edge_nodes, &mut mesh);
-    }
-    Ok(mesh)
+    guard::guarded(
+        || "the assembly of the mesh".to_string(),
+        || {
+            let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
+            if options.order == 2 {
+                quadratic::elevate(model, &edge_nodes, &mut mesh);
+            }
+            Ok(mesh)
+        },
+    )
 }
 
 /// Each face's area limit: the smallest of `max_area` and the `area=` of
@@ -240,20 +272,29 @@ fn mesh_faces(
         .collect();
     for round in 0..=MAX_ROUNDS {
         let mut splits: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
-        for &f in &todo {
-            let settings = Settings {
-                keep_boundary: round == MAX_ROUNDS,
-                max_area: face_areas.get(f).copied().unwrap_or(base.max_area),
-                ..base
-            };
-            let face_constraints = constraints.get(&f).map_or(&[][..], |c| c.as_slice());
-            match face::mesh_face(
-                model,
-                &model.faces[f],
-                edge_nodes,
-                &settings,
-                face_constraints,
-            )? {
+        // Faces mesh independently against the shared edge nodes: in
+        // parallel, with results taken in face order (deterministic, and the
+        // first error in face order wins as it would sequentially).
+        let edges_now: &[EdgeNodes] = edge_nodes;
+        let outcomes: Vec<(usize, Result<Outcome, MeshError>)> = todo
+            .par_iter()
+            .map(|&f| {
+                let face = &model.faces[f];
+                let settings = Settings {
+                    keep_boundary: round == MAX_ROUNDS,
+                    max_area: face_areas.get(f).copied().unwrap_or(base.max_area),
+                    ..base
+                };
+                let face_constraints = constraints.get(&f).map_or(&[][..], |c| c.as_slice());
+                let outcome = guard::guarded(
+                    || format!("face `{}`", face.name),
+                    || face::mesh_face(model, face, edges_now, &settings, face_constraints),
+                );
+                (f, outcome)
+            })
+            .collect();
+        for (f, outcome) in outcomes {
+            match outcome? {
                 Outcome::Meshed(mesh) => meshes[f] = Some(mesh),
                 Outcome::Split(points) => {
                     for (edge, s) in points {

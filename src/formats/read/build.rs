@@ -196,7 +196,10 @@ pub struct FastHasher(u64);
 
 impl Hasher for FastHasher {
     fn finish(&self) -> u64 {
-        self.0
+        // The product's high bits are the well-mixed ones; the map indexes by
+        // the low bits (as rustc-hash does). Coordinates read as f32 have 29
+        // zero low bits, which without this would collide.
+        self.0.rotate_left(26)
     }
 
     fn write(&mut self, bytes: &[u8]) {

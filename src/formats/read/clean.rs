@@ -70,14 +70,18 @@ impl CleanReport {
 
 /// The checks of a whole mesh and of each face.
 pub fn check(mesh: &Mesh) -> CleanReport {
-    let all: Vec<[u32; 3]> = mesh
-        .faces
-        .iter()
-        .flat_map(|f| f.triangles.iter().copied())
-        .collect();
     let scale = diagonal(mesh);
-    let whole = counts(&mesh.nodes, &all, scale);
-    drop(all);
+    let whole = if let [only] = &mesh.faces[..] {
+        // One group (STL, most single-object files): no copy of its triangles.
+        counts(&mesh.nodes, &only.triangles, scale)
+    } else {
+        let all: Vec<[u32; 3]> = mesh
+            .faces
+            .iter()
+            .flat_map(|f| f.triangles.iter().copied())
+            .collect();
+        counts(&mesh.nodes, &all, scale)
+    };
     let faces = if mesh.faces.len() == 1 {
         vec![whole.clone()]
     } else {

@@ -131,7 +131,12 @@ pub fn load_mesh_as(path: &Path, format: Option<ReadFormat>) -> Result<Loaded, V
         return frag::load(path, &bytes);
     }
     let folder = path.parent().unwrap_or(Path::new(""));
-    load_bytes(format, &bytes, folder)
+    let (builder, binary) = parse(format, &bytes, folder)?;
+    // The file's bytes are not needed for the checks: free them first.
+    drop(bytes);
+    let mut loaded = builder.finish()?;
+    loaded.binary = binary;
+    Ok(loaded)
 }
 
 /// Reads a mesh from bytes already in memory. `folder` is where relative
@@ -141,7 +146,16 @@ pub fn load_bytes(
     bytes: &[u8],
     folder: &Path,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (builder, binary) = match format {
+    let (builder, binary) = parse(format, bytes, folder)?;
+    let mut loaded = builder.finish()?;
+    loaded.binary = binary;
+    Ok(loaded)
+}
+
+type Parsed = (Builder, Option<bool>);
+
+fn parse(format: ReadFormat, bytes: &[u8], folder: &Path) -> Result<Parsed, Vec<Diagnostic>> {
+    Ok(match format {
         ReadFormat::Stl => stl::read(bytes)?,
         ReadFormat::Obj => (obj::read(bytes)?, None),
         ReadFormat::Gltf | ReadFormat::Glb => (gltf::read(bytes, folder)?, None),
@@ -154,10 +168,7 @@ pub fn load_bytes(
                 "a .frag.xml describes a mesh file: read it from its path so the mesh file can be found",
             )]);
         }
-    };
-    let mut loaded = builder.finish()?;
-    loaded.binary = binary;
-    Ok(loaded)
+    })
 }
 
 /// The format by content first, then by ending.

@@ -1,0 +1,54 @@
+"""Peers of benches/convert.rs, measured in the same run as geomc: each
+conversion runs as its own process, timed by wall clock, with its peak
+resident memory from os.wait4.
+
+Usage: convert_peers.py GEOMC DIR  (DIR holds big.stl and mid.msh)
+Prints one JSON object: case -> {tool: {"seconds": s, "peak_bytes": b}}.
+
+Peers: meshio 5.3.5 (`meshio.read` + `meshio.write`, as `meshio convert`
+does) for STL -> MSH 4.1 binary; meshio cannot write glTF, so the GLB cases
+use trimesh 5.2.0 (STL -> GLB) and meshio's MSH reader + trimesh's GLB
+export (MSH -> GLB).
+"""
+import json
+import os
+import subprocess
+import sys
+import time
+
+geomc, d = sys.argv[1], sys.argv[2]
+j = lambda name: os.path.join(d, name)
+
+
+def run(argv):
+    start = time.perf_counter()
+    p = subprocess.Popen(argv, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    _, status, usage = os.wait4(p.pid, 0)
+    seconds = time.perf_counter() - start
+    err = p.stderr.read().decode(errors="replace")
+    if status != 0:
+        raise SystemExit(f"{argv} failed ({status}): {err}")
+    return {"seconds": seconds, "peak_bytes": usage.ru_maxrss * 1024}
+
+
+py = sys.executable
+cases = {
+    "stl_to_glb": {
+        "geomc": [geomc, "convert", j("big.stl"), j("g.glb")],
+        "trimesh": [py, "-c", f"import trimesh; trimesh.load({j('big.stl')!r}).export({j('p.glb')!r})"],
+    },
+    "stl_to_msh41_binary": {
+        "geomc": [geomc, "convert", "--binary", j("big.stl"), j("g.msh")],
+        "meshio": [py, "-c", f"import meshio; meshio.write({j('p.msh')!r}, meshio.read({j('big.stl')!r}), file_format='gmsh', binary=True)"],
+    },
+    "msh_to_glb": {
+        "geomc": [geomc, "convert", j("mid.msh"), j("g2.glb")],
+        "meshio+trimesh": [py, "-c", "import meshio, trimesh; m = meshio.read(%r); "
+                           "trimesh.Trimesh(m.points, m.cells_dict['triangle'], process=False).export(%r)"
+                           % (j("mid.msh"), j("p2.glb"))],
+    },
+}
+out = {}
+for case, tools in cases.items():
+    out[case] = {tool: run(argv) for tool, argv in tools.items()}
+print(json.dumps(out))

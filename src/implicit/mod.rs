@@ -1,0 +1,113 @@
+//! Implicit solids {f ≥ 0} (papers 001 and 004): an expression IR built from
+//! R-functions ([`ir`], [`rfs`], [`library`]), paper 001's modelling language
+//! ([`lang`], `.rfs` files), a flat evaluation tape over coordinate streams
+//! ([`tape`]), interval pruning ([`interval`]) and paper 004's watertight
+//! polygonization ([`polygonize`]) into geomc's mesh IR.
+
+pub mod interval;
+pub mod ir;
+pub mod lang;
+pub mod library;
+pub mod polygonize;
+pub mod rfs;
+pub mod tape;
+
+use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};
+use crate::span::Span;
+use ir::{Ctx, NodeId};
+use polygonize::{Grid, Options, Surface};
+use rfs::RSystem;
+use tape::Ssa;
+
+/// What paper 001's `Geom` object holds.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Geom {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    /// Grid cells per axis (nx, ny, nz).
+    pub cells: [usize; 3],
+    /// The result function's name and where it was set.
+    pub name: Option<(String, Span)>,
+    pub optiterations: u32,
+    pub optiterations_span: Option<Span>,
+    pub rsystem: RSystem,
+}
+
+impl Default for Geom {
+    fn default() -> Geom {
+        Geom {
+            min: [-1.0; 3],
+            max: [1.0; 3],
+            cells: [20; 3],
+            name: None,
+            optiterations: 0,
+            optiterations_span: None,
+            rsystem: RSystem::Rvachev,
+        }
+    }
+}
+
+impl Geom {
+    pub fn grid(&self) -> Grid {
+        Grid {
+            min: self.min,
+            max: self.max,
+            cells: self.cells,
+        }
+    }
+}
+
+/// A compiled implicit solid: f positive inside.
+#[derive(Debug, Clone)]
+pub struct ImplicitModel {
+    pub geom: Geom,
+    pub ctx: Ctx,
+    pub root: NodeId,
+}
+
+impl ImplicitModel {
+    /// The solid's name: Geom.name, else `r_main`.
+    pub fn name(&self) -> &str {
+        self.geom.name.as_ref().map_or("r_main", |n| n.0.as_str())
+    }
+
+    pub fn ssa(&self) -> Ssa {
+        Ssa::from_ctx(&self.ctx, self.root)
+    }
+
+    /// Polygonizes the boundary on the Geom grid (or `cells` per axis).
+    pub fn polygonize(&self, cells: Option<[usize; 3]>) -> Surface {
+        let mut grid = self.geom.grid();
+        if let Some(c) = cells {
+            grid.cells = c;
+        }
+        polygonize::polygonize(&self.ssa(), &grid, &Options::default())
+    }
+}
+
+/// The surface as geomc's mesh IR: one face, one subdomain (the solid) whose
+/// boundary it is, and its fragment against the exterior.
+pub fn surface_to_mesh(surface: &Surface, name: &str) -> Mesh {
+    Mesh {
+        dimension: 3,
+        nodes: surface.positions.clone(),
+        faces: vec![MeshFace {
+            name: format!("{name}_boundary"),
+            triangles: surface.triangles.clone(),
+            boundary: Vec::new(),
+        }],
+        subdomains: vec![MeshSubdomain {
+            name: name.to_string(),
+            material: None,
+            faces: vec![(0, true)],
+        }],
+        fragments: vec![MeshFragment {
+            name: format!("{name}|exterior"),
+            subdomain: 0,
+            other: None,
+            faces: vec![0],
+            edges: Vec::new(),
+        }],
+        ..Mesh::default()
+    }
+}

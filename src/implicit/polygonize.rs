@@ -1,0 +1,693 @@
+//! Paper 004's polygonization of {f = 0} on a regular grid, made watertight:
+//!
+//! 1. The field is sampled block by block (8³ samples); interval arithmetic
+//!    proves most blocks entirely inside or outside (their samples get ±1 and
+//!    are never evaluated), and each remaining block gets its own simplified
+//!    program (`interval::simplify`).
+//! 2. Every grid edge whose end samples differ in sign gets one vertex, placed
+//!    by root finding (Illinois false position) on the edge with the owning
+//!    block's program. Vertices are numbered plane by plane, so the indexed
+//!    mesh is the same for any thread count.
+//! 3. In each cell the surface pieces are paper 004's cycles: the crossed
+//!    edges are nodes, each cell face joins its crossings in pairs (a face
+//!    with four crossings pairs them by the asymptotic decider: the sign of
+//!    the bilinear saddle value), and the resulting cycles are triangulated.
+//!    A face's pairing depends only on its four values, so the two cells
+//!    sharing it agree, and every mesh edge has exactly two triangles.
+//!
+//! Rules: a sample is inside when f > 0; a value exactly 0 counts as outside
+//! (the vertex then sits on that sample). When `close_at_box` is set, samples
+//! on the box's faces count as at most 0, so a solid leaving the box is capped
+//! on the box face. Triangles are oriented with normals pointing out of the
+//! solid (towards decreasing f).
+
+use super::interval::{self, Interval, Sign};
+use super::tape::{Ssa, Tape};
+use rayon::prelude::*;
+use std::sync::Arc;
+
+/// The sampling grid: `cells` cells per axis over the box.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Grid {
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+    pub cells: [usize; 3],
+}
+
+impl Grid {
+    /// Sample coordinates along one axis (the last is exactly `max`).
+    pub fn coords(&self, axis: usize) -> Vec<f64> {
+        let n = self.cells[axis];
+        (0..=n)
+            .map(|i| {
+                if i == n {
+                    self.max[axis]
+                } else {
+                    self.min[axis] + (self.max[axis] - self.min[axis]) * (i as f64 / n as f64)
+                }
+            })
+            .collect()
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Options {
+    /// Skip blocks interval arithmetic proves inside or outside.
+    pub prune: bool,
+    /// Root-finding iterations per crossed edge.
+    pub iterations: usize,
+    /// Cap the solid on the box faces where it leaves the box.
+    pub close_at_box: bool,
+}
+
+impl Default for Options {
+    fn default() -> Options {
+        Options {
+            prune: true,
+            iterations: 6,
+            close_at_box: true,
+        }
+    }
+}
+
+/// An indexed triangle mesh of the surface.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Surface {
+    pub positions: Vec<[f64; 3]>,
+    pub triangles: Vec<[u32; 3]>,
+    /// Blocks in the grid and blocks proven inside/outside.
+    pub blocks: usize,
+    pub pruned_blocks: usize,
+}
+
+const BS: usize = 8;
+
+#[derive(Clone)]
+enum Block {
+    Inside,
+    Outside,
+    Mixed(Arc<Tape>),
+    /// Given samples without a function: vertices by linear interpolation.
+    Sampled,
+}
+
+struct Field {
+    n1: [usize; 3],
+    values: Vec<f64>,
+    nb: [usize; 3],
+    blocks: Vec<Block>,
+}
+
+impl Field {
+    fn idx(&self, i: usize, j: usize, k: usize) -> usize {
+        (k * self.n1[1] + j) * self.n1[0] + i
+    }
+    fn block(&self, i: usize, j: usize, k: usize) -> &Block {
+        &self.blocks[((k / BS) * self.nb[1] + j / BS) * self.nb[0] + i / BS]
+    }
+}
+
+/// Samples f on every grid point, densely (no pruning), in parallel over z
+/// planes. Used by the dense-throughput benchmark and for density volumes.
+pub fn sample_grid(tape: &Tape, grid: &Grid) -> Vec<f64> {
+    let [xs, ys, zs] = [grid.coords(0), grid.coords(1), grid.coords(2)];
+    let plane = xs.len() * ys.len();
+    let mut values = vec![0.0; plane * zs.len()];
+    // Whole planes per call, so batches are full (a 257-point row would leave
+    // its last batch nearly empty).
+    let px: Vec<f64> = (0..plane).map(|m| xs[m % xs.len()]).collect();
+    let py: Vec<f64> = (0..plane).map(|m| ys[m / xs.len()]).collect();
+    values.par_chunks_mut(plane).enumerate().for_each_init(
+        || (tape.workspace(), vec![0.0; plane]),
+        |(ws, pz), (k, out)| {
+            pz.fill(zs[k]);
+            tape.eval(ws, &px, &py, pz, out);
+        },
+    );
+    values
+}
+
+fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
+    let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
+    let n1 = [coords[0].len(), coords[1].len(), coords[2].len()];
+    let nb = [n1[0].div_ceil(BS), n1[1].div_ceil(BS), n1[2].div_ceil(BS)];
+    let full = Arc::new(Tape::new(ssa));
+    let sign = interval::sign_only(ssa);
+    let layer = BS * n1[0] * n1[1];
+    let mut values = vec![0.0; n1[0] * n1[1] * n1[2]];
+    let layers: Vec<Vec<Block>> = values
+        .par_chunks_mut(layer)
+        .enumerate()
+        .map(|(bk, chunk)| {
+            let mut blocks = Vec::with_capacity(nb[0] * nb[1]);
+            let (mut px, mut py, mut pz, mut out) =
+                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+            for bj in 0..nb[1] {
+                for bi in 0..nb[0] {
+                    let lo = [bi * BS, bj * BS, bk * BS];
+                    let owned = [0, 1, 2].map(|a| (lo[a] + BS).min(n1[a]));
+                    let block = if options.prune {
+                        let bounds = [0, 1, 2].map(|a| {
+                            let hi = (lo[a] + BS).min(n1[a] - 1);
+                            Interval::new(coords[a][lo[a]], coords[a][hi])
+                        });
+                        let iv = interval::eval(ssa, &sign, bounds);
+                        match interval::classify(iv[ssa.root()]) {
+                            Sign::Inside => Block::Inside,
+                            Sign::Outside => Block::Outside,
+                            Sign::Ambiguous => Block::Mixed(Arc::new(Tape::new(
+                                &interval::simplify(ssa, &sign, &iv),
+                            ))),
+                        }
+                    } else {
+                        Block::Mixed(full.clone())
+                    };
+                    let placeholder = match &block {
+                        Block::Inside => Some(1.0),
+                        Block::Outside => Some(-1.0),
+                        Block::Mixed(_) | Block::Sampled => None,
+                    };
+                    px.clear();
+                    py.clear();
+                    pz.clear();
+                    for k in lo[2]..owned[2] {
+                        for j in lo[1]..owned[1] {
+                            for i in lo[0]..owned[0] {
+                                px.push(coords[0][i]);
+                                py.push(coords[1][j]);
+                                pz.push(coords[2][k]);
+                            }
+                        }
+                    }
+                    out.clear();
+                    out.resize(px.len(), placeholder.unwrap_or(0.0));
+                    if let Block::Mixed(tape) = &block {
+                        let mut ws = tape.workspace();
+                        tape.eval(&mut ws, &px, &py, &pz, &mut out);
+                    }
+                    let mut m = 0;
+                    for k in lo[2]..owned[2] {
+                        for j in lo[1]..owned[1] {
+                            let start = ((k - lo[2]) * n1[1] + j) * n1[0] + lo[0];
+                            let len = owned[0] - lo[0];
+                            chunk[start..start + len].copy_from_slice(&out[m..m + len]);
+                            m += len;
+                        }
+                    }
+                    blocks.push(block);
+                }
+            }
+            blocks
+        })
+        .collect();
+    let mut field = Field {
+        n1,
+        values,
+        nb,
+        blocks: layers.into_iter().flatten().collect(),
+    };
+    close_at_box(&mut field, options);
+    field
+}
+
+fn close_at_box(field: &mut Field, options: &Options) {
+    let n1 = field.n1;
+    if options.close_at_box {
+        for k in 0..n1[2] {
+            for j in 0..n1[1] {
+                for i in 0..n1[0] {
+                    let on_box = i == 0
+                        || j == 0
+                        || k == 0
+                        || i == n1[0] - 1
+                        || j == n1[1] - 1
+                        || k == n1[2] - 1;
+                    if on_box {
+                        let at = field.idx(i, j, k);
+                        field.values[at] = field.values[at].min(0.0);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// The crossed edges whose lower end lies in one z plane, and their vertices.
+struct PlaneVertices {
+    /// (j · nx1 + i) · 3 + axis, ascending.
+    keys: Vec<u32>,
+    positions: Vec<[f64; 3]>,
+}
+
+fn plane_vertices(
+    field: &Field,
+    coords: &[Vec<f64>; 3],
+    k: usize,
+    options: &Options,
+) -> PlaneVertices {
+    let n1 = field.n1;
+    let mut keys = Vec::new();
+    let mut ends = Vec::new();
+    for j in 0..n1[1] {
+        for i in 0..n1[0] {
+            let v0 = field.values[field.idx(i, j, k)];
+            for (axis, (ii, jj, kk)) in [(i + 1, j, k), (i, j + 1, k), (i, j, k + 1)]
+                .into_iter()
+                .enumerate()
+            {
+                if ii >= n1[0] || jj >= n1[1] || kk >= n1[2] {
+                    continue;
+                }
+                let v1 = field.values[field.idx(ii, jj, kk)];
+                if (v0 > 0.0) != (v1 > 0.0) {
+                    keys.push(((j * n1[0] + i) * 3 + axis) as u32);
+                    ends.push((
+                        [coords[0][i], coords[1][j], coords[2][k]],
+                        [coords[0][ii], coords[1][jj], coords[2][kk]],
+                        v0,
+                        v1,
+                    ));
+                }
+            }
+        }
+    }
+    // Initial guess: linear interpolation of the samples.
+    let mut t: Vec<f64> = ends
+        .iter()
+        .map(|&(_, _, v0, v1)| (v0 / (v0 - v1)).clamp(0.0, 1.0))
+        .collect();
+    // Refine with the owning block's program, grouped by block.
+    let mut order: Vec<usize> = (0..keys.len()).collect();
+    let block_of = |e: usize| {
+        let key = keys[e] as usize / 3;
+        ((key % n1[0]) / BS, (key / n1[0]) / BS)
+    };
+    order.sort_by_key(|&e| block_of(e));
+    let mut start = 0;
+    while start < order.len() {
+        let b = block_of(order[start]);
+        let mut end = start;
+        while end < order.len() && block_of(order[end]) == b {
+            end += 1;
+        }
+        let key = keys[order[start]] as usize / 3;
+        if let Block::Mixed(tape) = field.block(key % n1[0], key / n1[0], k) {
+            refine(tape, &order[start..end], &ends, &mut t, options.iterations);
+        }
+        start = end;
+    }
+    let positions = ends
+        .iter()
+        .zip(&t)
+        .map(|(&(p0, p1, _, _), &t)| {
+            [0, 1, 2].map(|a| {
+                if p0[a] == p1[a] {
+                    p0[a]
+                } else {
+                    p0[a] + t * (p1[a] - p0[a])
+                }
+            })
+        })
+        .collect();
+    PlaneVertices { keys, positions }
+}
+
+type Ends = ([f64; 3], [f64; 3], f64, f64);
+
+/// Illinois false position on each edge, batched over one block's edges.
+fn refine(tape: &Tape, edges: &[usize], ends: &[Ends], t: &mut [f64], iterations: usize) {
+    let n = edges.len();
+    let mut ws = tape.workspace();
+    let point = |e: usize, s: f64, a: usize| {
+        let (p0, p1, _, _) = ends[e];
+        p0[a] + s * (p1[a] - p0[a])
+    };
+    let eval_at = |ws: &mut _, s: &[f64], out: &mut [f64]| {
+        let xs: Vec<f64> = edges.iter().zip(s).map(|(&e, &s)| point(e, s, 0)).collect();
+        let ys: Vec<f64> = edges.iter().zip(s).map(|(&e, &s)| point(e, s, 1)).collect();
+        let zs: Vec<f64> = edges.iter().zip(s).map(|(&e, &s)| point(e, s, 2)).collect();
+        tape.eval(ws, &xs, &ys, &zs, out);
+    };
+    let (mut tl, mut tr) = (vec![0.0; n], vec![1.0; n]);
+    let (mut fl, mut fr) = (vec![0.0; n], vec![0.0; n]);
+    eval_at(&mut ws, &tl, &mut fl);
+    eval_at(&mut ws, &tr, &mut fr);
+    // Edges whose exact end values do not bracket (a capped box sample, a
+    // pruned neighbour) keep the linear guess.
+    let ok: Vec<bool> = (0..n)
+        .map(|m| {
+            let (_, _, v0, v1) = ends[edges[m]];
+            (fl[m] > 0.0) == (v0 > 0.0)
+                && (fr[m] > 0.0) == (v1 > 0.0)
+                && (fl[m] > 0.0) != (fr[m] > 0.0)
+        })
+        .collect();
+    let mut side = vec![0i8; n];
+    let mut s: Vec<f64> = (0..n).map(|m| t[edges[m]]).collect();
+    let mut fs = vec![0.0; n];
+    for _ in 0..iterations {
+        for m in 0..n {
+            let d = fr[m] - fl[m];
+            s[m] = if d != 0.0 {
+                ((tl[m] * fr[m] - tr[m] * fl[m]) / d).clamp(tl[m], tr[m])
+            } else {
+                0.5 * (tl[m] + tr[m])
+            };
+        }
+        eval_at(&mut ws, &s, &mut fs);
+        for m in 0..n {
+            if (fs[m] > 0.0) == (fl[m] > 0.0) {
+                tl[m] = s[m];
+                fl[m] = fs[m];
+                if side[m] == -1 {
+                    fr[m] *= 0.5;
+                }
+                side[m] = -1;
+            } else {
+                tr[m] = s[m];
+                fr[m] = fs[m];
+                if side[m] == 1 {
+                    fl[m] *= 0.5;
+                }
+                side[m] = 1;
+            }
+        }
+    }
+    for m in 0..n {
+        if ok[m] {
+            t[edges[m]] = s[m];
+        }
+    }
+}
+
+/// Corner c of a cell is at offset (c & 1, c >> 1 & 1, c >> 2 & 1).
+const EDGES: [(u8, u8); 12] = [
+    (0, 1),
+    (2, 3),
+    (4, 5),
+    (6, 7),
+    (0, 2),
+    (1, 3),
+    (4, 6),
+    (5, 7),
+    (0, 4),
+    (1, 5),
+    (2, 6),
+    (3, 7),
+];
+/// The six faces, corners counter-clockwise seen from outside the cell.
+const FACES: [[u8; 4]; 6] = [
+    [0, 4, 6, 2],
+    [1, 3, 7, 5],
+    [0, 1, 5, 4],
+    [2, 6, 7, 3],
+    [0, 2, 3, 1],
+    [4, 5, 7, 6],
+];
+
+const fn edge_table() -> [[u8; 8]; 8] {
+    let mut t = [[u8::MAX; 8]; 8];
+    let mut e = 0;
+    while e < 12 {
+        let (a, b) = EDGES[e];
+        t[a as usize][b as usize] = e as u8;
+        t[b as usize][a as usize] = e as u8;
+        e += 1;
+    }
+    t
+}
+const EDGE_OF: [[u8; 8]; 8] = edge_table();
+
+const fn face_masks() -> [u8; 12] {
+    let mut m = [0u8; 12];
+    let mut f = 0;
+    while f < 6 {
+        let mut s = 0;
+        while s < 4 {
+            let e = EDGE_OF[FACES[f][s] as usize][FACES[f][(s + 1) % 4] as usize];
+            m[e as usize] |= 1 << f;
+            s += 1;
+        }
+        f += 1;
+    }
+    m
+}
+/// Which faces each cell edge lies on.
+const FACE_MASK: [u8; 12] = face_masks();
+
+/// The successor of each crossed edge in its cycle (u8::MAX: not crossed):
+/// on every face each exit crossing (inside → outside, counter-clockwise
+/// seen from outside) is joined to an entry crossing.
+pub fn cell_links(v: &[f64; 8]) -> [u8; 12] {
+    let mut next = [u8::MAX; 12];
+    let inside = |c: u8| v[c as usize] > 0.0;
+    for q in FACES {
+        let ins = q.map(inside);
+        let crossings = (0..4).filter(|&s| ins[s] != ins[(s + 1) % 4]).count();
+        let edge = |a: u8, b: u8| EDGE_OF[a as usize][b as usize];
+        if crossings == 2 {
+            let exit = (0..4).find(|&s| ins[s] && !ins[(s + 1) % 4]);
+            let entry = (0..4).find(|&s| !ins[s] && ins[(s + 1) % 4]);
+            if let (Some(x), Some(n)) = (exit, entry) {
+                next[edge(q[x], q[(x + 1) % 4]) as usize] = edge(q[n], q[(n + 1) % 4]);
+            }
+        } else if crossings == 4 {
+            let r = if ins[0] { 0 } else { 1 };
+            let p = [q[r], q[(r + 1) % 4], q[(r + 2) % 4], q[(r + 3) % 4]];
+            let val = |c: u8| v[c as usize];
+            // Asymptotic decider: the bilinear interpolant's saddle value
+            // (v0 v2 − v1 v3) / (v0 + v2 − v1 − v3) has a positive denominator
+            // here, so the centre is inside when v0 v2 > v1 v3.
+            let centre_inside = val(p[0]) * val(p[2]) > val(p[1]) * val(p[3]);
+            let (e0, e1, e2, e3) = (
+                edge(p[0], p[1]),
+                edge(p[1], p[2]),
+                edge(p[2], p[3]),
+                edge(p[3], p[0]),
+            );
+            if centre_inside {
+                next[e0 as usize] = e1;
+                next[e2 as usize] = e3;
+            } else {
+                next[e0 as usize] = e3;
+                next[e2 as usize] = e1;
+            }
+        }
+    }
+    next
+}
+
+/// The cycles of a cell, each as its cell edges in the order that gives
+/// outward-facing triangles.
+pub fn cell_cycles(v: &[f64; 8]) -> Vec<Vec<u8>> {
+    let next = cell_links(v);
+    let mut seen = [false; 12];
+    let mut cycles = Vec::new();
+    for e in 0..12u8 {
+        if next[e as usize] == u8::MAX || seen[e as usize] {
+            continue;
+        }
+        let mut cycle = Vec::new();
+        let mut cur = e;
+        while !seen[cur as usize] && next[cur as usize] != u8::MAX {
+            seen[cur as usize] = true;
+            cycle.push(cur);
+            cur = next[cur as usize];
+        }
+        // The links run with the inside on their left seen from outside the
+        // cell; reversed, the polygon's normal points out of the solid.
+        cycle.reverse();
+        cycles.push(cycle);
+    }
+    cycles
+}
+
+/// Marks a vertex id as local to one slab (a cycle centre), renumbered once
+/// every slab's count is known.
+const CENTRE: u32 = 1 << 31;
+
+/// One slab's triangles and its cycle-centre vertices.
+type SlabOutput = (Vec<[u32; 3]>, Vec<[f64; 3]>);
+
+/// Triangulates one cycle of vertex ids as a fan whose diagonals never join
+/// two crossings on one cell face (the neighbour cell might join the same
+/// pair); for quads the shorter valid diagonal. When no such fan exists (a
+/// face whose two segments both belong to this cycle) the cycle is fanned
+/// around a new vertex at its centroid.
+fn triangulate(
+    edges: &[u8],
+    ids: &[u32],
+    positions: &[[f64; 3]],
+    out: &mut Vec<[u32; 3]>,
+    centres: &mut Vec<[f64; 3]>,
+) {
+    let n = ids.len();
+    if n < 3 {
+        return;
+    }
+    let valid = |s: usize| {
+        (2..n - 1)
+            .all(|d| FACE_MASK[edges[s] as usize] & FACE_MASK[edges[(s + d) % n] as usize] == 0)
+    };
+    let start = if n == 4 {
+        let len = |a: usize, b: usize| {
+            let (p, q) = (positions[ids[a] as usize], positions[ids[b] as usize]);
+            (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>()
+        };
+        match (valid(0), valid(1)) {
+            (true, true) if len(1, 3) < len(0, 2) => Some(1),
+            (true, _) => Some(0),
+            (false, true) => Some(1),
+            (false, false) => None,
+        }
+    } else {
+        (0..n).find(|&s| valid(s))
+    };
+    match start {
+        Some(start) => {
+            for d in 1..n - 1 {
+                out.push([ids[start], ids[(start + d) % n], ids[(start + d + 1) % n]]);
+            }
+        }
+        None => {
+            let mut c = [0.0; 3];
+            for &id in ids {
+                for (k, ck) in c.iter_mut().enumerate() {
+                    *ck += positions[id as usize][k] / n as f64;
+                }
+            }
+            let centre = CENTRE | centres.len() as u32;
+            centres.push(c);
+            for m in 0..n {
+                out.push([centre, ids[m], ids[(m + 1) % n]]);
+            }
+        }
+    }
+}
+
+/// Polygonizes {f = 0} of `ssa` over the grid.
+pub fn polygonize(ssa: &Ssa, grid: &Grid, options: &Options) -> Surface {
+    let field = sample_field(ssa, grid, options);
+    mesh_field(&field, grid, options)
+}
+
+/// Polygonizes {v = 0} of given samples (x fastest, then y, then z; one per
+/// grid point), vertices by linear interpolation along the edges.
+///
+/// # Panics
+/// If `values` does not hold one value per grid point (a caller bug).
+pub fn polygonize_samples(values: Vec<f64>, grid: &Grid, options: &Options) -> Surface {
+    let n1 = grid.cells.map(|n| n + 1);
+    assert_eq!(
+        values.len(),
+        n1[0] * n1[1] * n1[2],
+        "one sample per grid point"
+    );
+    let nb = n1.map(|n| n.div_ceil(BS));
+    let mut field = Field {
+        n1,
+        values,
+        nb,
+        blocks: vec![Block::Sampled; nb[0] * nb[1] * nb[2]],
+    };
+    close_at_box(&mut field, options);
+    mesh_field(&field, grid, options)
+}
+
+fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
+    let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
+    let n1 = field.n1;
+    let planes: Vec<PlaneVertices> = (0..n1[2])
+        .into_par_iter()
+        .map(|k| plane_vertices(field, &coords, k, options))
+        .collect();
+    let mut offsets = Vec::with_capacity(planes.len());
+    let mut total = 0u32;
+    for p in &planes {
+        offsets.push(total);
+        total += p.keys.len() as u32;
+    }
+    let positions: Vec<[f64; 3]> = planes
+        .iter()
+        .flat_map(|p| p.positions.iter().copied())
+        .collect();
+    let dense = |k: usize| {
+        let mut map = vec![u32::MAX; n1[0] * n1[1] * 3];
+        for (m, &key) in planes[k].keys.iter().enumerate() {
+            map[key as usize] = offsets[k] + m as u32;
+        }
+        map
+    };
+    let touches_box = |i: usize, j: usize, k: usize| {
+        let b = [i / BS, j / BS, k / BS];
+        (0..3).any(|a| b[a] == 0 || (b[a] * BS + BS) >= n1[a] - 1)
+    };
+    let slabs: Vec<SlabOutput> = (0..grid.cells[2])
+        .into_par_iter()
+        .map(|k| {
+            let maps = [dense(k), dense(k + 1)];
+            let mut tris = Vec::new();
+            let mut centres = Vec::new();
+            let mut ids = Vec::with_capacity(12);
+            for j in 0..grid.cells[1] {
+                for i in 0..grid.cells[0] {
+                    match field.block(i, j, k) {
+                        Block::Outside => continue,
+                        Block::Inside if !(options.close_at_box && touches_box(i, j, k)) => {
+                            continue;
+                        }
+                        _ => {}
+                    }
+                    let v: [f64; 8] = std::array::from_fn(|c| {
+                        field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))]
+                    });
+                    let first = v[0] > 0.0;
+                    if v.iter().all(|&x| (x > 0.0) == first) {
+                        continue;
+                    }
+                    for cycle in cell_cycles(&v) {
+                        ids.clear();
+                        for &e in &cycle {
+                            let (a, b) = EDGES[e as usize];
+                            let axis = (a ^ b).trailing_zeros() as usize;
+                            let (a, dz) = (a as usize, (a as usize >> 2) & 1);
+                            let key = ((j + (a >> 1 & 1)) * n1[0] + i + (a & 1)) * 3 + axis;
+                            ids.push(maps[dz][key]);
+                        }
+                        if ids.contains(&u32::MAX) {
+                            continue;
+                        }
+                        triangulate(&cycle, &ids, &positions, &mut tris, &mut centres);
+                    }
+                }
+            }
+            (tris, centres)
+        })
+        .collect();
+    let mut positions = positions;
+    let mut triangles = Vec::with_capacity(slabs.iter().map(|s| s.0.len()).sum());
+    for (tris, centres) in slabs {
+        let base = positions.len() as u32;
+        triangles.extend(tris.into_iter().map(|t| {
+            t.map(|id| {
+                if id & CENTRE != 0 {
+                    base + (id & !CENTRE)
+                } else {
+                    id
+                }
+            })
+        }));
+        positions.extend(centres);
+    }
+    let pruned_blocks = field
+        .blocks
+        .iter()
+        .filter(|b| matches!(b, Block::Inside | Block::Outside))
+        .count();
+    Surface {
+        positions,
+        triangles,
+        blocks: field.blocks.len(),
+        pruned_blocks,
+    }
+}

@@ -1,0 +1,380 @@
+//! A flat evaluation tape: the reachable nodes of one function in SSA order
+//! ([`Ssa`]), register-allocated into a few slots ([`Tape`]), evaluated over
+//! batches of points laid out coordinate stream by coordinate stream (x[],
+//! y[], z[]), so each instruction is one tight loop the compiler vectorises.
+
+use super::ir::{Binary, Ctx, Node, NodeId, Unary, r_and, r_or};
+
+/// Points per batch: small enough that the live slots stay in L1.
+pub const BATCH: usize = 128;
+
+/// The reachable part of a function, renumbered densely; children refer to
+/// earlier indices; the last entry is the root.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Ssa {
+    pub ops: Vec<Node>,
+}
+
+impl Ssa {
+    pub fn from_ctx(ctx: &Ctx, root: NodeId) -> Ssa {
+        let n = root as usize + 1;
+        let mut live = vec![false; n];
+        live[root as usize] = true;
+        for i in (0..n).rev() {
+            if live[i] {
+                for c in children(&ctx.nodes[i]) {
+                    live[c as usize] = true;
+                }
+            }
+        }
+        let mut renumber = vec![u32::MAX; n];
+        let mut ops = Vec::new();
+        for i in 0..n {
+            if live[i] {
+                renumber[i] = ops.len() as u32;
+                ops.push(remap(ctx.nodes[i], &renumber));
+            }
+        }
+        Ssa { ops }
+    }
+
+    pub fn root(&self) -> usize {
+        self.ops.len() - 1
+    }
+
+    /// Evaluates at one point (for tests and scalar uses).
+    pub fn eval_point(&self, p: [f64; 3]) -> f64 {
+        let mut v = vec![0.0; self.ops.len()];
+        for (i, op) in self.ops.iter().enumerate() {
+            v[i] = match *op {
+                Node::Const(bits) => f64::from_bits(bits),
+                Node::Var(axis) => p[axis as usize],
+                Node::Unary(u, a) => u.apply(v[a as usize]),
+                Node::Binary(b, x, y) => b.apply(v[x as usize], v[y as usize]),
+                Node::RAnd(x, y, a) => r_and(v[x as usize], v[y as usize], f64::from_bits(a)),
+                Node::ROr(x, y, a) => r_or(v[x as usize], v[y as usize], f64::from_bits(a)),
+            };
+        }
+        v[self.root()]
+    }
+}
+
+pub fn children(node: &Node) -> impl Iterator<Item = NodeId> {
+    let (a, b) = match *node {
+        Node::Const(_) | Node::Var(_) => (None, None),
+        Node::Unary(_, a) => (Some(a), None),
+        Node::Binary(_, a, b) | Node::RAnd(a, b, _) | Node::ROr(a, b, _) => (Some(a), Some(b)),
+    };
+    a.into_iter().chain(b)
+}
+
+/// The node with its children renumbered through `map`.
+pub fn remap(node: Node, map: &[u32]) -> Node {
+    let m = |i: NodeId| map[i as usize];
+    match node {
+        Node::Const(_) | Node::Var(_) => node,
+        Node::Unary(u, a) => Node::Unary(u, m(a)),
+        Node::Binary(b, x, y) => Node::Binary(b, m(x), m(y)),
+        Node::RAnd(x, y, a) => Node::RAnd(m(x), m(y), a),
+        Node::ROr(x, y, a) => Node::ROr(m(x), m(y), a),
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+enum Op {
+    Unary(Unary),
+    Binary(Binary),
+    /// R_α conjunction/disjunction with α = 0 (Rvachev), the common case.
+    RvAnd,
+    RvOr,
+    RAnd(f64),
+    ROr(f64),
+}
+
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Instr {
+    op: Op,
+    out: u32,
+    a: u32,
+    b: u32,
+}
+
+/// A register-allocated program: constants and coordinates live in fixed
+/// slots; operation results reuse slots freed after their last use.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Tape {
+    instrs: Vec<Instr>,
+    consts: Vec<(u32, f64)>,
+    vars: [Option<u32>; 3],
+    slots: usize,
+    out: u32,
+}
+
+impl Tape {
+    pub fn new(ssa: &Ssa) -> Tape {
+        let n = ssa.ops.len();
+        let mut last_use = vec![usize::MAX; n];
+        for (i, op) in ssa.ops.iter().enumerate() {
+            for c in children(op) {
+                last_use[c as usize] = i;
+            }
+        }
+        let mut slot_of = vec![0u32; n];
+        let mut fixed = vec![false; n];
+        let mut free: Vec<u32> = Vec::new();
+        let mut slots = 0u32;
+        let mut consts = Vec::new();
+        let mut vars = [None; 3];
+        let mut instrs = Vec::new();
+        // Constants and coordinates get slots of their own, never reused:
+        // their values are written before the instructions run.
+        let mut alloc = |free: &mut Vec<u32>, fresh: bool| {
+            let reused = if fresh { None } else { free.pop() };
+            reused.unwrap_or_else(|| {
+                slots += 1;
+                slots - 1
+            })
+        };
+        for (i, op) in ssa.ops.iter().enumerate() {
+            let out = match *op {
+                Node::Const(bits) => {
+                    let s = alloc(&mut free, true);
+                    consts.push((s, f64::from_bits(bits)));
+                    fixed[i] = true;
+                    s
+                }
+                Node::Var(axis) => {
+                    let s = alloc(&mut free, true);
+                    vars[axis as usize] = Some(s);
+                    fixed[i] = true;
+                    s
+                }
+                _ => {
+                    let s = alloc(&mut free, false);
+                    let mut args = children(op);
+                    let a = args.next().map_or(s, |c| slot_of[c as usize]);
+                    let b = args.next().map_or(a, |c| slot_of[c as usize]);
+                    let op = match *op {
+                        Node::Unary(u, _) => Op::Unary(u),
+                        Node::Binary(bin, _, _) => Op::Binary(bin),
+                        Node::RAnd(_, _, al) if f64::from_bits(al) == 0.0 => Op::RvAnd,
+                        Node::ROr(_, _, al) if f64::from_bits(al) == 0.0 => Op::RvOr,
+                        Node::RAnd(_, _, al) => Op::RAnd(f64::from_bits(al)),
+                        Node::ROr(_, _, al) => Op::ROr(f64::from_bits(al)),
+                        Node::Const(_) | Node::Var(_) => unreachable!("handled above"),
+                    };
+                    instrs.push(Instr { op, out: s, a, b });
+                    s
+                }
+            };
+            slot_of[i] = out;
+            // Free operands whose last use is this instruction (after allocating
+            // the output, so an output never aliases an input).
+            let mut seen = [u32::MAX; 2];
+            for (k, c) in children(op).enumerate() {
+                let c = c as usize;
+                if last_use[c] == i && !fixed[c] && !seen.contains(&(c as u32)) {
+                    free.push(slot_of[c]);
+                }
+                seen[k] = c as u32;
+            }
+        }
+        Tape {
+            instrs,
+            consts,
+            vars,
+            slots: slots as usize,
+            out: slot_of[n - 1],
+        }
+    }
+
+    pub fn from_ctx(ctx: &Ctx, root: NodeId) -> Tape {
+        Tape::new(&Ssa::from_ctx(ctx, root))
+    }
+
+    /// Instructions (excluding constants and coordinates).
+    pub fn len(&self) -> usize {
+        self.instrs.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.instrs.is_empty()
+    }
+
+    /// Working memory for evaluating this tape, reusable across calls.
+    pub fn workspace(&self) -> Workspace {
+        let mut buf = vec![0.0; self.slots.max(1) * BATCH];
+        for &(s, v) in &self.consts {
+            buf[s as usize * BATCH..][..BATCH].fill(v);
+        }
+        Workspace { buf }
+    }
+
+    /// Evaluates f at the points (xs[i], ys[i], zs[i]) into `out`.
+    pub fn eval(&self, ws: &mut Workspace, xs: &[f64], ys: &[f64], zs: &[f64], out: &mut [f64]) {
+        let n = out.len();
+        let mut start = 0;
+        while start < n {
+            let len = (n - start).min(BATCH);
+            for (axis, src) in [xs, ys, zs].into_iter().enumerate() {
+                if let Some(s) = self.vars[axis] {
+                    let dst = &mut ws.buf[s as usize * BATCH..][..BATCH];
+                    dst[..len].copy_from_slice(&src[start..start + len]);
+                }
+            }
+            self.run(&mut ws.buf);
+            out[start..start + len].copy_from_slice(&ws.buf[self.out as usize * BATCH..][..len]);
+            start += len;
+        }
+    }
+
+    fn run(&self, buf: &mut [f64]) {
+        for ins in &self.instrs {
+            let (o, a, b) = io(buf, ins.out as usize, ins.a as usize, ins.b as usize);
+            match ins.op {
+                Op::Unary(u) => unary(u, o, a),
+                Op::Binary(bin) => binary(bin, o, a, b),
+                Op::RvAnd => {
+                    for i in 0..BATCH {
+                        o[i] = a[i] + b[i] - (a[i] * a[i] + b[i] * b[i]).sqrt();
+                    }
+                }
+                Op::RvOr => {
+                    for i in 0..BATCH {
+                        o[i] = a[i] + b[i] + (a[i] * a[i] + b[i] * b[i]).sqrt();
+                    }
+                }
+                Op::RAnd(al) => {
+                    for i in 0..BATCH {
+                        o[i] = r_and(a[i], b[i], al);
+                    }
+                }
+                Op::ROr(al) => {
+                    for i in 0..BATCH {
+                        o[i] = r_or(a[i], b[i], al);
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Scratch memory for one thread.
+pub struct Workspace {
+    buf: Vec<f64>,
+}
+
+/// The output slot (mutable) and two input slots of one instruction; the
+/// allocator guarantees the output differs from both inputs.
+fn io(
+    buf: &mut [f64],
+    o: usize,
+    a: usize,
+    b: usize,
+) -> (&mut [f64; BATCH], &[f64; BATCH], &[f64; BATCH]) {
+    let (lo, hi) = buf.split_at_mut(o * BATCH);
+    let (out, rest) = hi.split_at_mut(BATCH);
+    let pick = |s: usize| -> &[f64; BATCH] {
+        let slice = if s < o {
+            &lo[s * BATCH..][..BATCH]
+        } else {
+            &rest[(s - o - 1) * BATCH..][..BATCH]
+        };
+        slice.try_into().expect("slot is BATCH long")
+    };
+    let (a, b) = (pick(a), pick(b));
+    (out.try_into().expect("slot is BATCH long"), a, b)
+}
+
+fn unary(u: Unary, o: &mut [f64; BATCH], a: &[f64; BATCH]) {
+    macro_rules! each {
+        ($f:expr) => {
+            for i in 0..BATCH {
+                o[i] = $f(a[i]);
+            }
+        };
+    }
+    match u {
+        Unary::Neg => each!(|x: f64| -x),
+        Unary::Square => each!(|x: f64| x * x),
+        Unary::Sqrt => each!(f64::sqrt),
+        Unary::Abs => each!(f64::abs),
+        _ => each!(|x| u.apply(x)),
+    }
+}
+
+fn binary(bin: Binary, o: &mut [f64; BATCH], a: &[f64; BATCH], b: &[f64; BATCH]) {
+    macro_rules! each {
+        ($f:expr) => {
+            for i in 0..BATCH {
+                o[i] = $f(a[i], b[i]);
+            }
+        };
+    }
+    match bin {
+        Binary::Add => each!(|x: f64, y: f64| x + y),
+        Binary::Sub => each!(|x: f64, y: f64| x - y),
+        Binary::Mul => each!(|x: f64, y: f64| x * y),
+        Binary::Div => each!(|x: f64, y: f64| x / y),
+        Binary::Min => each!(|x: f64, y: f64| if x < y { x } else { y }),
+        Binary::Max => each!(|x: f64, y: f64| if x > y { x } else { y }),
+        _ => each!(|x, y| bin.apply(x, y)),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn tape_matches_scalar_evaluation() {
+        let mut ctx = Ctx::new();
+        let (x, y, z) = (ctx.var(0), ctx.var(1), ctx.var(2));
+        let xy = ctx.add(x, y);
+        let s = ctx.unary(Unary::Sin, xy);
+        let t = ctx.sub(s, z);
+        let one = ctx.constant(1.0);
+        let a = ctx.add(t, one);
+        let zz = ctx.sub(z, s);
+        let root = ctx.r_and(a, zz, 0.0);
+        let root = ctx.r_or(root, x, 0.3);
+        let tape = Tape::from_ctx(&ctx, root);
+        let mut ws = tape.workspace();
+        let n = 300;
+        let xs: Vec<f64> = (0..n).map(|i| i as f64 * 0.01 - 1.0).collect();
+        let ys: Vec<f64> = (0..n).map(|i| (i as f64 * 0.37).sin()).collect();
+        let zs: Vec<f64> = (0..n).map(|i| (i as f64 * 0.11).cos()).collect();
+        let mut out = vec![0.0; n];
+        tape.eval(&mut ws, &xs, &ys, &zs, &mut out);
+        for i in 0..n {
+            let want = ctx.eval_point(root, [xs[i], ys[i], zs[i]]);
+            assert!((out[i] - want).abs() < 1e-14, "{i}: {} vs {want}", out[i]);
+        }
+        assert!(tape.slots < ctx.nodes.len());
+    }
+
+    #[test]
+    fn constants_after_operations_keep_their_slots() {
+        // Regression: a constant first used after a freed operation slot must
+        // not share that slot (its value is written before the tape runs).
+        let mut ctx = Ctx::new();
+        let (x, y, z) = (ctx.var(0), ctx.var(1), ctx.var(2));
+        let xx = ctx.square(x);
+        let yy = ctx.square(y);
+        let r2 = ctx.add(xx, yy);
+        let r = ctx.unary(Unary::Sqrt, r2);
+        let big = ctx.constant(0.6);
+        let d = ctx.sub(r, big);
+        let dd = ctx.square(d);
+        let small = ctx.constant(0.0625);
+        let a = ctx.sub(small, dd);
+        let zz = ctx.square(z);
+        let root = ctx.sub(a, zz);
+        let tape = Tape::from_ctx(&ctx, root);
+        let mut ws = tape.workspace();
+        let mut out = [0.0; 2];
+        tape.eval(&mut ws, &[1.0, 0.6], &[1.0, 0.0], &[1.0, 0.1], &mut out);
+        assert!((out[0] - (0.0625 - (2f64.sqrt() - 0.6).powi(2) - 1.0)).abs() < 1e-14);
+        assert!((out[1] - (0.0625 - 0.01)).abs() < 1e-14);
+    }
+}

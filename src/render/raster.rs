@@ -1,0 +1,245 @@
+//! The z-buffer rasteriser. Each sample keeps one `u64`: the depth's bits
+//! above the triangle's id (`2 × triangle + back side`), and the smallest value
+//! wins. A minimum does not depend on the order triangles arrive in, so bands
+//! rasterised in parallel give the same buffer for any thread count.
+//! Coordinates are snapped to 1/16 sample so shared edges are exact (no
+//! cracks) and the top-left rule decides which triangle owns a sample on one.
+
+use super::scene::{HIDDEN, Scene};
+use rayon::prelude::*;
+
+pub const EMPTY: u64 = u64::MAX;
+/// Sub-sample steps per sample of the snapped coordinates.
+const SUB: i64 = 16;
+/// Sample rows per band (the unit of parallel work).
+const BAND: usize = 32;
+/// Triangles per binning chunk.
+const CHUNK: usize = 1 << 15;
+
+/// Node positions in sample space: snapped x, y and a depth in [0, 1].
+pub struct Projected {
+    pub xy: Vec<[i64; 2]>,
+    /// Unsnapped, for interpolation in shading.
+    pub xy_f: Vec<[f32; 2]>,
+    pub z: Vec<f32>,
+}
+
+pub struct ZBuffer {
+    pub width: usize,
+    pub height: usize,
+    pub data: Vec<u64>,
+}
+
+pub fn depth_of(value: u64) -> f32 {
+    f32::from_bits((value >> 32) as u32)
+}
+
+/// The triangle's corners ordered with positive area, and which side faces the eye.
+#[inline]
+fn setup(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], [f32; 3], u32)> {
+    let (a, b, c) = (
+        proj.xy[t[0] as usize],
+        proj.xy[t[1] as usize],
+        proj.xy[t[2] as usize],
+    );
+    let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    if area == 0 {
+        return None;
+    }
+    let z = [
+        proj.z[t[0] as usize],
+        proj.z[t[1] as usize],
+        proj.z[t[2] as usize],
+    ];
+    // Image y points down, so a triangle counter-clockwise from the eye has a
+    // negative area here: that is its front.
+    if area < 0 {
+        Some(([a, c, b], [z[0], z[2], z[1]], 0))
+    } else {
+        Some(([a, b, c], z, 1))
+    }
+}
+
+#[inline]
+fn visible_side(scene: &Scene, tri: usize, back: u32) -> bool {
+    scene.face_sides[scene.tri_face[tri] as usize][back as usize] != HIDDEN
+}
+
+/// Sample rows a triangle may cover, clamped to the image.
+#[inline]
+fn row_range(v: &[[i64; 2]; 3], height: usize) -> Option<(usize, usize)> {
+    let lo = v[0][1].min(v[1][1]).min(v[2][1]);
+    let hi = v[0][1].max(v[1][1]).max(v[2][1]);
+    // Sample centres sit at (i + 1/2) samples.
+    let first = (lo - SUB / 2 + SUB - 1).div_euclid(SUB).max(0);
+    let last = (hi - SUB / 2).div_euclid(SUB).min(height as i64 - 1);
+    (first <= last).then_some((first as usize, last as usize))
+}
+
+pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
+    let n_bands = height.div_ceil(BAND);
+    // Binning: for each chunk of triangles, the ids each band must draw.
+    let bins: Vec<Vec<Vec<u32>>> = (0..scene.tris.len().div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| {
+            let mut bands: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
+            let end = ((c + 1) * CHUNK).min(scene.tris.len());
+            for tri in c * CHUNK..end {
+                let Some((v, _, back)) = setup(proj, scene.tris[tri]) else {
+                    continue;
+                };
+                if !visible_side(scene, tri, back) {
+                    continue;
+                }
+                if let Some((first, last)) = row_range(&v, height) {
+                    for band in bands.iter_mut().take(last / BAND + 1).skip(first / BAND) {
+                        band.push(tri as u32);
+                    }
+                }
+            }
+            bands
+        })
+        .collect();
+    let mut data = vec![EMPTY; width * height];
+    data.par_chunks_mut(width * BAND)
+        .enumerate()
+        .for_each(|(band, rows)| {
+            let y0 = band * BAND;
+            let y1 = (y0 + BAND).min(height);
+            for chunk in &bins {
+                for &tri in &chunk[band] {
+                    if let Some((v, z, back)) = setup(proj, scene.tris[tri as usize]) {
+                        draw(rows, width, y0, y1, v, z, tri * 2 + back);
+                    }
+                }
+            }
+        });
+    ZBuffer {
+        width,
+        height,
+        data,
+    }
+}
+
+/// Fills the samples of rows `y0..y1` (stored from `rows[0]`) inside the
+/// triangle `v` (positive area) where it is nearer than what is there.
+#[inline]
+fn draw(
+    rows: &mut [u64],
+    width: usize,
+    y0: usize,
+    y1: usize,
+    v: [[i64; 2]; 3],
+    z: [f32; 3],
+    id: u32,
+) {
+    let min_x = v[0][0].min(v[1][0]).min(v[2][0]);
+    let max_x = v[0][0].max(v[1][0]).max(v[2][0]);
+    let min_y = v[0][1].min(v[1][1]).min(v[2][1]);
+    let max_y = v[0][1].max(v[1][1]).max(v[2][1]);
+    let sx0 = (min_x - SUB / 2 + SUB - 1).div_euclid(SUB);
+    let sx1 = (max_x - SUB / 2).div_euclid(SUB).min(width as i64 - 1);
+    let sy0 = (min_y - SUB / 2 + SUB - 1).div_euclid(SUB);
+    let sy1 = (max_y - SUB / 2).div_euclid(SUB).min(y1 as i64 - 1);
+    let (x_first, y_first) = (sx0.max(0), sy0.max(y0 as i64));
+    if x_first > sx1 || y_first > sy1 {
+        return;
+    }
+    // Edge k runs from v[k] to v[k+1]; E_k(p) = (b−a)×(p−a) is positive inside.
+    let mut e_row = [0i64; 3];
+    let mut step_x = [0i64; 3];
+    let mut step_y = [0i64; 3];
+    let px = x_first * SUB + SUB / 2;
+    let py = y_first * SUB + SUB / 2;
+    for k in 0..3 {
+        let (a, b) = (v[k], v[(k + 1) % 3]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        // Top-left rule (y down): an edge going up, or horizontal going left… in
+        // this orientation: owning samples exactly on it for exactly one of the
+        // two triangles that share it.
+        let owns = dy < 0 || (dy == 0 && dx > 0);
+        e_row[k] = dx * (py - a[1]) - dy * (px - a[0]) - if owns { 0 } else { 1 };
+        step_x[k] = -dy * SUB;
+        step_y[k] = dx * SUB;
+    }
+    // Depth as a plane over sample coordinates, referenced at the triangle's
+    // own first sample so bands agree exactly.
+    let area = ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
+        - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0])) as f64;
+    let weight = |k: usize, x: i64, y: i64| {
+        let (a, b) = (v[(k + 1) % 3], v[(k + 2) % 3]);
+        ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) as f64 / area
+    };
+    let z_at = |x: i64, y: i64| (0..3).map(|k| weight(k, x, y) * z[k] as f64).sum::<f64>();
+    let (rx, ry) = (sx0 * SUB + SUB / 2, sy0 * SUB + SUB / 2);
+    let z_ref = z_at(rx, ry);
+    let dzdx = (z_at(rx + SUB, ry) - z_ref) as f32;
+    let dzdy = (z_at(rx, ry + SUB) - z_ref) as f32;
+    let z_ref = z_ref as f32;
+    let id = id as u64;
+    for sy in y_first..=sy1 {
+        let row = &mut rows[(sy as usize - y0) * width..][..width];
+        let mut e = e_row;
+        let zy = z_ref + dzdy * (sy - sy0) as f32;
+        for sx in x_first..=sx1 {
+            if (e[0] | e[1] | e[2]) >= 0 {
+                let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
+                let value = ((depth.to_bits() as u64) << 32) | id;
+                let slot = &mut row[sx as usize];
+                if value < *slot {
+                    *slot = value;
+                }
+            }
+            e[0] += step_x[0];
+            e[1] += step_x[1];
+            e[2] += step_x[2];
+        }
+        e_row[0] += step_y[0];
+        e_row[1] += step_y[1];
+        e_row[2] += step_y[2];
+    }
+}
+
+/// Marks the samples of visible edge segments (sample-space endpoints with
+/// depths): a line about `half_width` samples to each side, drawn where it is
+/// not behind the surface by more than `tolerance` of the depth range.
+/// A section cap hides every edge but the section's own outline (`on_plane`).
+pub fn mark_edges(
+    zbuf: &ZBuffer,
+    segments: &[([[f32; 3]; 2], bool)],
+    half_width: f32,
+    tolerance: f32,
+    is_cap: impl Fn(u64) -> bool,
+    mask: &mut [bool],
+) {
+    let (w, h) = (zbuf.width as i64, zbuf.height as i64);
+    for &([a, b], on_plane) in segments {
+        let len = (b[0] - a[0]).abs().max((b[1] - a[1]).abs());
+        let steps = (len * 2.0).ceil().max(1.0) as usize;
+        let r = half_width.ceil() as i64;
+        for i in 0..=steps {
+            let u = i as f32 / steps as f32;
+            let (x, y, z) = (
+                a[0] + u * (b[0] - a[0]),
+                a[1] + u * (b[1] - a[1]),
+                a[2] + u * (b[2] - a[2]),
+            );
+            let (cx, cy) = (x.floor() as i64, y.floor() as i64);
+            for sy in (cy - r).max(0)..=(cy + r).min(h - 1) {
+                for sx in (cx - r).max(0)..=(cx + r).min(w - 1) {
+                    let (dx, dy) = (sx as f32 + 0.5 - x, sy as f32 + 0.5 - y);
+                    if dx * dx + dy * dy > half_width * half_width {
+                        continue;
+                    }
+                    let index = (sy * w + sx) as usize;
+                    let value = zbuf.data[index];
+                    if value == EMPTY
+                        || (z <= depth_of(value) + tolerance && (on_plane || !is_cap(value)))
+                    {
+                        mask[index] = true;
+                    }
+                }
+            }
+        }
+    }
+}

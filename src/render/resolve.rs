@@ -1,0 +1,155 @@
+//! From samples to pixels: each visible sample is shaded with its group's
+//! colour times the interpolated light, once per distinct triangle in a pixel
+//! (as multisampling does, so anti-aliasing costs coverage tests, not shading),
+//! and the samples of a pixel are averaged with straight alpha.
+
+use super::raster::{EMPTY, Projected, ZBuffer};
+use super::scene::Scene;
+use rayon::prelude::*;
+
+pub const EDGE_COLOR: [u8; 4] = [25, 25, 30, 255];
+
+/// An RGBA picture, 8 bits per channel, straight (not premultiplied) alpha.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Image {
+    pub width: u32,
+    pub height: u32,
+    pub rgba: Vec<u8>,
+}
+
+impl Image {
+    pub fn pixel(&self, x: u32, y: u32) -> [u8; 4] {
+        let i = 4 * (y as usize * self.width as usize + x as usize);
+        [
+            self.rgba[i],
+            self.rgba[i + 1],
+            self.rgba[i + 2],
+            self.rgba[i + 3],
+        ]
+    }
+
+    /// Blends `color` over the pixel with coverage `alpha` in [0, 1].
+    pub fn blend(&mut self, x: i64, y: i64, color: [u8; 3], alpha: f32) {
+        if x < 0 || y < 0 || x >= self.width as i64 || y >= self.height as i64 {
+            return;
+        }
+        let i = 4 * (y as usize * self.width as usize + x as usize);
+        let dst_a = self.rgba[i + 3] as f32 / 255.0;
+        let out_a = alpha + dst_a * (1.0 - alpha);
+        if out_a <= 0.0 {
+            return;
+        }
+        for (c, &src) in color.iter().enumerate() {
+            let v = (src as f32 * alpha + self.rgba[i + c] as f32 * dst_a * (1.0 - alpha)) / out_a;
+            self.rgba[i + c] = v.round().clamp(0.0, 255.0) as u8;
+        }
+        self.rgba[i + 3] = (out_a * 255.0).round() as u8;
+    }
+}
+
+fn shade(
+    scene: &Scene,
+    proj: &Projected,
+    id: u64,
+    sx: usize,
+    sy: usize,
+    px: usize,
+    py: usize,
+) -> [u8; 3] {
+    let tri = (id >> 1) as usize;
+    let back = (id & 1) as usize;
+    let group = &scene.groups[scene.face_sides[scene.tri_face[tri] as usize][back] as usize];
+    let light = if group.cap {
+        // Section caps are flat and hatched, as drawings show cut material.
+        if (px + py) % 8 < 2 { 0.6 } else { 0.95 }
+    } else {
+        let s = scene.corner_slots[tri];
+        if s[0] == s[1] && s[1] == s[2] {
+            scene.light[s[0] as usize][back]
+        } else {
+            let t = scene.tris[tri];
+            let (a, b, c) = (
+                proj.xy_f[t[0] as usize],
+                proj.xy_f[t[1] as usize],
+                proj.xy_f[t[2] as usize],
+            );
+            let (x, y) = (sx as f32 + 0.5, sy as f32 + 0.5);
+            let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+            let w1 = ((c[0] - a[0]) * (y - a[1]) - (c[1] - a[1]) * (x - a[0])) / -area;
+            let w2 = ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) / area;
+            let (w1, w2) = (w1.clamp(0.0, 1.0), w2.clamp(0.0, 1.0));
+            let w0 = (1.0 - w1 - w2).max(0.0);
+            let l = |k: usize| scene.light[s[k] as usize][back];
+            w0 * l(0) + w1 * l(1) + w2 * l(2)
+        }
+    };
+    group
+        .color
+        .map(|c| (c as f32 * light).round().clamp(0.0, 255.0) as u8)
+}
+
+/// Averages `ss`×`ss` samples per pixel over `background`.
+pub fn resolve(
+    scene: &Scene,
+    proj: &Projected,
+    zbuf: &ZBuffer,
+    edges: &[bool],
+    ss: usize,
+    background: [u8; 4],
+) -> Image {
+    let width = zbuf.width / ss;
+    let height = zbuf.height / ss;
+    let mut rgba = vec![0u8; width * height * 4];
+    rgba.par_chunks_mut(width * 4)
+        .enumerate()
+        .for_each(|(py, row)| {
+            for px in 0..width {
+                let mut sum = [0u32; 4];
+                let mut last: Option<(u64, [u8; 3])> = None;
+                for sy in py * ss..(py + 1) * ss {
+                    for sx in px * ss..(px + 1) * ss {
+                        let index = sy * zbuf.width + sx;
+                        let (color, alpha) = if edges.get(index).copied().unwrap_or(false) {
+                            ([EDGE_COLOR[0], EDGE_COLOR[1], EDGE_COLOR[2]], 255)
+                        } else {
+                            let value = zbuf.data[index];
+                            if value == EMPTY {
+                                (
+                                    [background[0], background[1], background[2]],
+                                    background[3] as u32,
+                                )
+                            } else {
+                                let id = value & 0xffff_ffff;
+                                let color = match last {
+                                    Some((l, c)) if l == id => c,
+                                    _ => {
+                                        let c = shade(scene, proj, id, sx, sy, px, py);
+                                        last = Some((id, c));
+                                        c
+                                    }
+                                };
+                                (color, 255)
+                            }
+                        };
+                        for c in 0..3 {
+                            sum[c] += color[c] as u32 * alpha;
+                        }
+                        sum[3] += alpha;
+                    }
+                }
+                let n = (ss * ss) as u32;
+                let out = &mut row[px * 4..px * 4 + 4];
+                for c in 0..3 {
+                    if let Some(v) = (sum[c] + sum[3] / 2).checked_div(sum[3]) {
+                        out[c] = v as u8;
+                    }
+                }
+                out[3] = ((sum[3] + n / 2) / n) as u8;
+            }
+        });
+    Image {
+        width: width as u32,
+        height: height as u32,
+        rgba,
+    }
+}
