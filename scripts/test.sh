@@ -40,6 +40,15 @@ if ! python3 -c "import trimesh" >/dev/null 2>&1; then
         || python3 -m pip install -q --break-system-packages trimesh==5.2.0
 fi
 
+# tests/tools/fem_poisson.py (tests/fem_2d.rs) and benches/mesh2d.rs' peer
+# (benches/mesh2d_triangle.py): scikit-fem solves on geomc's meshes, Triangle
+# is the 2D meshing peer.
+if ! python3 -c "import skfem, triangle" >/dev/null 2>&1; then
+    echo "installing: scikit-fem triangle (pip)" >&2
+    python3 -m pip install -q scikit-fem==10.0.2 triangle==20250106 \
+        || python3 -m pip install -q --break-system-packages scikit-fem==10.0.2 triangle==20250106
+fi
+
 # tests/tools/validate_gltf.js: the validator pinned by tests/tools/package-lock.json.
 if [ ! -f tests/tools/node_modules/gltf-validator/package.json ]; then
     echo "installing: gltf-validator (npm, tests/tools/node_modules)" >&2

@@ -56,6 +56,8 @@ pub struct Args {
     quiet: bool,
     #[command(flatten)]
     input: InputOptions,
+    #[command(flatten)]
+    solver_mesh: super::solver_args::SolverMeshArgs,
     /// Grid cells per axis for implicit (.rfs) inputs, overriding Geom.nx/ny/nz.
     #[arg(long, value_name = "N")]
     cells: Option<usize>,
@@ -167,7 +169,10 @@ pub fn run(args: &Args) -> i32 {
 }
 
 fn mesh_options(args: &Args) -> Result<MeshOptions, geomc::diag::Diagnostic> {
-    super::mesh_args::parse_mesh_options(&args.tolerance, args.max_edge, args.min_angle)
+    let mut options =
+        super::mesh_args::parse_mesh_options(&args.tolerance, args.max_edge, args.min_angle)?;
+    args.solver_mesh.apply(&mut options)?;
+    Ok(options)
 }
 
 /// The output files of each input: the -o files for one input, or

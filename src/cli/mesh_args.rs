@@ -1,10 +1,12 @@
 //! The meshing options shared by `geomc compile` and `geomc inspect --mesh`,
 //! checked into [`MeshOptions`] or an E501 diagnostic naming the bad value.
 
+use super::solver_args::SolverMeshArgs;
 use geomc::diag::{Code, Diagnostic};
 use geomc::meshing::{MeshOptions, Tolerance};
 
-/// The options as `inspect` takes them (compile declares the same three).
+/// The options as `inspect` takes them (compile declares the same three and
+/// flattens the same [`SolverMeshArgs`]).
 #[derive(clap::Args, Clone, Debug)]
 pub struct MeshArgs {
     /// Chordal tolerance: a length (0.01), or a percentage of the model's
@@ -27,11 +29,15 @@ pub struct MeshArgs {
         allow_hyphen_values = true
     )]
     pub min_angle: f64,
+    #[command(flatten)]
+    pub solver: SolverMeshArgs,
 }
 
 impl MeshArgs {
     pub fn to_options(&self) -> Result<MeshOptions, Diagnostic> {
-        parse_mesh_options(&self.tolerance, self.max_edge, self.min_angle)
+        let mut options = parse_mesh_options(&self.tolerance, self.max_edge, self.min_angle)?;
+        self.solver.apply(&mut options)?;
+        Ok(options)
     }
 }
 
@@ -80,6 +86,7 @@ pub fn parse_mesh_options(
         tolerance,
         max_edge,
         min_angle_degrees: min_angle,
+        ..MeshOptions::default()
     })
 }
 

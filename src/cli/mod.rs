@@ -9,6 +9,7 @@ mod inspect_mesh;
 mod mesh_args;
 mod render;
 mod rfs;
+mod solver_args;
 mod validate;
 
 use clap::{Parser, Subcommand};

@@ -271,6 +271,13 @@ codes! {
         "An edge whose line is a patch9 runs along one side of the patch, so its vertices must be two corners of the patch joined by a side: the ends of the first or last row, or of the first or last column. Use two adjacent corners; an edge across the patch needs a curve of its own.";
     UnusedPatch = "W180", Warning, "patch9 is not the surface of any face",
         "A patch9 is a surface: it is meshed as the carrier of the faces that name it with surface=\"…\" and bounded by edges along its sides. No face names this patch, so it produces no output. Add a face on it, or remove it.";
+
+    // ---- 2D domains (issue 6) ----
+    PolygonEdgesCross = "E660", Error, "polygon edges cross",
+        "A <polygon> must be simple: its edges may meet only where consecutive edges share a vertex. Two of its edges cross, touch, or fold back along one line. Reorder or move the vertices so that the boundary does not meet itself.";
+    AreaIn3d = "W150", Warning, "area limit ignored in a 3D model",
+        "The area= attribute of a <subdomain> limits triangle areas in 2D meshes only; in a 3D model it is ignored. Remove it, or use compile --max-edge to limit the size of surface triangles.";
+
     // ---- render (issue 8) ----
     RenderUnsupportedInput = "E720", Error, "input cannot be rendered",
         "geomc render draws a domain file (.xml), which it compiles on the fly, or a mesh file geomc can read. The input's extension names neither. Compile the model to a mesh format geomc reads first, or give the domain XML itself.";

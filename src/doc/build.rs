@@ -81,6 +81,7 @@ impl Builder<'_> {
                         material: e.attribute("material").map(|a| a.value.to_string()),
                         faces: self.ref_list(e, "faces"),
                         tree: e.children.first().and_then(|c| self.solid_tree(c)),
+                        area: self.number(e, "area"),
                         span: e.name_span,
                     });
                 }
@@ -129,6 +130,18 @@ impl Builder<'_> {
             "parallelogram" => ObjectKind::Parallelogram {
                 base: self.point_child(e, "base_point"),
                 vertices: self.points_named(e, "vertex"),
+            },
+            "polygon" => ObjectKind::Polygon {
+                vertices: self.points_named(e, "vertex"),
+            },
+            "rectangle" => ObjectKind::Rectangle {
+                first: self.point_child(e, "first_point"),
+                second: self.point_child(e, "second_point"),
+            },
+            "regular_polygon" => ObjectKind::RegularPolygon {
+                center: self.point_child(e, "center"),
+                radius: self.value_child(e, "radius"),
+                sides: self.number(e, "sides"),
             },
             "poly_line" => ObjectKind::PolyLine {
                 segments: e

@@ -275,6 +275,24 @@ pub static PARALLELOGRAM: Rule = Rule {
     any_attrs: false,
     content: Content::Sequence(&[one(&BASE_POINT), exactly(&VERTEX_POINT, 2)]),
 };
+pub static POLYGON: Rule = Rule {
+    name: "polygon",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[many(&VERTEX_POINT, 3)]),
+};
+pub static RECTANGLE: Rule = Rule {
+    name: "rectangle",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[one(&FIRST_POINT), one(&SECOND_POINT)]),
+};
+pub static REGULAR_POLYGON: Rule = Rule {
+    name: "regular_polygon",
+    attrs: &[req("name", Name), opt("cs", Ref), req("sides", Expr)],
+    any_attrs: false,
+    content: Content::All(&[one(&CENTER), one(&RADIUS)]),
+};
 pub static POLY_LINE_SEGMENT: Rule = Rule {
     name: "line",
     attrs: &[],
@@ -599,6 +617,7 @@ pub static SUBDOMAIN: Rule = Rule {
         req("name", Name),
         opt("faces", RefList),
         opt("material", Text),
+        opt("area", Expr),
     ],
     any_attrs: false,
     content: Content::Choice {
@@ -636,6 +655,9 @@ pub static GEOMETRY: Rule = Rule {
             &CIRCLE,
             &TRIANGLE,
             &PARALLELOGRAM,
+            &POLYGON,
+            &RECTANGLE,
+            &REGULAR_POLYGON,
             &POLY_LINE,
             &TRUNCATED_CONE,
             &PARALLELEPIPED,

@@ -223,6 +223,20 @@ pub enum ObjectKind {
         base: Option<PointSpec>,
         vertices: Vec<PointSpec>,
     },
+    /// A simple polygon, vertices in document order (either orientation).
+    Polygon {
+        vertices: Vec<PointSpec>,
+    },
+    /// An axis-aligned rectangle (in its coordinate system) by opposite corners.
+    Rectangle {
+        first: Option<PointSpec>,
+        second: Option<PointSpec>,
+    },
+    RegularPolygon {
+        center: Option<PointSpec>,
+        radius: Option<Number>,
+        sides: Option<Number>,
+    },
     PolyLine {
         segments: Vec<(Option<PointSpec>, Option<PointSpec>)>,
     },
@@ -296,6 +310,9 @@ impl ObjectKind {
             ObjectKind::Circle { .. } => "circle",
             ObjectKind::Triangle { .. } => "triangle",
             ObjectKind::Parallelogram { .. } => "parallelogram",
+            ObjectKind::Polygon { .. } => "polygon",
+            ObjectKind::Rectangle { .. } => "rectangle",
+            ObjectKind::RegularPolygon { .. } => "regular_polygon",
             ObjectKind::PolyLine { .. } => "poly_line",
             ObjectKind::TruncatedCone { .. } => "truncated_cone",
             ObjectKind::Parallelepiped(_) => "parallelepiped",
@@ -344,6 +361,8 @@ pub struct SubdomainDef {
     pub material: Option<String>,
     pub faces: Option<(Vec<Ref>, Span)>,
     pub tree: Option<SolidTree>,
+    /// 2D: the largest triangle area allowed in its mesh.
+    pub area: Option<Number>,
     pub span: Span,
 }
 

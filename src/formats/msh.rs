@@ -7,7 +7,8 @@
 //! (dim 2 in 3D, 1 in 2D), every subdomain (dim 3 in 3D; in 2D its region
 //! faces, dim 2), faces in neither kind of group (dim 2, by face name),
 //! poly_lines (dim 1, as extra curves) and point sets (dim 0, one extra point
-//! entity per point). Elements (15 point, 1 line, 2 triangle) are written per
+//! entity per point). Elements (15 point, 1 line, 2 triangle; second order: 8
+//! 3-node line, 9 6-node triangle) are written per
 //! entity, only for entities in a physical group — what Gmsh itself saves by
 //! default, and what meshio needs to attach groups to every element block.
 
@@ -132,6 +133,9 @@ impl Model {
                     .iter()
                     .map(|s| s.to_vec())
                     .collect();
+                if let Some(q) = &mesh.quadratic {
+                    add_mid_nodes(&mut e, q.edges.get(i).map(|m| m.as_slice()));
+                }
                 e
             })
             .collect();
@@ -148,6 +152,17 @@ impl Model {
                     .collect();
                 e.used = face.triangles.iter().flatten().copied().collect();
                 e.elements = face.triangles.iter().map(|t| t.to_vec()).collect();
+                if let Some(q) = &mesh.quadratic {
+                    let mids: Vec<u32> = q
+                        .faces
+                        .get(i)
+                        .into_iter()
+                        .flatten()
+                        .flatten()
+                        .copied()
+                        .collect();
+                    add_mid_nodes_grouped(&mut e, &mids, 3);
+                }
                 e
             })
             .collect();
@@ -211,7 +226,7 @@ impl Model {
                 surfaces[i].physicals.push(tag);
             }
         }
-        for p in &mesh.polylines {
+        for (line_index, p) in mesh.polylines.iter().enumerate() {
             let tag = names.add(1, &p.name);
             let mut e = Entity::new(curves.len() + 1);
             e.physicals.push(tag);
@@ -222,6 +237,9 @@ impl Model {
                 .iter()
                 .map(|s| s.to_vec())
                 .collect();
+            if let Some(q) = &mesh.quadratic {
+                add_mid_nodes(&mut e, q.polylines.get(line_index).map(|m| m.as_slice()));
+            }
             curves.push(e);
         }
         for p in &mesh.point_sets {
@@ -266,6 +284,24 @@ impl Model {
             unused_nodes,
         }
     }
+}
+
+/// Appends each segment's mid node (3-node lines); segments without one
+/// stay linear.
+fn add_mid_nodes(e: &mut Entity, mids: Option<&[u32]>) {
+    add_mid_nodes_grouped(e, mids.unwrap_or(&[]), 1);
+}
+
+/// Appends `per` mid nodes to each element (6-node triangles: 3), when
+/// there is exactly one group per element.
+fn add_mid_nodes_grouped(e: &mut Entity, mids: &[u32], per: usize) {
+    if mids.len() != e.elements.len() * per || mids.is_empty() {
+        return;
+    }
+    for (element, extra) in e.elements.iter_mut().zip(mids.chunks_exact(per)) {
+        element.extend_from_slice(extra);
+    }
+    e.used.extend_from_slice(mids);
 }
 
 /// Physical tags numbered per dimension from 1, with their names.
@@ -530,9 +566,13 @@ fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
     s.end_line()?;
     let mut tag = 0usize;
     for (dim, e) in blocks {
-        let kind = match dim {
-            0 => 15,
-            1 => 1,
+        // Gmsh element types: 15 point, 1 line, 8 3-node line, 2 triangle,
+        // 9 6-node triangle.
+        let kind = match (dim, e.elements.first().map_or(0, Vec::len)) {
+            (0, _) => 15,
+            (1, 3) => 8,
+            (1, _) => 1,
+            (_, 6) => 9,
             _ => 2,
         };
         s.int(dim as i32)?;

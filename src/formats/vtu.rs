@@ -104,29 +104,39 @@ fn cells(mesh: &Mesh) -> Vec<Cell> {
         } else {
             (-1, face_region[f].map_or(-1, id), -1)
         };
-        for t in &face.triangles {
+        let mids = mesh.quadratic.as_ref().and_then(|q| q.faces.get(f));
+        for (k, t) in face.triangles.iter().enumerate() {
+            // VTK 22, the quadratic triangle: corners, then the mids of 0–1, 1–2, 2–0.
+            let (kind, nodes) = match mids.and_then(|m| m.get(k)) {
+                Some(m) => (22, [&t[..], &m[..]].concat()),
+                None => (5, t.to_vec()),
+            };
             cells.push(Cell {
-                kind: 5,
-                nodes: t.to_vec(),
+                kind,
+                nodes,
                 data: [fragment, subdomain, other, id(f), -1, -1, -1],
             });
         }
     }
     for (e, edge) in mesh.edges.iter().enumerate() {
         let (fragment, subdomain, other) = pair(edge_fragment[e]);
-        for s in groups::segments(&edge.nodes) {
+        let mids = mesh.quadratic.as_ref().and_then(|q| q.edges.get(e));
+        for (k, s) in groups::segments(&edge.nodes).iter().enumerate() {
+            let (kind, nodes) = line_cell(s, mids.and_then(|m| m.get(k)));
             cells.push(Cell {
-                kind: 3,
-                nodes: s.to_vec(),
+                kind,
+                nodes,
                 data: [fragment, subdomain, other, -1, id(e), -1, -1],
             });
         }
     }
     for (i, p) in mesh.polylines.iter().enumerate() {
-        for s in groups::segments(&p.nodes) {
+        let mids = mesh.quadratic.as_ref().and_then(|q| q.polylines.get(i));
+        for (k, s) in groups::segments(&p.nodes).iter().enumerate() {
+            let (kind, nodes) = line_cell(s, mids.and_then(|m| m.get(k)));
             cells.push(Cell {
-                kind: 3,
-                nodes: s.to_vec(),
+                kind,
+                nodes,
                 data: [-1, -1, -1, -1, -1, id(i), -1],
             });
         }
@@ -141,6 +151,14 @@ fn cells(mesh: &Mesh) -> Vec<Cell> {
         }
     }
     cells
+}
+
+/// A segment as VTK line (3) or, with a mid node, quadratic edge (21).
+fn line_cell(segment: &[u32; 2], mid: Option<&u32>) -> (u8, Vec<u32>) {
+    match mid {
+        Some(&m) => (21, vec![segment[0], segment[1], m]),
+        None => (3, segment.to_vec()),
+    }
 }
 
 /// One data array, already in the chosen encoding.

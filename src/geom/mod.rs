@@ -12,6 +12,7 @@ mod frame;
 mod intersect;
 mod newton;
 pub mod point_calculus;
+pub mod polygon;
 mod sampling;
 mod shape_eval;
 mod solid;

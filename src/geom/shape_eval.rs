@@ -84,6 +84,14 @@ pub(super) enum ShapeEval {
         plane: InPlane,
         edges: Vec<(Vector2<f64>, Vector2<f64>)>,
     },
+    /// A non-convex simple polygon: even–odd inside test in local
+    /// coordinates, distance to the nearest edge in global coordinates.
+    Nonconvex {
+        plane: InPlane,
+        local: Vec<Vector2<f64>>,
+        global: Vec<Point3>,
+        linear: Mat3,
+    },
     /// A degenerate shape with no interior: everything is outside.
     Empty,
 }
@@ -165,6 +173,19 @@ impl ShapeEval {
             },
             SolidShape::Polygon { frame, vertices } => {
                 let plane = InPlane::new(frame.origin, &frame.linear)?;
+                if !super::polygon::is_convex(vertices) {
+                    let local = vertices.iter().map(|v| Vector2::new(v.x, v.y)).collect();
+                    let global = vertices
+                        .iter()
+                        .map(|v| frame.to_global(&Point3::new(v.x, v.y, 0.0)))
+                        .collect();
+                    return Some(ShapeEval::Nonconvex {
+                        plane,
+                        local,
+                        global,
+                        linear: frame.linear,
+                    });
+                }
                 let edges = polygon_edges(&plane, vertices);
                 if edges.len() < 3 {
                     return None;
@@ -248,6 +269,27 @@ impl ShapeEval {
                     .iter()
                     .map(|(v, n)| n.dot(&(q - v)))
                     .fold(f64::INFINITY, f64::min)
+            }
+            ShapeEval::Nonconvex {
+                plane,
+                local,
+                global,
+                linear,
+            } => {
+                let q = plane.local(p);
+                // The foot of p in the polygon's plane, in global coordinates.
+                let foot = plane.origin + linear.fixed_columns::<2>(0) * q;
+                let n = global.len();
+                let distance = (0..n)
+                    .map(|i| {
+                        super::polygon::segment_distance(&foot, &global[i], &global[(i + 1) % n])
+                    })
+                    .fold(f64::INFINITY, f64::min);
+                if super::polygon::contains(local, [q.x, q.y]) {
+                    distance
+                } else {
+                    -distance
+                }
             }
             ShapeEval::Empty => f64::NEG_INFINITY,
         }

@@ -25,8 +25,9 @@ pub enum SolidShape {
     },
     /// 2D: the unit disk x² + y² ≤ 1, z = 0 of `frame` (circle, ellipse).
     Disk { frame: Frame },
-    /// 2D: a convex polygon in the z = 0 plane of `frame`, vertices
-    /// counter-clockwise (triangle, parallelogram), local coordinates.
+    /// 2D: a simple polygon in the z = 0 plane of `frame`, local coordinates
+    /// (triangle and parallelogram: convex and counter-clockwise; polygon,
+    /// rectangle, regular polygon: as given, either orientation).
     Polygon { frame: Frame, vertices: Vec<Point3> },
 }
 
@@ -123,6 +124,9 @@ impl SolidShape {
             SolidShape::Cone { frame, .. } => frame.to_global(&Point3::new(0.0, 0.0, 0.5)),
             SolidShape::Torus { frame, major, .. } => {
                 frame.to_global(&Point3::new(*major, 0.0, 0.0))
+            }
+            SolidShape::Polygon { frame, vertices } if !super::polygon::is_convex(vertices) => {
+                frame.to_global(&super::polygon::interior_point(vertices))
             }
             SolidShape::Polygon { frame, vertices } => {
                 // The vertex centroid of a convex polygon is inside it.

@@ -90,7 +90,13 @@ pub enum SubdomainCells {
     Region { faces: Vec<FaceId> },
 }
 
-#[derive(Debug, Clone, PartialEq)]
+impl Default for SubdomainCells {
+    fn default() -> SubdomainCells {
+        SubdomainCells::Region { faces: Vec::new() }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq, Default)]
 pub struct Subdomain {
     pub name: String,
     pub material: Option<String>,
@@ -98,6 +104,8 @@ pub struct Subdomain {
     /// The leaf solids of its boolean tree, when it was built from solids
     /// (used to classify points); empty for explicit face lists.
     pub solids: Vec<SolidId>,
+    /// 2D: the largest triangle area its mesh may have (`area=`).
+    pub max_area: Option<f64>,
 }
 
 /// A lowered primitive solid: its shape and the entities of its canonical

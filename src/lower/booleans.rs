@@ -56,7 +56,7 @@ pub(super) fn lower_subdomains(
     diags: &mut Diagnostics,
 ) {
     let mut trees: Vec<(SubdomainId, Built)> = Vec::new();
-    for def in &doc.subdomains {
+    for (def_index, def) in doc.subdomains.iter().enumerate() {
         let id = SubdomainId(model.subdomains.len() as u32);
         let cells = match (&def.faces, &def.tree) {
             (Some(_), Some(_)) => {
@@ -112,6 +112,7 @@ pub(super) fn lower_subdomains(
             material: def.material.clone(),
             cells,
             solids: Vec::new(),
+            max_area: resolved.subdomain_areas.get(def_index).copied().flatten(),
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
     }

@@ -6,12 +6,12 @@ use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
 use std::f64::consts::TAU;
 
 pub struct BrepVertex {
-    pub name: &'static str,
+    pub name: std::borrow::Cow<'static, str>,
     pub position: Point3,
 }
 
 pub struct BrepEdge {
-    pub name: &'static str,
+    pub name: std::borrow::Cow<'static, str>,
     pub curve: Curve,
     pub begin: usize,
     pub end: usize,
@@ -84,7 +84,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
     let corner = |i: usize, j: usize, k: usize| i + 2 * j + 4 * k;
     let vertices = (0..8)
         .map(|n| BrepVertex {
-            name: VERTEX_NAMES[n],
+            name: VERTEX_NAMES[n].into(),
             position: frame.to_global(&Point3::new(
                 (n & 1) as f64,
                 ((n >> 1) & 1) as f64,
@@ -107,7 +107,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
                 at[axis] = 1;
                 let end = corner(at[0], at[1], at[2]);
                 edges.push(BrepEdge {
-                    name,
+                    name: name.into(),
                     curve: Curve::Segment {
                         a: vertices[begin].position,
                         b: vertices[end].position,
@@ -176,11 +176,11 @@ fn ball(frame: &Frame) -> Brep {
     let surface = Surface::Ellipsoid { frame: *frame };
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam",
+            name: "seam".into(),
             position: seam,
         }],
         edges: vec![BrepEdge {
-            name: "equator",
+            name: "equator".into(),
             curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
             begin: 0,
             end: 0,
@@ -219,12 +219,12 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
         }
         let v = vertices.len();
         vertices.push(BrepVertex {
-            name: vertex,
+            name: vertex.into(),
             position: frame.to_global(&Point3::new(r, 0.0, z)),
         });
         let e = edges.len();
         edges.push(BrepEdge {
-            name: rim,
+            name: rim.into(),
             curve: ellipse(frame, Vec3::new(0.0, 0.0, z), Vec3::x() * r, Vec3::y() * r),
             begin: v,
             end: v,
@@ -274,18 +274,18 @@ fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
     }
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam",
+            name: "seam".into(),
             position: frame.to_global(&Point3::new(outer, 0.0, 0.0)),
         }],
         edges: vec![
             BrepEdge {
-                name: "parallel",
+                name: "parallel".into(),
                 curve: ellipse(frame, Vec3::zeros(), Vec3::x() * outer, Vec3::y() * outer),
                 begin: 0,
                 end: 0,
             },
             BrepEdge {
-                name: "meridian",
+                name: "meridian".into(),
                 curve: ellipse(
                     frame,
                     Vec3::new(major, 0.0, 0.0),
@@ -323,11 +323,11 @@ fn disk(frame: &Frame) -> Brep {
     let center = frame.origin;
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam",
+            name: "seam".into(),
             position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)),
         }],
         edges: vec![BrepEdge {
-            name: "rim",
+            name: "rim".into(),
             curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
             begin: 0,
             end: 0,
@@ -345,14 +345,14 @@ fn disk(frame: &Frame) -> Brep {
     }
 }
 
-const POLYGON_VERTICES: [&str; 4] = ["v1", "v2", "v3", "v4"];
-const POLYGON_EDGES: [&str; 4] = ["e1", "e2", "e3", "e4"];
-
+/// A polygon's boundary: vertices v1…vn in the given order, edge ei from vi
+/// to the next vertex, the loop counter-clockwise in local coordinates
+/// (a clockwise vertex list is walked backwards).
 fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
-    let n = local.len().min(POLYGON_VERTICES.len());
+    let n = local.len();
     let vertices: Vec<BrepVertex> = (0..n)
         .map(|i| BrepVertex {
-            name: POLYGON_VERTICES[i],
+            name: format!("v{}", i + 1).into(),
             position: frame.to_global(&local[i]),
         })
         .collect();
@@ -360,7 +360,7 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
         .map(|i| {
             let j = (i + 1) % n;
             BrepEdge {
-                name: POLYGON_EDGES[i],
+                name: format!("e{}", i + 1).into(),
                 curve: Curve::Segment {
                     a: vertices[i].position,
                     b: vertices[j].position,
@@ -370,20 +370,33 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
             }
         })
         .collect();
-    let centroid =
-        Point3::from(vertices.iter().map(|v| v.position.coords).sum::<Vec3>() / n.max(1) as f64);
-    let ring: Vec<(usize, bool)> = (0..n).map(|i| (i, true)).collect();
+    let twice_area: f64 = (0..n)
+        .map(|i| {
+            let (v, w) = (local[i], local[(i + 1) % n]);
+            v.x * w.y - w.x * v.y
+        })
+        .sum();
+    let ring: Vec<(usize, bool)> = if twice_area >= 0.0 {
+        (0..n).map(|i| (i, true)).collect()
+    } else {
+        (0..n).rev().map(|i| (i, false)).collect()
+    };
+    let shape = SolidShape::Polygon {
+        frame: *frame,
+        vertices: local.to_vec(),
+    };
+    let sample = shape.interior_point();
     Brep {
         vertices,
         edges,
         faces: vec![BrepFace {
             name: "region",
             surface: Surface::Plane {
-                origin: centroid,
+                origin: sample,
                 normal: region_normal(frame),
             },
             loops: vec![ring.clone()],
-            sample: centroid,
+            sample,
         }],
         boundary: ring,
     }

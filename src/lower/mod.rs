@@ -48,10 +48,10 @@ impl Entities {
     /// ("box.xmin" → its welded face). Explicit entities keep their names: an
     /// explicit entity of the same name wins, and among solids the first does.
     fn add_solid_entities(&mut self, model: &Model) {
-        fn add<T: Copy>(
+        fn add<'n, T: Copy>(
             table: &mut HashMap<String, T>,
             solid: &str,
-            names: impl Iterator<Item = &'static str>,
+            names: impl Iterator<Item = &'n str>,
             ids: impl Iterator<Item = T>,
         ) {
             for (local, id) in names.zip(ids) {
@@ -69,13 +69,13 @@ impl Entities {
             add(
                 &mut self.vertices,
                 name,
-                brep.vertices.iter().map(|v| v.name),
+                brep.vertices.iter().map(|v| v.name.as_ref()),
                 solid.vertices.iter().copied(),
             );
             add(
                 &mut self.edges,
                 name,
-                brep.edges.iter().map(|e| e.name),
+                brep.edges.iter().map(|e| e.name.as_ref()),
                 solid.edges.iter().copied(),
             );
             add(

@@ -72,4 +72,21 @@ pub struct Mesh {
     pub fragments: Vec<MeshFragment>,
     pub point_sets: Vec<MeshPolyline>,
     pub polylines: Vec<MeshPolyline>,
+    /// Mid-edge nodes of second-order meshes (`None`: linear elements).
+    pub quadratic: Option<QuadraticNodes>,
+}
+
+/// The extra nodes of 6-node triangles and 3-node lines: one per element
+/// edge, shared by the elements meeting there; on a model edge it lies on
+/// the curve (at the middle parameter), elsewhere at the chord's middle.
+#[derive(Debug, Clone, PartialEq, Default)]
+pub struct QuadraticNodes {
+    /// Per mesh edge, per segment (nodes[i] to nodes[i + 1]): its mid node.
+    pub edges: Vec<Vec<u32>>,
+    /// Per mesh face, per triangle: the mid nodes of its sides (0–1, 1–2,
+    /// 2–0), the node order of Gmsh's 6-node triangle and VTK's
+    /// quadratic triangle.
+    pub faces: Vec<Vec<[u32; 3]>>,
+    /// Per poly_line, per segment: its mid node.
+    pub polylines: Vec<Vec<u32>>,
 }

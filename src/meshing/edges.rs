@@ -114,6 +114,42 @@ fn finish(mut points: Vec<Point3>, n: usize, begin: Point3, end: Point3) -> Edge
 }
 
 impl EdgeNodes {
+    /// Splits chords longer than the size field at their curve midpoint (in
+    /// parameter) until none is; the new points lie on the curve.
+    pub(crate) fn refine_to_size(&mut self, curve: &Curve, sizing: &super::size::Sizing) {
+        if sizing.is_uniform() {
+            return;
+        }
+        loop {
+            let mut params = Vec::with_capacity(self.params.len());
+            let mut points = Vec::with_capacity(self.points.len());
+            let mut split = false;
+            for i in 0..self.params.len() {
+                params.push(self.params[i]);
+                points.push(self.points[i]);
+                if i + 1 == self.params.len() {
+                    break;
+                }
+                let (a, b) = (&self.points[i], &self.points[i + 1]);
+                let s = 0.5 * (self.params[i] + self.params[i + 1]);
+                let m = curve.point(s);
+                if (b - a).norm() > sizing.at(&m)
+                    && self.params.len() + params.len() < MAX_SEGMENTS
+                    && m.coords.iter().all(|x| x.is_finite())
+                {
+                    params.push(s);
+                    points.push(m);
+                    split = true;
+                }
+            }
+            self.params = params;
+            self.points = points;
+            if !split {
+                return;
+            }
+        }
+    }
+
     /// Adds the curve point at parameter `s` (a split requested by a face's
     /// refinement); false when it is already there.
     pub(crate) fn insert(&mut self, curve: &Curve, s: f64) -> bool {

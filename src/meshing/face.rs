@@ -24,6 +24,7 @@
 use super::MeshError;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
+use super::size::Sizing;
 use crate::geom::{Point3, Surface, Vec3};
 use crate::ir::{Face, Model};
 use spade::{
@@ -56,6 +57,9 @@ pub(crate) enum FacePoint {
 pub(crate) struct FaceMesh {
     pub points: Vec<FacePoint>,
     pub triangles: Vec<[usize; 3]>,
+    /// Constrained poly_lines: (poly_line index, its points in order, as
+    /// indices into `points`, refinement points included).
+    pub polylines: Vec<(usize, Vec<usize>)>,
 }
 
 pub(crate) enum Outcome {
@@ -64,12 +68,14 @@ pub(crate) enum Outcome {
     Split(Vec<(usize, f64)>),
 }
 
-#[derive(Debug, Clone, Copy)]
-pub(crate) struct Settings {
+#[derive(Clone, Copy)]
+pub(crate) struct Settings<'a> {
     pub tolerance: f64,
-    pub max_edge: f64,
+    pub sizing: &'a Sizing,
     pub min_angle: f64,
     pub keep_boundary: bool,
+    /// Largest triangle area (2D subdomains' `area=` and `--max-area`).
+    pub max_area: f64,
 }
 
 /// One point of a loop: its node, position, and the segment to the next point.
@@ -90,6 +96,7 @@ pub(crate) fn mesh_face(
     face: &Face,
     edges: &[EdgeNodes],
     settings: &Settings,
+    constraints: &[(usize, Vec<Point3>)],
 ) -> Result<Outcome, MeshError> {
     let failed = |reason: String| MeshError::Face {
         face: face.name.clone(),
@@ -149,14 +156,62 @@ pub(crate) fn mesh_face(
             positions.push(p);
         }
     }
+    // Poly_lines inside the face: constraint chains the mesh must follow.
+    let mut polyline_handles: Vec<(usize, Vec<usize>)> = Vec::new();
+    for (index, points) in constraints {
+        let mut handles = Vec::with_capacity(points.len());
+        for p in points {
+            let uv = chart
+                .to_param(p)
+                .ok_or_else(|| failed("a poly_line point has no parameters".into()))?;
+            let handle = cdt
+                .insert(point2(uv))
+                .map_err(|e| failed(format!("a poly_line point cannot be triangulated: {e:?}")))?;
+            if handle.index() == keys.len() {
+                keys.push(FacePoint::Interior(*p));
+                positions.push(*p);
+            } else if handles.last() != Some(&handle.index()) {
+                return Err(failed(format!(
+                    "a point of poly_line #{} coincides with another node",
+                    index + 1
+                )));
+            }
+            if handles.last() != Some(&handle.index()) {
+                handles.push(handle.index());
+            }
+        }
+        for w in handles.windows(2) {
+            let (a, b) = (
+                spade::handles::FixedVertexHandle::from_index(w[0]),
+                spade::handles::FixedVertexHandle::from_index(w[1]),
+            );
+            if !cdt.can_add_constraint(a, b) {
+                return Err(failed(format!(
+                    "poly_line #{} crosses its boundary or another poly_line",
+                    index + 1
+                )));
+            }
+            cdt.add_constraint(a, b);
+        }
+        polyline_handles.push((*index, handles));
+    }
+    let polyline_segments: Vec<(usize, usize)> = polyline_handles
+        .iter()
+        .flat_map(|(_, h)| h.windows(2).map(|w| (w[0], w[1])))
+        .collect();
     let fixed = cdt.num_vertices();
 
     let mut parameters = RefinementParameters::<f64>::new()
-        .exclude_outer_faces(true)
+        // Spade's peeling takes an open poly_line for a loop: with poly_lines
+        // the outside is found here instead (`outside_faces`).
+        .exclude_outer_faces(polyline_segments.is_empty())
         .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
-        .with_max_additional_vertices(200_000);
+        .with_max_additional_vertices(vertex_budget(&uv_loops, settings.max_area));
     if settings.keep_boundary {
         parameters = parameters.keep_constraint_edges();
+    }
+    if settings.max_area.is_finite() {
+        parameters = parameters.with_max_allowed_area(settings.max_area);
     }
     let mut inner = Vec::new();
     // Triangles (by their corner nodes, which never move) already found
@@ -166,7 +221,8 @@ pub(crate) fn mesh_face(
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if !settings.keep_boundary {
-            let splits = boundary_splits(&cdt, fixed, &segments).map_err(failed)?;
+            let splits =
+                boundary_splits(&cdt, fixed, &segments, &polyline_segments).map_err(failed)?;
             if !splits.is_empty() {
                 return Ok(Outcome::Split(splits));
             }
@@ -185,10 +241,14 @@ pub(crate) fn mesh_face(
             positions.push(p);
         }
         let mut excluded = vec![false; cdt.num_all_faces()];
-        for f in &result.excluded_faces {
-            if let Some(slot) = excluded.get_mut(f.index()) {
-                *slot = true;
+        if polyline_segments.is_empty() {
+            for f in &result.excluded_faces {
+                if let Some(slot) = excluded.get_mut(f.index()) {
+                    *slot = true;
+                }
             }
+        } else {
+            excluded = outside_faces(&cdt, &polyline_segments);
         }
         inner.clear();
         let mut bad = Vec::new();
@@ -202,11 +262,19 @@ pub(crate) fn mesh_face(
             if key.is_some_and(|k| fine.contains(&k)) {
                 continue;
             }
-            if too_coarse(
-                &deviation,
-                [&positions[a], &positions[b], &positions[c]],
-                settings,
-            ) {
+            let [pa, pb, pc] = f.positions();
+            let uv_area =
+                0.5 * ((pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x)).abs();
+            let over_area = settings.max_area.is_finite()
+                && matches!(face.surface, Surface::Plane { .. })
+                && uv_area > settings.max_area;
+            if over_area
+                || too_coarse(
+                    &deviation,
+                    [&positions[a], &positions[b], &positions[c]],
+                    settings,
+                )
+            {
                 let [pa, pb, pc] = f.positions();
                 let centroid = point2([(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0]);
                 // A corner of the triangle is a good start for locating it.
@@ -241,9 +309,14 @@ pub(crate) fn mesh_face(
             t.swap(1, 2);
         }
     }
+    let polylines = polyline_handles
+        .iter()
+        .map(|(index, handles)| (*index, polyline_chain(&cdt, fixed, handles)))
+        .collect();
     Ok(Outcome::Meshed(FaceMesh {
         points: keys,
         triangles: inner,
+        polylines,
     }))
 }
 
@@ -378,6 +451,7 @@ fn boundary_splits(
     cdt: &Cdt,
     fixed: usize,
     segments: &Segments,
+    polyline_segments: &[(usize, usize)],
 ) -> Result<Vec<(usize, f64)>, String> {
     let mut splits = Vec::new();
     for v in fixed..cdt.num_vertices() {
@@ -386,6 +460,12 @@ fn boundary_splits(
             continue;
         }
         let p = vertex.position();
+        if polyline_segments
+            .iter()
+            .any(|&(a, b)| on_segment(cdt, a, b, p).is_some())
+        {
+            continue;
+        }
         let found = segments.iter().find_map(|(&(a, b), &(edge, sa, sb))| {
             let pa = cdt
                 .vertex(spade::handles::FixedVertexHandle::from_index(a))
@@ -404,6 +484,120 @@ fn boundary_splits(
     Ok(splits)
 }
 
+/// Points one refinement call may add: enough for the area limit (about two
+/// triangles per vertex, with room for grading), at least 200,000 (spade's
+/// guard against non-termination), at most the face's node limit.
+fn vertex_budget(uv_loops: &[Vec<[f64; 2]>], max_area: f64) -> usize {
+    let area = uv_loops.iter().map(|lp| shoelace(lp)).sum::<f64>().abs() / 2.0;
+    let wanted = if max_area.is_finite() {
+        (2.0 * area / max_area).min(MAX_FACE_VERTICES as f64) as usize
+    } else {
+        0
+    };
+    wanted.clamp(200_000, MAX_FACE_VERTICES)
+}
+
+/// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and
+/// `b`, when it lies on it.
+fn on_segment(cdt: &Cdt, a: usize, b: usize, p: Point2<f64>) -> Option<f64> {
+    let pa = cdt
+        .vertex(spade::handles::FixedVertexHandle::from_index(a))
+        .position();
+    let pb = cdt
+        .vertex(spade::handles::FixedVertexHandle::from_index(b))
+        .position();
+    let (dx, dy) = (pb.x - pa.x, pb.y - pa.y);
+    let len2 = dx * dx + dy * dy;
+    let t = ((p.x - pa.x) * dx + (p.y - pa.y) * dy) / len2;
+    let off = ((p.x - pa.x) * dy - (p.y - pa.y) * dx).abs() / len2.sqrt();
+    (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some(t)
+}
+
+/// Faces outside the loops (indexed by face index): a flood fill from the
+/// convex hull that flips inside/outside when it crosses a loop segment but
+/// not a poly_line.
+fn outside_faces(cdt: &Cdt, polyline_segments: &[(usize, usize)]) -> Vec<bool> {
+    let mut outside: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+    let crosses_loop = |constraint: bool, ia: usize, ib: usize| {
+        if !constraint {
+            return false;
+        }
+        let (a, b) = (
+            cdt.vertex(spade::handles::FixedVertexHandle::from_index(ia))
+                .position(),
+            cdt.vertex(spade::handles::FixedVertexHandle::from_index(ib))
+                .position(),
+        );
+        let mid = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
+        !polyline_segments.iter().any(|&(p, q)| {
+            (p == ia && q == ib) || (p == ib && q == ia) || on_segment(cdt, p, q, mid).is_some()
+        })
+    };
+    let mut stack = Vec::new();
+    for e in cdt.convex_hull() {
+        let inner = e.rev();
+        if let Some(face) = inner.face().as_inner() {
+            let state = !crosses_loop(
+                inner.is_constraint_edge(),
+                inner.from().fix().index(),
+                inner.to().fix().index(),
+            );
+            if outside[face.fix().index()].is_none() {
+                outside[face.fix().index()] = Some(state);
+                stack.push(face.fix());
+            }
+        }
+    }
+    while let Some(f) = stack.pop() {
+        let face = cdt.face(f);
+        let state = outside[f.index()].unwrap_or(true);
+        for e in face.adjacent_edges() {
+            let twin = e.rev();
+            if let Some(next) = twin.face().as_inner() {
+                let slot = &mut outside[next.fix().index()];
+                if slot.is_none() {
+                    *slot = Some(
+                        state
+                            != crosses_loop(
+                                e.is_constraint_edge(),
+                                e.from().fix().index(),
+                                e.to().fix().index(),
+                            ),
+                    );
+                    stack.push(next.fix());
+                }
+            }
+        }
+    }
+    outside.into_iter().map(|s| s.unwrap_or(true)).collect()
+}
+
+/// A constrained poly_line's vertices in order: its own points with the
+/// points refinement added on each segment, sorted along it.
+fn polyline_chain(cdt: &Cdt, fixed: usize, handles: &[usize]) -> Vec<usize> {
+    let added: Vec<(usize, Point2<f64>)> = (fixed..cdt.num_vertices())
+        .filter_map(|v| {
+            let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(v));
+            vertex
+                .out_edges()
+                .any(|e| e.is_constraint_edge())
+                .then(|| (v, vertex.position()))
+        })
+        .collect();
+    let mut chain = Vec::new();
+    for w in handles.windows(2) {
+        chain.push(w[0]);
+        let mut on: Vec<(f64, usize)> = added
+            .iter()
+            .filter_map(|&(v, p)| on_segment(cdt, w[0], w[1], p).map(|t| (t, v)))
+            .collect();
+        on.sort_by(|x, y| x.0.total_cmp(&y.0));
+        chain.extend(on.into_iter().map(|(_, v)| v));
+    }
+    chain.extend(handles.last().copied());
+    chain
+}
+
 /// True when a triangle is longer than `max_edge` or strays from the surface
 /// by more than the tolerance. The deviation is measured at the centroid and
 /// the edge midpoints, and its largest value inside the triangle is
@@ -412,7 +606,14 @@ fn boundary_splits(
 /// centroid misses on skewed triangles).
 fn too_coarse(surface: &Deviation, [a, b, c]: [&Point3; 3], settings: &Settings) -> bool {
     let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-    if longest > settings.max_edge {
+    let size = if settings.sizing.is_uniform() {
+        settings.sizing.at(a)
+    } else {
+        settings
+            .sizing
+            .at(&Point3::from((a.coords + b.coords + c.coords) / 3.0))
+    };
+    if longest > size {
         return true;
     }
     if matches!(surface, Deviation::Plane) {

@@ -23,16 +23,20 @@
 
 mod chart;
 mod check;
+mod constraints;
 mod diagnostic;
 mod edges;
 pub mod exact;
 mod face;
 mod guard;
+mod quadratic;
 mod report;
+mod size;
 
 pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
 pub use guard::panics_are_caught;
 pub use report::{MeshReport, SubdomainReport};
+pub use size::SizeField;
 
 use crate::ir::{self, Dimension, Model, Side, SubdomainCells};
 use crate::mesh::{
@@ -70,6 +74,14 @@ pub struct MeshOptions {
     /// The smallest triangle angle refinement aims for (planar faces exactly,
     /// curved faces in their chart).
     pub min_angle_degrees: f64,
+    /// 2D: the largest triangle area anywhere (a subdomain's `area=` may
+    /// lower it there).
+    pub max_area: Option<f64>,
+    /// A size field h(x, y, z[, d]): no triangle edge longer than h.
+    pub size_field: Option<SizeField>,
+    /// 1: linear elements; 2: quadratic (mid-edge nodes, on the curve for
+    /// boundary edges).
+    pub order: u8,
 }
 
 impl Default for MeshOptions {
@@ -78,6 +90,9 @@ impl Default for MeshOptions {
             tolerance: Tolerance::default(),
             max_edge: None,
             min_angle_degrees: 25.0,
+            max_area: None,
+            size_field: None,
+            order: 1,
         }
     }
 }
@@ -128,18 +143,48 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         )));
     }
 
+    let max_area = options.max_area.unwrap_or(f64::INFINITY);
+    if max_area.is_nan() || max_area <= 0.0 {
+        return Err(MeshError::Options("max_area must be positive".into()));
+    }
+    if !(1..=2).contains(&options.order) {
+        return Err(MeshError::Options(format!(
+            "the element order must be 1 or 2 (got {})",
+            options.order
+        )));
+    }
+
     // Half the tolerance on edges leaves room for the triangles beside them.
+    // Under an area limit, edges start at the side of an equilateral triangle
+    // of that area, so refinement rarely has to send splits back (each round
+    // re-meshes the faces).
+    let face_areas = face_area_limits(model, max_area);
+    let mut edge_area = vec![f64::INFINITY; model.edges.len()];
+    for (face, &area) in model.faces.iter().zip(&face_areas) {
+        for oe in face.loops.iter().flatten() {
+            if let Some(slot) = edge_area.get_mut(oe.edge.index()) {
+                *slot = slot.min(area);
+            }
+        }
+    }
     let mut edge_nodes = model
         .edges
         .iter()
-        .map(|e| {
+        .zip(&edge_area)
+        .map(|(e, &area)| {
+            let side = (4.0 * area / 3f64.sqrt()).sqrt();
             guard::guarded(
                 || format!("edge `{}`", e.name),
-                || edges::discretise(model, e, 0.5 * tolerance, max_edge),
+                || edges::discretise(model, e, 0.5 * tolerance, max_edge.min(side)),
             )
         })
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
-    let face_meshes = mesh_faces(model, &mut edge_nodes, tolerance, max_edge, min_angle)?;
+    let edge_points: Vec<Vec<crate::geom::Point3>> =
+        edge_nodes.iter().map(|n| n.points.clone()).collect();
+    let sizing = size::Sizing::new(model, options.size_field.as_ref(), max_edge, &edge_points)?;
+    for (nodes, edge) in edge_nodes.iter_mut().zip(&model.edges) {
+        nodes.refine_to_size(&edge.curve, &sizing);
+    }
     let lines = model
         .polylines
         .iter()
@@ -150,19 +195,50 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             )
         })
         .collect::<Result<Vec<_>, MeshError>>()?;
+    let constraints = constraints::assign(model, &edge_nodes, &lines)?;
+    let settings = Settings {
+        tolerance,
+        sizing: &sizing,
+        min_angle,
+        keep_boundary: false,
+        max_area,
+    };
+    let face_meshes = mesh_faces(model, &mut edge_nodes, settings, &face_areas, &constraints)?;
     guard::guarded(
         || "the assembly of the mesh".to_string(),
-        || Ok(assemble(model, &edge_nodes, &face_meshes, &lines)),
+        || {
+            let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
+            if options.order == 2 {
+                quadratic::elevate(model, &edge_nodes, &mut mesh);
+            }
+            Ok(mesh)
+        },
     )
+}
+
+/// Each face's area limit: the smallest of `max_area` and the `area=` of
+/// the 2D subdomains it belongs to.
+fn face_area_limits(model: &Model, max_area: f64) -> Vec<f64> {
+    let mut limits = vec![max_area; model.faces.len()];
+    for sub in &model.subdomains {
+        if let (SubdomainCells::Region { faces }, Some(area)) = (&sub.cells, sub.max_area) {
+            for f in faces {
+                if let Some(limit) = limits.get_mut(f.index()) {
+                    *limit = limit.min(area);
+                }
+            }
+        }
+    }
+    limits
 }
 
 /// Meshes the faces in rounds until no face asks for new boundary points.
 fn mesh_faces(
     model: &Model,
     edge_nodes: &mut [EdgeNodes],
-    tolerance: f64,
-    max_edge: f64,
-    min_angle: f64,
+    base: Settings,
+    face_areas: &[f64],
+    constraints: &constraints::Constraints,
 ) -> Result<Vec<Option<FaceMesh>>, MeshError> {
     let mut faces_of_edge: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
     for (f, face) in model.faces.iter().enumerate() {
@@ -195,12 +271,6 @@ fn mesh_faces(
         .filter(|&f| !model.faces[f].loops.is_empty())
         .collect();
     for round in 0..=MAX_ROUNDS {
-        let settings = Settings {
-            tolerance,
-            max_edge,
-            min_angle,
-            keep_boundary: round == MAX_ROUNDS,
-        };
         let mut splits: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
         // Faces mesh independently against the shared edge nodes: in
         // parallel, with results taken in face order (deterministic, and the
@@ -210,9 +280,15 @@ fn mesh_faces(
             .par_iter()
             .map(|&f| {
                 let face = &model.faces[f];
+                let settings = Settings {
+                    keep_boundary: round == MAX_ROUNDS,
+                    max_area: face_areas.get(f).copied().unwrap_or(base.max_area),
+                    ..base
+                };
+                let face_constraints = constraints.get(&f).map_or(&[][..], |c| c.as_slice());
                 let outcome = guard::guarded(
                     || format!("face `{}`", face.name),
-                    || face::mesh_face(model, face, edges_now, &settings),
+                    || face::mesh_face(model, face, edges_now, &settings, face_constraints),
                 );
                 (f, outcome)
             })
@@ -284,6 +360,7 @@ fn assemble(
         edge_ids.push(ids);
     }
     let mut faces = Vec::with_capacity(model.faces.len());
+    let mut constrained: BTreeMap<usize, Vec<u32>> = BTreeMap::new();
     for (face, mesh) in model.faces.iter().zip(face_meshes) {
         let mut triangles = Vec::new();
         if let Some(mesh) = mesh {
@@ -305,6 +382,10 @@ fn assemble(
                     *slot = id;
                 }
                 triangles.push(tri);
+            }
+            for (index, chain) in &mesh.polylines {
+                let nodes = chain.iter().filter_map(|&i| ids.get(i).copied().flatten());
+                constrained.insert(*index, nodes.collect());
             }
         }
         faces.push(MeshFace {
@@ -354,8 +435,11 @@ fn assemble(
         });
     }
     let mut polylines = Vec::new();
-    for (line, points) in model.polylines.iter().zip(lines) {
-        let ids = points.iter().map(|p| push(&mut nodes, p)).collect();
+    for (index, (line, points)) in model.polylines.iter().zip(lines).enumerate() {
+        let ids = match constrained.remove(&index) {
+            Some(chain) => chain,
+            None => points.iter().map(|p| push(&mut nodes, p)).collect(),
+        };
         polylines.push(MeshPolyline {
             name: line.name.clone(),
             nodes: ids,
@@ -382,5 +466,6 @@ fn assemble(
         fragments,
         point_sets,
         polylines,
+        ..Mesh::default()
     }
 }

@@ -1,6 +1,8 @@
 //! The mesh report of `geomc inspect --mesh`: counts, triangle quality
 //! (smallest angles and their histogram, aspect ratios) and, per subdomain,
-//! the mesh's volume and area against the exact ones with relative errors.
+//! the mesh's volume and area against the exact ones with relative errors,
+//! and the range of its triangle areas (2D: its region triangles; 3D: the
+//! triangles of its boundary), which `area=` and `--max-area` bound.
 
 use super::exact::{ExactMeasure, subdomain_measures};
 use crate::ir::Model;
@@ -52,6 +54,9 @@ pub struct SubdomainReport {
     pub mesh_area: f64,
     pub exact_area: Option<f64>,
     pub area_error: Option<f64>,
+    /// The smallest and largest triangle area (0 without triangles).
+    pub min_area: f64,
+    pub max_area: f64,
 }
 
 /// Per-triangle figures gathered in one pass.
@@ -121,6 +126,7 @@ impl MeshReport {
             .map(|(k, sub)| {
                 let mut angles = Angles::new();
                 let (mut volume, mut area) = (0.0, 0.0);
+                let (mut min_area, mut max_area) = (f64::INFINITY, 0.0f64);
                 for &(f, outward) in &sub.faces {
                     let Some(face) = mesh.faces.get(f as usize) else {
                         continue;
@@ -129,7 +135,10 @@ impl MeshReport {
                     for t in &face.triangles {
                         let [a, b, c] = t.map(point);
                         angles.add([a, b, c]);
-                        area += 0.5 * (b - a).cross(&(c - a)).norm();
+                        let triangle = 0.5 * (b - a).cross(&(c - a)).norm();
+                        area += triangle;
+                        min_area = min_area.min(triangle);
+                        max_area = max_area.max(triangle);
                         volume += sign * a.dot(&b.cross(&c)) / 6.0;
                     }
                 }
@@ -150,6 +159,8 @@ impl MeshReport {
                     mesh_area: area,
                     exact_area: exact.map(|e| e.area),
                     area_error: exact.map(|e| relative(area, e.area)),
+                    min_area: if angles.count > 0 { min_area } else { 0.0 },
+                    max_area,
                 }
             })
             .collect();
@@ -219,10 +230,12 @@ impl MeshReport {
         for sub in &self.subdomains {
             let _ = writeln!(
                 s,
-                "  {}: {} triangles, min angle {}°",
+                "  {}: {} triangles, min angle {}°, triangle area {} .. {}",
                 sub.name,
                 sub.triangles,
-                fixed(sub.min_angle, 2)
+                fixed(sub.min_angle, 2),
+                sci(sub.min_area),
+                sci(sub.max_area)
             );
             if let Some(volume) = sub.mesh_volume {
                 let bound = sub
@@ -297,5 +310,37 @@ mod tests {
         assert!((a.min - 60.0).abs() < 1e-9);
         assert!((a.max_aspect - 1.0).abs() < 1e-12);
         assert_eq!(a.histogram[11], 1);
+    }
+
+    #[test]
+    fn a_right_isosceles_pair_reports_45_degrees_and_its_areas() {
+        use crate::mesh::{MeshFace, MeshSubdomain};
+        let mesh = Mesh {
+            dimension: 2,
+            nodes: vec![[0., 0., 0.], [1., 0., 0.], [1., 1., 0.], [0., 2., 0.]],
+            faces: vec![MeshFace {
+                name: "f".into(),
+                triangles: vec![[0, 1, 2], [0, 2, 3]],
+                boundary: Vec::new(),
+            }],
+            subdomains: vec![MeshSubdomain {
+                name: "s".into(),
+                material: None,
+                faces: vec![(0, true)],
+            }],
+            ..Mesh::default()
+        };
+        let r = MeshReport::of(
+            &Model::empty(crate::ir::Dimension::Two),
+            &mesh,
+            0.01,
+            None,
+            25.0,
+        );
+        assert_eq!(r.triangles, 2);
+        assert!((r.min_angle - 45.0).abs() < 1e-9);
+        assert_eq!(r.min_angle_histogram[9], 2);
+        let s = &r.subdomains[0];
+        assert_eq!((s.min_area, s.max_area), (0.5, 1.0));
     }
 }

@@ -6,6 +6,7 @@ mod geometry;
 mod names;
 mod objects;
 mod point_calculus;
+mod polygons;
 mod shapes;
 mod values;
 
@@ -39,6 +40,9 @@ pub struct Resolved {
     pub by_name: HashMap<String, usize>,
     /// Parameter values in force, in definition order.
     pub parameters: Vec<(String, f64)>,
+    /// `subdomain_areas[i]`: the `area=` limit of `doc.subdomains[i]`, when
+    /// given, positive and in a 2D model.
+    pub subdomain_areas: Vec<Option<f64>>,
 }
 
 impl Resolved {
@@ -130,6 +134,11 @@ pub fn resolve(
     check_basis_order(doc, &values, diags);
     let mut resolver = objects::Resolver::new(doc, &names, values, diags);
     let objects = resolver.resolve_all();
+    let subdomain_areas = doc
+        .subdomains
+        .iter()
+        .map(|def| shapes::subdomain_area(&mut resolver, def, doc.dimension))
+        .collect();
     let values = resolver.finish();
     for (name, span) in values.unused_parameters() {
         diags.push(
@@ -151,6 +160,7 @@ pub fn resolve(
         objects,
         by_name,
         parameters,
+        subdomain_areas,
     }
 }
 

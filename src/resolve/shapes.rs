@@ -170,6 +170,22 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
                 ],
             }))
         }
+        ObjectKind::Polygon { vertices } => super::polygons::polygon(r, object, vertices, frame),
+        ObjectKind::Rectangle { first, second } => {
+            super::polygons::rectangle(r, object, first.as_ref()?, second.as_ref()?, frame)
+        }
+        ObjectKind::RegularPolygon {
+            center,
+            radius,
+            sides,
+        } => super::polygons::regular_polygon(
+            r,
+            object,
+            center.as_ref()?,
+            radius.as_ref()?,
+            sides.as_ref()?,
+            frame,
+        ),
         ObjectKind::PolyLine { segments } => {
             let mut points: Vec<Point3> = Vec::new();
             for (k, (begin, end)) in segments.iter().enumerate() {
@@ -1003,7 +1019,33 @@ fn transformed(
     }
 }
 
-fn positive(r: &mut Resolver, n: &Number, what: &str, name: &str) -> Option<f64> {
+/// A subdomain's `area=` limit: positive, and only meaningful in 2D (W150).
+pub(super) fn subdomain_area(
+    r: &mut Resolver,
+    def: &crate::doc::SubdomainDef,
+    dimension: u8,
+) -> Option<f64> {
+    let spec = def.area.as_ref()?;
+    let area = positive(r, spec, "the area limit", &def.name.text)?;
+    if dimension != 2 {
+        r.diags.push(
+            Diagnostic::new(
+                Code::AreaIn3d,
+                spec.span,
+                format!(
+                    "subdomain '{}' gives area={} in a 3D model, where it is ignored",
+                    def.name.text,
+                    fmt(area)
+                ),
+            )
+            .with_help("remove area=, or set dimension=\"2\" on <geometry> for a planar model"),
+        );
+        return None;
+    }
+    Some(area)
+}
+
+pub(super) fn positive(r: &mut Resolver, n: &Number, what: &str, name: &str) -> Option<f64> {
     let v = r.number(n)?;
     if v <= 0.0 {
         r.diags.push(

@@ -173,7 +173,7 @@ pub(crate) mod fixtures {
                 name: name.to_string(),
                 material: None,
                 cells,
-                solids: Vec::new(),
+                ..Default::default()
             });
             let origin = self.origin();
             self.map.subdomains.insert(id, origin);

@@ -1,0 +1,189 @@
+//! 2D meshing benchmark (issue 6): geomc's 2D mesher against Shewchuk's
+//! Triangle (PyPI `triangle`, benches/mesh2d_triangle.py) in the same run, on
+//! the issue's three domains at the same minimum angle: a disk with 50
+//! holes, a polygon with 10,000 boundary vertices, and about a million
+//! triangles from an area limit. Triangle gets geomc's own boundary nodes as
+//! its PSLG, so both mesh the same boundary. Reports best-of-3 times, their
+//! ratio, and the triangle-count ratio.
+//!
+//! Run: `cargo bench --bench mesh2d` (`-- --quick`: smaller sizes). Needs
+//! `pip install triangle` (./scripts/test.sh installs it).
+
+use geomc::driver::{Options, check_source};
+use geomc::ir::Model;
+use geomc::mesh::Mesh;
+use geomc::meshing::{MeshOptions, mesh_model};
+use geomc::span::SourceFile;
+use std::fmt::Write as _;
+use std::time::Instant;
+
+const MIN_ANGLE: f64 = 28.0;
+
+struct Case {
+    name: &'static str,
+    xml: String,
+    max_area: Option<f64>,
+    /// A point inside each hole, for Triangle.
+    holes: Vec<[f64; 2]>,
+}
+
+fn disk_with_holes() -> Case {
+    let mut xml = String::from(
+        "<geometry version=\"1\" dimension=\"2\">\n<circle name=\"disk\"><center x=\"0\" y=\"0\"/><radius value=\"10\"/></circle>\n",
+    );
+    let mut holes = Vec::new();
+    let mut k = 0;
+    for i in -4..=4 {
+        for j in -4..=4 {
+            let (x, y) = (2.0 * i as f64, 2.0 * j as f64);
+            if k < 50 && x.hypot(y) < 8.5 {
+                writeln!(xml, "<circle name=\"h{k}\"><center x=\"{x}\" y=\"{y}\"/><radius value=\"0.4\"/></circle>").unwrap();
+                holes.push([x, y]);
+                k += 1;
+            }
+        }
+    }
+    xml.push_str("<subdomain name=\"plate\"><difference><solid ref=\"disk\"/>");
+    for h in 0..k {
+        write!(xml, "<solid ref=\"h{h}\"/>").unwrap();
+    }
+    xml.push_str("</difference></subdomain>\n</geometry>\n");
+    Case {
+        name: "disk with holes",
+        xml,
+        max_area: Some(0.02),
+        holes,
+    }
+}
+
+fn wiggly_polygon(n: usize) -> Case {
+    let mut xml = String::from("<geometry version=\"1\" dimension=\"2\">\n<polygon name=\"star\">");
+    for k in 0..n {
+        let t = std::f64::consts::TAU * k as f64 / n as f64;
+        let r = 1.0 + 0.1 * (20.0 * t).sin();
+        write!(
+            xml,
+            "<vertex x=\"{:.12}\" y=\"{:.12}\"/>",
+            r * t.cos(),
+            r * t.sin()
+        )
+        .unwrap();
+    }
+    xml.push_str(
+        "</polygon>\n<subdomain name=\"inside\"><solid ref=\"star\"/></subdomain>\n</geometry>\n",
+    );
+    Case {
+        name: "polygon",
+        xml,
+        max_area: None,
+        holes: Vec::new(),
+    }
+}
+
+fn square(area: f64) -> Case {
+    Case {
+        name: "area-limited square",
+        xml: "<geometry version=\"1\" dimension=\"2\"><rectangle name=\"sq\"><first_point x=\"0\" y=\"0\"/><second_point x=\"1\" y=\"1\"/></rectangle><subdomain name=\"inside\"><solid ref=\"sq\"/></subdomain></geometry>".into(),
+        max_area: Some(area),
+        holes: Vec::new(),
+    }
+}
+
+fn model(xml: &str) -> Model {
+    let checked = check_source(SourceFile::new("bench.xml", xml), &Options::default());
+    assert!(checked.is_valid(), "{:?}", checked.diagnostics.items);
+    checked.lowered.expect("model").model
+}
+
+/// geomc's boundary nodes and segments as Triangle's PSLG.
+fn pslg(mesh: &Mesh, case: &Case) -> String {
+    let mut ids = std::collections::BTreeMap::new();
+    let mut vertices = Vec::new();
+    let mut segments = Vec::new();
+    for edge in &mesh.edges {
+        for w in edge.nodes.windows(2) {
+            let mut id = |n: u32| {
+                *ids.entry(n).or_insert_with(|| {
+                    let p = mesh.nodes[n as usize];
+                    vertices.push(format!("[{:.17},{:.17}]", p[0], p[1]));
+                    vertices.len() - 1
+                })
+            };
+            let (a, b) = (id(w[0]), id(w[1]));
+            segments.push(format!("[{a},{b}]"));
+        }
+    }
+    let holes: Vec<String> = case
+        .holes
+        .iter()
+        .map(|h| format!("[{},{}]", h[0], h[1]))
+        .collect();
+    format!(
+        "{{\"vertices\":[{}],\"segments\":[{}],\"holes\":[{}],\"min_angle\":{MIN_ANGLE},\"max_area\":{}}}",
+        vertices.join(","),
+        segments.join(","),
+        holes.join(","),
+        case.max_area.map_or("null".to_string(), |a| a.to_string())
+    )
+}
+
+fn main() {
+    let quick = std::env::args().any(|a| a == "--quick");
+    let cases = if quick {
+        vec![disk_with_holes(), wiggly_polygon(2_000), square(2e-5)]
+    } else {
+        vec![disk_with_holes(), wiggly_polygon(10_000), square(1e-6)]
+    };
+    let runs = if quick { 1 } else { 3 };
+    let dir = std::env::temp_dir().join(format!("geomc-mesh2d-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    println!(
+        "| domain | geomc s | geomc triangles | Triangle s | Triangle triangles | time ratio | count ratio |"
+    );
+    println!("|---|---|---|---|---|---|---|");
+    for case in &cases {
+        let model = model(&case.xml);
+        let options = MeshOptions {
+            min_angle_degrees: MIN_ANGLE,
+            max_area: case.max_area,
+            ..MeshOptions::default()
+        };
+        let mut best = f64::INFINITY;
+        let mut mesh = None;
+        for _ in 0..runs {
+            let start = Instant::now();
+            let m = mesh_model(&model, &options).expect("meshable");
+            best = best.min(start.elapsed().as_secs_f64());
+            mesh = Some(m);
+        }
+        let mesh = mesh.expect("one run");
+        let triangles: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
+        let input = dir.join("pslg.json");
+        std::fs::write(&input, pslg(&mesh, case)).expect("write PSLG");
+        let script = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/mesh2d_triangle.py");
+        let out = std::process::Command::new("python3")
+            .arg(script)
+            .arg(&input)
+            .arg(runs.to_string())
+            .output()
+            .expect("run python3");
+        if !out.status.success() {
+            panic!(
+                "the Triangle peer failed (pip install triangle): {}",
+                String::from_utf8_lossy(&out.stderr)
+            );
+        }
+        let peer: serde_json::Value = serde_json::from_slice(&out.stdout).expect("peer JSON");
+        let (peer_s, peer_n) = (
+            peer["seconds"].as_f64().unwrap_or(f64::NAN),
+            peer["triangles"].as_f64().unwrap_or(f64::NAN),
+        );
+        println!(
+            "| {} | {best:.3} | {triangles} | {peer_s:.3} | {peer_n} | {:.2} | {:.2} |",
+            case.name,
+            best / peer_s,
+            triangles as f64 / peer_n
+        );
+    }
+    let _ = std::fs::remove_dir_all(&dir);
+}
