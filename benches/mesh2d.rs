@@ -128,8 +128,14 @@ fn pslg(mesh: &Mesh, case: &Case) -> String {
 }
 
 fn main() {
-    let quick = std::env::args().any(|a| a == "--quick");
-    let cases = if quick {
+    // `cargo bench` passes --bench; under `cargo test --all-targets` this runs as a
+    // small smoke run (debug build) so the test suite stays fast.
+    let args: Vec<String> = std::env::args().collect();
+    let smoke = !args.iter().any(|a| a == "--bench");
+    let quick = smoke || args.iter().any(|a| a == "--quick");
+    let cases = if smoke {
+        vec![wiggly_polygon(200), square(1e-3)]
+    } else if quick {
         vec![disk_with_holes(), wiggly_polygon(2_000), square(2e-5)]
     } else {
         vec![disk_with_holes(), wiggly_polygon(10_000), square(1e-6)]
