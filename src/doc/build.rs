@@ -144,6 +144,7 @@ impl Builder<'_> {
                 sides: self.number(e, "sides"),
             },
             "poly_line" => ObjectKind::PolyLine {
+                crack: e.attribute("crack").is_some_and(|a| a.value.trim() == "true"),
                 segments: e
                     .children_named("line")
                     .map(|l| {

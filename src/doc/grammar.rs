@@ -301,7 +301,11 @@ pub static POLY_LINE_SEGMENT: Rule = Rule {
 };
 pub static POLY_LINE: Rule = Rule {
     name: "poly_line",
-    attrs: NAMED,
+    attrs: &[
+        req("name", Name),
+        opt("cs", Ref),
+        opt("crack", AttrKind::Enum(&["true", "false"])),
+    ],
     any_attrs: false,
     content: Content::Sequence(&[many(&POLY_LINE_SEGMENT, 1)]),
 };

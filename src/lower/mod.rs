@@ -175,7 +175,7 @@ fn tolerance(resolved: &Resolved) -> f64 {
     fn visit(g: &Geometry, bbox: &mut Aabb) {
         match g {
             Geometry::Solid(s) => *bbox = bbox.union(&s.bbox()),
-            Geometry::Points { points, .. } | Geometry::Polyline { points } => {
+            Geometry::Points { points, .. } | Geometry::Polyline { points, .. } => {
                 points.iter().for_each(|p| bbox.include(p))
             }
             Geometry::Vertex(p) => bbox.include(p),
@@ -207,9 +207,10 @@ fn lower_free(
             name: name.to_string(),
             points: points.clone(),
         }),
-        Geometry::Polyline { points } => model.polylines.push(Polyline {
+        Geometry::Polyline { points, crack } => model.polylines.push(Polyline {
             name: name.to_string(),
             points: points.clone(),
+            crack: *crack,
             ..Polyline::default()
         }),
         Geometry::PointCurve(curve) => model

@@ -24,6 +24,7 @@
 mod chart;
 mod check;
 mod constraints;
+mod crack;
 mod diagnostic;
 mod edges;
 pub mod exact;
@@ -208,6 +209,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         || "the assembly of the mesh".to_string(),
         || {
             let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
+            crack::open(model, &mut mesh);
             if options.order == 2 {
                 quadratic::elevate(model, &edge_nodes, &mut mesh);
             }
