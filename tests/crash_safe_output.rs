@@ -19,11 +19,14 @@ fn previous(name: &str) -> Vec<u8> {
 
 /// The temporary file of a target being written, if any.
 fn temporary_of(dir: &Path) -> Option<(String, u64)> {
-    std::fs::read_dir(dir).ok()?.filter_map(|e| e.ok()).find_map(|e| {
-        let name = e.file_name().to_string_lossy().into_owned();
-        let size = e.metadata().map(|m| m.len()).unwrap_or(0);
-        (name.starts_with('.') && name.ends_with(".tmp") && size > 0).then_some((name, size))
-    })
+    std::fs::read_dir(dir)
+        .ok()?
+        .filter_map(|e| e.ok())
+        .find_map(|e| {
+            let name = e.file_name().to_string_lossy().into_owned();
+            let size = e.metadata().map(|m| m.len()).unwrap_or(0);
+            (name.starts_with('.') && name.ends_with(".tmp") && size > 0).then_some((name, size))
+        })
 }
 
 /// Whether `path` is a complete mesh file: geomc reads it back without error.
@@ -95,7 +98,11 @@ fn sigkill_mid_write_leaves_the_previous_file_or_a_complete_one() {
     }
     // Leftovers are only hidden temporaries, named as such.
     for entry in std::fs::read_dir(dir.path()).expect("folder") {
-        let name = entry.expect("entry").file_name().to_string_lossy().into_owned();
+        let name = entry
+            .expect("entry")
+            .file_name()
+            .to_string_lossy()
+            .into_owned();
         assert!(
             TARGETS.contains(&name.as_str()) || (name.starts_with('.') && name.ends_with(".tmp")),
             "unexpected file {name}"

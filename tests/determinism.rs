@@ -39,7 +39,10 @@ fn compile_all(threads: usize, formats: &[&str], extra: &[&str]) -> BTreeMap<Str
         .args(extra)
         .status()
         .expect("geomc runs");
-    assert!(status.success(), "compiling the valid fixtures failed: {status:?}");
+    assert!(
+        status.success(),
+        "compiling the valid fixtures failed: {status:?}"
+    );
     let mut files = BTreeMap::new();
     for entry in std::fs::read_dir(dir.path()).expect("output folder") {
         let entry = entry.expect("entry");
@@ -56,7 +59,10 @@ fn assert_same(a: &BTreeMap<String, Vec<u8>>, b: &BTreeMap<String, Vec<u8>>, wha
         "{what}: different files"
     );
     let differing: Vec<&String> = a.keys().filter(|k| a[*k] != b[*k]).collect();
-    assert!(differing.is_empty(), "{what}: bytes differ in {differing:?}");
+    assert!(
+        differing.is_empty(),
+        "{what}: bytes differ in {differing:?}"
+    );
 }
 
 #[test]
@@ -78,5 +84,9 @@ fn every_valid_fixture_compiles_to_the_same_bytes_on_1_and_4_threads() {
 fn text_encodings_are_the_same_on_1_and_4_threads() {
     let formats = ["stl", "msh", "vtu"];
     let one = compile_all(1, &formats, &["--ascii"]);
-    assert_same(&one, &compile_all(4, &formats, &["--ascii"]), "--ascii, 1 thread against 4");
+    assert_same(
+        &one,
+        &compile_all(4, &formats, &["--ascii"]),
+        "--ascii, 1 thread against 4",
+    );
 }
