@@ -62,7 +62,11 @@ fn crack_opens_into_two_sides_with_shared_tips() {
     let closed = mesh_of("false");
     let open = mesh_of("true");
     let chain = open.polylines[0].nodes.clone();
-    assert!(chain.len() > 4, "refinement split the crack: {}", chain.len());
+    assert!(
+        chain.len() > 4,
+        "refinement split the crack: {}",
+        chain.len()
+    );
     // The same triangulation, with the chain's inner nodes duplicated.
     let triangles = |m: &Mesh| m.faces.iter().map(|f| f.triangles.len()).sum::<usize>();
     assert_eq!(triangles(&open), triangles(&closed));
@@ -119,8 +123,9 @@ fn crack_opens_into_two_sides_with_shared_tips() {
     // Every triangle at a copied node lies right of the crack, every one at
     // an original inner node left of it (centroids).
     for t in open.faces.iter().flat_map(|f| &f.triangles) {
-        let c: [f64; 3] =
-            std::array::from_fn(|i| t.iter().map(|&n| open.nodes[n as usize][i]).sum::<f64>() / 3.0);
+        let c: [f64; 3] = std::array::from_fn(|i| {
+            t.iter().map(|&n| open.nodes[n as usize][i]).sum::<f64>() / 3.0
+        });
         for k in 1..chain.len() - 1 {
             if t.contains(&right.nodes[k]) {
                 assert_eq!(side(c), -1.0);

@@ -524,7 +524,11 @@ fn section_paths(svg: &str) -> Vec<Vec<Vec<[f64; 2]>>> {
     svg.lines()
         .filter(|l| l.contains(r#"class="section""#))
         .map(|l| {
-            let d = l.split(" d=\"").nth(1).expect("a d").trim_end_matches("\"/>");
+            let d = l
+                .split(" d=\"")
+                .nth(1)
+                .expect("a d")
+                .trim_end_matches("\"/>");
             d.split('Z')
                 .filter(|lp| !lp.is_empty())
                 .map(|lp| {
@@ -575,7 +579,10 @@ fn svg_section_fills_the_cut_face_of_each_subdomain() {
     let k2 = camera.scale * camera.scale;
     let (matrix, inclusion) = (even_odd_area(&paths[0]), even_odd_area(&paths[1]));
     let disc = std::f64::consts::PI * k2;
-    assert!((inclusion - disc).abs() < 0.01 * disc, "{inclusion} vs {disc}");
+    assert!(
+        (inclusion - disc).abs() < 0.01 * disc,
+        "{inclusion} vs {disc}"
+    );
     let rest = 16.0 * k2 - disc;
     assert!((matrix - rest).abs() < 0.01 * rest, "{matrix} vs {rest}");
     // Loops come oriented by nesting: the hole runs against the outline.

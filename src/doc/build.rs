@@ -144,7 +144,9 @@ impl Builder<'_> {
                 sides: self.number(e, "sides"),
             },
             "poly_line" => ObjectKind::PolyLine {
-                crack: e.attribute("crack").is_some_and(|a| a.value.trim() == "true"),
+                crack: e
+                    .attribute("crack")
+                    .is_some_and(|a| a.value.trim() == "true"),
                 segments: e
                     .children_named("line")
                     .map(|l| {

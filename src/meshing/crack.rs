@@ -56,11 +56,9 @@ pub(crate) fn open(model: &Model, mesh: &mut Mesh) {
 }
 
 fn face_with_edge(mesh: &Mesh, a: u32, b: u32) -> Option<usize> {
-    mesh.faces.iter().position(|f| {
-        f.triangles
-            .iter()
-            .any(|t| t.contains(&a) && t.contains(&b))
-    })
+    mesh.faces
+        .iter()
+        .position(|f| f.triangles.iter().any(|t| t.contains(&a) && t.contains(&b)))
 }
 
 /// Duplicates the chain's inner nodes for the triangles on its right;
@@ -95,9 +93,8 @@ fn open_chain(mesh: &mut Mesh, face: usize, chain: &[u32]) -> Vec<u32> {
             let Some(slot) = t.iter().position(|&n| n == node) else {
                 continue;
             };
-            let centroid: [f64; 3] = std::array::from_fn(|c| {
-                t.iter().map(|&n| nodes[n as usize][c]).sum::<f64>() / 3.0
-            });
+            let centroid: [f64; 3] =
+                std::array::from_fn(|c| t.iter().map(|&n| nodes[n as usize][c]).sum::<f64>() / 3.0);
             if from_next(centroid) > limit {
                 t[slot] = copy;
             }

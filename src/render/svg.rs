@@ -441,7 +441,13 @@ fn write_cut_faces(out: &mut String, faces: &[CutFace], scene: &Scene) {
         let mut d = String::new();
         for lp in &face.loops {
             for (i, p) in lp.iter().enumerate() {
-                let _ = write!(d, "{}{} {}", if i == 0 { 'M' } else { 'L' }, num(p[0]), num(p[1]));
+                let _ = write!(
+                    d,
+                    "{}{} {}",
+                    if i == 0 { 'M' } else { 'L' },
+                    num(p[0]),
+                    num(p[1])
+                );
             }
             d.push('Z');
         }
