@@ -65,6 +65,9 @@ pub struct Args {
     /// (into a folder: one STEM.png per input when it ends in '/').
     #[arg(long, value_name = "OUT.png")]
     preview: Option<PathBuf>,
+    /// Contour lines of the plane cut AXIS=VALUE (e.g. z=0) of implicit subdomains, written as line elements.
+    #[arg(long, value_name = "AXIS=VALUE", allow_hyphen_values = true)]
+    section: Option<String>,
 }
 
 /// What one input produced, collected so output is printed in input order.
@@ -84,6 +87,13 @@ pub fn run(args: &Args) -> i32 {
     };
     let mesh_options = match mesh_options(args) {
         Ok(m) => m,
+        Err(diagnostic) => {
+            report_usage(&[diagnostic]);
+            return EXIT_USAGE;
+        }
+    };
+    let section = match super::implicit::parse_section(args.section.as_deref()) {
+        Ok(s) => s,
         Err(diagnostic) => {
             report_usage(&[diagnostic]);
             return EXIT_USAGE;
@@ -129,6 +139,7 @@ pub fn run(args: &Args) -> i32 {
                     args.quiet,
                     args.cells,
                     preview.as_deref(),
+                    section,
                 );
                 if let Some(bar) = &progress {
                     bar.inc(1);
@@ -243,6 +254,7 @@ fn compile_one(
     quiet: bool,
     cells: Option<usize>,
     preview: Option<&Path>,
+    section: Option<geomc::implicit::xml::mesh::Plane>,
 ) -> Outcome {
     if super::rfs::is_rfs(input) {
         let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells);
@@ -270,7 +282,23 @@ fn compile_one(
     let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
         return fail(messages);
     };
-    let mesh = match mesh_model(&lowered.model, mesh_options) {
+    let model = &lowered.model;
+    // A model of implicit subdomains only has nothing for the face mesher (and
+    // no bounding box for a relative tolerance).
+    let implicit_only = !checked.implicit.is_empty()
+        && model.vertices.is_empty()
+        && model.edges.is_empty()
+        && model.faces.is_empty()
+        && model.point_sets.is_empty();
+    let meshed = if implicit_only {
+        Ok(geomc::mesh::Mesh {
+            dimension: 3,
+            ..Default::default()
+        })
+    } else {
+        mesh_model(model, mesh_options)
+    };
+    let mut mesh = match meshed {
         Ok(mesh) => mesh,
         Err(e) => {
             let diagnostic = e.to_diagnostic(&lowered.model, &lowered.source_map);
@@ -278,6 +306,9 @@ fn compile_one(
             return fail(messages);
         }
     };
+    messages.push_str(&super::implicit::add_to_mesh(
+        &mut mesh, &checked, cells, section, quiet,
+    ));
     // A fragment description refers to the MSH written beside it, if any.
     let mesh_file = outputs
         .iter()

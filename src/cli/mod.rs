@@ -4,6 +4,7 @@
 mod compile;
 mod convert;
 mod explain;
+mod implicit;
 mod inspect;
 mod inspect_mesh;
 mod mesh_args;
@@ -66,6 +67,9 @@ pub struct InputOptions {
     /// Most XML nodes in one file.
     #[arg(long, value_name = "N", default_value_t = Limits::default().max_nodes)]
     pub max_nodes: u32,
+    /// Also read data files (density volumes, .rfs) from this folder (repeatable).
+    #[arg(long = "allow-path", value_name = "DIR")]
+    pub allow_path: Vec<std::path::PathBuf>,
 }
 
 impl InputOptions {
@@ -89,6 +93,7 @@ impl InputOptions {
                 max_depth: self.max_depth,
                 max_nodes: self.max_nodes,
             },
+            allowed_paths: self.allow_path.clone(),
         })
     }
 }
