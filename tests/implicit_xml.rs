@@ -269,7 +269,7 @@ fn an_rfs_program_file_is_an_operand_and_the_seven_balls_keep_their_volume() {
             r#"<rfunction name="balls" x_min="-1.1" x_max="1.1" y_min="-1.1" y_max="1.1" z_min="-1.1" z_max="1.1" nx="64" ny="64" nz="64">
   <rfs file="seven.rfs"/>
 </rfunction>
-<rfunction name="inline"> <rfs program="function r_main(x, y, z) { return Ball(x, y, z, 0.5, 0, 0, 0); }"/> </rfunction>
+<rfunction name="inline" x_min="2.4" x_max="3.6"> <rfs program="function r_main(x, y, z) { return Ball(x, y, z, 0.5, 3, 0, 0); }"/> </rfunction>
 <subdomain name="s"> <solid ref="balls"/> </subdomain>
 <subdomain name="t"> <solid ref="inline"/> </subdomain>"#,
         ),
@@ -344,7 +344,7 @@ fn a_level_surface_takes_any_three_variable_names() {
     // two cones of height 1 and radius 1 — volume 2π/3.
     let c = check(&model(
         r#"<level_surface name="cone" variables="t x y" expression="t^2 - x^2 - y^2" nx="64" ny="64" nz="64"/>
-<level_surface name="ball" variables="u v w" expression="-(u^2 + v^2 + w^2)" level="-0.36" nx="40" ny="40" nz="40"/>
+<level_surface name="ball" variables="u v w" expression="-((u - 3)^2 + v^2 + w^2)" level="-0.36" x_min="2" x_max="4" nx="40" ny="40" nz="40"/>
 <subdomain name="c"> <solid ref="cone"/> </subdomain>
 <subdomain name="b"> <solid ref="ball"/> </subdomain>"#,
     ));
@@ -624,4 +624,60 @@ fn the_schema_accepts_the_implicit_elements() {
         "{}",
         String::from_utf8_lossy(&run.stderr)
     );
+}
+
+#[test]
+fn a_cylinder_through_a_box_must_be_carved_out_of_it() {
+    let parts = r#"<rfunction name="cyl" rsystem="minmax" nx="48" ny="48" nz="48">
+  <intersection> <disk r="0.3" x0="0" y0="0"/> <formula value="0.9 - abs(z)"/> </intersection>
+</rfunction>
+<rfunction name="box" rsystem="minmax" nx="48" ny="48" nz="48"> <box x0="-0.6" y0="-0.6" z0="-0.5" w="1.2" h="1.2" d="1"/> </rfunction>
+<subdomain name="pin"> <solid ref="cyl"/> </subdomain>"#;
+    let overlapping = check(&model(&format!(
+        "{parts}\n<subdomain name=\"block\"> <solid ref=\"box\"/> </subdomain>"
+    )));
+    assert_eq!(codes(&overlapping), vec![("E407".to_string(), 8, 2)]);
+    let carved = check(&model(&format!(
+        "{parts}\n<subdomain name=\"block\"> <difference> <solid ref=\"box\"/> <solid ref=\"cyl\"/> </difference> </subdomain>"
+    )));
+    let subs = valid(&carved);
+    let pin = subs[0].polygonize(None);
+    let block = subs[1].polygonize(None);
+    assert_watertight(&pin);
+    assert_watertight(&block);
+    // Each is its own closed surface (the interface is meshed twice, not yet
+    // shared): the pin is the whole cylinder, the block the box minus it.
+    // Rims and box edges are chamfered by the cells: 1.5%.
+    let cylinder = PI * 0.09 * 1.8;
+    let block_exact = 1.44 - PI * 0.09;
+    assert!(rel(volume(&pin), cylinder) < 0.015, "{}", volume(&pin));
+    assert!(
+        rel(volume(&block), block_exact) < 0.015,
+        "{}",
+        volume(&block)
+    );
+}
+
+#[test]
+fn rfs_inputs_take_section_too() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rfs = write(dir.path(), "balls.rfs", SEVEN_BALLS.as_bytes());
+    let obj = dir.path().join("balls.obj");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
+        .args(["compile", "--section", "z=0", "-o"])
+        .arg(&obj)
+        .arg(&rfs)
+        .output()
+        .expect("run geomc");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    let text = std::fs::read_to_string(&obj).expect("read obj");
+    // The plane z = 0 cuts the central ball and the four side balls in one
+    // outline: a single closed contour.
+    let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("l ")).collect();
+    assert_eq!(lines.len(), 1, "{lines:?}");
+    assert!(text.contains("balls_section_1"));
 }

@@ -257,7 +257,7 @@ fn compile_one(
     section: Option<geomc::implicit::xml::mesh::Plane>,
 ) -> Outcome {
     if super::rfs::is_rfs(input) {
-        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells);
+        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells, section);
         return Outcome {
             input: input.to_path_buf(),
             messages,

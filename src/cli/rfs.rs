@@ -5,6 +5,7 @@
 use super::{EXIT_INVALID, EXIT_USAGE};
 use geomc::diag::render_human;
 use geomc::formats::{self, Encoding, WriteOptions};
+use geomc::implicit::xml::mesh::{Plane, add_section};
 use geomc::implicit::{lang, surface_to_mesh};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
@@ -23,6 +24,16 @@ pub fn load(
     input: &Path,
     quiet: bool,
     cells: Option<usize>,
+) -> (String, Result<(Mesh, usize), i32>) {
+    load_with_section(input, quiet, cells, None)
+}
+
+/// [`load`], adding the contour lines of a `--section` plane.
+pub fn load_with_section(
+    input: &Path,
+    quiet: bool,
+    cells: Option<usize>,
+    section: Option<Plane>,
 ) -> (String, Result<(Mesh, usize), i32>) {
     let mut messages = String::new();
     let text = match std::fs::read(input) {
@@ -65,7 +76,23 @@ pub fn load(
         }
     }
     let surface = model.polygonize(cells.map(|n| [n; 3]));
-    let mesh = surface_to_mesh(&surface, model.name());
+    let mut mesh = surface_to_mesh(&surface, model.name());
+    if let Some(plane) = section {
+        if !add_section(
+            &mut mesh,
+            &surface.positions,
+            &surface.triangles,
+            model.name(),
+            plane,
+        ) && !quiet
+        {
+            messages.push_str(&format!(
+                "{}: warning[W133]: the section plane does not cut the surface of '{}'\n",
+                input.display(),
+                model.name()
+            ));
+        }
+    }
     (messages, Ok((mesh, surface.triangles.len())))
 }
 
@@ -76,8 +103,9 @@ pub fn compile(
     encoding: Option<Encoding>,
     quiet: bool,
     cells: Option<usize>,
+    section: Option<Plane>,
 ) -> (String, bool) {
-    let (mut messages, loaded) = load(input, quiet, cells);
+    let (mut messages, loaded) = load_with_section(input, quiet, cells, section);
     let Ok((mesh, triangles)) = loaded else {
         return (messages, false);
     };

@@ -74,30 +74,44 @@ pub fn append(
         });
         out.triangles.push(surface.triangles.len());
         if let Some(plane) = section {
-            let lines = section::contours(
+            if !add_section(
+                mesh,
                 &surface.positions,
                 &surface.triangles,
-                plane.axis,
-                plane.value,
-            );
-            if lines.is_empty() {
+                &sub.name,
+                plane,
+            ) {
                 out.missed_by_section.push(sub.name.clone());
-            }
-            for (k, line) in lines.into_iter().enumerate() {
-                let first = mesh.nodes.len() as u32;
-                let closed = line.len() > 2 && line.first() == line.last();
-                let n = if closed { line.len() - 1 } else { line.len() };
-                mesh.nodes.extend_from_slice(&line[..n]);
-                let mut nodes: Vec<u32> = (first..first + n as u32).collect();
-                if closed {
-                    nodes.push(first);
-                }
-                mesh.polylines.push(MeshPolyline {
-                    name: format!("{}_section_{}", sub.name, k + 1),
-                    nodes,
-                });
             }
         }
     }
     out
+}
+
+/// Adds the contour lines of `plane` on a surface as polylines `NAME_section_K`
+/// (closed loops end on their first node); false when the plane misses it.
+pub fn add_section(
+    mesh: &mut Mesh,
+    positions: &[[f64; 3]],
+    triangles: &[[u32; 3]],
+    name: &str,
+    plane: Plane,
+) -> bool {
+    let lines = section::contours(positions, triangles, plane.axis, plane.value);
+    let any = !lines.is_empty();
+    for (k, line) in lines.into_iter().enumerate() {
+        let first = mesh.nodes.len() as u32;
+        let closed = line.len() > 2 && line.first() == line.last();
+        let n = if closed { line.len() - 1 } else { line.len() };
+        mesh.nodes.extend_from_slice(&line[..n]);
+        let mut nodes: Vec<u32> = (first..first + n as u32).collect();
+        if closed {
+            nodes.push(first);
+        }
+        mesh.polylines.push(MeshPolyline {
+            name: format!("{name}_section_{}", k + 1),
+            nodes,
+        });
+    }
+    any
 }

@@ -7,6 +7,7 @@
 
 pub mod density;
 pub mod mesh;
+mod overlap;
 mod paths;
 mod settings;
 mod tree;
@@ -182,6 +183,7 @@ pub fn lower(ex: &Extracted, env: &Env, diags: &mut Diagnostics) -> Lowered {
             solid,
         });
     }
+    overlap::check(&out.subdomains, diags);
     out
 }
 
