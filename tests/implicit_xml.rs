@@ -681,3 +681,28 @@ fn rfs_inputs_take_section_too() {
     assert_eq!(lines.len(), 1, "{lines:?}");
     assert!(text.contains("balls_section_1"));
 }
+
+#[test]
+fn doubling_calls_and_huge_grids_are_refused_quickly() {
+    // Each level calls the next twice: 2^40 operands if expanded naively.
+    let mut functions = String::from(
+        r#"<function name="f0" args="a"> <ball r="a" x0="0" y0="0" z0="0"/> </function>"#,
+    );
+    for k in 1..=40 {
+        functions.push_str(&format!(
+            "\n<function name=\"f{k}\" args=\"a\"> <union> <call function=\"f{}\" a=\"a\"/> <call function=\"f{}\" a=\"a*0.99\"/> </union> </function>",
+            k - 1,
+            k - 1
+        ));
+    }
+    let c = check(&model(&format!(
+        "{functions}\n<rfunction name=\"p\"> <call function=\"f40\" a=\"0.5\"/> </rfunction>\n<subdomain name=\"s\"> <solid ref=\"p\"/> </subdomain>"
+    )));
+    let got: Vec<String> = codes(&c).into_iter().map(|c| c.0).collect();
+    assert_eq!(got, vec!["E615"]);
+    let big = check(&model(
+        r#"<rfunction name="p" nx="1024" ny="1024" nz="1024"> <ball r="1" x0="0" y0="0" z0="0"/> </rfunction>
+<subdomain name="s"> <solid ref="p"/> </subdomain>"#,
+    ));
+    assert_eq!(codes(&big), vec![("E613".to_string(), 3, 25)]);
+}

@@ -10,6 +10,9 @@ use crate::implicit::rfs::RSystem;
 use crate::syntax::Element;
 use std::collections::BTreeSet;
 
+/// Most grid samples of one solid (2²⁷, about 512³: 1 GiB of f64 values).
+pub const MAX_SAMPLES: usize = 1 << 27;
+
 /// A constant attribute: `None` when absent, `Some(None)` when bad (reported).
 pub fn constant(
     e: &Element,
@@ -91,6 +94,18 @@ pub fn geom(
             Some(None) => ok = false,
             None => {}
         }
+    }
+    let samples: usize = geom.cells.iter().map(|n| n + 1).product();
+    if samples > MAX_SAMPLES {
+        diags.push(Diagnostic::new(
+            Code::ImplicitBadSetting,
+            e.attribute("nx").map_or(e.name_span, |a| a.value_span),
+            format!(
+                "{} x {} x {} cells need {samples} samples, over the limit of {MAX_SAMPLES}",
+                geom.cells[0], geom.cells[1], geom.cells[2]
+            ),
+        ));
+        ok = false;
     }
     match constant(e, "optiterations", env, used, diags) {
         Some(Some(v)) if v.fract() == 0.0 && (0.0..=1000.0).contains(&v) => {

@@ -20,6 +20,10 @@ use std::collections::{BTreeSet, HashMap};
 const MAX_CALL_DEPTH: usize = 64;
 /// Largest expression an implicit solid may expand to.
 const MAX_NODES: usize = 2_000_000;
+/// Most operands expanded for one solid: calls are inlined, and hash-consing
+/// keeps repeated results small, so the work, not the size, is what a
+/// doubling chain of calls (f = union(g, g), g = union(h, h), …) blows up.
+const MAX_WORK: usize = 200_000;
 
 /// Names in scope: coordinates and function arguments.
 pub type Scope = HashMap<String, NodeId>;
@@ -81,6 +85,7 @@ pub struct Lowerer<'e, 'a, 's> {
     env: &'e Env<'e>,
     functions: Option<&'a Functions<'a, 's>>,
     stack: Vec<String>,
+    work: usize,
 }
 
 /// The scope of the three coordinates named `names`.
@@ -173,6 +178,7 @@ impl<'e, 'a, 's> Lowerer<'e, 'a, 's> {
             env,
             functions,
             stack: Vec::new(),
+            work: 0,
         }
     }
 
@@ -283,12 +289,17 @@ impl<'e, 'a, 's> Lowerer<'e, 'a, 's> {
 
     /// One operand of a tree; `None` after reporting its errors.
     pub fn node(&mut self, e: &Element, scope: &Scope, diags: &mut Diagnostics) -> Option<NodeId> {
-        if self.ctx.nodes.len() > MAX_NODES {
-            diags.push(Diagnostic::new(
-                Code::ImplicitRecursion,
-                e.name_span,
-                format!("the implicit solid expands to more than {MAX_NODES} nodes"),
-            ));
+        self.work += 1;
+        if self.ctx.nodes.len() > MAX_NODES || self.work > MAX_WORK {
+            // Report once, at the operand where the budget ran out.
+            if self.work <= MAX_WORK + 1 {
+                diags.push(Diagnostic::new(
+                    Code::ImplicitRecursion,
+                    e.name_span,
+                    format!("the implicit solid expands to more than {MAX_NODES} nodes or {MAX_WORK} operands"),
+                ));
+            }
+            self.work = MAX_WORK + 2;
             return None;
         }
         match e.name {
