@@ -35,6 +35,15 @@ impl SampleType {
         }
     }
 
+    pub fn name(self) -> &'static str {
+        match self {
+            SampleType::U8 => "u8",
+            SampleType::U16 => "u16",
+            SampleType::I16 => "i16",
+            SampleType::F32 => "f32",
+        }
+    }
+
     fn parse(text: &str) -> Option<SampleType> {
         Some(match text {
             "u8" => SampleType::U8,
@@ -370,7 +379,7 @@ pub(super) fn read(
         bad(
             Code::ImplicitFileUnreadable,
             file.value_span,
-            format!("cannot read {}: {err}", path.display()),
+            format!("cannot read '{}': {err}", file.value.trim()),
         )
     };
     let mut handle = std::fs::File::open(&path)
@@ -448,12 +457,12 @@ pub(super) fn read(
                 Code::ImplicitFileSize,
                 file.value_span,
                 format!(
-                    "{} holds {actual} bytes of samples; {} x {} x {} samples of {:?} need {expected}",
-                    data_path.display(),
+                    "'{}' holds {actual} bytes of samples; {} x {} x {} samples of {} need {expected}",
+                    file.value.trim(),
                     layout.dims[0],
                     layout.dims[1],
                     layout.dims[2],
-                    layout.ty
+                    layout.ty.name()
                 ),
             )
             .with_help("check dims and type against the file"),

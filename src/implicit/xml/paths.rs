@@ -36,8 +36,7 @@ pub fn resolve_in(
             Code::ImplicitPathRefused,
             attr.value_span,
             format!(
-                "'{relative}' leads to {}, outside the input's folder {}",
-                canonical.display(),
+                "'{relative}' leads outside the input's folder {}",
                 env.folder.display()
             ),
         )

@@ -524,16 +524,15 @@ impl<'e, 'a, 's> Lowerer<'e, 'a, 's> {
                 let lc = source.line_col(s.start as usize);
                 format!(":{}:{}", lc.line, lc.column)
             });
-            diags.push(Diagnostic::new(
+            let mut outer = Diagnostic::new(
                 Code::ImplicitRfsProgram,
                 span,
-                format!(
-                    "{label}{at}: {}[{}]: {}",
-                    "error",
-                    d.code.as_str(),
-                    d.message
-                ),
-            ));
+                format!("{label}{at}: error[{}]: {}", d.code.as_str(), d.message),
+            );
+            if let Some(help) = &d.help {
+                outer = outer.with_help(help.clone());
+            }
+            diags.push(outer);
         }
         let model = model.filter(|_| !failed)?;
         Some(super::import(&mut self.ctx, &model.ctx, model.root))
