@@ -706,3 +706,31 @@ fn doubling_calls_and_huge_grids_are_refused_quickly() {
     ));
     assert_eq!(codes(&big), vec![("E613".to_string(), 3, 25)]);
 }
+
+#[test]
+fn compile_checks_implicit_grids_against_max_grid_cells() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let xml = write(
+        dir.path(),
+        "m.xml",
+        model(
+            r#"<rfunction name="part" nx="20" ny="20" nz="20"> <ball r="0.5" x0="0" y0="0" z0="0"/> </rfunction>
+<subdomain name="ball"> <solid ref="part"/> </subdomain>"#,
+        )
+        .as_bytes(),
+    );
+    let obj = dir.path().join("m.obj");
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
+        .args(["compile", "--max-grid-cells", "7999", "-o"])
+        .arg(&obj)
+        .arg(&xml)
+        .output()
+        .expect("run geomc");
+    assert_eq!(run.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&run.stderr);
+    assert!(
+        stderr.contains("E800") && stderr.contains(":4:2:"),
+        "{stderr}"
+    );
+    assert!(!obj.exists(), "no partial output");
+}

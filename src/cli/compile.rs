@@ -58,6 +58,8 @@ pub struct Args {
     input: InputOptions,
     #[command(flatten)]
     solver_mesh: super::solver_args::SolverMeshArgs,
+    #[command(flatten)]
+    budget: super::limits::Budget,
     /// Grid cells per axis for implicit (.rfs) inputs, overriding Geom.nx/ny/nz.
     #[arg(long, value_name = "N")]
     cells: Option<usize>,
@@ -139,6 +141,7 @@ pub fn run(args: &Args) -> i32 {
                     args.quiet,
                     args.cells,
                     preview.as_deref(),
+                    &args.budget,
                     section,
                 );
                 if let Some(bar) = &progress {
@@ -254,10 +257,16 @@ fn compile_one(
     quiet: bool,
     cells: Option<usize>,
     preview: Option<&Path>,
+    budget: &super::limits::Budget,
     section: Option<geomc::implicit::xml::mesh::Plane>,
 ) -> Outcome {
     if super::rfs::is_rfs(input) {
-        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells, section);
+        let limits = super::rfs::RfsLimits {
+            budget: *budget,
+            max_file_size: options.limits.max_file_size as u64,
+        };
+        let (messages, ok) =
+            super::rfs::compile(input, outputs, encoding, quiet, cells, &limits, section);
         return Outcome {
             input: input.to_path_buf(),
             messages,
@@ -282,6 +291,13 @@ fn compile_one(
     let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
         return fail(messages);
     };
+    // Refuse a mesh too fine for the limit before meshing spends the memory.
+    let estimate = super::limits::estimate_triangles(&lowered.model, mesh_options);
+    if estimate > budget.max_triangles {
+        let d = super::limits::too_many_triangles(estimate, budget.max_triangles, true);
+        messages.push_str(&render_human(&checked.source, &d));
+        return fail(messages);
+    }
     let model = &lowered.model;
     // A model of implicit subdomains only has nothing for the face mesher (and
     // no bounding box for a relative tolerance).
@@ -306,9 +322,26 @@ fn compile_one(
             return fail(messages);
         }
     };
-    messages.push_str(&super::implicit::add_to_mesh(
-        &mut mesh, &checked, cells, section, quiet,
-    ));
+    match super::implicit::add_to_mesh(
+        &mut mesh,
+        &checked,
+        cells,
+        section,
+        quiet,
+        budget.max_grid_cells,
+    ) {
+        Ok(text) => messages.push_str(&text),
+        Err(text) => {
+            messages.push_str(&text);
+            return fail(messages);
+        }
+    }
+    let triangles: u64 = mesh.faces.iter().map(|f| f.triangles.len() as u64).sum();
+    if triangles > budget.max_triangles {
+        let d = super::limits::too_many_triangles(triangles, budget.max_triangles, false);
+        messages.push_str(&render_human(&checked.source, &d));
+        return fail(messages);
+    }
     // A fragment description refers to the MSH written beside it, if any.
     let mesh_file = outputs
         .iter()

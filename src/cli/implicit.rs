@@ -4,6 +4,7 @@
 
 use geomc::diag::{Code, Diagnostic, render_human};
 use geomc::driver::Checked;
+use geomc::implicit::xml::ImplicitSolid;
 use geomc::implicit::xml::mesh::{Plane, append};
 use geomc::mesh::Mesh;
 
@@ -22,15 +23,32 @@ pub fn parse_section(text: Option<&str>) -> Result<Option<Plane>, Diagnostic> {
     })
 }
 
-/// Adds the implicit subdomains of `checked` to `mesh`; the messages to print.
+/// Adds the implicit subdomains of `checked` to `mesh`: the messages to
+/// print, or with `Err` the messages of a grid over the `--max-grid-cells`
+/// limit (E800), checked before any grid is allocated.
 pub fn add_to_mesh(
     mesh: &mut Mesh,
     checked: &Checked,
     cells: Option<usize>,
     section: Option<Plane>,
     quiet: bool,
-) -> String {
+    max_grid_cells: u64,
+) -> Result<String, String> {
     let mut messages = String::new();
+    for sub in &checked.implicit {
+        let grid = match &sub.solid {
+            ImplicitSolid::Function(m) => cells.map_or(m.geom.cells, |n| [n; 3]),
+            ImplicitSolid::Samples { grid, .. } => grid.cells,
+        };
+        if let Err(d) = super::limits::check_grid(grid, max_grid_cells) {
+            let d = Diagnostic {
+                span: Some(sub.span),
+                ..d
+            };
+            messages.push_str(&render_human(&checked.source, &d));
+            return Err(messages);
+        }
+    }
     if checked.implicit.is_empty() {
         if section.is_some() && !quiet {
             messages.push_str(&format!(
@@ -38,11 +56,11 @@ pub fn add_to_mesh(
                 checked.source.name
             ));
         }
-        return messages;
+        return Ok(messages);
     }
     let appended = append(mesh, &checked.implicit, cells, section);
     if quiet {
-        return messages;
+        return Ok(messages);
     }
     for (sub, triangles) in checked.implicit.iter().zip(&appended.triangles) {
         messages.push_str(&format!(
@@ -60,5 +78,5 @@ pub fn add_to_mesh(
             messages.push_str(&render_human(&checked.source, &d));
         }
     }
-    messages
+    Ok(messages)
 }

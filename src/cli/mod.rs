@@ -7,6 +7,7 @@ mod explain;
 mod implicit;
 mod inspect;
 mod inspect_mesh;
+mod limits;
 mod mesh_args;
 mod render;
 mod rfs;
