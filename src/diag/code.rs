@@ -303,6 +303,10 @@ codes! {
         "The picture is too short to name every colour group, so the legend ends with '... and N more'. Make the picture taller with --size, or colour by subdomain (--color-by subdomain) to have fewer groups.";
     RenderSectionEmpty = "W171", Warning, "section leaves nothing to draw",
         "The section plane lies below the whole model, so everything was cut away and the picture is empty. Pick a value inside the model's extent (geomc inspect prints the bounding box).";
+
+    // ---- mesh-perf: locate, volume cells (issues 3, 4) ----
+    LocateBadPoint = "E504", Error, "bad row in a points file",
+        "geomc locate reads one point per row: 2 or 3 finite numbers separated by commas or spaces (x,y or x,y,z). A first row of column names (x,y,z) is allowed; empty rows and rows starting with # are skipped. Fix or remove the row named.";
 }
 
 impl Code {
