@@ -319,7 +319,13 @@ mod tests {
         // y = z: the ray runs through the faces' diagonals; y = 0.5, z = 0:
         // along the bottom faces' plane; (y, z) = (0, 0): along cube edges.
         // (The perturbation moves such points towards +y, +z: into the cubes.)
-        for (y, z) in [(0.5, 0.5), (0.25, 0.25), (0.75, 0.75), (0.5, 0.0), (0.0, 0.0)] {
+        for (y, z) in [
+            (0.5, 0.5),
+            (0.25, 0.25),
+            (0.75, 0.75),
+            (0.5, 0.0),
+            (0.0, 0.0),
+        ] {
             assert_eq!(locator.locate([0.5, y, z]), Some(0), "y {y} z {z} in a");
             assert_eq!(locator.locate([1.5, y, z]), Some(1), "y {y} z {z} in b");
             assert_eq!(locator.locate([-1.0, y, z]), None, "y {y} z {z} outside");
