@@ -8,6 +8,7 @@ mod implicit;
 mod inspect;
 mod inspect_mesh;
 mod limits;
+mod locate;
 mod mesh_args;
 mod render;
 mod rfs;
@@ -51,6 +52,8 @@ enum Command {
     Convert(convert::Args),
     /// Draw a domain or mesh: a shaded PNG or a hidden-line SVG.
     Render(render::Args),
+    /// Which subdomain (or the exterior) each point of a CSV file lies in.
+    Locate(locate::Args),
 }
 
 /// Options shared by every subcommand that reads XML.
@@ -131,6 +134,7 @@ pub fn run() -> i32 {
         Command::Explain(args) => explain::run(&args),
         Command::Convert(args) => convert::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Locate(args) => locate::run(&args),
     });
     result.unwrap_or(EXIT_INTERNAL)
 }

@@ -344,6 +344,10 @@ codes! {
         "The input mesh file parsed, but it holds no triangles, lines or points, so converting it would write an empty file. The file is probably truncated, not a mesh, or written by a tool that failed. Check it, or pass --from if its format was guessed wrongly.";
     EmptySurface = "E803", Error, "implicit solid has no surface on its grid",
         "Polygonizing the .rfs program found no triangles: the solid {f > 0} is empty, fills the whole Geom box, or is too thin for the grid's cells. Writing would give an empty mesh, so nothing is written. Check the Geom box (x_min..z_max) against where the solid lies, and use more cells (Geom.nx/ny/nz or --cells) for thin features.";
+
+    // ---- mesh-perf: locate, volume cells (issues 3, 4) ----
+    LocateBadPoint = "E504", Error, "bad row in a points file",
+        "geomc locate reads one point per row: 2 or 3 finite numbers separated by commas or spaces (x,y or x,y,z). A first row of column names (x,y,z) is allowed; empty rows and rows starting with # are skipped. Fix or remove the row named.";
 }
 
 impl Code {
