@@ -26,6 +26,16 @@ pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Do
     doc
 }
 
+/// Parses one attribute's expression with spans in the source, reporting
+/// malformed ones (E120–E124) as every numeric attribute does.
+pub fn parse_attribute_expr(
+    source: &SourceFile,
+    attr: &Attribute,
+    diags: &mut Diagnostics,
+) -> Option<crate::expr::Expr> {
+    Builder { source, diags }.parse_number(attr).expr
+}
+
 struct Builder<'a> {
     source: &'a SourceFile,
     diags: &'a mut Diagnostics,

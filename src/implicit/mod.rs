@@ -10,7 +10,9 @@ pub mod lang;
 pub mod library;
 pub mod polygonize;
 pub mod rfs;
+pub mod section;
 pub mod tape;
+pub mod xml;
 
 use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};
 use crate::span::Span;

@@ -6,6 +6,7 @@
 
 use crate::diag::{Code, Diagnostic};
 use crate::mesh::Mesh;
+use rayon::slice::ParallelSliceMut;
 
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct EdgeCounts {
@@ -125,7 +126,8 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
             half.push((u64::from(lo) << 33) | (u64::from(hi) << 1) | dir);
         }
     }
-    half.sort_unstable();
+    // Plain integers: the parallel sort gives the same order on any thread count.
+    half.par_sort_unstable();
     let mut i = 0;
     while i < half.len() {
         let key = half[i] >> 1;
