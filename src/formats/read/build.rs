@@ -161,9 +161,12 @@ fn attach_fragments(
             continue;
         };
         let other = fr.other.as_deref().and_then(|o| index.get(o).copied());
-        mesh.subdomains[sub as usize].faces.push((face, true));
-        if let Some(o) = other {
-            mesh.subdomains[o as usize].faces.push((face, false));
+        // The index maps names to positions in `mesh.subdomains`.
+        if let Some(s) = mesh.subdomains.get_mut(sub as usize) {
+            s.faces.push((face, true));
+        }
+        if let Some(s) = other.and_then(|o| mesh.subdomains.get_mut(o as usize)) {
+            s.faces.push((face, false));
         }
         mesh.fragments.push(MeshFragment {
             name: fr.group.clone(),
@@ -205,7 +208,9 @@ impl Hasher for FastHasher {
     fn write(&mut self, bytes: &[u8]) {
         for chunk in bytes.chunks(8) {
             let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
+            for (w, &c) in word.iter_mut().zip(chunk) {
+                *w = c;
+            }
             self.write_u64(u64::from_le_bytes(word));
         }
     }
