@@ -155,6 +155,13 @@ pub fn load_bytes(
     Ok(loaded)
 }
 
+/// Reads a `.frag.xml` from bytes already in memory; `frag_path` places it, so
+/// the mesh file it names is read from `frag_path`'s folder (the fuzz target's
+/// entry, which needs no file for the description itself).
+pub fn load_frag_bytes(frag_path: &Path, bytes: &[u8]) -> Result<Loaded, Vec<Diagnostic>> {
+    frag::load(frag_path, bytes)
+}
+
 type Parsed = (Builder, Option<bool>);
 
 fn parse(format: ReadFormat, bytes: &[u8], folder: &Path) -> Result<Parsed, Vec<Diagnostic>> {
