@@ -8,7 +8,9 @@ use geomc::span::SourceFile;
 use std::path::{Path, PathBuf};
 
 fn inputs(target: &str) -> Vec<(PathBuf, Vec<u8>)> {
-    let dir = Path::new(env!("CARGO_MANIFEST_DIR")).join("fuzz/regressions").join(target);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("fuzz/regressions")
+        .join(target);
     let mut out: Vec<(PathBuf, Vec<u8>)> = std::fs::read_dir(&dir)
         .map(|entries| {
             entries
@@ -31,7 +33,11 @@ fn replay_reader(target: &str, format: ReadFormat) -> usize {
     for (path, bytes) in &found {
         let result = load_bytes(format, bytes, Path::new("/nonexistent/geomc-fuzz"));
         if let Err(diagnostics) = result {
-            assert!(!diagnostics.is_empty(), "{}: an error without a diagnostic", path.display());
+            assert!(
+                !diagnostics.is_empty(),
+                "{}: an error without a diagnostic",
+                path.display()
+            );
         }
     }
     found.len()

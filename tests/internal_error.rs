@@ -9,7 +9,8 @@ use std::process::Command;
 
 fn compile(out: &Path, panic: bool) -> std::process::Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_geomc"));
-    cmd.args(["compile", "examples/ball_in_box.xml", "-o"]).arg(out);
+    cmd.args(["compile", "examples/ball_in_box.xml", "-o"])
+        .arg(out);
     if panic {
         cmd.env("GEOMC_DEBUG_PANIC", "1");
     } else {

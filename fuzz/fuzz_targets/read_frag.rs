@@ -10,13 +10,19 @@ use libfuzzer_sys::fuzz_target;
 use std::path::Path;
 
 fuzz_target!(|data: &[u8]| {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/frag_meshes/fuzz.frag.xml"));
+    let path = Path::new(concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/frag_meshes/fuzz.frag.xml"
+    ));
     if let Ok(loaded) = load_frag_bytes(path, data) {
         let mesh = &loaded.mesh;
         let n = mesh.nodes.len();
         for face in &mesh.faces {
             for t in &face.triangles {
-                assert!(t.iter().all(|&i| (i as usize) < n), "triangle {t:?} of {n} nodes");
+                assert!(
+                    t.iter().all(|&i| (i as usize) < n),
+                    "triangle {t:?} of {n} nodes"
+                );
             }
         }
         for s in &mesh.subdomains {

@@ -19,7 +19,10 @@ fuzz_target!(|data: &[u8]| {
         let surface = model.polygonize(Some([4, 4, 4]));
         let n = surface.positions.len();
         for t in &surface.triangles {
-            assert!(t.iter().all(|&i| (i as usize) < n), "triangle {t:?} of {n} nodes");
+            assert!(
+                t.iter().all(|&i| (i as usize) < n),
+                "triangle {t:?} of {n} nodes"
+            );
         }
     }
 });

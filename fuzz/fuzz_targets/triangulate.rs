@@ -82,7 +82,12 @@ fuzz_target!(|data: &[u8]| {
     let area = shoelace(&polygon).abs();
     let (lo, hi) = polygon.iter().fold(
         ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]),
-        |(lo, hi), p| ([lo[0].min(p[0]), lo[1].min(p[1])], [hi[0].max(p[0]), hi[1].max(p[1])]),
+        |(lo, hi), p| {
+            (
+                [lo[0].min(p[0]), lo[1].min(p[1])],
+                [hi[0].max(p[0]), hi[1].max(p[1])],
+            )
+        },
     );
     let extent = (hi[0] - lo[0]).max(hi[1] - lo[1]);
     // An area limit keeps every mesh small (at most a few thousand triangles
@@ -115,7 +120,10 @@ fuzz_target!(|data: &[u8]| {
             sum += twice.abs() / 2.0;
         }
     }
-    assert!(signs[0] == 0 || signs[1] == 0, "mixed orientations {signs:?}");
+    assert!(
+        signs[0] == 0 || signs[1] == 0,
+        "mixed orientations {signs:?}"
+    );
     let scale = extent * extent;
     assert!(
         (sum - area).abs() <= 1e-9 * scale.max(1e-300),
