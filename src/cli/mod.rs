@@ -10,6 +10,7 @@ mod inspect_mesh;
 mod limits;
 mod locate;
 mod mesh_args;
+mod panic_probe;
 mod render;
 mod rfs;
 mod solver_args;
@@ -127,7 +128,7 @@ pub fn run() -> i32 {
             return code;
         }
     };
-    let result = std::panic::catch_unwind(|| match cli.command {
+    let result = std::panic::catch_unwind(|| match panic_probe::checked(cli.command) {
         Command::Validate(args) => validate::run(&args),
         Command::Compile(args) => compile::run(&args),
         Command::Inspect(args) => inspect::run(&args),

@@ -266,6 +266,8 @@ pub struct Workspace {
 
 /// The output slot (mutable) and two input slots of one instruction; the
 /// allocator guarantees the output differs from both inputs.
+// Slot numbers come from the tape compiler, never from input: a bad one is a bug.
+#[allow(clippy::expect_used)]
 fn io(
     buf: &mut [f64],
     o: usize,

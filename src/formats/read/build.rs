@@ -160,9 +160,12 @@ fn attach_fragments(
             continue;
         };
         let other = fr.other.as_deref().and_then(|o| index.get(o).copied());
-        mesh.subdomains[sub as usize].faces.push((face, true));
-        if let Some(o) = other {
-            mesh.subdomains[o as usize].faces.push((face, false));
+        // The index maps names to positions in `mesh.subdomains`.
+        if let Some(s) = mesh.subdomains.get_mut(sub as usize) {
+            s.faces.push((face, true));
+        }
+        if let Some(s) = other.and_then(|o| mesh.subdomains.get_mut(o as usize)) {
+            s.faces.push((face, false));
         }
         mesh.fragments.push(MeshFragment {
             name: fr.group.clone(),

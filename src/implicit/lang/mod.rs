@@ -1,6 +1,9 @@
 //! Paper 001's modelling language (`.rfs` files): lexer → parser → expansion
 //! of the result function into one IR expression.
 
+// User-controlled bytes and values: no panicking index (docs/reliability.md).
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
+
 pub mod ast;
 pub mod expand;
 pub mod lexer;
