@@ -235,15 +235,19 @@ impl NodeDedup {
         let mix = (key[0] ^ key[1].rotate_left(21) ^ key[2].rotate_left(42))
             .wrapping_mul(0x9e37_79b9_7f4a_7c15);
         let slot = (mix >> 52) as usize & (RECENT - 1);
-        let (cached, id) = self.recent[slot];
-        if id != u32::MAX && cached == key {
+        if let Some(&(cached, id)) = self.recent.get(slot)
+            && id != u32::MAX
+            && cached == key
+        {
             return id;
         }
         let id = *self.map.entry(key).or_insert_with(|| {
             nodes.push(p);
             (nodes.len() - 1) as u32
         });
-        self.recent[slot] = (key, id);
+        if let Some(entry) = self.recent.get_mut(slot) {
+            *entry = (key, id);
+        }
         id
     }
 }
