@@ -33,7 +33,7 @@ const NOT_COVERED_BY_FIXTURES: &[&str] = &[
     "E610", // string used as a number
     "E611", // no return
     "W130", // unknown Geom field
-    "W131", // optiterations not applied
+    "W131", // optiterations not applied: retired, optimisation is applied now
     // Compile-time (issue 3): meshing runs in `geomc compile` and `geomc
     // inspect --mesh`, not in the `validate` run fixtures use; tested in
     // tests/mesh_report.rs and src/meshing/guard.rs.
