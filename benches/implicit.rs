@@ -177,7 +177,10 @@ fn fidget_mesh(ssa: &Ssa, depth: u8) -> usize {
 /// VTK flying edges on `values` through the Python peer: (seconds, triangles),
 /// or None when Python or `vtk` is missing.
 fn vtk_flying_edges(values: &[f32], n: usize, threads: usize, reps: usize) -> Option<(f64, u64)> {
-    let script = concat!(env!("CARGO_MANIFEST_DIR"), "/benches/peers/vtk_flying_edges.py");
+    let script = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/benches/peers/vtk_flying_edges.py"
+    );
     let dir = tempfile::tempdir().ok()?;
     let path = dir.path().join("field.f32");
     let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
@@ -193,7 +196,10 @@ fn vtk_flying_edges(values: &[f32], n: usize, threads: usize, reps: usize) -> Op
     if !out.status.success() {
         eprintln!(
             "VTK peer skipped: {}",
-            String::from_utf8_lossy(&out.stderr).lines().last().unwrap_or("")
+            String::from_utf8_lossy(&out.stderr)
+                .lines()
+                .last()
+                .unwrap_or("")
         );
         return None;
     }

@@ -93,9 +93,8 @@ impl Field<'_> {
         let f = out[..n].to_vec();
         let g = (0..n)
             .map(|m| {
-                [0, 1, 2].map(|a| {
-                    (out[(1 + 2 * a) * n + m] - out[(2 + 2 * a) * n + m]) / (2.0 * self.h)
-                })
+                [0, 1, 2]
+                    .map(|a| (out[(1 + 2 * a) * n + m] - out[(2 + 2 * a) * n + m]) / (2.0 * self.h))
             })
             .collect();
         (f, g)
@@ -139,7 +138,8 @@ pub fn optimize(surface: &mut Surface, ssa: &Ssa, grid: &Grid, iterations: u32) 
     };
     let nv = surface.positions.len();
     let tol = cell * 1e-6;
-    let on_box = |p: P| (0..3).any(|a| (p[a] - bounds.0[a]).abs() < tol || (p[a] - bounds.1[a]).abs() < tol);
+    let on_box =
+        |p: P| (0..3).any(|a| (p[a] - bounds.0[a]).abs() < tol || (p[a] - bounds.1[a]).abs() < tol);
     let fixed_box: Vec<bool> = surface.positions.iter().map(|&p| on_box(p)).collect();
     let crease = snap_creases(surface, &field, &fixed_box);
     let fixed: Vec<bool> = (0..nv).map(|v| fixed_box[v] || crease[v]).collect();
@@ -172,14 +172,19 @@ fn snap_creases(surface: &mut Surface, field: &Field, fixed: &[bool]) -> Vec<boo
     if candidates.is_empty() {
         return vec![false; nv];
     }
-    let mut q: Vec<P> = candidates.iter().map(|&(_, a, _)| surface.positions[a]).collect();
-    for _ in 0..4 {
+    let mut q: Vec<P> = candidates
+        .iter()
+        .map(|&(_, a, _)| surface.positions[a])
+        .collect();
+    // The first step linearises at the two vertices themselves; later ones
+    // ever closer to the current estimate, still on each vertex's side.
+    for t in [1.0, 0.3, 0.1, 0.05, 0.02] {
         let side = |c: &[(f64, usize, usize)], which: usize, q: &[P]| -> Vec<P> {
             c.iter()
                 .zip(q)
                 .map(|(&(_, a, b), &q)| {
                     let p = surface.positions[if which == 0 { a } else { b }];
-                    [0, 1, 2].map(|i| q[i] + 0.1 * (p[i] - q[i]))
+                    [0, 1, 2].map(|i| q[i] + t * (p[i] - q[i]))
                 })
                 .collect()
         };
@@ -202,7 +207,11 @@ fn snap_creases(surface: &mut Surface, field: &Field, fixed: &[bool]) -> Vec<boo
     let reach = 0.5 * mean_edge(surface);
     for (m, c) in candidates.iter_mut().enumerate() {
         let d = norm(sub(q[m], surface.positions[c.1]));
-        c.0 = if d.is_finite() && d < reach { d } else { f64::INFINITY };
+        c.0 = if d.is_finite() && d < reach {
+            d
+        } else {
+            f64::INFINITY
+        };
     }
     let mut order: Vec<usize> = (0..candidates.len()).collect();
     order.sort_by(|&x, &y| candidates[x].0.total_cmp(&candidates[y].0).then(x.cmp(&y)));
@@ -231,7 +240,10 @@ fn snap_creases(surface: &mut Surface, field: &Field, fixed: &[bool]) -> Vec<boo
 fn mean_edge(surface: &Surface) -> f64 {
     let mut sum = 0.0;
     for t in &surface.triangles {
-        sum += norm(sub(surface.positions[t[0] as usize], surface.positions[t[1] as usize]));
+        sum += norm(sub(
+            surface.positions[t[0] as usize],
+            surface.positions[t[1] as usize],
+        ));
     }
     sum / surface.triangles.len().max(1) as f64
 }
@@ -242,7 +254,8 @@ fn edge_key(a: u32, b: u32) -> (u32, u32) {
 
 /// One pass of angle-improving flips between nearly coplanar triangles.
 fn flip_edges(surface: &mut Surface) {
-    let mut edges: HashMap<(u32, u32), [u32; 2]> = HashMap::with_capacity(surface.triangles.len() * 2);
+    let mut edges: HashMap<(u32, u32), [u32; 2]> =
+        HashMap::with_capacity(surface.triangles.len() * 2);
     for (ti, t) in surface.triangles.iter().enumerate() {
         for k in 0..3 {
             let e = edge_key(t[k], t[(k + 1) % 3]);
@@ -258,17 +271,24 @@ fn flip_edges(surface: &mut Surface) {
     keys.sort_unstable();
     let pos = |s: &Surface, i: u32| s.positions[i as usize];
     for e in keys {
-        let Some(&[t0, t1]) = edges.get(&e) else { continue };
+        let Some(&[t0, t1]) = edges.get(&e) else {
+            continue;
+        };
         if t1 == u32::MAX {
             continue;
         }
         let (a, b) = e;
-        let (ta, tb) = (surface.triangles[t0 as usize], surface.triangles[t1 as usize]);
+        let (ta, tb) = (
+            surface.triangles[t0 as usize],
+            surface.triangles[t1 as usize],
+        );
         // Still adjacent over (a, b)? (Earlier flips may have changed them.)
         let third = |t: [u32; 3]| {
             (t.contains(&a) && t.contains(&b)).then(|| t.into_iter().find(|&v| v != a && v != b))
         };
-        let (Some(Some(c)), Some(Some(d))) = (third(ta), third(tb)) else { continue };
+        let (Some(Some(c)), Some(Some(d))) = (third(ta), third(tb)) else {
+            continue;
+        };
         if c == d || edges.contains_key(&edge_key(c, d)) {
             continue;
         }
@@ -281,10 +301,26 @@ fn flip_edges(surface: &mut Surface) {
         let (p, q) = if ta[(k + 1) % 3] == b { (a, b) } else { (b, a) };
         // ta = (p, q, c), tb = (q, p, d) → (p, d, c), (q, c, d).
         let (n0, n1) = ([p, d, c], [q, c, d]);
-        let before = min_angle(pos(surface, ta[0]), pos(surface, ta[1]), pos(surface, ta[2]))
-            .min(min_angle(pos(surface, tb[0]), pos(surface, tb[1]), pos(surface, tb[2])));
-        let after = min_angle(pos(surface, n0[0]), pos(surface, n0[1]), pos(surface, n0[2]))
-            .min(min_angle(pos(surface, n1[0]), pos(surface, n1[1]), pos(surface, n1[2])));
+        let before = min_angle(
+            pos(surface, ta[0]),
+            pos(surface, ta[1]),
+            pos(surface, ta[2]),
+        )
+        .min(min_angle(
+            pos(surface, tb[0]),
+            pos(surface, tb[1]),
+            pos(surface, tb[2]),
+        ));
+        let after = min_angle(
+            pos(surface, n0[0]),
+            pos(surface, n0[1]),
+            pos(surface, n0[2]),
+        )
+        .min(min_angle(
+            pos(surface, n1[0]),
+            pos(surface, n1[1]),
+            pos(surface, n1[2]),
+        ));
         let (m0, m1) = (unit(tri_normal(surface, n0)), unit(tri_normal(surface, n1)));
         if after <= before + 1e-9 || dot(m0, na) < FLAT_COS || dot(m1, na) < FLAT_COS {
             continue;
@@ -346,7 +382,11 @@ fn smooth(surface: &mut Surface, field: &Field, fixed: &[bool], cell: f64) {
     }
     field.project(&mut pts, 3);
     let before = surface.positions.clone();
-    let normals: Vec<P> = surface.triangles.iter().map(|t| tri_normal(surface, *t)).collect();
+    let normals: Vec<P> = surface
+        .triangles
+        .iter()
+        .map(|t| tri_normal(surface, *t))
+        .collect();
     for (m, &v) in moved.iter().enumerate() {
         if pts[m].iter().all(|x| x.is_finite()) {
             surface.positions[v] = pts[m];

@@ -350,7 +350,13 @@ fn plane_vertices(
         }
         let key = keys[order[start]] as usize / 3;
         if let Block::Mixed(kernel) = field.block(key % n1[0], key / n1[0], k) {
-            refine(&kernel.tape, &order[start..end], &ends, &mut t, options.iterations);
+            refine(
+                &kernel.tape,
+                &order[start..end],
+                &ends,
+                &mut t,
+                options.iterations,
+            );
         }
         start = end;
     }
@@ -677,12 +683,15 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
         .iter()
         .flat_map(|p| p.positions.iter().copied())
         .collect();
-    let dense = |k: usize| {
-        let mut map = vec![u32::MAX; n1[0] * n1[1] * 3];
-        for (m, &key) in planes[k].keys.iter().enumerate() {
-            map[key as usize] = offsets[k] + m as u32;
+    // Edge key → vertex id for one plane, in a buffer reused per thread
+    // (only the entries set are cleared afterwards).
+    let fill = |map: &mut Vec<u32>, k: usize, on: bool| {
+        if map.is_empty() {
+            map.resize(n1[0] * n1[1] * 3, u32::MAX);
         }
-        map
+        for (m, &key) in planes[k].keys.iter().enumerate() {
+            map[key as usize] = if on { offsets[k] + m as u32 } else { u32::MAX };
+        }
     };
     let touches_box = |i: usize, j: usize, k: usize| {
         let b = [i / BS, j / BS, k / BS];
@@ -690,45 +699,52 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
     };
     let slabs: Vec<SlabOutput> = (0..grid.cells[2])
         .into_par_iter()
-        .map(|k| {
-            let maps = [dense(k), dense(k + 1)];
-            let mut tris = Vec::new();
-            let mut centres = Vec::new();
-            let mut ids = Vec::with_capacity(12);
-            for j in 0..grid.cells[1] {
-                for i in 0..grid.cells[0] {
-                    match field.block(i, j, k) {
-                        Block::Outside => continue,
-                        Block::Inside if !(options.close_at_box && touches_box(i, j, k)) => {
+        .map_init(
+            || [Vec::new(), Vec::new()],
+            |maps, k| {
+                fill(&mut maps[0], k, true);
+                fill(&mut maps[1], k + 1, true);
+                let mut tris = Vec::new();
+                let mut centres = Vec::new();
+                let mut ids = Vec::with_capacity(12);
+                for j in 0..grid.cells[1] {
+                    for i in 0..grid.cells[0] {
+                        match field.block(i, j, k) {
+                            Block::Outside => continue,
+                            Block::Inside if !(options.close_at_box && touches_box(i, j, k)) => {
+                                continue;
+                            }
+                            _ => {}
+                        }
+                        let v: [f64; 8] = std::array::from_fn(|c| {
+                            field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))]
+                                as f64
+                        });
+                        let first = v[0] > 0.0;
+                        if v.iter().all(|&x| (x > 0.0) == first) {
                             continue;
                         }
-                        _ => {}
-                    }
-                    let v: [f64; 8] = std::array::from_fn(|c| {
-                        field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] as f64
-                    });
-                    let first = v[0] > 0.0;
-                    if v.iter().all(|&x| (x > 0.0) == first) {
-                        continue;
-                    }
-                    for cycle in cell_cycles(&v) {
-                        ids.clear();
-                        for &e in &cycle {
-                            let (a, b) = EDGES[e as usize];
-                            let axis = (a ^ b).trailing_zeros() as usize;
-                            let (a, dz) = (a as usize, (a as usize >> 2) & 1);
-                            let key = ((j + (a >> 1 & 1)) * n1[0] + i + (a & 1)) * 3 + axis;
-                            ids.push(maps[dz][key]);
+                        for cycle in cell_cycles(&v) {
+                            ids.clear();
+                            for &e in &cycle {
+                                let (a, b) = EDGES[e as usize];
+                                let axis = (a ^ b).trailing_zeros() as usize;
+                                let (a, dz) = (a as usize, (a as usize >> 2) & 1);
+                                let key = ((j + (a >> 1 & 1)) * n1[0] + i + (a & 1)) * 3 + axis;
+                                ids.push(maps[dz][key]);
+                            }
+                            if ids.contains(&u32::MAX) {
+                                continue;
+                            }
+                            triangulate(&cycle, &ids, &positions, &mut tris, &mut centres);
                         }
-                        if ids.contains(&u32::MAX) {
-                            continue;
-                        }
-                        triangulate(&cycle, &ids, &positions, &mut tris, &mut centres);
                     }
                 }
-            }
-            (tris, centres)
-        })
+                fill(&mut maps[0], k, false);
+                fill(&mut maps[1], k + 1, false);
+                (tris, centres)
+            },
+        )
         .collect();
     let mut positions = positions;
     let mut triangles = Vec::with_capacity(slabs.iter().map(|s| s.0.len()).sum());

@@ -275,7 +275,12 @@ fn run_generic(lane: &[LaneInstr], ws: &mut RowWorkspace) {
 
 /// One lane loop with each operand either a lane slot (Ok) or a scalar (Err).
 #[inline(always)]
-fn each2(o: &mut [f32], a: Result<&[f32], f32>, b: Result<&[f32], f32>, f: impl Fn(f32, f32) -> f32) {
+fn each2(
+    o: &mut [f32],
+    a: Result<&[f32], f32>,
+    b: Result<&[f32], f32>,
+    f: impl Fn(f32, f32) -> f32,
+) {
     match (a, b) {
         (Ok(a), Ok(b)) => {
             for ((o, &a), &b) in o.iter_mut().zip(a).zip(b) {
@@ -350,7 +355,11 @@ mod tests {
             tape.eval_row(&mut ws, y, z, &mut out);
             for (i, &x) in xs.iter().enumerate() {
                 let want = ssa.eval_point([x, y, z]);
-                assert!((out[i] as f64 - want).abs() < 1e-5, "{x} {y} {z}: {} vs {want}", out[i]);
+                assert!(
+                    (out[i] as f64 - want).abs() < 1e-5,
+                    "{x} {y} {z}: {} vs {want}",
+                    out[i]
+                );
             }
         }
         // A function of y only fills the row with one value.
