@@ -92,6 +92,9 @@ fn m3() -> Ssa {
     Ssa::from_ctx(&ctx, f.expect("1000 balls"))
 }
 
+/// A model's name and its builder.
+type Model = (&'static str, fn() -> Ssa);
+
 fn median(mut runs: Vec<Duration>) -> Duration {
     runs.sort();
     runs[runs.len() / 2]
@@ -228,7 +231,7 @@ fn main() {
         max: [1.0; 3],
         cells: [n; 3],
     };
-    let models: [(&str, fn() -> Ssa); 3] = [
+    let models: [Model; 3] = [
         ("M1 seven balls", m1),
         ("M2 gyroid in ball", m2),
         ("M3 1,000 balls", m3),

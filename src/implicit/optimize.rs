@@ -28,6 +28,9 @@ type P = [f64; 3];
 fn sub(a: P, b: P) -> P {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
+fn add(a: P, b: P) -> P {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
 fn dot(a: P, b: P) -> f64 {
     a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
 }
@@ -343,6 +346,7 @@ fn flip_edges(surface: &mut Surface) {
 }
 
 /// Tangential smoothing towards the 1-ring centroid, then re-projection.
+#[allow(clippy::needless_range_loop)] // v indexes five per-vertex arrays
 fn smooth(surface: &mut Surface, field: &Field, fixed: &[bool], cell: f64) {
     let nv = surface.positions.len();
     let mut sum = vec![[0.0; 3]; nv];
@@ -353,15 +357,10 @@ fn smooth(surface: &mut Surface, field: &Field, fixed: &[bool], cell: f64) {
         for k in 0..3 {
             let (v, w) = (t[k] as usize, t[(k + 1) % 3] as usize);
             for (x, y) in [(v, w), (w, v)] {
-                let p = surface.positions[y];
-                for i in 0..3 {
-                    sum[x][i] += p[i];
-                }
+                sum[x] = add(sum[x], surface.positions[y]);
                 count[x] += 1;
             }
-            for i in 0..3 {
-                normal[v][i] += n[i];
-            }
+            normal[v] = add(normal[v], n);
         }
     }
     let mut moved: Vec<usize> = Vec::new();

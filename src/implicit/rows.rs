@@ -92,12 +92,12 @@ impl RowTape {
         let mut slot_of = vec![u32::MAX; n];
         let mut slots = 0u32;
         // x-only nodes get slots of their own (filled once per x set).
-        for (i, _) in ssa.ops.iter().enumerate() {
-            if mask[i] == X {
+        for (i, &m) in mask.iter().enumerate() {
+            if m == X {
                 slot_of[i] = slots;
                 x_nodes.push((i as u32, slots));
                 slots += 1;
-            } else if mask[i] & X == 0 {
+            } else if m & X == 0 {
                 row_nodes.push(i as u32);
             }
         }
