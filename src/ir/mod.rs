@@ -18,7 +18,7 @@ mod source_map;
 
 pub use fragments::{Fragment, Side, derive_fragments};
 pub use incidence::{Incidence, IncidenceMatrices};
-pub use source_map::{Origin, SourceMap};
+pub use source_map::{DenseId, IdMap, Origin, SourceMap};
 
 use crate::geom::{Aabb, Curve, Point3, SolidShape, Surface};
 

@@ -20,7 +20,7 @@ use crate::ir::{
 };
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
-use std::collections::HashMap;
+use foldhash::HashMap;
 
 /// The model and its side table of source positions.
 #[derive(Debug, Clone)]
@@ -40,7 +40,7 @@ pub(crate) struct Entities {
     pub solids: HashMap<String, Vec<SolidId>>,
     /// Objects that failed to resolve (already reported): references to them
     /// are not reported again.
-    pub failed: std::collections::HashSet<String>,
+    pub failed: foldhash::HashSet<String>,
 }
 
 impl Entities {
