@@ -33,7 +33,7 @@ const NOT_COVERED_BY_FIXTURES: &[&str] = &[
     "E610", // string used as a number
     "E611", // no return
     "W130", // unknown Geom field
-    "W131", // optiterations not applied
+    "W131", // optiterations not applied: retired, optimisation is applied now
     // XML implicit solids (issue 5): compile-time only; tests/implicit_xml.rs.
     "E624", // invalid --section
     "W133", // section plane misses a subdomain

@@ -36,15 +36,8 @@ pub fn compile(source: &SourceFile) -> (Option<ImplicitModel>, Diagnostics) {
         }
     };
     let geom = expand::read_geom(&program, &mut diags);
-    if geom.optiterations > 0 {
-        if let Some(span) = geom.optiterations_span {
-            diags.push(Diagnostic::new(
-                Code::RfsOptimizeIgnored,
-                span,
-                format!("Geom.optiterations = {}: mesh optimisation is not implemented yet; triangles are written as polygonized", geom.optiterations),
-            ));
-        }
-    }
+    // Geom.optiterations is applied by `ImplicitModel::polygonize` (W131 is
+    // no longer emitted).
     let expanded = if diags.has_errors() {
         None
     } else {

@@ -110,14 +110,8 @@ pub fn geom(
     match constant(e, "optiterations", env, used, diags) {
         Some(Some(v)) if v.fract() == 0.0 && (0.0..=1000.0).contains(&v) => {
             geom.optiterations = v as u32;
-            if let Some(a) = e.attribute("optiterations").filter(|_| v > 0.0) {
-                geom.optiterations_span = Some(a.value_span);
-                diags.push(Diagnostic::new(
-                    Code::RfsOptimizeIgnored,
-                    a.value_span,
-                    format!("optiterations = {v}: mesh optimisation is not applied by this geomc; triangles are written as polygonized"),
-                ));
-            }
+            // Applied by `ImplicitModel::polygonize` (W131 is retired).
+            geom.optiterations_span = e.attribute("optiterations").map(|a| a.value_span);
         }
         Some(Some(v)) => {
             let span = e.attribute("optiterations").map(|a| a.value_span);
