@@ -96,3 +96,177 @@ fn xml_front_end_crashes_stay_fixed() {
         }
     }
 }
+
+/// The `triangulate` target's decoding (fuzz/fuzz_targets/triangulate.rs):
+/// flags, corner count, corners and poly_line segments on a 1/4096 grid.
+struct Triangulate {
+    polygon: Vec<[f64; 2]>,
+    segments: Vec<[[f64; 2]; 2]>,
+    options: geomc::meshing::MeshOptions,
+}
+
+fn decode_triangulate(data: &[u8]) -> Triangulate {
+    let mut bytes = data.iter().copied();
+    let mut u8 = || bytes.next().unwrap_or(0);
+    let flags = u8();
+    let count = 3 + usize::from(u8() % 10);
+    let mut point = || {
+        let mut c = || f64::from(i16::from_le_bytes([u8(), u8()])) / 4096.0;
+        [c(), c()]
+    };
+    let polygon: Vec<[f64; 2]> = (0..count).map(|_| point()).collect();
+    let segments = (0..usize::from(flags >> 6))
+        .map(|_| [point(), point()])
+        .collect();
+    let extent = ["x", "y"]
+        .iter()
+        .enumerate()
+        .map(|(k, _)| {
+            let values = polygon.iter().map(|p| p[k]);
+            values.clone().fold(f64::NEG_INFINITY, f64::max) - values.fold(f64::INFINITY, f64::min)
+        })
+        .fold(0.0, f64::max);
+    let options = geomc::meshing::MeshOptions {
+        min_angle_degrees: [0.0, 15.0, 20.0, 25.0][usize::from(flags & 3)],
+        max_area: Some((extent * extent / f64::from(8 + (flags >> 2 & 15) * 32)).max(1e-6)),
+        order: 1 + (flags >> 2 & 1),
+        ..geomc::meshing::MeshOptions::default()
+    };
+    Triangulate {
+        polygon,
+        segments,
+        options,
+    }
+}
+
+fn triangulate_xml(input: &Triangulate) -> String {
+    use std::fmt::Write;
+    let mut xml = String::from(r#"<geometry version="1" dimension="2"><polygon name="p">"#);
+    for [x, y] in &input.polygon {
+        let _ = write!(xml, r#"<vertex x="{x}" y="{y}"/>"#);
+    }
+    xml.push_str("</polygon>");
+    if !input.segments.is_empty() {
+        xml.push_str(r#"<poly_line name="cut">"#);
+        for [[x0, y0], [x1, y1]] in &input.segments {
+            let _ = write!(
+                xml,
+                r#"<line><begin_point x="{x0}" y="{y0}"/><end_point x="{x1}" y="{y1}"/></line>"#
+            );
+        }
+        xml.push_str("</poly_line>");
+    }
+    xml.push_str(r#"<subdomain name="inside"><solid ref="p"/></subdomain></geometry>"#);
+    xml
+}
+
+/// The angle at `o` between the rays to `a` and `b`, in degrees.
+fn corner_angle(o: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let (u, v) = ([a[0] - o[0], a[1] - o[1]], [b[0] - o[0], b[1] - o[1]]);
+    (u[0] * v[1] - u[1] * v[0])
+        .abs()
+        .atan2(u[0] * v[0] + u[1] * v[1])
+        .to_degrees()
+}
+
+/// The smallest angle of triangle pqr, in degrees.
+fn smallest_angle(p: [f64; 2], q: [f64; 2], r: [f64; 2]) -> f64 {
+    corner_angle(p, q, r)
+        .min(corner_angle(q, r, p))
+        .min(corner_angle(r, p, q))
+}
+
+/// True when `p` lies on segment ab (to rounding).
+fn on_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> bool {
+    let (d, e) = ([b[0] - a[0], b[1] - a[1]], [p[0] - a[0], p[1] - a[1]]);
+    let len2 = d[0] * d[0] + d[1] * d[1];
+    let t = (e[0] * d[0] + e[1] * d[1]) / len2;
+    let off = (e[0] * d[1] - e[1] * d[0]).abs() / len2.sqrt();
+    (-1e-12..=1.0 + 1e-12).contains(&t) && off <= 1e-9 * len2.sqrt()
+}
+
+/// Thin polygons (a 0.02° corner) once refined to spade's 200,000-vertex
+/// budget for minutes: they now mesh small, covering the polygon, and every
+/// triangle keeps the minimum angle unless all its corners lie on the two
+/// sides of a polygon corner smaller than it (Triangle's exception,
+/// docs/reliability.md).
+#[test]
+fn thin_polygons_mesh_small_and_keep_angles_away_from_small_corners() {
+    let found = inputs("triangulate");
+    assert_eq!(found.len(), 3, "triangulate regression inputs");
+    let mut meshed = 0;
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
+        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let Some(lowered) = checked
+            .lowered
+            .filter(|_| checked.diagnostics.items.is_empty())
+        else {
+            continue;
+        };
+        let mesh = geomc::meshing::mesh_model(&lowered.model, &input.options)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        geomc::meshing::sanity_check(&mesh).expect("a sane mesh");
+        let limit = input.options.min_angle_degrees;
+        let n = input.polygon.len();
+        // The sides of each corner below the limit.
+        let exempt_sides: Vec<[[f64; 2]; 3]> = (0..n)
+            .filter_map(|i| {
+                let (prev, at, next) = (
+                    input.polygon[(i + n - 1) % n],
+                    input.polygon[i],
+                    input.polygon[(i + 1) % n],
+                );
+                (corner_angle(at, prev, next) < limit).then_some([prev, at, next])
+            })
+            .collect();
+        let exempt = |p: [f64; 2]| {
+            exempt_sides
+                .iter()
+                .any(|[a, o, b]| on_segment(p, *o, *a) || on_segment(p, *o, *b))
+        };
+        let node = |i: u32| {
+            let p = mesh.nodes[i as usize];
+            [p[0], p[1]]
+        };
+        let (mut triangles, mut area, mut worst) = (0, 0.0, 180.0f64);
+        for &[a, b, c] in mesh.faces.iter().flat_map(|f| f.triangles.iter()) {
+            let (p, q, r) = (node(a), node(b), node(c));
+            triangles += 1;
+            area += ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])).abs() / 2.0;
+            if !(exempt(p) && exempt(q) && exempt(r)) {
+                worst = worst.min(smallest_angle(p, q, r));
+            }
+        }
+        let polygon_area = (0..n)
+            .map(|i| {
+                let (p, q) = (input.polygon[i], input.polygon[(i + 1) % n]);
+                p[0] * q[1] - q[0] * p[1]
+            })
+            .sum::<f64>()
+            .abs()
+            / 2.0;
+        eprintln!(
+            "{}: {triangles} triangles, worst non-exempt angle {worst:.2}°",
+            path.display()
+        );
+        assert!(
+            (1..=5_000).contains(&triangles),
+            "{}: {triangles} triangles",
+            path.display()
+        );
+        assert!(
+            (area - polygon_area).abs() <= 1e-9 * polygon_area.max(1e-12),
+            "{}: triangles cover {area}, the polygon {polygon_area}",
+            path.display()
+        );
+        assert!(
+            worst >= limit - 1e-9,
+            "{}: {worst}° < {limit}°",
+            path.display()
+        );
+        meshed += 1;
+    }
+    assert!(meshed >= 2, "{meshed} of the thin polygons meshed");
+}

@@ -201,17 +201,26 @@ pub(crate) fn mesh_face(
         .collect();
     let fixed = cdt.num_vertices();
 
+    let small_angle = has_small_input_angle(&cdt, settings.min_angle);
     let mut parameters = RefinementParameters::<f64>::new()
         // Spade's peeling takes an open poly_line for a loop: with poly_lines
         // the outside is found here instead (`outside_faces`).
         .exclude_outer_faces(polyline_segments.is_empty())
         .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
-        .with_max_additional_vertices(vertex_budget(&uv_loops, settings.max_area));
+        .with_max_additional_vertices(vertex_budget(&uv_loops, settings, small_angle));
     if settings.keep_boundary {
         parameters = parameters.keep_constraint_edges();
     }
     if settings.max_area.is_finite() {
         parameters = parameters.with_max_allowed_area(settings.max_area);
+    }
+    // Next to an input angle below the limit no triangle can meet it, and
+    // chasing it ran to the vertex budget (a 0.02° sliver took minutes): in
+    // such a face, triangles smaller than the tolerance squared (below the
+    // model's resolution) are not refined for their angles, and the budget
+    // follows from that size (`vertex_budget`).
+    if small_angle {
+        parameters = parameters.with_min_required_area(settings.tolerance * settings.tolerance);
     }
     let mut inner = Vec::new();
     // Triangles (by their corner nodes, which never move) already found
@@ -220,6 +229,16 @@ pub(crate) fn mesh_face(
     let deviation = Deviation::of(&face.surface);
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
+        if small_angle && !result.refinement_complete && !settings.keep_boundary {
+            // Segments at a tiny angle split each other without end, and
+            // each round would start over from the splits sent back: mesh
+            // the face against its boundary as it is instead.
+            let keep = Settings {
+                keep_boundary: true,
+                ..*settings
+            };
+            return mesh_face(model, face, edges, &keep, constraints);
+        }
         if !settings.keep_boundary {
             // Only this pass's vertices: earlier ones were checked in their pass.
             let new = positions.len().max(fixed);
@@ -487,17 +506,51 @@ fn boundary_splits(
     Ok(splits)
 }
 
+/// True when two constraint segments (loop or poly_line) meet at a vertex at
+/// an angle below `min_angle` degrees.
+fn has_small_input_angle(cdt: &Cdt, min_angle: f64) -> bool {
+    let limit = min_angle.to_radians();
+    cdt.vertices().any(|v| {
+        let p = v.position();
+        let directions: Vec<f64> = v
+            .out_edges()
+            .filter(|e| e.is_constraint_edge())
+            .map(|e| {
+                let q = e.to().position();
+                (q.y - p.y).atan2(q.x - p.x)
+            })
+            .collect();
+        directions.iter().enumerate().any(|(i, a)| {
+            directions[i + 1..].iter().any(|b| {
+                let gap = (a - b).abs();
+                gap.min(std::f64::consts::TAU - gap) < limit
+            })
+        })
+    })
+}
+
 /// Points one refinement call may add: enough for the area limit (about two
 /// triangles per vertex, with room for grading), at least 200,000 (spade's
-/// guard against non-termination), at most the face's node limit.
-fn vertex_budget(uv_loops: &[Vec<[f64; 2]>], max_area: f64) -> usize {
+/// guard against non-termination), at most the face's node limit. A face
+/// with an input angle below the minimum gets four points per
+/// tolerance-squared of its area (the smallest triangle refined for its
+/// angles there) and 1,000 more instead of the 200,000 floor: segments
+/// meeting at a tiny angle keep encroaching each other, which no area
+/// threshold stops.
+fn vertex_budget(uv_loops: &[Vec<[f64; 2]>], settings: &Settings, small_angle: bool) -> usize {
     let area = uv_loops.iter().map(|lp| shoelace(lp)).sum::<f64>().abs() / 2.0;
-    let wanted = if max_area.is_finite() {
-        (2.0 * area / max_area).min(MAX_FACE_VERTICES as f64) as usize
+    let for_area = if settings.max_area.is_finite() {
+        2.0 * area / settings.max_area
     } else {
-        0
+        0.0
     };
-    wanted.clamp(200_000, MAX_FACE_VERTICES)
+    let cap = MAX_FACE_VERTICES as f64;
+    if small_angle {
+        let for_angles = 1_000.0 + 4.0 * area / (settings.tolerance * settings.tolerance);
+        (for_area + for_angles).min(cap) as usize
+    } else {
+        for_area.clamp(200_000.0, cap) as usize
+    }
 }
 
 /// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and

@@ -10,7 +10,8 @@
 //! - Chordal deviation ≤ tolerance on edges (≤ half of it) and faces;
 //!   planar faces have angles ≥ `min_angle_degrees` except where their own
 //!   loops meet at smaller angles (or the last round had to forbid boundary
-//!   splits).
+//!   splits); in a face with such an angle, refinement work is bounded
+//!   (`face::vertex_budget`) and triangles below tolerance² are left.
 //! - Deterministic: the same model and options give the same mesh.
 //!
 //! # Limitations
