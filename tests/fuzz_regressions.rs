@@ -192,14 +192,12 @@ fn on_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> bool {
 /// area is below tolerance². Returns the triangle count and the
 /// smallest checked angle.
 fn mesh_thin(label: &str, input: &Triangulate) -> Option<(usize, f64)> {
-    let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
+    let source = SourceFile::new("fuzz.xml", triangulate_xml(input));
     let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
-    let Some(lowered) = checked
-        .lowered
-        .filter(|_| checked.diagnostics.items.is_empty())
-    else {
+    if !checked.is_valid() {
         return None;
-    };
+    }
+    let lowered = checked.lowered?;
     let mesh = geomc::meshing::mesh_model(&lowered.model, &input.options)
         .unwrap_or_else(|e| panic!("{}: {e}", label));
     geomc::meshing::sanity_check(&mesh).expect("a sane mesh");
