@@ -199,8 +199,8 @@ codes! {
         "Every function must end with `return <expression>;`. Add the return statement.";
     RfsUnknownGeomField = "W130", Warning, "unknown Geom field",
         "This Geom field is not one geomc uses (dimension, x_min, x_max, y_min, y_max, z_min, z_max, nx, ny, nz, name, optiterations, rsystem, alpha); it is ignored. Check the spelling.";
-    RfsOptimizeIgnored = "W131", Warning, "mesh optimisation iterations not applied",
-        "Geom.optiterations asks for mesh optimisation (edge flips and smoothing); this geomc does not implement it yet, so the marching-cubes triangles are written as they are.";
+    RfsOptimizeIgnored = "W131", Warning, "mesh optimisation iterations not applied (retired: optimisation is applied)",
+        "Retired: earlier versions warned that Geom.optiterations was not applied. geomc now applies it (edge flips and tangential smoothing with re-projection onto the surface), so this warning is no longer given; the code keeps its meaning and is not reused.";
 
     // ---- compile (issue 3) ----
     InternalMeshingFailure = "E500", Error, "internal meshing failure",
