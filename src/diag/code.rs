@@ -303,6 +303,12 @@ codes! {
         "The picture is too short to name every colour group, so the legend ends with '... and N more'. Make the picture taller with --size, or colour by subdomain (--color-by subdomain) to have fewer groups.";
     RenderSectionEmpty = "W171", Warning, "section leaves nothing to draw",
         "The section plane lies below the whole model, so everything was cut away and the picture is empty. Pick a value inside the model's extent (geomc inspect prints the bounding box).";
+
+    // ---- trimmed parametric surfaces (issue 9, branch trim) ----
+    TrimmedCarrierInvalid = "E740", Error, "invalid parametric surface",
+        "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
+    TrimmedUnknownVariable = "E741", Error, "unknown variable in a surface or trim expression",
+        "The coordinates of a parametric_surface are expressions in u and v, and a trim's equation is an expression in the global x, y and z; other names must be parameters or basis coordinates. Rename the variable or define the parameter.";
 }
 
 impl Code {
