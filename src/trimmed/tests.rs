@@ -189,12 +189,83 @@ fn untrimmed_full_cone_closes_its_seam() {
         m.boundary.iter().map(|c| c.len()).collect::<Vec<_>>()
     );
     let q = m.quality(&s);
-    assert!(q.min_angle >= 25.0 - 1e-6, "{q:?}");
+    assert!(q.min_angle >= 25.0, "{q:?}");
+    assert!(q.max_centroid_distance <= 0.01, "{q:?}");
     let slant = (3.0f64 * 3.0 + 0.25).sqrt();
     let exact = std::f64::consts::PI * (2.0 + 1.5) * slant;
     assert!(
         (q.area - exact).abs() / exact < 2e-3,
         "{} vs {exact}",
+        q.area
+    );
+}
+
+/// The interstage fixture: a cone with rounded-rectangle and bounded-cylinder
+/// cut-outs, one of them across the seam v = 0.
+#[test]
+fn interstage_cone_with_cut_outs() {
+    let source = crate::span::SourceFile::new(
+        "trimmed_interstage.xml",
+        include_str!("../../fixtures/valid/trimmed_interstage.xml"),
+    );
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    assert!(checked.is_valid(), "{:?}", checked.diagnostics);
+    let model = &checked.lowered.as_ref().expect("lowered").model;
+    assert_eq!(model.trimmed.len(), 1);
+    let s = &model.trimmed[0];
+    let settings = TrimSettings {
+        tolerance: 0.005,
+        min_angle: 20.0,
+        max_edge: f64::INFINITY,
+    };
+    let m = mesh_trimmed(s, settings).expect("meshable");
+    let boundary_segments = check_manifold(&m);
+    assert!(boundary_segments > 100, "{boundary_segments}");
+    let trim = s.trim.as_ref().expect("trim");
+    // Every boundary node is on a rim (y = 0 or 3) or on the trim's zero set.
+    let (mut rims, mut cuts) = (0.0, 0usize);
+    for chain in &m.boundary {
+        for w in chain.windows(2) {
+            let (a, b) = (m.nodes[w[0] as usize], m.nodes[w[1] as usize]);
+            if a.y.abs() < 1e-9 && b.y.abs() < 1e-9
+                || (a.y - 3.0).abs() < 1e-9 && (b.y - 3.0).abs() < 1e-9
+            {
+                rims += (b - a).norm();
+            }
+        }
+        for &i in chain {
+            let p = m.nodes[i as usize];
+            if p.y.abs() > 1e-9 && (p.y - 3.0).abs() > 1e-9 {
+                let f = trim.program.eval_point([p.x, p.y, p.z]);
+                assert!(f.abs() < 1e-8, "boundary node {p} has F = {f}");
+                cuts += 1;
+            }
+        }
+    }
+    assert!(cuts > 100, "{cuts} nodes on the cut-outs");
+    // The rims are whole circles (no cut-out reaches them), inscribed polygons.
+    let circles = std::f64::consts::TAU * (2.0 + 1.5);
+    assert!(
+        rims < circles && circles - rims < 0.01 * circles,
+        "{rims} vs {circles}"
+    );
+    let q = m.quality(s);
+    assert!(q.max_centroid_distance <= settings.tolerance, "{q:?}");
+    // The seam and the trim curves keep their boundary edges on a periodic
+    // surface: a few triangles beside them fall short of the threshold.
+    let below: usize = q.histogram[..4].iter().sum();
+    assert!(
+        below * 200 < m.triangles.len(),
+        "{below} of {} below 20°: {q:?}",
+        m.triangles.len()
+    );
+    assert!(q.min_angle > 10.0, "{q:?}");
+    // Less area than the whole cone: the cut-outs took some.
+    let slant = (9.0f64 + 0.25).sqrt();
+    let whole = std::f64::consts::PI * 3.5 * slant;
+    assert!(
+        q.area < 0.97 * whole && q.area > 0.85 * whole,
+        "{} of {whole}",
         q.area
     );
 }

@@ -66,11 +66,14 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     let mut b = boundary::trace(s, [nu, nv])?;
     let cell = (lu / nu as f64).hypot(lv / nv as f64);
     b.merge_short(s, 0.4 * cell);
-    b.refine_chords(s, 0.5 * tol, h.max(0.5 * cell));
+    let periodic = is_periodic_v(s, extent);
+    // Boundary edges stay as they are on a periodic surface (both sides of
+    // the seam must match), so they start shorter there.
+    let side = if periodic { 0.5 * h } else { h.max(0.5 * cell) };
+    b.refine_chords(s, 0.5 * tol, side);
     if b.loops.is_empty() {
         return Err("the trim leaves no material on the surface".into());
     }
-    let periodic = is_periodic_v(s, extent);
     let chart = |uv: [f64; 2]| {
         let c = arc.to_chart(uv);
         Point2::new(c[0], c[1])
@@ -111,11 +114,15 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     // Spade stops after this many insertions (triangles of side ~h cover the
     // surface about 2·area/h² times over; room for grading near the trim).
     let budget = ((8.0 * lu * lv / (h * h)) as usize + 4 * uvs.len() + 1000).min(MAX_VERTICES);
-    let params = RefinementParameters::<f64>::new()
+    let mut params = RefinementParameters::<f64>::new()
         .exclude_outer_faces(true)
-        .keep_constraint_edges()
         .with_angle_limit(AngleLimit::from_deg((settings.min_angle + 3.0).min(30.0)))
         .with_max_additional_vertices(budget);
+    // A periodic seam must be split the same way on both sides: keep its
+    // edges (and the trim's) as they are.
+    if periodic {
+        params = params.keep_constraint_edges();
+    }
     let mut points3: Vec<Point3> = uvs.iter().map(|p| s.point(p[0], p[1])).collect();
     let mut inner: Vec<[usize; 3]> = Vec::new();
     // Triangles this small are left as they are (next to small input angles).
@@ -155,13 +162,6 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
                 inserts.push((point, f.vertices()[0].fix()));
             }
         }
-        if std::env::var_os("GEOMC_TRIM_DEBUG").is_some() {
-            eprintln!(
-                "pass: {} vertices, {} inserts",
-                cdt.num_vertices(),
-                inserts.len()
-            );
-        }
         if inserts.is_empty() {
             break;
         }
@@ -171,6 +171,9 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             ));
         }
         for (uv, hint) in inserts {
+            if encroaches(&cdt, chart(uv), hint) {
+                continue;
+            }
             let h = cdt
                 .insert_with_hint(chart(uv), hint)
                 .map_err(|e| format!("a refinement point cannot be inserted: {e:?}"))?;
@@ -190,6 +193,23 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             c
         })
         .collect();
+    if !periodic {
+        let mut sides = vec![0u8; uvs.len()];
+        for (p, &h) in handles.iter().enumerate() {
+            if h != usize::MAX {
+                sides[h] = b.sides[p];
+            }
+        }
+        snap_splits(
+            &cdt,
+            s,
+            fixed,
+            &sides,
+            &mut boundary_chains,
+            &mut uvs,
+            &mut points3,
+        );
+    }
     let mut remap: Vec<usize> = (0..uvs.len()).collect();
     if periodic {
         weld_seam(&b, &handles, &uvs, s.rect, &mut remap, &mut boundary_chains);
@@ -427,4 +447,109 @@ fn assemble(
         mesh.boundary.push(c);
     }
     mesh
+}
+
+/// True when `p` falls on a vertex or edge, or inside the diametral circle
+/// of a constraint edge of the triangle holding it: a point there would
+/// make a sliver against the boundary, which refinement keeps as it is.
+fn encroaches(cdt: &Cdt, p: Point2<f64>, hint: spade::handles::FixedVertexHandle) -> bool {
+    use spade::PositionInTriangulation::OnFace;
+    let OnFace(face) = cdt.locate_with_hint(p, hint) else {
+        return true;
+    };
+    cdt.face(face).adjacent_edges().iter().any(|e| {
+        if !cdt.is_constraint_edge(e.as_undirected().fix()) {
+            return false;
+        }
+        let [a, b] = e.positions();
+        let m = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
+        let r2 = 0.25 * ((a.x - b.x).powi(2) + (a.y - b.y).powi(2));
+        (p.x - m.x).powi(2) + (p.y - m.y).powi(2) < r2
+    })
+}
+
+/// Puts the boundary points spade added (splitting constraint edges at
+/// their chart midpoints) back on the boundary: on the side they split, or
+/// on W = 0; and threads them into the boundary chains.
+fn snap_splits(
+    cdt: &Cdt,
+    s: &TrimmedSurface,
+    fixed: usize,
+    sides: &[u8],
+    chains: &mut [Vec<usize>],
+    uvs: &mut [[f64; 2]],
+    points3: &mut [Point3],
+) {
+    let mut next: HashMap<usize, Vec<usize>> = HashMap::new();
+    for e in cdt.undirected_edges() {
+        if cdt.is_constraint_edge(e.fix()) {
+            let [a, b] = e.vertices().map(|v| v.fix().index());
+            next.entry(a).or_default().push(b);
+            next.entry(b).or_default().push(a);
+        }
+    }
+    for chain in chains.iter_mut() {
+        let mut out = Vec::with_capacity(chain.len());
+        for w in chain.windows(2) {
+            let (x, y) = (w[0], w[1]);
+            out.push(x);
+            let direct = next.get(&x).is_some_and(|n| n.contains(&y));
+            if direct {
+                continue;
+            }
+            // Walk from x through added points (each on two constraint edges) to y.
+            let starts: Vec<usize> = next.get(&x).map_or(Vec::new(), |n| {
+                n.iter().copied().filter(|&n| n >= fixed).collect()
+            });
+            for start in starts {
+                let mut path = vec![start];
+                let (mut prev, mut cur) = (x, start);
+                while cur >= fixed && path.len() <= uvs.len() {
+                    let Some(&n) = next.get(&cur).and_then(|n| n.iter().find(|&&n| n != prev))
+                    else {
+                        break;
+                    };
+                    prev = cur;
+                    cur = n;
+                    if cur >= fixed {
+                        path.push(cur);
+                    }
+                }
+                if cur == y {
+                    let (ux, uy) = (uvs[x], uvs[y]);
+                    let common = sides[x] & sides[y];
+                    for &p in &path {
+                        let uv = if common != 0 {
+                            snap_to_side(uvs[p], common, s.rect)
+                        } else {
+                            boundary::project(s, uvs[p], ux, uy)
+                        };
+                        uvs[p] = uv;
+                        points3[p] = s.point(uv[0], uv[1]);
+                    }
+                    out.extend(path);
+                    break;
+                }
+            }
+        }
+        out.push(*chain.last().unwrap_or(&0));
+        *chain = out;
+    }
+}
+
+fn snap_to_side(uv: [f64; 2], side: u8, rect: [f64; 4]) -> [f64; 2] {
+    let mut uv = uv;
+    if side & boundary::U_MIN != 0 {
+        uv[0] = rect[0];
+    }
+    if side & boundary::U_MAX != 0 {
+        uv[0] = rect[1];
+    }
+    if side & V_MIN != 0 {
+        uv[1] = rect[2];
+    }
+    if side & V_MAX != 0 {
+        uv[1] = rect[3];
+    }
+    uv
 }
