@@ -76,6 +76,11 @@ const NOT_COVERED_BY_FIXTURES: &[&str] = &[
     "E729", // meshing failed while rendering
     "W170", // the legend does not fit the picture's height
     "W171", // --section below the whole model (tests/render.rs)
+    // ---- resource limits (issue 10): compile/convert, tests/hostile_corpus.rs and tests/limits.rs ----
+    "E800", // implicit grid over --max-grid-cells
+    "E801", // mesh over --max-triangles
+    "E802", // a mesh file holding nothing
+    "E803", // an implicit solid without surface on its grid
 ];
 
 /// Command-line options an `args:` header may name, and whether each takes a value.

@@ -58,6 +58,8 @@ pub struct Args {
     input: InputOptions,
     #[command(flatten)]
     solver_mesh: super::solver_args::SolverMeshArgs,
+    #[command(flatten)]
+    budget: super::limits::Budget,
     /// Grid cells per axis for implicit (.rfs) inputs, overriding Geom.nx/ny/nz.
     #[arg(long, value_name = "N")]
     cells: Option<usize>,
@@ -129,6 +131,7 @@ pub fn run(args: &Args) -> i32 {
                     args.quiet,
                     args.cells,
                     preview.as_deref(),
+                    &args.budget,
                 );
                 if let Some(bar) = &progress {
                     bar.inc(1);
@@ -243,9 +246,14 @@ fn compile_one(
     quiet: bool,
     cells: Option<usize>,
     preview: Option<&Path>,
+    budget: &super::limits::Budget,
 ) -> Outcome {
     if super::rfs::is_rfs(input) {
-        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells);
+        let limits = super::rfs::RfsLimits {
+            budget: *budget,
+            max_file_size: options.limits.max_file_size as u64,
+        };
+        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells, &limits);
         return Outcome {
             input: input.to_path_buf(),
             messages,
@@ -270,6 +278,13 @@ fn compile_one(
     let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
         return fail(messages);
     };
+    // Refuse a mesh too fine for the limit before meshing spends the memory.
+    let estimate = super::limits::estimate_triangles(&lowered.model, mesh_options);
+    if estimate > budget.max_triangles {
+        let d = super::limits::too_many_triangles(estimate, budget.max_triangles, true);
+        messages.push_str(&render_human(&checked.source, &d));
+        return fail(messages);
+    }
     let mesh = match mesh_model(&lowered.model, mesh_options) {
         Ok(mesh) => mesh,
         Err(e) => {
@@ -278,6 +293,12 @@ fn compile_one(
             return fail(messages);
         }
     };
+    let triangles: u64 = mesh.faces.iter().map(|f| f.triangles.len() as u64).sum();
+    if triangles > budget.max_triangles {
+        let d = super::limits::too_many_triangles(triangles, budget.max_triangles, false);
+        messages.push_str(&render_human(&checked.source, &d));
+        return fail(messages);
+    }
     // A fragment description refers to the MSH written beside it, if any.
     let mesh_file = outputs
         .iter()

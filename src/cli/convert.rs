@@ -49,6 +49,9 @@ pub struct Args {
     /// Keep only this group (repeatable): a face, physical group, solid or object name.
     #[arg(long = "group", value_name = "NAME")]
     groups: Vec<String>,
+    /// Largest accepted input file, in bytes.
+    #[arg(long, value_name = "BYTES", default_value_t = super::limits::MAX_FILE_SIZE)]
+    max_file_size: u64,
 }
 
 fn non_negative(s: &str) -> Result<f64, String> {
@@ -127,6 +130,14 @@ fn load(path: &Path, from: Option<ReadFormat>) -> Result<geomc::formats::read::L
     })
 }
 
+/// A mesh with nothing a writer could carry.
+fn is_empty(mesh: &geomc::mesh::Mesh) -> bool {
+    mesh.faces.iter().all(|f| f.triangles.is_empty())
+        && mesh.polylines.iter().all(|p| p.nodes.is_empty())
+        && mesh.point_sets.iter().all(|p| p.nodes.is_empty())
+        && mesh.edges.iter().all(|e| e.nodes.len() < 2)
+}
+
 pub fn run(args: &Args) -> i32 {
     let from = match read_format(args.from.as_deref()) {
         Ok(f) => f,
@@ -159,10 +170,26 @@ pub fn run(args: &Args) -> i32 {
             }
         },
     };
+    if let Err(d) = super::limits::check_file_size(&args.input, args.max_file_size) {
+        report(&args.input, &[d]);
+        return EXIT_INVALID;
+    }
     let mut loaded = match load(&args.input, from) {
         Ok(l) => l,
         Err(code) => return code,
     };
+    if is_empty(&loaded.mesh) {
+        report(
+            &args.input,
+            &[Diagnostic::new(
+                Code::EmptyMesh,
+                None,
+                "the file holds no triangles, lines or points: there is nothing to convert",
+            )
+            .with_help("check that the file is complete and is the format its ending says (or pass --from)")],
+        );
+        return EXIT_INVALID;
+    }
     report(&args.input, &loaded.warnings);
     let options = ConvertOptions {
         groups: args.groups.clone(),

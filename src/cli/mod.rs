@@ -6,6 +6,7 @@ mod convert;
 mod explain;
 mod inspect;
 mod inspect_mesh;
+mod limits;
 mod mesh_args;
 mod render;
 mod rfs;

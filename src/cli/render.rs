@@ -233,7 +233,8 @@ fn load_input(
         .unwrap_or("")
         .to_ascii_lowercase();
     if name.ends_with(".rfs") {
-        let (messages, loaded) = super::rfs::load(path, quiet, None);
+        let (messages, loaded) =
+            super::rfs::load(path, quiet, None, &super::rfs::RfsLimits::default());
         eprint!("{messages}");
         return loaded.map(|(mesh, _)| mesh);
     }

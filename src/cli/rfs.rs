@@ -3,12 +3,28 @@
 //! written in every requested format.
 
 use super::{EXIT_INVALID, EXIT_USAGE};
-use geomc::diag::render_human;
+use geomc::diag::{Code, Diagnostic, render_human};
 use geomc::formats::{self, Encoding, WriteOptions};
 use geomc::implicit::{lang, surface_to_mesh};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use std::path::{Path, PathBuf};
+
+/// The limits an `.rfs` input is held to.
+#[derive(Clone, Copy, Debug)]
+pub struct RfsLimits {
+    pub budget: super::limits::Budget,
+    pub max_file_size: u64,
+}
+
+impl Default for RfsLimits {
+    fn default() -> RfsLimits {
+        RfsLimits {
+            budget: super::limits::Budget::default(),
+            max_file_size: super::limits::MAX_FILE_SIZE,
+        }
+    }
+}
 
 /// Whether a path names an `.rfs` program.
 pub fn is_rfs(path: &Path) -> bool {
@@ -23,19 +39,28 @@ pub fn load(
     input: &Path,
     quiet: bool,
     cells: Option<usize>,
+    limits: &RfsLimits,
 ) -> (String, Result<(Mesh, usize), i32>) {
     let mut messages = String::new();
+    let refuse = |d: Diagnostic| {
+        let source = SourceFile::new(input.display().to_string(), "");
+        (render_human(&source, &d), Err(EXIT_INVALID))
+    };
+    if let Err(d) = super::limits::check_file_size(input, limits.max_file_size) {
+        return refuse(d);
+    }
     let text = match std::fs::read(input) {
         Ok(bytes) => match String::from_utf8(bytes) {
             Ok(t) => t,
             Err(e) => {
-                return (
-                    format!(
-                        "{}: error: not UTF-8 text (byte {})\n",
-                        input.display(),
-                        e.utf8_error().valid_up_to()
-                    ),
-                    Err(EXIT_INVALID),
+                let at = e.utf8_error().valid_up_to();
+                return refuse(
+                    Diagnostic::new(
+                        Code::NotUtf8,
+                        None,
+                        format!("the file is not UTF-8 text: byte {at} starts an invalid sequence"),
+                    )
+                    .with_help("save the program as UTF-8 text"),
                 );
             }
         },
@@ -64,7 +89,31 @@ pub fn load(
             return (messages, Err(EXIT_USAGE));
         }
     }
+    let grid = cells.map_or(model.geom.cells, |n| [n; 3]);
+    if let Err(d) = super::limits::check_grid(grid, limits.budget.max_grid_cells) {
+        messages.push_str(&render_human(&source, &d));
+        return (messages, Err(EXIT_INVALID));
+    }
     let surface = model.polygonize(cells.map(|n| [n; 3]));
+    let triangles = surface.triangles.len() as u64;
+    if triangles == 0 {
+        let d = Diagnostic::new(
+            Code::EmptySurface,
+            None,
+            format!(
+                "no triangles: the solid's boundary does not cross the Geom box sampled on {} x {} x {} cells",
+                grid[0], grid[1], grid[2]
+            ),
+        )
+        .with_help("check the Geom box against where the solid lies, or use more cells for thin features");
+        messages.push_str(&render_human(&source, &d));
+        return (messages, Err(EXIT_INVALID));
+    }
+    if triangles > limits.budget.max_triangles {
+        let d = super::limits::too_many_triangles(triangles, limits.budget.max_triangles, false);
+        messages.push_str(&render_human(&source, &d));
+        return (messages, Err(EXIT_INVALID));
+    }
     let mesh = surface_to_mesh(&surface, model.name());
     (messages, Ok((mesh, surface.triangles.len())))
 }
@@ -76,8 +125,9 @@ pub fn compile(
     encoding: Option<Encoding>,
     quiet: bool,
     cells: Option<usize>,
+    limits: &RfsLimits,
 ) -> (String, bool) {
-    let (mut messages, loaded) = load(input, quiet, cells);
+    let (mut messages, loaded) = load(input, quiet, cells, limits);
     let Ok((mesh, triangles)) = loaded else {
         return (messages, false);
     };

@@ -304,6 +304,16 @@ codes! {
     RenderSectionEmpty = "W171", Warning, "section leaves nothing to draw",
         "The section plane lies below the whole model, so everything was cut away and the picture is empty. Pick a value inside the model's extent (geomc inspect prints the bounding box).";
 
+    // --- Resource limits and hostile input (issue 10, branch harden-corpus) ---
+    GridTooLarge = "E800", Error, "implicit grid has too many cells",
+        "Polygonizing an implicit (.rfs) solid samples a grid of nx x ny x nz cells, (nx + 1)(ny + 1)(nz + 1) values of 8 bytes each, and the grid asked for exceeds the cell limit (16,777,216 = 256^3 by default). It is refused before any memory is spent. Use fewer cells (Geom.nx/ny/nz or --cells), or raise the limit with --max-grid-cells.";
+    TooManyTriangles = "E801", Error, "mesh would have too many triangles",
+        "The output mesh would have more triangles than the limit (20,000,000 by default). geomc estimates the count from the tolerance and the curved area before meshing, and checks the real count before writing. Use a coarser --tolerance or a longer --max-edge, or raise the limit with --max-triangles.";
+    EmptyMesh = "E802", Error, "mesh file holds nothing",
+        "The input mesh file parsed, but it holds no triangles, lines or points, so converting it would write an empty file. The file is probably truncated, not a mesh, or written by a tool that failed. Check it, or pass --from if its format was guessed wrongly.";
+    EmptySurface = "E803", Error, "implicit solid has no surface on its grid",
+        "Polygonizing the .rfs program found no triangles: the solid {f > 0} is empty, fills the whole Geom box, or is too thin for the grid's cells. Writing would give an empty mesh, so nothing is written. Check the Geom box (x_min..z_max) against where the solid lies, and use more cells (Geom.nx/ny/nz or --cells) for thin features.";
+
     // ---- trimmed parametric surfaces (issue 9, branch trim) ----
     TrimmedCarrierInvalid = "E740", Error, "invalid parametric surface",
         "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";

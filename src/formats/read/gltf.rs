@@ -47,6 +47,7 @@ pub fn read(bytes: &[u8], folder: &Path) -> Result<Builder, Vec<Diagnostic>> {
             ),
         }]
     })?;
+    check_asset(&root).map_err(|d| vec![d])?;
     let mut r = Reader {
         root: &root,
         buffers: Vec::new(),
@@ -187,6 +188,42 @@ fn uint(v: &Value, key: &str, path: &str) -> Result<Option<usize>, Diagnostic> {
     }
 }
 
+/// A glTF document is a JSON object whose `asset.version` is 2.x: anything
+/// else (an array, a glTF 1.0 file) would read as an empty or wrong mesh.
+fn check_asset(root: &Value) -> Result<(), Diagnostic> {
+    if !root.is_object() {
+        return Err(bad("the document", "a JSON value that is not an object"));
+    }
+    match root
+        .get("asset")
+        .and_then(|a| a.get("version"))
+        .and_then(Value::as_str)
+    {
+        Some(v) if v.starts_with("2.") => Ok(()),
+        Some(v) => Err(Diagnostic::new(
+            Code::MeshUnsupportedVersion,
+            None,
+            format!("glTF asset.version is `{v}`: geomc reads glTF 2.x"),
+        )),
+        None => Err(bad("asset", "no asset.version string (glTF requires it)")),
+    }
+}
+
+/// `scheme:` before any `/` (RFC 3986), as in `file:`, `http:`; a one-letter
+/// scheme is a Windows drive (`C:`), which is an absolute path too.
+fn has_scheme(uri: &str) -> bool {
+    match uri.split_once(':') {
+        Some((scheme, _)) => {
+            !scheme.is_empty()
+                && scheme.starts_with(|c: char| c.is_ascii_alphabetic())
+                && scheme
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || matches!(c, '+' | '-' | '.'))
+        }
+        None => false,
+    }
+}
+
 impl<'a> Reader<'a> {
     fn load_buffers(&mut self, bin: Option<&'a [u8]>, folder: &Path) -> Result<(), Diagnostic> {
         for (i, buf) in list(self.root, "buffers").iter().enumerate() {
@@ -211,6 +248,14 @@ impl<'a> Reader<'a> {
                         base64::decode(data.as_bytes())
                             .ok_or_else(|| bad(&path, "the data URI is not valid base64"))?,
                     )
+                }
+                Some(uri) if has_scheme(uri) => {
+                    return Err(bad(
+                        &path,
+                        format!(
+                            "buffer uri `{uri}` is not a file beside the glTF: geomc reads only relative file names and data: URIs, never other schemes"
+                        ),
+                    ));
                 }
                 Some(uri) => {
                     let name = percent_decode(uri);

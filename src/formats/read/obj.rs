@@ -51,6 +51,7 @@ fn read_inner(bytes: &[u8]) -> Result<Builder, Diagnostic> {
                 corners.clear();
                 while let Some(c) = s.next_on_line() {
                     corners.push(index(c, b.nodes.len())?);
+                    check_extra_indices(c, ignored.texture, ignored.normals)?;
                 }
                 let need = match t.text {
                     b"f" => 3,
@@ -162,6 +163,36 @@ fn short_line(s: &Scanner, what: &str) -> Diagnostic {
         at,
         format!("the line ends where {what} were expected"),
     )
+}
+
+/// The texture and normal indices of a corner (`7/2/3`) are not kept, but a
+/// malformed or dangling one means the file is broken, so it is refused.
+fn check_extra_indices(t: Token, textures: usize, normals: usize) -> Result<(), Diagnostic> {
+    let mut parts = t.text.split(|&c| c == b'/').skip(1);
+    for (count, what) in [(textures, "texture coordinate"), (normals, "normal")] {
+        let Some(part) = parts.next().filter(|p| !p.is_empty()) else {
+            continue;
+        };
+        let v = std::str::from_utf8(part)
+            .ok()
+            .and_then(|p| p.parse::<i64>().ok())
+            .ok_or_else(|| syntax(t, &format!("a {what} index after `/`")))?;
+        let resolved = if v > 0 { v - 1 } else { count as i64 + v };
+        if v == 0 || resolved < 0 || resolved >= count as i64 {
+            return Err(error_at(
+                Code::MeshIndexOutOfRange,
+                t.start,
+                t.end(),
+                format!(
+                    "{what} index {v} is out of range: {count} {what}s are defined before this line"
+                ),
+            ));
+        }
+    }
+    if parts.next().is_some() {
+        return Err(syntax(t, "at most three `/`-separated indices"));
+    }
+    Ok(())
 }
 
 /// `7`, `7/2`, `7//3`, `7/2/3` or negative (relative to the end): the

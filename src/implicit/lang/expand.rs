@@ -15,6 +15,8 @@ use std::collections::HashMap;
 pub const MAX_CALL_DEPTH: usize = 64;
 /// Largest expanded expression.
 pub const MAX_NODES: usize = 2_000_000;
+/// Most expressions visited while inlining calls (the work of expansion).
+pub const MAX_STEPS: usize = 1_000_000;
 
 const GEOM_FIELDS: &[&str] = &[
     "dimension",
@@ -49,6 +51,9 @@ struct Expander<'p> {
     ctx: Ctx,
     sys: RSystem,
     stack: Vec<&'p str>,
+    /// Expressions expanded so far: hash-consing keeps the result small even
+    /// when calls double at every level, so the work needs its own bound.
+    steps: usize,
 }
 
 fn err(code: Code, span: Span, message: impl Into<String>) -> Diagnostic {
@@ -67,6 +72,7 @@ pub fn read_geom(program: &Program, diags: &mut Diagnostics) -> Geom {
             ctx: Ctx::new(),
             sys: RSystem::Rvachev,
             stack: Vec::new(),
+            steps: 0,
         };
         let mut env = HashMap::new();
         for (k, v) in &values {
@@ -309,6 +315,7 @@ pub fn expand(program: &Program, geom: &Geom, diags: &mut Diagnostics) -> Option
         ctx: Ctx::new(),
         sys: geom.rsystem,
         stack: Vec::new(),
+        steps: 0,
     };
     let args: Vec<Value> = (0..3).map(|a| Value::Num(ex.ctx.var(a))).collect();
     match ex.call_user(result, args, result.span) {
@@ -421,7 +428,18 @@ impl<'p> Expander<'p> {
         }
     }
 
-    fn check_size(&self, span: Span) -> Result<(), Diagnostic> {
+    fn check_size(&mut self, span: Span) -> Result<(), Diagnostic> {
+        self.steps += 1;
+        if self.steps > MAX_STEPS {
+            return Err(err(
+                Code::RfsTooLarge,
+                span,
+                format!(
+                    "expanding the program visits over {MAX_STEPS} expressions (calls inlined repeatedly)"
+                ),
+            )
+            .with_help("a function calling another twice per level doubles the work at every level; compute shared values once in a variable"));
+        }
         if self.ctx.nodes.len() > MAX_NODES {
             return Err(err(
                 Code::RfsTooLarge,
