@@ -360,18 +360,11 @@ fn weld_seam(
             remap[h] = lh;
         }
     }
-    let on_side = |h: usize, bit: u8| {
-        b.sides
-            .iter()
-            .zip(handles)
-            .any(|(&s, &hh)| hh == h && s & bit != 0)
-    };
+    // The side bits of each handle (a handle may come from several points).
     let mut side_of: HashMap<usize, u8> = HashMap::new();
-    for &h in handles.iter().filter(|&&h| h != usize::MAX) {
-        if seam[h] {
-            let bits = (if on_side(h, V_MIN) { V_MIN } else { 0 })
-                | (if on_side(h, V_MAX) { V_MAX } else { 0 });
-            side_of.insert(h, bits);
+    for (&bits, &h) in b.sides.iter().zip(handles) {
+        if h != usize::MAX && seam.get(h).copied().unwrap_or(false) {
+            *side_of.entry(h).or_default() |= bits & (V_MIN | V_MAX);
         }
     }
     let along_seam = |x: usize, y: usize| {
