@@ -72,7 +72,8 @@ pub(super) fn surface(
             let l = r.number(length.as_ref()?)?;
             let a0 = optional(r, from_angle, 0.0)?;
             let a1 = optional(r, to_angle, 360.0)?;
-            if !(l > 0.0) || r1 < 0.0 || r2 < 0.0 || r1 + r2 <= 0.0 || !(a1 > a0) {
+            let ok = l > 0.0 && r1 >= 0.0 && r2 >= 0.0 && r1 + r2 > 0.0 && a1 > a0;
+            if !ok {
                 invalid(
                     r,
                     format!(

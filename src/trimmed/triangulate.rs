@@ -308,7 +308,7 @@ pub(crate) fn nearest_parameter(s: &TrimmedSurface, target: Point3, start: [f64;
         let (du, dv) = s.tangents(uv[0], uv[1]);
         let (a, b, c) = (du.dot(&du), du.dot(&dv), dv.dot(&dv));
         let det = a * c - b * b;
-        if !(det.abs() > 0.0) {
+        if det.is_nan() || det == 0.0 {
             break;
         }
         let (gu, gv) = (du.dot(&r), dv.dot(&r));
