@@ -7,6 +7,10 @@
 //! Run: `cargo bench --bench front_end` (add `-- --quick` for 10,000 primitives).
 
 use std::fmt::Write as _;
+
+// The allocator of the geomc binary, so the in-process figures match the command.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 use std::time::{Duration, Instant};
 
 fn generate(count: usize) -> String {

@@ -3,6 +3,7 @@
 
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::{self, grammar};
+use crate::implicit::xml::ImplicitSubdomain;
 use crate::ir::{Dimension, SubdomainCells};
 use crate::lower::{self, Lowered};
 use crate::resolve::{self, Override};
@@ -15,6 +16,8 @@ pub struct Options {
     /// `--set NAME=VALUE` overrides, already parsed.
     pub overrides: Vec<Override>,
     pub limits: Limits,
+    /// Folders besides the input's own from which data files may be read (`--allow-path`).
+    pub allowed_paths: Vec<std::path::PathBuf>,
 }
 
 /// The outcome of checking one source.
@@ -24,6 +27,9 @@ pub struct Checked {
     pub diagnostics: Diagnostics,
     /// The model, when the file parsed and resolved (it may still have errors).
     pub lowered: Option<Lowered>,
+    /// Subdomains whose solids are implicit (`<rfunction>`, `<level_surface>`,
+    /// `<density_volume>`): polygonized by compile rather than meshed from faces.
+    pub implicit: Vec<ImplicitSubdomain>,
 }
 
 impl Checked {
@@ -55,6 +61,7 @@ pub fn check_file(path: &Path, options: &Options) -> std::io::Result<Checked> {
             source: SourceFile::new(name, ""),
             diagnostics,
             lowered: None,
+            implicit: Vec::new(),
         });
     }
     let bytes = std::fs::read(path)?;
@@ -82,6 +89,7 @@ pub fn check_bytes(name: String, bytes: Vec<u8>, options: &Options) -> Checked {
                 source,
                 diagnostics,
                 lowered: None,
+                implicit: Vec::new(),
             }
         }
     }
@@ -89,17 +97,24 @@ pub fn check_bytes(name: String, bytes: Vec<u8>, options: &Options) -> Checked {
 
 pub fn check_source(source: SourceFile, options: &Options) -> Checked {
     let mut diags = Diagnostics::default();
-    let lowered = run(&source, options, &mut diags);
+    let mut implicit = Vec::new();
+    let lowered = run(&source, options, &mut diags, &mut implicit);
     diags.sort();
     Checked {
         source,
         diagnostics: diags,
         lowered,
+        implicit,
     }
 }
 
-fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Option<Lowered> {
-    let root = match syntax::parse(source, &options.limits) {
+fn run(
+    source: &SourceFile,
+    options: &Options,
+    diags: &mut Diagnostics,
+    implicit: &mut Vec<ImplicitSubdomain>,
+) -> Option<Lowered> {
+    let mut root = match syntax::parse(source, &options.limits) {
         Ok(root) => root,
         Err(d) => {
             diags.push(d);
@@ -137,24 +152,63 @@ fn run(source: &SourceFile, options: &Options, diags: &mut Diagnostics) -> Optio
         }
     }
     doc::structure::check(&root, &grammar::GEOMETRY, diags);
+    // Implicit solids and the subdomains using them take their own path.
+    let extracted = crate::implicit::xml::extract(&mut root);
     let document = doc::build(source, &root, diags);
     // Each stage's input is dropped as soon as the next no longer needs it,
     // which keeps the peak memory of large files down.
     drop(root);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     let lowered = lower::lower(&document, &resolved, diags);
+    if !extracted.is_empty() {
+        *implicit = lower_implicit(source, options, &extracted, &resolved, diags);
+    }
     drop(resolved);
     diags.extend(crate::valid::check_topology(
         &lowered.model,
         &lowered.source_map,
     ));
     check_domain(&document, &lowered, diags);
+    if !extracted.subdomains.is_empty() {
+        // The implicit subdomains describe the domain.
+        diags.items.retain(|d| d.code != Code::EmptySubdomainList);
+    }
     if diags.has_errors() {
         // An entity left unused because something else failed is a consequence,
         // not a finding of its own.
         diags.items.retain(|d| d.code != Code::Dangling);
     }
     Some(lowered)
+}
+
+/// Lowers the implicit elements; parameters they use are no longer unused (W006).
+fn lower_implicit(
+    source: &SourceFile,
+    options: &Options,
+    extracted: &crate::implicit::xml::Extracted,
+    resolved: &resolve::Resolved,
+    diags: &mut Diagnostics,
+) -> Vec<ImplicitSubdomain> {
+    let folder = Path::new(&source.name)
+        .parent()
+        .filter(|p| !p.as_os_str().is_empty())
+        .map_or_else(|| std::path::PathBuf::from("."), Path::to_path_buf);
+    let taken = |name: &str| resolved.by_name.contains_key(name);
+    let env = crate::implicit::xml::Env {
+        source,
+        parameters: &resolved.parameters,
+        folder,
+        allowed: &options.allowed_paths,
+        taken: &taken,
+    };
+    let out = crate::implicit::xml::lower(extracted, &env, diags);
+    diags.items.retain(|d| {
+        d.code != Code::UnusedParameter
+            || !d
+                .span
+                .is_some_and(|s| out.used_parameters.contains(source.snippet(s).trim()))
+    });
+    out.subdomains
 }
 
 /// Whole-model warnings: no subdomains, boundaries on no subdomain.

@@ -7,6 +7,9 @@
 //! and the topology graph, no spans) → [`valid`] (topology checks). [`driver`]
 //! runs them all. The library never prints and never exits: only the CLI does.
 
+// Bad input must become a diagnostic, never a panic (docs/reliability.md).
+#![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
+
 pub mod diag;
 pub mod doc;
 pub mod driver;

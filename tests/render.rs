@@ -518,3 +518,90 @@ fn compile_writes_a_preview_in_the_same_run() {
         std::fs::read(&direct).unwrap()
     );
 }
+
+/// The `d` of every filled section path: its loops as point lists.
+fn section_paths(svg: &str) -> Vec<Vec<Vec<[f64; 2]>>> {
+    svg.lines()
+        .filter(|l| l.contains(r#"class="section""#))
+        .map(|l| {
+            let d = l
+                .split(" d=\"")
+                .nth(1)
+                .expect("a d")
+                .trim_end_matches("\"/>");
+            d.split('Z')
+                .filter(|lp| !lp.is_empty())
+                .map(|lp| {
+                    lp.split(['M', 'L'])
+                        .filter(|p| !p.is_empty())
+                        .map(|p| {
+                            let (x, y) = p.split_once(' ').expect("x y");
+                            [x.parse().expect("x"), y.parse().expect("y")]
+                        })
+                        .collect()
+                })
+                .collect()
+        })
+        .collect()
+}
+
+fn even_odd_area(loops: &[Vec<[f64; 2]>]) -> f64 {
+    loops
+        .iter()
+        .map(|lp| {
+            let n = lp.len();
+            0.5 * (0..n)
+                .map(|i| lp[i][0] * lp[(i + 1) % n][1] - lp[(i + 1) % n][0] * lp[i][1])
+                .sum::<f64>()
+        })
+        .sum::<f64>()
+}
+
+#[test]
+fn svg_section_fills_the_cut_face_of_each_subdomain() {
+    let mesh = ball_in_box();
+    let options = RenderOptions {
+        section: Some(Section {
+            axis: 2,
+            value: 2.0,
+        }),
+        ..bare(400, 400, View::TOP)
+    };
+    let drawing = render_svg(&mesh, &options).expect("draws");
+    let paths = section_paths(&drawing.text);
+    // One filled path per subdomain: the matrix's square with the ball's
+    // circle as a hole (two loops), the inclusion's disc (one loop).
+    assert_eq!(paths.len(), 2);
+    assert_eq!(paths.iter().map(|p| p.len()).collect::<Vec<_>>(), [2, 1]);
+    assert_eq!(drawing.cut_faces.len(), 2);
+    // Areas in square pixels against the exact cut (box 4×4, ball radius 1).
+    let camera = render::camera_for(&mesh, &options);
+    let k2 = camera.scale * camera.scale;
+    let (matrix, inclusion) = (even_odd_area(&paths[0]), even_odd_area(&paths[1]));
+    let disc = std::f64::consts::PI * k2;
+    assert!(
+        (inclusion - disc).abs() < 0.01 * disc,
+        "{inclusion} vs {disc}"
+    );
+    let rest = 16.0 * k2 - disc;
+    assert!((matrix - rest).abs() < 0.01 * rest, "{matrix} vs {rest}");
+    // Loops come oriented by nesting: the hole runs against the outline.
+    assert!((drawing.cut_faces[0].area() - matrix).abs() < 1.0);
+    assert!((drawing.cut_faces[1].area() - inclusion).abs() < 1.0);
+    // From below, the kept material hides the cut face: nothing is filled.
+    let below = render_svg(
+        &mesh,
+        &RenderOptions {
+            view: View {
+                azimuth: 0.0,
+                elevation: -90.0,
+            },
+            ..options.clone()
+        },
+    )
+    .expect("draws");
+    assert!(section_paths(&below.text).is_empty());
+    // Without --section there is no fill.
+    let plain = render_svg(&mesh, &bare(400, 400, View::TOP)).expect("draws");
+    assert!(section_paths(&plain.text).is_empty());
+}

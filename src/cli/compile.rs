@@ -67,6 +67,9 @@ pub struct Args {
     /// (into a folder: one STEM.png per input when it ends in '/').
     #[arg(long, value_name = "OUT.png")]
     preview: Option<PathBuf>,
+    /// Contour lines of the plane cut AXIS=VALUE (e.g. z=0) of implicit subdomains, written as line elements.
+    #[arg(long, value_name = "AXIS=VALUE", allow_hyphen_values = true)]
+    section: Option<String>,
 }
 
 /// What one input produced, collected so output is printed in input order.
@@ -86,6 +89,13 @@ pub fn run(args: &Args) -> i32 {
     };
     let mesh_options = match mesh_options(args) {
         Ok(m) => m,
+        Err(diagnostic) => {
+            report_usage(&[diagnostic]);
+            return EXIT_USAGE;
+        }
+    };
+    let section = match super::implicit::parse_section(args.section.as_deref()) {
+        Ok(s) => s,
         Err(diagnostic) => {
             report_usage(&[diagnostic]);
             return EXIT_USAGE;
@@ -132,6 +142,7 @@ pub fn run(args: &Args) -> i32 {
                     args.cells,
                     preview.as_deref(),
                     &args.budget,
+                    section,
                 );
                 if let Some(bar) = &progress {
                     bar.inc(1);
@@ -247,13 +258,15 @@ fn compile_one(
     cells: Option<usize>,
     preview: Option<&Path>,
     budget: &super::limits::Budget,
+    section: Option<geomc::implicit::xml::mesh::Plane>,
 ) -> Outcome {
     if super::rfs::is_rfs(input) {
         let limits = super::rfs::RfsLimits {
             budget: *budget,
             max_file_size: options.limits.max_file_size as u64,
         };
-        let (messages, ok) = super::rfs::compile(input, outputs, encoding, quiet, cells, &limits);
+        let (messages, ok) =
+            super::rfs::compile(input, outputs, encoding, quiet, cells, &limits, section);
         return Outcome {
             input: input.to_path_buf(),
             messages,
@@ -285,7 +298,23 @@ fn compile_one(
         messages.push_str(&render_human(&checked.source, &d));
         return fail(messages);
     }
-    let mesh = match mesh_model(&lowered.model, mesh_options) {
+    let model = &lowered.model;
+    // A model of implicit subdomains only has nothing for the face mesher (and
+    // no bounding box for a relative tolerance).
+    let implicit_only = !checked.implicit.is_empty()
+        && model.vertices.is_empty()
+        && model.edges.is_empty()
+        && model.faces.is_empty()
+        && model.point_sets.is_empty();
+    let meshed = if implicit_only {
+        Ok(geomc::mesh::Mesh {
+            dimension: 3,
+            ..Default::default()
+        })
+    } else {
+        mesh_model(model, mesh_options)
+    };
+    let mut mesh = match meshed {
         Ok(mesh) => mesh,
         Err(e) => {
             let diagnostic = e.to_diagnostic(&lowered.model, &lowered.source_map);
@@ -293,6 +322,20 @@ fn compile_one(
             return fail(messages);
         }
     };
+    match super::implicit::add_to_mesh(
+        &mut mesh,
+        &checked,
+        cells,
+        section,
+        quiet,
+        budget.max_grid_cells,
+    ) {
+        Ok(text) => messages.push_str(&text),
+        Err(text) => {
+            messages.push_str(&text);
+            return fail(messages);
+        }
+    }
     let triangles: u64 = mesh.faces.iter().map(|f| f.triangles.len() as u64).sum();
     if triangles > budget.max_triangles {
         let d = super::limits::too_many_triangles(triangles, budget.max_triangles, false);

@@ -4,10 +4,13 @@
 mod compile;
 mod convert;
 mod explain;
+mod implicit;
 mod inspect;
 mod inspect_mesh;
 mod limits;
+mod locate;
 mod mesh_args;
+mod panic_probe;
 mod render;
 mod rfs;
 mod solver_args;
@@ -50,6 +53,8 @@ enum Command {
     Convert(convert::Args),
     /// Draw a domain or mesh: a shaded PNG or a hidden-line SVG.
     Render(render::Args),
+    /// Which subdomain (or the exterior) each point of a CSV file lies in.
+    Locate(locate::Args),
 }
 
 /// Options shared by every subcommand that reads XML.
@@ -67,6 +72,9 @@ pub struct InputOptions {
     /// Most XML nodes in one file.
     #[arg(long, value_name = "N", default_value_t = Limits::default().max_nodes)]
     pub max_nodes: u32,
+    /// Also read data files (density volumes, .rfs) from this folder (repeatable).
+    #[arg(long = "allow-path", value_name = "DIR")]
+    pub allow_path: Vec<std::path::PathBuf>,
 }
 
 impl InputOptions {
@@ -90,6 +98,7 @@ impl InputOptions {
                 max_depth: self.max_depth,
                 max_nodes: self.max_nodes,
             },
+            allowed_paths: self.allow_path.clone(),
         })
     }
 }
@@ -119,13 +128,14 @@ pub fn run() -> i32 {
             return code;
         }
     };
-    let result = std::panic::catch_unwind(|| match cli.command {
+    let result = std::panic::catch_unwind(|| match panic_probe::checked(cli.command) {
         Command::Validate(args) => validate::run(&args),
         Command::Compile(args) => compile::run(&args),
         Command::Inspect(args) => inspect::run(&args),
         Command::Explain(args) => explain::run(&args),
         Command::Convert(args) => convert::run(&args),
         Command::Render(args) => render::run(&args),
+        Command::Locate(args) => locate::run(&args),
     });
     result.unwrap_or(EXIT_INTERNAL)
 }

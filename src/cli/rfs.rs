@@ -5,6 +5,7 @@
 use super::{EXIT_INVALID, EXIT_USAGE};
 use geomc::diag::{Code, Diagnostic, render_human};
 use geomc::formats::{self, Encoding, WriteOptions};
+use geomc::implicit::xml::mesh::{Plane, add_section};
 use geomc::implicit::{lang, surface_to_mesh};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
@@ -40,6 +41,17 @@ pub fn load(
     quiet: bool,
     cells: Option<usize>,
     limits: &RfsLimits,
+) -> (String, Result<(Mesh, usize), i32>) {
+    load_with_section(input, quiet, cells, limits, None)
+}
+
+/// [`load`], adding the contour lines of a `--section` plane.
+pub fn load_with_section(
+    input: &Path,
+    quiet: bool,
+    cells: Option<usize>,
+    limits: &RfsLimits,
+    section: Option<Plane>,
 ) -> (String, Result<(Mesh, usize), i32>) {
     let mut messages = String::new();
     let refuse = |d: Diagnostic| {
@@ -114,7 +126,23 @@ pub fn load(
         messages.push_str(&render_human(&source, &d));
         return (messages, Err(EXIT_INVALID));
     }
-    let mesh = surface_to_mesh(&surface, model.name());
+    let mut mesh = surface_to_mesh(&surface, model.name());
+    if let Some(plane) = section {
+        if !add_section(
+            &mut mesh,
+            &surface.positions,
+            &surface.triangles,
+            model.name(),
+            plane,
+        ) && !quiet
+        {
+            messages.push_str(&format!(
+                "{}: warning[W133]: the section plane does not cut the surface of '{}'\n",
+                input.display(),
+                model.name()
+            ));
+        }
+    }
     (messages, Ok((mesh, surface.triangles.len())))
 }
 
@@ -126,8 +154,9 @@ pub fn compile(
     quiet: bool,
     cells: Option<usize>,
     limits: &RfsLimits,
+    section: Option<Plane>,
 ) -> (String, bool) {
-    let (mut messages, loaded) = load(input, quiet, cells, limits);
+    let (mut messages, loaded) = load_with_section(input, quiet, cells, limits, section);
     let Ok((mesh, triangles)) = loaded else {
         return (messages, false);
     };

@@ -304,6 +304,37 @@ codes! {
     RenderSectionEmpty = "W171", Warning, "section leaves nothing to draw",
         "The section plane lies below the whole model, so everything was cut away and the picture is empty. Pick a value inside the model's extent (geomc inspect prints the bounding box).";
 
+    // ---- implicit solids in the XML: rfunction, level_surface, density_volume (issue 5) ----
+    ImplicitUnknownName = "E612", Error, "unknown name in an implicit function",
+        "An expression of an <rfunction>, <function> or <level_surface> names something that is neither a coordinate (x, y, z, or the level surface's variables), a parameter of the file, an argument of the enclosing <function>, nor pi. Check the spelling; the message suggests the nearest name.";
+    ImplicitBadSetting = "E613", Error, "bad implicit solid setting",
+        "A setting of an implicit solid is out of range: the bounding box needs x_min < x_max (likewise y, z), grid cells per axis are whole numbers from 1 to 1024, dimension is 3, rsystem is rvachev, minmax or alpha with alpha in (-1, 1], optiterations a whole number from 0 to 1000, a level a finite number, variables three distinct names. Fix the value the message names.";
+    ImplicitUnknownFunction = "E614", Error, "unknown function or argument in a call",
+        "<call function=\"f\" a=\"...\"> names a <function> of the file and gives every one of its named arguments exactly once. The message names the unknown function, the unknown argument, or the missing one.";
+    ImplicitRecursion = "E615", Error, "recursive implicit function",
+        "A <function> calls itself, directly or through others, or calls nest deeper than 64. Functions are expanded at compile time, so recursion cannot end; write the repetition out.";
+    ImplicitLibraryArgument = "E616", Error, "invalid primitive argument",
+        "A primitive of an <rfunction> got a value it cannot use: for example regular_polygon's n must be a whole constant from 3 to 10000, sector's angles constants with angle2 - angle1 in (0, 2*pi], convex_polygon at least three vertices.";
+    ImplicitMixedTree = "E617", Error, "subdomain mixes implicit and boundary solids",
+        "A subdomain's solid tree combines implicit solids (<rfunction>, <level_surface>, <density_volume>) with boundary-represented primitives (sphere, parallelepiped, ...), or uses a <density_volume> inside a boolean. This version meshes such trees only when all leaves are functions: write the primitive inside the <rfunction> (ball, box, ...) instead.";
+    ImplicitPathRefused = "E618", Error, "data file path leaves the input's folder",
+        "Files named by <density_volume file> and <rfs file> are read relative to the XML file's folder, and a path that leads outside it (an absolute path, or one through ..) is refused so that a model cannot read arbitrary files. Move the file next to the model, or allow its folder with --allow-path DIR.";
+    ImplicitFileUnreadable = "E619", Error, "cannot read a data file",
+        "The file named by <density_volume file> or <rfs file> does not exist or cannot be read. Paths are relative to the XML file's folder.";
+    ImplicitFileSize = "E620", Error, "data file size does not match its description",
+        "A raw density file must hold exactly dims[0] x dims[1] x dims[2] samples of the sample type (for NRRD, after the header). The message gives the expected and the actual number of bytes: fix dims or type, or the file.";
+    ImplicitNrrdHeader = "E621", Error, "malformed NRRD header",
+        "The NRRD header could not be read: it must start with NRRD000N, give type, dimension: 3, sizes, encoding: raw and (for multi-byte types) endian, with optional spacings or space directions and space origin. The message names the line. Only raw encoding and detached data files ('data file:') in the same folder are read.";
+    ImplicitDensityAttribute = "E622", Error, "bad density_volume description",
+        "A <density_volume> needs type (u8, u16, i16 or f32), endian (little or big), dims (three whole numbers of at least 2 samples), and optionally spacing (three positive numbers) and origin (three numbers), unless the file is an NRRD file whose header gives them; attributes that the header also sets are refused. The message names the bad value.";
+    ImplicitRfsProgram = "E623", Error, "error in an embedded .rfs program",
+        "An <rfs> node's program (program= or file=) has an error; the message quotes the .rfs diagnostic with its own code and line:column in the program.";
+    ImplicitBadSection = "E624", Error, "invalid --section for implicit solids",
+        "geomc compile --section takes AXIS=VALUE, for example --section z=0: the contour lines of the plane cut of every implicit subdomain are written as line elements (named SUBDOMAIN_section).";
+    ImplicitDuplicate = "W132", Warning, "duplicate implicit definition",
+        "Two <function> elements share a name, or a function lists an argument twice; the later definition is ignored.";
+    ImplicitSectionEmpty = "W133", Warning, "section plane misses an implicit subdomain",
+        "The plane of --section does not cut this implicit subdomain's surface, so no contour line is written for it.";
     // --- Resource limits and hostile input (issue 10, branch harden-corpus) ---
     GridTooLarge = "E800", Error, "implicit grid has too many cells",
         "Polygonizing an implicit (.rfs) solid samples a grid of nx x ny x nz cells, (nx + 1)(ny + 1)(nz + 1) values of 8 bytes each, and the grid asked for exceeds the cell limit (16,777,216 = 256^3 by default). It is refused before any memory is spent. Use fewer cells (Geom.nx/ny/nz or --cells), or raise the limit with --max-grid-cells.";
@@ -313,6 +344,10 @@ codes! {
         "The input mesh file parsed, but it holds no triangles, lines or points, so converting it would write an empty file. The file is probably truncated, not a mesh, or written by a tool that failed. Check it, or pass --from if its format was guessed wrongly.";
     EmptySurface = "E803", Error, "implicit solid has no surface on its grid",
         "Polygonizing the .rfs program found no triangles: the solid {f > 0} is empty, fills the whole Geom box, or is too thin for the grid's cells. Writing would give an empty mesh, so nothing is written. Check the Geom box (x_min..z_max) against where the solid lies, and use more cells (Geom.nx/ny/nz or --cells) for thin features.";
+
+    // ---- mesh-perf: locate, volume cells (issues 3, 4) ----
+    LocateBadPoint = "E504", Error, "bad row in a points file",
+        "geomc locate reads one point per row: 2 or 3 finite numbers separated by commas or spaces (x,y or x,y,z). A first row of column names (x,y,z) is allowed; empty rows and rows starting with # are skipped. Fix or remove the row named.";
 
     // ---- trimmed parametric surfaces (issue 9, branch trim) ----
     TrimmedCarrierInvalid = "E740", Error, "invalid parametric surface",

@@ -26,6 +26,16 @@ pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Do
     doc
 }
 
+/// Parses one attribute's expression with spans in the source, reporting
+/// malformed ones (E120–E124) as every numeric attribute does.
+pub fn parse_attribute_expr(
+    source: &SourceFile,
+    attr: &Attribute,
+    diags: &mut Diagnostics,
+) -> Option<crate::expr::Expr> {
+    Builder { source, diags }.parse_number(attr).expr
+}
+
 struct Builder<'a> {
     source: &'a SourceFile,
     diags: &'a mut Diagnostics,
@@ -144,6 +154,9 @@ impl Builder<'_> {
                 sides: self.number(e, "sides"),
             },
             "poly_line" => ObjectKind::PolyLine {
+                crack: e
+                    .attribute("crack")
+                    .is_some_and(|a| a.value.trim() == "true"),
                 segments: e
                     .children_named("line")
                     .map(|l| {

@@ -301,7 +301,11 @@ pub static POLY_LINE_SEGMENT: Rule = Rule {
 };
 pub static POLY_LINE: Rule = Rule {
     name: "poly_line",
-    attrs: NAMED,
+    attrs: &[
+        req("name", Name),
+        opt("cs", Ref),
+        opt("crack", AttrKind::Enum(&["true", "false"])),
+    ],
     any_attrs: false,
     content: Content::Sequence(&[many(&POLY_LINE_SEGMENT, 1)]),
 };
@@ -693,6 +697,256 @@ pub static BOUNDARY: Rule = leaf(
     ],
 );
 
+// ---- implicit solids (issue 5): <rfunction>, <function>, <level_surface>, <density_volume> ----
+
+/// Paper 001's Geom fields as attributes: bounding box, cells per axis, optimisation.
+macro_rules! geom_attrs {
+    ($($extra:expr),* $(,)?) => {
+        &[
+            $($extra,)*
+            opt("x_min", Expr),
+            opt("x_max", Expr),
+            opt("y_min", Expr),
+            opt("y_max", Expr),
+            opt("z_min", Expr),
+            opt("z_max", Expr),
+            opt("nx", Expr),
+            opt("ny", Expr),
+            opt("nz", Expr),
+            opt("optiterations", Expr),
+        ]
+    };
+}
+
+pub static F_HALF_PLANE: Rule = leaf(
+    "half_plane",
+    &[
+        req("x1", Expr),
+        req("y1", Expr),
+        req("x2", Expr),
+        req("y2", Expr),
+    ],
+);
+pub static F_HALF_SPACE: Rule = leaf(
+    "half_space",
+    &[
+        req("xp", Expr),
+        req("yp", Expr),
+        req("zp", Expr),
+        req("nx", Expr),
+        req("ny", Expr),
+        req("nz", Expr),
+    ],
+);
+pub static F_ELLIPSE: Rule = leaf(
+    "ellipse",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("a", Expr),
+        req("b", Expr),
+    ],
+);
+pub static F_DISK: Rule = leaf("disk", &[req("r", Expr), req("x0", Expr), req("y0", Expr)]);
+pub static F_ELLIPSOID: Rule = leaf(
+    "ellipsoid",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("z0", Expr),
+        req("a", Expr),
+        req("b", Expr),
+        req("c", Expr),
+    ],
+);
+pub static F_BALL: Rule = leaf(
+    "ball",
+    &[
+        req("r", Expr),
+        req("x0", Expr),
+        req("y0", Expr),
+        req("z0", Expr),
+    ],
+);
+pub static F_REGULAR_POLYGON: Rule = leaf(
+    "regular_polygon",
+    &[
+        req("r", Expr),
+        req("x0", Expr),
+        req("y0", Expr),
+        req("n", Expr),
+    ],
+);
+pub static F_PARALLELOGRAM: Rule = leaf(
+    "parallelogram",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("a", Expr),
+        req("h", Expr),
+        req("alpha", Expr),
+    ],
+);
+pub static F_RECTANGLE: Rule = leaf(
+    "rectangle",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("w", Expr),
+        req("h", Expr),
+    ],
+);
+pub static F_PARALLELEPIPED: Rule = leaf(
+    "parallelepiped",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("z0", Expr),
+        req("a", Expr),
+        req("h", Expr),
+        req("d", Expr),
+        req("alpha", Expr),
+        req("beta", Expr),
+    ],
+);
+pub static F_BOX: Rule = leaf(
+    "box",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("z0", Expr),
+        req("w", Expr),
+        req("h", Expr),
+        req("d", Expr),
+    ],
+);
+pub static F_ROUNDED_RECTANGLE: Rule = leaf(
+    "rounded_rectangle",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("w", Expr),
+        req("h", Expr),
+        req("r", Expr),
+    ],
+);
+pub static F_SECTOR: Rule = leaf(
+    "sector",
+    &[
+        req("x0", Expr),
+        req("y0", Expr),
+        req("r", Expr),
+        req("angle1", Expr),
+        req("angle2", Expr),
+    ],
+);
+pub static F_VERTEX: Rule = leaf("vertex", &[req("x", Expr), req("y", Expr)]);
+/// Vertices clockwise, as paper 001's (9).
+pub static F_CONVEX_POLYGON: Rule = Rule {
+    name: "convex_polygon",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Sequence(&[many(&F_VERTEX, 3)]),
+};
+pub static F_FORMULA: Rule = leaf("formula", &[req("value", Expr)]);
+/// A call of a <function>: every other attribute is a named argument.
+pub static F_CALL: Rule = Rule {
+    name: "call",
+    attrs: &[req("function", Ref)],
+    any_attrs: true,
+    content: Content::Empty,
+};
+/// Paper 001's language inside the XML: a program in an attribute or a file.
+pub static F_RFS: Rule = leaf("rfs", &[opt("file", Text), opt("program", Text)]);
+const fn r_operation(name: &'static str, min: u32, max: Option<u32>) -> Rule {
+    Rule {
+        name,
+        attrs: &[],
+        any_attrs: false,
+        content: Content::Choice {
+            options: &R_TREE,
+            min,
+            max,
+        },
+    }
+}
+pub static F_UNION: Rule = r_operation("union", 1, None);
+pub static F_INTERSECTION: Rule = r_operation("intersection", 1, None);
+/// The first operand minus all the others.
+pub static F_DIFFERENCE: Rule = r_operation("difference", 2, None);
+pub static F_NOT: Rule = r_operation("not", 1, Some(1));
+/// The operands of an R-function tree.
+pub static R_TREE: [&Rule; 21] = [
+    &F_UNION,
+    &F_INTERSECTION,
+    &F_DIFFERENCE,
+    &F_NOT,
+    &F_FORMULA,
+    &F_CALL,
+    &F_RFS,
+    &F_CONVEX_POLYGON,
+    &F_HALF_PLANE,
+    &F_HALF_SPACE,
+    &F_ELLIPSE,
+    &F_DISK,
+    &F_ELLIPSOID,
+    &F_BALL,
+    &F_REGULAR_POLYGON,
+    &F_PARALLELOGRAM,
+    &F_RECTANGLE,
+    &F_PARALLELEPIPED,
+    &F_BOX,
+    &F_ROUNDED_RECTANGLE,
+    &F_SECTOR,
+];
+pub static RFUNCTION: Rule = Rule {
+    name: "rfunction",
+    attrs: geom_attrs![
+        req("name", Name),
+        opt("dimension", AttrKind::Enum(&["3"])),
+        opt("rsystem", AttrKind::Enum(&["rvachev", "minmax", "alpha"])),
+        opt("alpha", Expr),
+    ],
+    any_attrs: false,
+    content: Content::Choice {
+        options: &R_TREE,
+        min: 1,
+        max: Some(1),
+    },
+};
+pub static FUNCTION: Rule = Rule {
+    name: "function",
+    attrs: &[req("name", Name), req("args", Text)],
+    any_attrs: false,
+    content: Content::Choice {
+        options: &R_TREE,
+        min: 1,
+        max: Some(1),
+    },
+};
+pub static LEVEL_SURFACE: Rule = leaf(
+    "level_surface",
+    geom_attrs![
+        req("name", Name),
+        req("expression", Expr),
+        opt("level", Expr),
+        opt("variables", Text),
+    ],
+);
+pub static DENSITY_VOLUME: Rule = leaf(
+    "density_volume",
+    &[
+        req("name", Name),
+        req("file", Text),
+        req("level", Expr),
+        opt("type", AttrKind::Enum(&["u8", "u16", "i16", "f32"])),
+        opt("endian", AttrKind::Enum(&["little", "big"])),
+        opt("dims", Text),
+        opt("spacing", Text),
+        opt("origin", Text),
+    ],
+);
+
 // ---- the root ----
 
 pub static GEOMETRY: Rule = Rule {
@@ -739,6 +993,10 @@ pub static GEOMETRY: Rule = Rule {
             &FACE,
             &SUBDOMAIN,
             &BOUNDARY,
+            &RFUNCTION,
+            &FUNCTION,
+            &LEVEL_SURFACE,
+            &DENSITY_VOLUME,
         ],
         min: 0,
         max: None,

@@ -239,6 +239,8 @@ pub enum ObjectKind {
     },
     PolyLine {
         segments: Vec<(Option<PointSpec>, Option<PointSpec>)>,
+        /// `crack="true"`: a 2D mesh is opened along it.
+        crack: bool,
     },
     TruncatedCone {
         bottom_center: Option<PointSpec>,

@@ -2,6 +2,9 @@
 //! basis coordinates, free variables), `+ - * / ^`, parentheses, unary minus,
 //! `pi`, and the functions sqrt sin cos tan asin acos atan exp ln abs min max.
 
+// User-controlled bytes and values: no panicking index (docs/reliability.md).
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
+
 mod eval;
 mod parse;
 

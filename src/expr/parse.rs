@@ -84,9 +84,10 @@ fn describe(token: &Token) -> String {
 fn lex(text: &str, base: usize) -> Result<Vec<(Token, Span)>, ParseError> {
     let bytes = text.as_bytes();
     let mut tokens = Vec::new();
+    // Out of range reads as 0, which no token starts with.
+    let at = |k: usize| bytes.get(k).copied().unwrap_or(0);
     let mut i = 0;
-    while i < bytes.len() {
-        let c = bytes[i];
+    while let Some(&c) = bytes.get(i) {
         let start = i;
         match c {
             b' ' | b'\t' | b'\n' | b'\r' => {
@@ -94,22 +95,22 @@ fn lex(text: &str, base: usize) -> Result<Vec<(Token, Span)>, ParseError> {
                 continue;
             }
             b'0'..=b'9' | b'.' => {
-                while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+                while at(i).is_ascii_digit() || at(i) == b'.' {
                     i += 1;
                 }
-                if i < bytes.len() && (bytes[i] == b'e' || bytes[i] == b'E') {
+                if at(i) == b'e' || at(i) == b'E' {
                     let mut j = i + 1;
-                    if j < bytes.len() && (bytes[j] == b'+' || bytes[j] == b'-') {
+                    if at(j) == b'+' || at(j) == b'-' {
                         j += 1;
                     }
-                    if j < bytes.len() && bytes[j].is_ascii_digit() {
-                        while j < bytes.len() && bytes[j].is_ascii_digit() {
+                    if at(j).is_ascii_digit() {
+                        while at(j).is_ascii_digit() {
                             j += 1;
                         }
                         i = j;
                     }
                 }
-                let literal = &text[start..i];
+                let literal = text.get(start..i).unwrap_or_default();
                 let value: f64 = literal.parse().map_err(|_| ParseError::Syntax {
                     span: Span::new(base + start, base + i),
                     message: format!("'{literal}' is not a number"),
@@ -124,11 +125,11 @@ fn lex(text: &str, base: usize) -> Result<Vec<(Token, Span)>, ParseError> {
             b')' => tokens.push((Token::RParen, Span::new(base + i, base + i + 1))),
             b',' => tokens.push((Token::Comma, Span::new(base + i, base + i + 1))),
             c if c.is_ascii_alphabetic() || c == b'_' => {
-                while i < bytes.len() && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_') {
+                while at(i).is_ascii_alphanumeric() || at(i) == b'_' {
                     i += 1;
                 }
                 tokens.push((
-                    Token::Ident(text[start..i].to_string()),
+                    Token::Ident(text.get(start..i).unwrap_or_default().to_string()),
                     Span::new(base + start, base + i),
                 ));
                 continue;

@@ -128,10 +128,11 @@ impl Document {
             warnings: Vec::new(),
         };
         let mut empty = Vec::new();
+        let mut expander = groups::Expander::new(mesh);
 
         let mut children = Vec::new();
         for g in groups::surface_groups(mesh) {
-            let ex = groups::expand(mesh, &g.faces);
+            let ex = expander.expand(&g.faces);
             if ex.triangles.is_empty() {
                 empty.push(g.name.to_string());
                 continue;
@@ -143,7 +144,7 @@ impl Document {
 
         let mut children = Vec::new();
         for g in groups::subdomain_surfaces(mesh) {
-            let ex = groups::expand(mesh, &g.faces);
+            let ex = expander.expand(&g.faces);
             if ex.triangles.is_empty() {
                 empty.push(g.name.to_string());
                 continue;
@@ -189,42 +190,46 @@ impl Document {
         d
     }
 
-    /// Appends 4-byte values as a new buffer view; returns its index.
-    fn view(&mut self, bytes: &[u8], target: u32) -> usize {
-        let offset = self.buffer.len();
-        self.buffer.extend_from_slice(bytes);
+    /// Records `self.buffer[offset..]` as a new buffer view; returns its index.
+    fn view(&mut self, offset: usize, target: u32) -> usize {
         self.views.push(json!({
             "buffer": 0,
             "byteOffset": offset,
-            "byteLength": bytes.len(),
+            "byteLength": self.buffer.len() - offset,
             "target": target,
         }));
         self.views.len() - 1
     }
 
-    fn vec3_accessor(&mut self, values: &[[f32; 3]], with_bounds: bool) -> usize {
-        let bytes: Vec<u8> = values
-            .iter()
-            .flatten()
-            .flat_map(|c| c.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, ARRAY_BUFFER);
+    /// Writes the values straight into the buffer (no copy in between).
+    fn vec3_accessor(
+        &mut self,
+        values: impl ExactSizeIterator<Item = [f32; 3]>,
+        with_bounds: bool,
+    ) -> usize {
+        let count = values.len();
+        let offset = self.buffer.len();
+        self.buffer.reserve(count * 12);
+        // The validator compares the bounds with the stored f32 values exactly.
+        let mut lo = [f32::INFINITY; 3];
+        let mut hi = [f32::NEG_INFINITY; 3];
+        for v in values {
+            let mut record = [0u8; 12];
+            for k in 0..3 {
+                record[4 * k..4 * k + 4].copy_from_slice(&v[k].to_le_bytes());
+                lo[k] = lo[k].min(v[k]);
+                hi[k] = hi[k].max(v[k]);
+            }
+            self.buffer.extend_from_slice(&record);
+        }
+        let view = self.view(offset, ARRAY_BUFFER);
         let mut accessor = json!({
             "bufferView": view,
             "componentType": FLOAT,
-            "count": values.len(),
+            "count": count,
             "type": "VEC3",
         });
         if with_bounds {
-            // The validator compares these with the stored f32 values exactly.
-            let mut lo = [f32::INFINITY; 3];
-            let mut hi = [f32::NEG_INFINITY; 3];
-            for v in values {
-                for k in 0..3 {
-                    lo[k] = lo[k].min(v[k]);
-                    hi[k] = hi[k].max(v[k]);
-                }
-            }
             accessor["min"] = json!(lo);
             accessor["max"] = json!(hi);
         }
@@ -232,25 +237,28 @@ impl Document {
         self.accessors.len() - 1
     }
 
-    fn index_accessor(&mut self, indices: &[u32]) -> usize {
-        let bytes: Vec<u8> = indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let view = self.view(&bytes, ELEMENT_ARRAY_BUFFER);
+    fn index_accessor(&mut self, indices: impl ExactSizeIterator<Item = u32>) -> usize {
+        let count = indices.len();
+        let offset = self.buffer.len();
+        self.buffer.reserve(count * 4);
+        for i in indices {
+            self.buffer.extend_from_slice(&i.to_le_bytes());
+        }
+        let view = self.view(offset, ELEMENT_ARRAY_BUFFER);
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": UNSIGNED_INT,
-            "count": indices.len(),
+            "count": count,
             "type": "SCALAR",
         }));
         self.accessors.len() - 1
     }
 
     fn triangles(&mut self, ex: &groups::Expanded) -> Value {
-        let positions: Vec<[f32; 3]> = ex.positions.iter().map(|p| p.map(|c| c as f32)).collect();
-        let normals: Vec<[f32; 3]> = ex.normals.iter().map(|n| n.map(|c| c as f32)).collect();
-        let indices: Vec<u32> = ex.triangles.iter().flatten().copied().collect();
-        let position = self.vec3_accessor(&positions, true);
-        let normal = self.vec3_accessor(&normals, false);
-        let indices = self.index_accessor(&indices);
+        let position = self.vec3_accessor(ex.positions.iter().map(|p| p.map(|c| c as f32)), true);
+        let normal = self.vec3_accessor(ex.normals.iter().map(|n| n.map(|c| c as f32)), false);
+        let flat = ex.triangles.as_flattened();
+        let indices = self.index_accessor(flat.iter().copied());
         json!({
             "attributes": {"POSITION": position, "NORMAL": normal},
             "indices": indices,
@@ -260,14 +268,15 @@ impl Document {
 
     /// A LINES (mode 1) or POINTS (mode 0) primitive over some mesh nodes.
     fn indexed(&mut self, mesh: &Mesh, nodes: &[u32], indices: Option<&[u32]>, mode: u32) -> Value {
-        let positions: Vec<[f32; 3]> = nodes
-            .iter()
-            .map(|&n| mesh.nodes[n as usize].map(|c| c as f32))
-            .collect();
-        let position = self.vec3_accessor(&positions, true);
+        let position = self.vec3_accessor(
+            nodes
+                .iter()
+                .map(|&n| mesh.nodes[n as usize].map(|c| c as f32)),
+            true,
+        );
         let mut primitive = json!({"attributes": {"POSITION": position}, "mode": mode});
         if let Some(indices) = indices {
-            primitive["indices"] = json!(self.index_accessor(indices));
+            primitive["indices"] = json!(self.index_accessor(indices.iter().copied()));
         }
         primitive
     }

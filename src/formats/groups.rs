@@ -5,7 +5,6 @@
 
 use super::WriteError;
 use crate::mesh::Mesh;
-use std::collections::HashMap;
 
 /// Rejects a mesh whose indices leave their tables or whose coordinates are
 /// not finite. After it, writers may index the mesh's tables directly.
@@ -247,25 +246,63 @@ pub(crate) struct Expanded {
     pub triangles: Vec<[u32; 3]>,
 }
 
-pub(crate) fn expand(mesh: &Mesh, faces: &[(u32, bool)]) -> Expanded {
-    let mut out = Expanded::default();
+/// Expands groups of one mesh: each node's vertex in the current face sits in
+/// a table indexed by node, valid while its stamp is the face's, so no hash
+/// map is built per face and the table is reused across calls.
+pub(crate) struct Expander<'a> {
+    mesh: &'a Mesh,
+    slot: Vec<(u32, u32)>,
+    stamp: u32,
+}
+
+impl<'a> Expander<'a> {
+    pub(crate) fn new(mesh: &'a Mesh) -> Expander<'a> {
+        Expander {
+            mesh,
+            slot: vec![(u32::MAX, 0); mesh.nodes.len()],
+            stamp: 0,
+        }
+    }
+
+    pub(crate) fn expand(&mut self, faces: &[(u32, bool)]) -> Expanded {
+        expand_into(self, faces)
+    }
+}
+
+fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
+    let mesh = ex.mesh;
+    let triangles: usize = faces
+        .iter()
+        .map(|&(f, _)| mesh.faces[f as usize].triangles.len())
+        .sum();
+    let mut out = Expanded {
+        triangles: Vec::with_capacity(triangles),
+        ..Expanded::default()
+    };
+    let mut sums: Vec<[f64; 3]> = Vec::new();
     for &(face, flip) in faces {
+        if ex.stamp == u32::MAX - 1 {
+            ex.slot.fill((u32::MAX, 0));
+            ex.stamp = 0;
+        }
+        ex.stamp += 1;
+        let stamp = ex.stamp;
         let first = out.positions.len();
-        // Lookup only, never iterated: the order stays deterministic.
-        let mut local: HashMap<u32, u32> = HashMap::new();
-        let mut sums: Vec<[f64; 3]> = Vec::new();
+        sums.clear();
         let mut total = [0.0; 3];
         for tri in oriented(mesh, face, flip) {
             let n = triangle_normal(mesh, tri);
             total = add(total, n);
             let mut t = [0u32; 3];
             for (k, &node) in tri.iter().enumerate() {
-                let index = *local.entry(node).or_insert_with(|| {
+                let entry = &mut ex.slot[node as usize];
+                if entry.0 != stamp {
                     out.positions.push(mesh.nodes[node as usize]);
                     out.nodes.push(node);
                     sums.push([0.0; 3]);
-                    (out.positions.len() - 1) as u32
-                });
+                    *entry = (stamp, (out.positions.len() - 1) as u32);
+                }
+                let index = entry.1;
                 // Area weighting: the unnormalised cross product is twice the area.
                 sums[index as usize - first] = add(sums[index as usize - first], n);
                 t[k] = index;
@@ -274,7 +311,7 @@ pub(crate) fn expand(mesh: &Mesh, faces: &[(u32, bool)]) -> Expanded {
         }
         let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
         out.normals
-            .extend(sums.into_iter().map(|s| unit(s).unwrap_or(fallback)));
+            .extend(sums.iter().map(|&s| unit(s).unwrap_or(fallback)));
     }
     out
 }

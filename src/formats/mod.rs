@@ -189,15 +189,28 @@ pub(crate) fn fmt_num(v: f64) -> String {
     }
 }
 
-/// The same for the `f32` values of viewer formats.
-pub(crate) fn fmt_num32(v: f32) -> String {
-    if v == 0.0 {
-        "0".to_string()
+/// [`fmt_num`] appended to `out`, without an allocation of its own.
+pub(crate) fn push_num(out: &mut String, v: f64) {
+    use std::fmt::Write as _;
+    let _ = if v == 0.0 {
+        out.write_str("0")
     } else if (1e-5..1e15).contains(&v.abs()) {
-        format!("{v}")
+        write!(out, "{v}")
     } else {
-        format!("{v:e}")
-    }
+        write!(out, "{v:e}")
+    };
+}
+
+/// [`push_num`] for the `f32` values of viewer formats.
+pub(crate) fn push_num32(out: &mut String, v: f32) {
+    use std::fmt::Write as _;
+    let _ = if v == 0.0 {
+        out.write_str("0")
+    } else if (1e-5..1e15).contains(&v.abs()) {
+        write!(out, "{v}")
+    } else {
+        write!(out, "{v:e}")
+    };
 }
 
 fn warning(format: &'static str, message: impl Into<String>) -> Warning {

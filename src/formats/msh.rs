@@ -13,9 +13,10 @@
 //! default, and what meshio needs to attach groups to every element block.
 
 use super::groups;
-use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, fmt_num, warning};
+use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, push_num, warning};
 use crate::mesh::Mesh;
 use std::collections::BTreeMap;
+use std::fmt::Write as _;
 use std::io::Write;
 
 pub(crate) struct Msh;
@@ -70,11 +71,18 @@ struct Entity {
     bounding: Vec<i32>,
     /// Mesh nodes whose bounding box the entity has (all it uses).
     used: Vec<u32>,
-    /// Elements, as mesh node lists (1, 2 or 3 nodes).
-    elements: Vec<Vec<u32>>,
+    /// Elements, as mesh node lists of `per` nodes each, one after the
+    /// other (one allocation per entity, not per element).
+    elements: Vec<u32>,
+    per: usize,
 }
 
 impl Entity {
+    /// How many elements it holds.
+    fn count(&self) -> usize {
+        self.elements.len() / self.per
+    }
+
     fn new(tag: usize) -> Entity {
         Entity {
             tag: tag as i32,
@@ -82,6 +90,7 @@ impl Entity {
             bounding: Vec::new(),
             used: Vec::new(),
             elements: Vec::new(),
+            per: 1,
         }
     }
 }
@@ -117,7 +126,7 @@ impl Model {
             .map(|(i, v)| {
                 let mut e = Entity::new(i + 1);
                 e.used = vec![v.node];
-                e.elements = vec![vec![v.node]];
+                e.elements = vec![v.node];
                 e
             })
             .collect();
@@ -129,10 +138,8 @@ impl Model {
                 let mut e = Entity::new(i + 1);
                 e.bounding = end_points(&edge.nodes, &vertex_of_node);
                 e.used = edge.nodes.clone();
-                e.elements = groups::segments(&edge.nodes)
-                    .iter()
-                    .map(|s| s.to_vec())
-                    .collect();
+                e.elements = segment_nodes(&edge.nodes);
+                e.per = 2;
                 if let Some(q) = &mesh.quadratic {
                     add_mid_nodes(&mut e, q.edges.get(i).map(|m| m.as_slice()));
                 }
@@ -151,7 +158,8 @@ impl Model {
                     .map(|&(edge, fwd)| signed(edge as usize + 1, fwd))
                     .collect();
                 e.used = face.triangles.iter().flatten().copied().collect();
-                e.elements = face.triangles.iter().map(|t| t.to_vec()).collect();
+                e.elements = face.triangles.as_flattened().to_vec();
+                e.per = 3;
                 if let Some(q) = &mesh.quadratic {
                     let mids: Vec<u32> = q
                         .faces
@@ -233,10 +241,8 @@ impl Model {
             // Only when a poly_line ends on model vertices does it have bounding points.
             e.bounding = end_points(&p.nodes, &vertex_of_node);
             e.used = p.nodes.clone();
-            e.elements = groups::segments(&p.nodes)
-                .iter()
-                .map(|s| s.to_vec())
-                .collect();
+            e.elements = segment_nodes(&p.nodes);
+            e.per = 2;
             if let Some(q) = &mesh.quadratic {
                 add_mid_nodes(&mut e, q.polylines.get(line_index).map(|m| m.as_slice()));
             }
@@ -248,7 +254,7 @@ impl Model {
                 let mut e = Entity::new(points.len() + 1);
                 e.physicals.push(tag);
                 e.used = vec![node];
-                e.elements = vec![vec![node]];
+                e.elements = vec![node];
                 points.push(e);
             }
         }
@@ -295,13 +301,22 @@ fn add_mid_nodes(e: &mut Entity, mids: Option<&[u32]>) {
 /// Appends `per` mid nodes to each element (6-node triangles: 3), when
 /// there is exactly one group per element.
 fn add_mid_nodes_grouped(e: &mut Entity, mids: &[u32], per: usize) {
-    if mids.len() != e.elements.len() * per || mids.is_empty() {
+    if mids.len() != e.count() * per || mids.is_empty() {
         return;
     }
-    for (element, extra) in e.elements.iter_mut().zip(mids.chunks_exact(per)) {
-        element.extend_from_slice(extra);
+    let mut elements = Vec::with_capacity(e.elements.len() + mids.len());
+    for (element, extra) in e.elements.chunks_exact(e.per).zip(mids.chunks_exact(per)) {
+        elements.extend_from_slice(element);
+        elements.extend_from_slice(extra);
     }
+    e.elements = elements;
+    e.per += per;
     e.used.extend_from_slice(mids);
+}
+
+/// Consecutive node pairs of a polyline, flat.
+fn segment_nodes(nodes: &[u32]) -> Vec<u32> {
+    nodes.windows(2).flatten().copied().collect()
 }
 
 /// Physical tags numbered per dimension from 1, with their names.
@@ -347,7 +362,10 @@ fn end_points(nodes: &[u32], vertex_of_node: &BTreeMap<u32, usize>) -> Vec<i32> 
 struct Sink<'a> {
     out: &'a mut dyn Write,
     binary: bool,
+    /// ASCII lines gathered the same way.
     line: String,
+    /// No token written on the current ASCII line yet.
+    fresh_line: bool,
     /// Binary values gathered here and handed to `out` in large pieces: one
     /// dynamic `write_all` per 8-byte value costs more than the copy itself.
     bytes: Vec<u8>,
@@ -357,11 +375,12 @@ struct Sink<'a> {
 const CHUNK: usize = 1 << 16;
 
 impl Sink<'_> {
-    fn token(&mut self, text: &str) {
-        if !self.line.is_empty() {
+    /// Starts a token: a space unless it is the first on its line.
+    fn space(&mut self) {
+        if !self.fresh_line {
             self.line.push(' ');
         }
-        self.line.push_str(text);
+        self.fresh_line = false;
     }
 
     fn raw(&mut self, bytes: &[u8]) -> std::io::Result<()> {
@@ -375,6 +394,8 @@ impl Sink<'_> {
     fn flush(&mut self) -> std::io::Result<()> {
         self.out.write_all(&self.bytes)?;
         self.bytes.clear();
+        self.out.write_all(self.line.as_bytes())?;
+        self.line.clear();
         Ok(())
     }
 
@@ -382,7 +403,8 @@ impl Sink<'_> {
         if self.binary {
             self.raw(&v.to_le_bytes())
         } else {
-            self.token(&v.to_string());
+            self.space();
+            let _ = write!(self.line, "{v}");
             Ok(())
         }
     }
@@ -391,7 +413,8 @@ impl Sink<'_> {
         if self.binary {
             self.raw(&(v as u64).to_le_bytes())
         } else {
-            self.token(&v.to_string());
+            self.space();
+            let _ = write!(self.line, "{v}");
             Ok(())
         }
     }
@@ -400,16 +423,21 @@ impl Sink<'_> {
         if self.binary {
             self.raw(&v.to_le_bytes())
         } else {
-            self.token(&fmt_num(v));
+            self.space();
+            push_num(&mut self.line, v);
             Ok(())
         }
     }
 
     fn end_line(&mut self) -> std::io::Result<()> {
         if !self.binary {
+            // Lines gathered like binary values: one dynamic write per piece.
             self.line.push('\n');
-            self.out.write_all(self.line.as_bytes())?;
-            self.line.clear();
+            if self.line.len() >= CHUNK {
+                self.out.write_all(self.line.as_bytes())?;
+                self.line.clear();
+            }
+            self.fresh_line = true;
         }
         Ok(())
     }
@@ -437,7 +465,8 @@ fn write_all(
     let mut s = Sink {
         out,
         binary,
-        line: String::new(),
+        line: String::with_capacity(if binary { 0 } else { CHUNK + 256 }),
+        fresh_line: true,
         bytes: Vec::with_capacity(if binary { CHUNK + 64 } else { 0 }),
     };
     s.text("$MeshFormat\n")?;
@@ -557,7 +586,7 @@ fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
         .flat_map(|(dim, list)| list.iter().map(move |e| (dim, e)))
         .filter(|(_, e)| !e.elements.is_empty())
         .collect();
-    let total: usize = blocks.iter().map(|(_, e)| e.elements.len()).sum();
+    let total: usize = blocks.iter().map(|(_, e)| e.count()).sum();
     s.text("$Elements\n")?;
     s.size(blocks.len())?;
     s.size(total)?;
@@ -568,7 +597,7 @@ fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
     for (dim, e) in blocks {
         // Gmsh element types: 15 point, 1 line, 8 3-node line, 2 triangle,
         // 9 6-node triangle.
-        let kind = match (dim, e.elements.first().map_or(0, Vec::len)) {
+        let kind = match (dim, e.per) {
             (0, _) => 15,
             (1, 3) => 8,
             (1, _) => 1,
@@ -578,9 +607,9 @@ fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
         s.int(dim as i32)?;
         s.int(e.tag)?;
         s.int(kind)?;
-        s.size(e.elements.len())?;
+        s.size(e.count())?;
         s.end_line()?;
-        for element in &e.elements {
+        for element in e.elements.chunks_exact(e.per) {
             tag += 1;
             s.size(tag)?;
             for &n in element {

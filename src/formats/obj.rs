@@ -6,8 +6,9 @@
 //! names, which a warning says.
 
 use super::groups::{self, Source};
-use super::{MeshWriter, Warning, WriteError, WriteOptions, count, fmt_num, warning};
+use super::{MeshWriter, Warning, WriteError, WriteOptions, count, push_num, warning};
 use crate::mesh::Mesh;
+use std::fmt::Write as _;
 use std::io::Write;
 
 pub(crate) struct Obj;
@@ -45,48 +46,44 @@ impl MeshWriter for Obj {
             ));
         }
 
-        writeln!(out, "# geomc mesh: {} nodes", mesh.nodes.len())?;
+        // Text gathered in large pieces, numbers formatted in place.
+        let mut text = String::with_capacity(PIECE + 512);
+        let _ = writeln!(text, "# geomc mesh: {} nodes", mesh.nodes.len());
         for p in &mesh.nodes {
-            writeln!(
-                out,
-                "v {} {} {}",
-                fmt_num(p[0]),
-                fmt_num(p[1]),
-                fmt_num(p[2])
-            )?;
+            vector(&mut text, "v ", *p);
+            spill(&mut text, out)?;
         }
 
         // Normals are numbered across the whole file, in the order written.
         let mut next_normal = 1usize;
+        let mut expander = groups::Expander::new(mesh);
         for g in groups::surface_groups(mesh) {
-            writeln!(out, "o {}", obj_name(g.name))?;
+            let _ = writeln!(text, "o {}", obj_name(g.name));
             for &(face, flip) in &g.faces {
-                let ex = groups::expand(mesh, &[(face, flip)]);
+                let ex = expander.expand(&[(face, flip)]);
                 if ex.triangles.is_empty() {
                     continue;
                 }
                 if !matches!(g.source, Source::Face(_)) {
-                    writeln!(out, "g {}", obj_name(&mesh.faces[face as usize].name))?;
+                    let _ = writeln!(text, "g {}", obj_name(&mesh.faces[face as usize].name));
                 }
                 for n in &ex.normals {
-                    writeln!(
-                        out,
-                        "vn {} {} {}",
-                        fmt_num(n[0]),
-                        fmt_num(n[1]),
-                        fmt_num(n[2])
-                    )?;
+                    vector(&mut text, "vn ", *n);
+                    spill(&mut text, out)?;
                 }
                 for t in &ex.triangles {
-                    let corner = |k: usize| {
-                        let local = t[k] as usize;
-                        format!("{}//{}", ex.nodes[local] + 1, next_normal + local)
-                    };
-                    writeln!(out, "f {} {} {}", corner(0), corner(1), corner(2))?;
+                    text.push('f');
+                    for &local in t {
+                        let local = local as usize;
+                        let _ = write!(text, " {}//{}", ex.nodes[local] + 1, next_normal + local);
+                    }
+                    text.push('\n');
+                    spill(&mut text, out)?;
                 }
                 next_normal += ex.normals.len();
             }
         }
+        out.write_all(text.as_bytes())?;
         for g in groups::line_groups(mesh) {
             if g.segments.is_empty() {
                 continue;
@@ -113,6 +110,29 @@ impl MeshWriter for Obj {
         }
         Ok(warnings)
     }
+}
+
+const PIECE: usize = 1 << 16;
+
+/// Hands the gathered text to `out` once it is a large piece.
+fn spill(text: &mut String, out: &mut dyn Write) -> Result<(), WriteError> {
+    if text.len() >= PIECE {
+        out.write_all(text.as_bytes())?;
+        text.clear();
+    }
+    Ok(())
+}
+
+/// `PREFIX x y z` and a newline.
+fn vector(text: &mut String, prefix: &str, v: [f64; 3]) {
+    text.push_str(prefix);
+    for (k, c) in v.into_iter().enumerate() {
+        if k > 0 {
+            text.push(' ');
+        }
+        push_num(text, c);
+    }
+    text.push('\n');
 }
 
 fn flush_line(out: &mut dyn Write, run: &[u32]) -> Result<(), WriteError> {

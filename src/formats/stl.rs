@@ -4,7 +4,7 @@
 //! Edges, poly_lines and point sets cannot be carried and are reported.
 
 use super::groups::{self, SurfaceGroup};
-use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, fmt_num32, warning};
+use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, push_num32, warning};
 use crate::mesh::Mesh;
 use std::io::Write;
 
@@ -143,10 +143,12 @@ fn write_binary(
     let mut bytes = Vec::with_capacity(CHUNK);
     for g in groups {
         for (normal, points) in facets(mesh, g) {
-            for c in normal.iter().chain(points.iter().flatten()) {
-                bytes.extend_from_slice(&c.to_le_bytes());
+            // One 50-byte record assembled on the stack, then one copy.
+            let mut record = [0u8; 50];
+            for (k, c) in normal.iter().chain(points.iter().flatten()).enumerate() {
+                record[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
             }
-            bytes.extend_from_slice(&[0, 0]);
+            bytes.extend_from_slice(&record);
             if bytes.len() >= CHUNK {
                 out.write_all(&bytes)?;
                 bytes.clear();
@@ -175,31 +177,36 @@ fn write_ascii(
     groups: &[SurfaceGroup],
     out: &mut dyn Write,
 ) -> Result<(), WriteError> {
+    // Text gathered in large pieces, numbers formatted in place.
+    const PIECE: usize = 1 << 16;
+    let mut text = String::with_capacity(PIECE + 512);
+    let vector = |text: &mut String, prefix: &str, v: [f32; 3]| {
+        text.push_str(prefix);
+        for (k, c) in v.into_iter().enumerate() {
+            if k > 0 {
+                text.push(' ');
+            }
+            push_num32(text, c);
+        }
+        text.push('\n');
+    };
     for g in groups {
         let name = solid_name(g.name);
-        writeln!(out, "solid {name}")?;
+        text.push_str(&format!("solid {name}\n"));
         for (n, points) in facets(mesh, g) {
-            writeln!(
-                out,
-                "  facet normal {} {} {}",
-                fmt_num32(n[0]),
-                fmt_num32(n[1]),
-                fmt_num32(n[2])
-            )?;
-            writeln!(out, "    outer loop")?;
+            vector(&mut text, "  facet normal ", n);
+            text.push_str("    outer loop\n");
             for p in points {
-                writeln!(
-                    out,
-                    "      vertex {} {} {}",
-                    fmt_num32(p[0]),
-                    fmt_num32(p[1]),
-                    fmt_num32(p[2])
-                )?;
+                vector(&mut text, "      vertex ", p);
             }
-            writeln!(out, "    endloop")?;
-            writeln!(out, "  endfacet")?;
+            text.push_str("    endloop\n  endfacet\n");
+            if text.len() >= PIECE {
+                out.write_all(text.as_bytes())?;
+                text.clear();
+            }
         }
-        writeln!(out, "endsolid {name}")?;
+        text.push_str(&format!("endsolid {name}\n"));
     }
+    out.write_all(text.as_bytes())?;
     Ok(())
 }

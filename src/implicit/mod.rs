@@ -8,9 +8,13 @@ pub mod interval;
 pub mod ir;
 pub mod lang;
 pub mod library;
+pub mod optimize;
 pub mod polygonize;
 pub mod rfs;
+pub mod rows;
+pub mod section;
 pub mod tape;
+pub mod xml;
 
 use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};
 use crate::span::Span;
@@ -81,7 +85,11 @@ impl ImplicitModel {
         if let Some(c) = cells {
             grid.cells = c;
         }
-        polygonize::polygonize(&self.ssa(), &grid, &Options::default())
+        let ssa = self.ssa();
+        let mut surface = polygonize::polygonize(&ssa, &grid, &Options::default());
+        let iterations = self.geom.optiterations;
+        optimize::optimize(&mut surface, &ssa, &grid, iterations);
+        surface
     }
 }
 

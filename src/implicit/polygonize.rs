@@ -22,6 +22,7 @@
 //! solid (towards decreasing f).
 
 use super::interval::{self, Interval, Sign};
+use super::rows::RowTape;
 use super::tape::{Ssa, Tape};
 use rayon::prelude::*;
 use std::sync::Arc;
@@ -82,18 +83,25 @@ pub struct Surface {
 
 const BS: usize = 8;
 
+/// What a block's samples need: the f64 tape refines crossings, the row
+/// tape samples the grid.
+struct Kernel {
+    tape: Tape,
+    rows: RowTape,
+}
+
 #[derive(Clone)]
 enum Block {
     Inside,
     Outside,
-    Mixed(Arc<Tape>),
+    Mixed(Arc<Kernel>),
     /// Given samples without a function: vertices by linear interpolation.
     Sampled,
 }
 
 struct Field {
     n1: [usize; 3],
-    values: Vec<f64>,
+    values: Vec<f32>,
     nb: [usize; 3],
     blocks: Vec<Block>,
 }
@@ -107,126 +115,176 @@ impl Field {
     }
 }
 
-/// Samples f on every grid point, densely (no pruning), in parallel over z
-/// planes. Used by the dense-throughput benchmark and for density volumes.
-pub fn sample_grid(tape: &Tape, grid: &Grid) -> Vec<f64> {
+/// Samples f on every grid point, densely (no pruning), as f32, in parallel
+/// over z planes, row by row with the x terms computed once (`RowTape`).
+/// Used by the dense-throughput benchmark.
+pub fn sample_grid(ssa: &Ssa, grid: &Grid) -> Vec<f32> {
+    let tape = RowTape::new(ssa);
     let [xs, ys, zs] = [grid.coords(0), grid.coords(1), grid.coords(2)];
     let plane = xs.len() * ys.len();
-    let mut values = vec![0.0; plane * zs.len()];
-    // Whole planes per call, so batches are full (a 257-point row would leave
-    // its last batch nearly empty).
-    let px: Vec<f64> = (0..plane).map(|m| xs[m % xs.len()]).collect();
-    let py: Vec<f64> = (0..plane).map(|m| ys[m / xs.len()]).collect();
+    let mut values = vec![0.0f32; plane * zs.len()];
     values.par_chunks_mut(plane).enumerate().for_each_init(
-        || (tape.workspace(), vec![0.0; plane]),
-        |(ws, pz), (k, out)| {
-            pz.fill(zs[k]);
-            tape.eval(ws, &px, &py, pz, out);
+        || tape.workspace(&xs),
+        |ws, (k, out)| {
+            for (j, row) in out.chunks_mut(xs.len()).enumerate() {
+                tape.eval_row(ws, ys[j], zs[k], row);
+            }
         },
     );
     values
+}
+
+/// A block range [lo, hi) per axis of the block grid.
+type Region = ([usize; 3], [usize; 3]);
+
+/// Classifies the blocks of `region` by interval arithmetic, recursively
+/// halving the region and simplifying the program on the way down, so a
+/// leaf block sees only the few union branches active near it (M3's
+/// 1,000-ball chain shrinks to a handful). Returns (block index, block).
+fn classify_region(
+    ssa: &Ssa,
+    region: Region,
+    coords: &[Vec<f64>; 3],
+    nb: [usize; 3],
+    out: &mut Vec<(usize, Block)>,
+) {
+    let (lo, hi) = region;
+    let n1 = [coords[0].len(), coords[1].len(), coords[2].len()];
+    let bounds = [0, 1, 2].map(|a| {
+        let top = (hi[a] * BS).min(n1[a] - 1);
+        Interval::new(coords[a][lo[a] * BS], coords[a][top])
+    });
+    let sign = interval::sign_only(ssa);
+    let iv = interval::eval(ssa, &sign, bounds);
+    let fill = |block: Block, out: &mut Vec<(usize, Block)>| {
+        for k in lo[2]..hi[2] {
+            for j in lo[1]..hi[1] {
+                for i in lo[0]..hi[0] {
+                    out.push(((k * nb[1] + j) * nb[0] + i, block.clone()));
+                }
+            }
+        }
+    };
+    match interval::classify(iv[ssa.root()]) {
+        Sign::Inside => return fill(Block::Inside, out),
+        Sign::Outside => return fill(Block::Outside, out),
+        Sign::Ambiguous => {}
+    }
+    let simpler = interval::simplify(ssa, &sign, &iv);
+    let extent = [0, 1, 2].map(|a| hi[a] - lo[a]);
+    let axis = (0..3).max_by_key(|&a| (extent[a], a)).unwrap_or(0);
+    if extent[axis] <= 1 {
+        let kernel = Kernel {
+            tape: Tape::new(&simpler),
+            rows: RowTape::new(&simpler),
+        };
+        return fill(Block::Mixed(Arc::new(kernel)), out);
+    }
+    let mid = lo[axis] + extent[axis] / 2;
+    let (mut a_hi, mut b_lo) = (hi, lo);
+    a_hi[axis] = mid;
+    b_lo[axis] = mid;
+    if extent.iter().product::<usize>() >= 64 {
+        let (mut left, mut right) = (Vec::new(), Vec::new());
+        rayon::join(
+            || classify_region(&simpler, (lo, a_hi), coords, nb, &mut left),
+            || classify_region(&simpler, (b_lo, hi), coords, nb, &mut right),
+        );
+        out.extend(left);
+        out.extend(right);
+    } else {
+        classify_region(&simpler, (lo, a_hi), coords, nb, out);
+        classify_region(&simpler, (b_lo, hi), coords, nb, out);
+    }
 }
 
 fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
     let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
     let n1 = [coords[0].len(), coords[1].len(), coords[2].len()];
     let nb = [n1[0].div_ceil(BS), n1[1].div_ceil(BS), n1[2].div_ceil(BS)];
-    let full = Arc::new(Tape::new(ssa));
-    let sign = interval::sign_only(ssa);
+    let mut blocks = vec![Block::Outside; nb[0] * nb[1] * nb[2]];
+    if options.prune {
+        let mut found = Vec::with_capacity(blocks.len());
+        classify_region(ssa, ([0; 3], nb), &coords, nb, &mut found);
+        for (at, block) in found {
+            blocks[at] = block;
+        }
+    } else {
+        let kernel = Arc::new(Kernel {
+            tape: Tape::new(ssa),
+            rows: RowTape::new(ssa),
+        });
+        blocks.fill(Block::Mixed(kernel));
+    }
     let layer = BS * n1[0] * n1[1];
-    let mut values = vec![0.0; n1[0] * n1[1] * n1[2]];
-    let layers: Vec<Vec<Block>> = values
+    let mut values = vec![0.0f32; n1[0] * n1[1] * n1[2]];
+    values
         .par_chunks_mut(layer)
         .enumerate()
-        .map(|(bk, chunk)| {
-            let mut blocks = Vec::with_capacity(nb[0] * nb[1]);
-            let (mut px, mut py, mut pz, mut out) =
-                (Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        .for_each(|(bk, chunk)| {
+            let mut row = [0.0f32; BS];
             for bj in 0..nb[1] {
                 for bi in 0..nb[0] {
                     let lo = [bi * BS, bj * BS, bk * BS];
                     let owned = [0, 1, 2].map(|a| (lo[a] + BS).min(n1[a]));
-                    let block = if options.prune {
-                        let bounds = [0, 1, 2].map(|a| {
-                            let hi = (lo[a] + BS).min(n1[a] - 1);
-                            Interval::new(coords[a][lo[a]], coords[a][hi])
-                        });
-                        let iv = interval::eval(ssa, &sign, bounds);
-                        match interval::classify(iv[ssa.root()]) {
-                            Sign::Inside => Block::Inside,
-                            Sign::Outside => Block::Outside,
-                            Sign::Ambiguous => Block::Mixed(Arc::new(Tape::new(
-                                &interval::simplify(ssa, &sign, &iv),
-                            ))),
+                    let len = owned[0] - lo[0];
+                    let block = &blocks[(bk * nb[1] + bj) * nb[0] + bi];
+                    let mut ws = match block {
+                        Block::Mixed(kernel) => {
+                            Some(kernel.rows.workspace(&coords[0][lo[0]..owned[0]]))
                         }
-                    } else {
-                        Block::Mixed(full.clone())
+                        _ => None,
                     };
-                    let placeholder = match &block {
-                        Block::Inside => Some(1.0),
-                        Block::Outside => Some(-1.0),
-                        Block::Mixed(_) | Block::Sampled => None,
-                    };
-                    px.clear();
-                    py.clear();
-                    pz.clear();
-                    for k in lo[2]..owned[2] {
-                        for j in lo[1]..owned[1] {
-                            for i in lo[0]..owned[0] {
-                                px.push(coords[0][i]);
-                                py.push(coords[1][j]);
-                                pz.push(coords[2][k]);
-                            }
-                        }
-                    }
-                    out.clear();
-                    out.resize(px.len(), placeholder.unwrap_or(0.0));
-                    if let Block::Mixed(tape) = &block {
-                        let mut ws = tape.workspace();
-                        tape.eval(&mut ws, &px, &py, &pz, &mut out);
-                    }
-                    let mut m = 0;
                     for k in lo[2]..owned[2] {
                         for j in lo[1]..owned[1] {
                             let start = ((k - lo[2]) * n1[1] + j) * n1[0] + lo[0];
-                            let len = owned[0] - lo[0];
-                            chunk[start..start + len].copy_from_slice(&out[m..m + len]);
-                            m += len;
+                            let dst = &mut chunk[start..start + len];
+                            match (block, ws.as_mut()) {
+                                (Block::Mixed(kernel), Some(ws)) => {
+                                    kernel.rows.eval_row(
+                                        ws,
+                                        coords[1][j],
+                                        coords[2][k],
+                                        &mut row[..len],
+                                    );
+                                    dst.copy_from_slice(&row[..len]);
+                                }
+                                (Block::Inside, _) => dst.fill(1.0),
+                                _ => dst.fill(-1.0),
+                            }
                         }
                     }
-                    blocks.push(block);
                 }
             }
-            blocks
-        })
-        .collect();
+        });
     let mut field = Field {
         n1,
         values,
         nb,
-        blocks: layers.into_iter().flatten().collect(),
+        blocks,
     };
     close_at_box(&mut field, options);
     field
 }
 
+/// Caps samples on the box faces at 0 (only the six faces are visited).
 fn close_at_box(field: &mut Field, options: &Options) {
+    if !options.close_at_box {
+        return;
+    }
     let n1 = field.n1;
-    if options.close_at_box {
-        for k in 0..n1[2] {
-            for j in 0..n1[1] {
-                for i in 0..n1[0] {
-                    let on_box = i == 0
-                        || j == 0
-                        || k == 0
-                        || i == n1[0] - 1
-                        || j == n1[1] - 1
-                        || k == n1[2] - 1;
-                    if on_box {
-                        let at = field.idx(i, j, k);
-                        field.values[at] = field.values[at].min(0.0);
-                    }
+    for k in 0..n1[2] {
+        let k_face = k == 0 || k == n1[2] - 1;
+        for j in 0..n1[1] {
+            let start = field.idx(0, j, k);
+            let row = &mut field.values[start..start + n1[0]];
+            if k_face || j == 0 || j == n1[1] - 1 {
+                for v in row.iter_mut() {
+                    *v = v.min(0.0);
                 }
+            } else {
+                row[0] = row[0].min(0.0);
+                row[n1[0] - 1] = row[n1[0] - 1].min(0.0);
             }
         }
     }
@@ -250,7 +308,7 @@ fn plane_vertices(
     let mut ends = Vec::new();
     for j in 0..n1[1] {
         for i in 0..n1[0] {
-            let v0 = field.values[field.idx(i, j, k)];
+            let v0 = field.values[field.idx(i, j, k)] as f64;
             for (axis, (ii, jj, kk)) in [(i + 1, j, k), (i, j + 1, k), (i, j, k + 1)]
                 .into_iter()
                 .enumerate()
@@ -258,7 +316,7 @@ fn plane_vertices(
                 if ii >= n1[0] || jj >= n1[1] || kk >= n1[2] {
                     continue;
                 }
-                let v1 = field.values[field.idx(ii, jj, kk)];
+                let v1 = field.values[field.idx(ii, jj, kk)] as f64;
                 if (v0 > 0.0) != (v1 > 0.0) {
                     keys.push(((j * n1[0] + i) * 3 + axis) as u32);
                     ends.push((
@@ -291,8 +349,14 @@ fn plane_vertices(
             end += 1;
         }
         let key = keys[order[start]] as usize / 3;
-        if let Block::Mixed(tape) = field.block(key % n1[0], key / n1[0], k) {
-            refine(tape, &order[start..end], &ends, &mut t, options.iterations);
+        if let Block::Mixed(kernel) = field.block(key % n1[0], key / n1[0], k) {
+            refine(
+                &kernel.tape,
+                &order[start..end],
+                &ends,
+                &mut t,
+                options.iterations,
+            );
         }
         start = end;
     }
@@ -584,6 +648,14 @@ pub fn polygonize_samples(values: Vec<f64>, grid: &Grid, options: &Options) -> S
         "one sample per grid point"
     );
     let nb = n1.map(|n| n.div_ceil(BS));
+    // To f32 keeping each sign (a tiny positive value must not round to 0).
+    let values = values
+        .iter()
+        .map(|&v| match v as f32 {
+            0.0 if v > 0.0 => f32::MIN_POSITIVE,
+            w => w,
+        })
+        .collect();
     let mut field = Field {
         n1,
         values,
@@ -611,12 +683,15 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
         .iter()
         .flat_map(|p| p.positions.iter().copied())
         .collect();
-    let dense = |k: usize| {
-        let mut map = vec![u32::MAX; n1[0] * n1[1] * 3];
-        for (m, &key) in planes[k].keys.iter().enumerate() {
-            map[key as usize] = offsets[k] + m as u32;
+    // Edge key → vertex id for one plane, in a buffer reused per thread
+    // (only the entries set are cleared afterwards).
+    let fill = |map: &mut Vec<u32>, k: usize, on: bool| {
+        if map.is_empty() {
+            map.resize(n1[0] * n1[1] * 3, u32::MAX);
         }
-        map
+        for (m, &key) in planes[k].keys.iter().enumerate() {
+            map[key as usize] = if on { offsets[k] + m as u32 } else { u32::MAX };
+        }
     };
     let touches_box = |i: usize, j: usize, k: usize| {
         let b = [i / BS, j / BS, k / BS];
@@ -624,45 +699,52 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
     };
     let slabs: Vec<SlabOutput> = (0..grid.cells[2])
         .into_par_iter()
-        .map(|k| {
-            let maps = [dense(k), dense(k + 1)];
-            let mut tris = Vec::new();
-            let mut centres = Vec::new();
-            let mut ids = Vec::with_capacity(12);
-            for j in 0..grid.cells[1] {
-                for i in 0..grid.cells[0] {
-                    match field.block(i, j, k) {
-                        Block::Outside => continue,
-                        Block::Inside if !(options.close_at_box && touches_box(i, j, k)) => {
+        .map_init(
+            || [Vec::new(), Vec::new()],
+            |maps, k| {
+                fill(&mut maps[0], k, true);
+                fill(&mut maps[1], k + 1, true);
+                let mut tris = Vec::new();
+                let mut centres = Vec::new();
+                let mut ids = Vec::with_capacity(12);
+                for j in 0..grid.cells[1] {
+                    for i in 0..grid.cells[0] {
+                        match field.block(i, j, k) {
+                            Block::Outside => continue,
+                            Block::Inside if !(options.close_at_box && touches_box(i, j, k)) => {
+                                continue;
+                            }
+                            _ => {}
+                        }
+                        let v: [f64; 8] = std::array::from_fn(|c| {
+                            field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))]
+                                as f64
+                        });
+                        let first = v[0] > 0.0;
+                        if v.iter().all(|&x| (x > 0.0) == first) {
                             continue;
                         }
-                        _ => {}
-                    }
-                    let v: [f64; 8] = std::array::from_fn(|c| {
-                        field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))]
-                    });
-                    let first = v[0] > 0.0;
-                    if v.iter().all(|&x| (x > 0.0) == first) {
-                        continue;
-                    }
-                    for cycle in cell_cycles(&v) {
-                        ids.clear();
-                        for &e in &cycle {
-                            let (a, b) = EDGES[e as usize];
-                            let axis = (a ^ b).trailing_zeros() as usize;
-                            let (a, dz) = (a as usize, (a as usize >> 2) & 1);
-                            let key = ((j + (a >> 1 & 1)) * n1[0] + i + (a & 1)) * 3 + axis;
-                            ids.push(maps[dz][key]);
+                        for cycle in cell_cycles(&v) {
+                            ids.clear();
+                            for &e in &cycle {
+                                let (a, b) = EDGES[e as usize];
+                                let axis = (a ^ b).trailing_zeros() as usize;
+                                let (a, dz) = (a as usize, (a as usize >> 2) & 1);
+                                let key = ((j + (a >> 1 & 1)) * n1[0] + i + (a & 1)) * 3 + axis;
+                                ids.push(maps[dz][key]);
+                            }
+                            if ids.contains(&u32::MAX) {
+                                continue;
+                            }
+                            triangulate(&cycle, &ids, &positions, &mut tris, &mut centres);
                         }
-                        if ids.contains(&u32::MAX) {
-                            continue;
-                        }
-                        triangulate(&cycle, &ids, &positions, &mut tris, &mut centres);
                     }
                 }
-            }
-            (tris, centres)
-        })
+                fill(&mut maps[0], k, false);
+                fill(&mut maps[1], k + 1, false);
+                (tris, centres)
+            },
+        )
         .collect();
     let mut positions = positions;
     let mut triangles = Vec::with_capacity(slabs.iter().map(|s| s.0.len()).sum());

@@ -222,35 +222,38 @@ impl Tape {
                     dst[..len].copy_from_slice(&src[start..start + len]);
                 }
             }
-            self.run(&mut ws.buf);
+            self.run(&mut ws.buf, len);
             out[start..start + len].copy_from_slice(&ws.buf[self.out as usize * BATCH..][..len]);
             start += len;
         }
     }
 
-    fn run(&self, buf: &mut [f64]) {
+    /// Runs the instructions over the first `len` lanes (a short last batch
+    /// or a small group of edges must not pay for a full batch).
+    fn run(&self, buf: &mut [f64], len: usize) {
         for ins in &self.instrs {
             let (o, a, b) = io(buf, ins.out as usize, ins.a as usize, ins.b as usize);
+            let (o, a, b) = (&mut o[..len], &a[..len], &b[..len]);
             match ins.op {
                 Op::Unary(u) => unary(u, o, a),
                 Op::Binary(bin) => binary(bin, o, a, b),
                 Op::RvAnd => {
-                    for i in 0..BATCH {
+                    for i in 0..len {
                         o[i] = a[i] + b[i] - (a[i] * a[i] + b[i] * b[i]).sqrt();
                     }
                 }
                 Op::RvOr => {
-                    for i in 0..BATCH {
+                    for i in 0..len {
                         o[i] = a[i] + b[i] + (a[i] * a[i] + b[i] * b[i]).sqrt();
                     }
                 }
                 Op::RAnd(al) => {
-                    for i in 0..BATCH {
+                    for i in 0..len {
                         o[i] = r_and(a[i], b[i], al);
                     }
                 }
                 Op::ROr(al) => {
-                    for i in 0..BATCH {
+                    for i in 0..len {
                         o[i] = r_or(a[i], b[i], al);
                     }
                 }
@@ -266,6 +269,8 @@ pub struct Workspace {
 
 /// The output slot (mutable) and two input slots of one instruction; the
 /// allocator guarantees the output differs from both inputs.
+// Slot numbers come from the tape compiler, never from input: a bad one is a bug.
+#[allow(clippy::expect_used)]
 fn io(
     buf: &mut [f64],
     o: usize,
@@ -286,11 +291,11 @@ fn io(
     (out.try_into().expect("slot is BATCH long"), a, b)
 }
 
-fn unary(u: Unary, o: &mut [f64; BATCH], a: &[f64; BATCH]) {
+fn unary(u: Unary, o: &mut [f64], a: &[f64]) {
     macro_rules! each {
         ($f:expr) => {
-            for i in 0..BATCH {
-                o[i] = $f(a[i]);
+            for (o, &a) in o.iter_mut().zip(a) {
+                *o = $f(a);
             }
         };
     }
@@ -303,11 +308,11 @@ fn unary(u: Unary, o: &mut [f64; BATCH], a: &[f64; BATCH]) {
     }
 }
 
-fn binary(bin: Binary, o: &mut [f64; BATCH], a: &[f64; BATCH], b: &[f64; BATCH]) {
+fn binary(bin: Binary, o: &mut [f64], a: &[f64], b: &[f64]) {
     macro_rules! each {
         ($f:expr) => {
-            for i in 0..BATCH {
-                o[i] = $f(a[i], b[i]);
+            for ((o, &a), &b) in o.iter_mut().zip(a).zip(b) {
+                *o = $f(a, b);
             }
         };
     }

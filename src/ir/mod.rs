@@ -18,7 +18,7 @@ mod source_map;
 
 pub use fragments::{Fragment, Side, derive_fragments};
 pub use incidence::{Incidence, IncidenceMatrices};
-pub use source_map::{Origin, SourceMap};
+pub use source_map::{DenseId, IdMap, Origin, SourceMap};
 
 use crate::geom::{Aabb, Curve, Point3, SolidShape, Surface};
 
@@ -138,6 +138,8 @@ pub struct Polyline {
     /// samples it to the chordal tolerance instead of using `points`, which
     /// then hold a coarse sample for bounding boxes.
     pub curve: Option<Curve>,
+    /// A crack: a 2D mesh is opened along it (two sides, shared tips).
+    pub crack: bool,
 }
 
 /// A user-named set of faces (3D) or edges (2D) where boundary conditions go.

@@ -3,7 +3,6 @@
 
 use super::{EdgeId, FaceId, SolidId, SubdomainId, VertexId};
 use crate::span::Span;
-use std::collections::HashMap;
 
 /// Where an entity came from: the span of the defining element's name (or the
 /// whole element) in the source file.
@@ -12,13 +11,99 @@ pub struct Origin {
     pub span: Span,
 }
 
+/// A typed id that indexes a dense vector.
+pub trait DenseId: Copy {
+    fn index(self) -> usize;
+    fn from_index(index: usize) -> Self;
+}
+
+macro_rules! dense_id {
+    ($($name:ident),*) => {$(
+        impl DenseId for $name {
+            fn index(self) -> usize { self.0 as usize }
+            fn from_index(index: usize) -> Self { $name(index as u32) }
+        }
+    )*};
+}
+dense_id!(VertexId, EdgeId, FaceId, SubdomainId, SolidId);
+
+/// A map from dense ids to values, stored as a vector indexed by id: ids are
+/// allocated in order, so this costs a slot per entity and no hashing (a
+/// hash map per entity kind dominated lowering time and memory on large files).
+#[derive(Debug, Clone)]
+pub struct IdMap<K, V> {
+    slots: Vec<Option<V>>,
+    len: usize,
+    _key: std::marker::PhantomData<K>,
+}
+
+impl<K, V> Default for IdMap<K, V> {
+    fn default() -> Self {
+        IdMap {
+            slots: Vec::new(),
+            len: 0,
+            _key: std::marker::PhantomData,
+        }
+    }
+}
+
+impl<K: DenseId, V: Copy> IdMap<K, V> {
+    /// Sets the value of `id`, returning the previous one.
+    pub fn insert(&mut self, id: K, value: V) -> Option<V> {
+        let i = id.index();
+        if self.slots.len() <= i {
+            self.slots.resize(i + 1, None);
+        }
+        let old = self.slots[i].replace(value);
+        if old.is_none() {
+            self.len += 1;
+        }
+        old
+    }
+
+    pub fn get(&self, id: &K) -> Option<&V> {
+        self.slots.get(id.index()).and_then(Option::as_ref)
+    }
+
+    pub fn contains_key(&self, id: &K) -> bool {
+        self.get(id).is_some()
+    }
+
+    pub fn len(&self) -> usize {
+        self.len
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.len == 0
+    }
+
+    /// The entries in id order.
+    pub fn iter(&self) -> impl Iterator<Item = (K, &V)> + '_ {
+        self.slots
+            .iter()
+            .enumerate()
+            .filter_map(|(i, v)| v.as_ref().map(|v| (K::from_index(i), v)))
+    }
+
+    /// The table with every id renamed by `map`; ids it drops are removed.
+    pub fn remap(&self, map: impl Fn(K) -> Option<K>) -> IdMap<K, V> {
+        let mut out = IdMap::default();
+        for (k, &v) in self.iter() {
+            if let Some(k) = map(k) {
+                out.insert(k, v);
+            }
+        }
+        out
+    }
+}
+
 #[derive(Debug, Clone, Default)]
 pub struct SourceMap {
-    pub vertices: HashMap<VertexId, Origin>,
-    pub edges: HashMap<EdgeId, Origin>,
-    pub faces: HashMap<FaceId, Origin>,
-    pub subdomains: HashMap<SubdomainId, Origin>,
-    pub solids: HashMap<SolidId, Origin>,
+    pub vertices: IdMap<VertexId, Origin>,
+    pub edges: IdMap<EdgeId, Origin>,
+    pub faces: IdMap<FaceId, Origin>,
+    pub subdomains: IdMap<SubdomainId, Origin>,
+    pub solids: IdMap<SolidId, Origin>,
 }
 
 impl SourceMap {

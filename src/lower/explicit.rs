@@ -12,7 +12,7 @@ use crate::ir::{
 };
 use crate::resolve::{Geometry, LineCarrier, Resolved};
 use crate::span::Span;
-use std::collections::HashMap;
+use foldhash::{HashMap, HashMapExt};
 use std::f64::consts::TAU;
 
 pub(super) fn lower_topology(

@@ -20,7 +20,7 @@ use crate::ir::{
 };
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
-use std::collections::HashMap;
+use foldhash::HashMap;
 
 /// The model and its side table of source positions.
 #[derive(Debug, Clone)]
@@ -40,7 +40,7 @@ pub(crate) struct Entities {
     pub solids: HashMap<String, Vec<SolidId>>,
     /// Objects that failed to resolve (already reported): references to them
     /// are not reported again.
-    pub failed: std::collections::HashSet<String>,
+    pub failed: foldhash::HashSet<String>,
 }
 
 impl Entities {
@@ -175,7 +175,7 @@ fn tolerance(resolved: &Resolved) -> f64 {
     fn visit(g: &Geometry, bbox: &mut Aabb) {
         match g {
             Geometry::Solid(s) => *bbox = bbox.union(&s.bbox()),
-            Geometry::Points { points, .. } | Geometry::Polyline { points } => {
+            Geometry::Points { points, .. } | Geometry::Polyline { points, .. } => {
                 points.iter().for_each(|p| bbox.include(p))
             }
             Geometry::Vertex(p) => bbox.include(p),
@@ -208,9 +208,10 @@ fn lower_free(
             name: name.to_string(),
             points: points.clone(),
         }),
-        Geometry::Polyline { points } => model.polylines.push(Polyline {
+        Geometry::Polyline { points, crack } => model.polylines.push(Polyline {
             name: name.to_string(),
             points: points.clone(),
+            crack: *crack,
             ..Polyline::default()
         }),
         Geometry::PointCurve(curve) => model

@@ -16,6 +16,7 @@ pub(super) fn standalone(name: &str, curve: &PcCurve) -> Polyline {
         name: name.to_string(),
         points: curve.samples(32),
         curve: Some(Curve::PointCalculus(Box::new(curve.clone()))),
+        crack: false,
     }
 }
 

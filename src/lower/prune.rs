@@ -2,7 +2,6 @@
 //! subdomains that bound no subdomain, and the edges and vertices only they used.
 
 use crate::ir::{EdgeId, FaceId, Model, SourceMap, SubdomainCells, VertexId};
-use std::collections::HashMap;
 
 pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     // Flag vectors, not sets: these run over every entity of the model.
@@ -187,17 +186,7 @@ fn apply(
         b.edges.retain(|&x| e(x).is_some());
         b.edges.iter_mut().for_each(|x| *x = e(*x).unwrap_or(*x));
     }
-    source_map.faces = remap(&source_map.faces, f);
-    source_map.edges = remap(&source_map.edges, e);
-    source_map.vertices = remap(&source_map.vertices, v);
-}
-
-fn remap<K: Copy + std::hash::Hash + Eq, V: Copy>(
-    table: &HashMap<K, V>,
-    map: impl Fn(K) -> Option<K>,
-) -> HashMap<K, V> {
-    table
-        .iter()
-        .filter_map(|(&k, &v)| map(k).map(|k| (k, v)))
-        .collect()
+    source_map.faces = source_map.faces.remap(f);
+    source_map.edges = source_map.edges.remap(e);
+    source_map.vertices = source_map.vertices.remap(v);
 }

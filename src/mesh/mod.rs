@@ -10,6 +10,8 @@
 //! counter-clockwise about the face normal; a subdomain lists its boundary
 //! faces with `outward` as in the model.
 
+pub mod locate;
+
 /// A named point of the model (a topology vertex).
 #[derive(Debug, Clone, PartialEq)]
 pub struct MeshVertex {

@@ -6,8 +6,8 @@
 //! - A poly_line must lie strictly inside one region: touching or crossing a
 //!   subdomain boundary is refused. Outside every region it stays a free
 //!   line of nodes, as in 3D.
-//! - The mesh follows the line but is not cut along it: both sides share
-//!   its nodes (a crack is not opened).
+//! - The mesh follows the line; `crack="true"` lines are then opened by
+//!   `crack.rs`.
 
 use super::MeshError;
 use super::edges::EdgeNodes;

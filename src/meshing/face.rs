@@ -221,8 +221,10 @@ pub(crate) fn mesh_face(
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if !settings.keep_boundary {
+            // Only this pass's vertices: earlier ones were checked in their pass.
+            let new = positions.len().max(fixed);
             let splits =
-                boundary_splits(&cdt, fixed, &segments, &polyline_segments).map_err(failed)?;
+                boundary_splits(&cdt, new, &segments, &polyline_segments).map_err(failed)?;
             if !splits.is_empty() {
                 return Ok(Outcome::Split(splits));
             }
@@ -446,15 +448,16 @@ fn winding_odd(loops: &[Vec<[f64; 2]>], p: [f64; 2]) -> bool {
     inside
 }
 
-/// Vertices the refinement put on boundary segments, as curve parameters.
+/// Vertices from index `first` on that the refinement put on boundary
+/// segments, as curve parameters.
 fn boundary_splits(
     cdt: &Cdt,
-    fixed: usize,
+    first: usize,
     segments: &Segments,
     polyline_segments: &[(usize, usize)],
 ) -> Result<Vec<(usize, f64)>, String> {
     let mut splits = Vec::new();
-    for v in fixed..cdt.num_vertices() {
+    for v in first..cdt.num_vertices() {
         let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(v));
         if !vertex.out_edges().any(|e| e.is_constraint_edge()) {
             continue;

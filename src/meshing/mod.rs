@@ -24,6 +24,7 @@
 mod chart;
 mod check;
 mod constraints;
+mod crack;
 mod diagnostic;
 mod edges;
 pub mod exact;
@@ -211,6 +212,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         || {
             let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
             trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
+            crack::open(model, &mut mesh);
             if options.order == 2 {
                 quadratic::elevate(model, &edge_nodes, &mut mesh);
             }

@@ -12,12 +12,15 @@ mod png_out;
 mod raster;
 mod resolve;
 mod scene;
+mod section_fill;
 mod svg;
 
 pub use camera::{Camera, View};
 pub use legend::LegendEntry;
 pub use resolve::Image;
 pub use scene::{Group, group_color};
+pub use section_fill::CutFace;
+pub use svg::SvgDrawing;
 
 use crate::diag::Code;
 use crate::mesh::Mesh;

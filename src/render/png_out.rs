@@ -4,6 +4,8 @@
 
 use super::resolve::Image;
 
+// Writing into a Vec cannot fail, and the header matches the data: a failure is a bug.
+#[allow(clippy::expect_used)]
 pub fn encode(image: &Image) -> Vec<u8> {
     let mut out = Vec::with_capacity(image.rgba.len() / 4);
     {
@@ -12,7 +14,6 @@ pub fn encode(image: &Image) -> Vec<u8> {
         encoder.set_depth(png::BitDepth::Eight);
         encoder.set_compression(png::Compression::Fast);
         encoder.set_filter(png::Filter::Up);
-        // Writing into a Vec cannot fail, and the header matches the data.
         let mut writer = encoder.write_header().expect("PNG header into memory");
         writer
             .write_image_data(&image.rgba)

@@ -163,18 +163,24 @@ fn draw(
         step_y[k] = dx * SUB;
     }
     // Depth as a plane over sample coordinates, referenced at the triangle's
-    // own first sample so bands agree exactly.
+    // own first sample so bands agree exactly: one division per triangle.
     let area = ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
         - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0])) as f64;
-    let weight = |k: usize, x: i64, y: i64| {
-        let (a, b) = (v[(k + 1) % 3], v[(k + 2) % 3]);
-        ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) as f64 / area
-    };
-    let z_at = |x: i64, y: i64| (0..3).map(|k| weight(k, x, y) * z[k] as f64).sum::<f64>();
+    let (x1, y1_, x2, y2) = (
+        (v[1][0] - v[0][0]) as f64,
+        (v[1][1] - v[0][1]) as f64,
+        (v[2][0] - v[0][0]) as f64,
+        (v[2][1] - v[0][1]) as f64,
+    );
+    let (z1, z2) = ((z[1] - z[0]) as f64, (z[2] - z[0]) as f64);
+    let inv = 1.0 / area;
+    // dz per snapped unit, then per sample.
+    let gx = (z1 * y2 - z2 * y1_) * inv;
+    let gy = (z2 * x1 - z1 * x2) * inv;
     let (rx, ry) = (sx0 * SUB + SUB / 2, sy0 * SUB + SUB / 2);
-    let z_ref = z_at(rx, ry);
-    let dzdx = (z_at(rx + SUB, ry) - z_ref) as f32;
-    let dzdy = (z_at(rx, ry + SUB) - z_ref) as f32;
+    let z_ref = z[0] as f64 + gx * (rx - v[0][0]) as f64 + gy * (ry - v[0][1]) as f64;
+    let dzdx = (gx * SUB as f64) as f32;
+    let dzdy = (gy * SUB as f64) as f32;
     let z_ref = z_ref as f32;
     let id = id as u64;
     for sy in y_first..=sy1 {

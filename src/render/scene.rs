@@ -261,12 +261,8 @@ fn shade(scene: &mut Scene, mesh: &Mesh, shading: Shading, camera: &Camera) {
             scene.corner_slots = (0..scene.tris.len() as u32).map(|i| [i, i, i]).collect();
         }
         Shading::Smooth => {
-            // Normals in parallel; the sums per node are a cheap serial scatter.
-            let normals: Vec<[f64; 3]> = scene
-                .tris
-                .par_iter()
-                .map(|&t| tri_normal(&scene.points, t))
-                .collect();
+            // Normals computed where they are summed: a stored array of them
+            // costs more in memory traffic than the cross products.
             let mut slot_of = vec![u32::MAX; mesh.nodes.len()];
             let mut sums: Vec<[f64; 3]> = Vec::new();
             scene.corner_slots = Vec::with_capacity(scene.tris.len());
@@ -277,7 +273,8 @@ fn shade(scene: &mut Scene, mesh: &Mesh, shading: Shading, camera: &Camera) {
                 while end < scene.tris.len() && scene.tri_face[end] == face {
                     end += 1;
                 }
-                for (&t, &n) in scene.tris[start..end].iter().zip(&normals[start..end]) {
+                for &t in &scene.tris[start..end] {
+                    let n = tri_normal(&scene.points, t);
                     let mut slots = [0u32; 3];
                     for (k, &node) in t.iter().enumerate() {
                         let s = &mut slot_of[node as usize];

@@ -8,6 +8,7 @@
 
 use super::camera::{Camera, cross, dot};
 use super::scene::{HIDDEN, Scene};
+use super::section_fill::{CutFace, cut_faces};
 use super::{Edges, RenderError, RenderOptions, RenderWarning, check, scene};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
@@ -231,6 +232,8 @@ pub struct SvgDrawing {
     pub text: String,
     /// Visible pieces drawn (one `M … L …` each).
     pub segments: usize,
+    /// `--section`: the cut face of each subdomain, filled under the lines.
+    pub cut_faces: Vec<CutFace>,
     pub warnings: Vec<RenderWarning>,
 }
 
@@ -374,6 +377,11 @@ pub fn render_svg(mesh: &Mesh, options: &RenderOptions) -> Result<SvgDrawing, Re
             num(bg[3] as f64 / 255.0)
         );
     }
+    let cut_faces = options
+        .section
+        .map(|section| cut_faces(mesh, section, &camera))
+        .unwrap_or_default();
+    write_cut_faces(&mut out, &cut_faces, &scene);
     let _ = writeln!(
         out,
         r#"<g fill="none" stroke-width="1.5" stroke-linecap="round">"#
@@ -410,8 +418,46 @@ pub fn render_svg(mesh: &Mesh, options: &RenderOptions) -> Result<SvgDrawing, Re
     Ok(SvgDrawing {
         text: out,
         segments: count,
+        cut_faces,
         warnings,
     })
+}
+
+/// One even–odd path per subdomain's cut face, in its section colour.
+fn write_cut_faces(out: &mut String, faces: &[CutFace], scene: &Scene) {
+    if faces.is_empty() {
+        return;
+    }
+    // The cap groups follow the surface groups, one per subdomain in order.
+    let caps: Vec<[u8; 3]> = scene
+        .groups
+        .iter()
+        .filter(|g| g.cap)
+        .map(|g| g.color)
+        .collect();
+    let _ = writeln!(out, r#"<g fill-rule="evenodd" stroke="none">"#);
+    for face in faces {
+        let c = caps.get(face.subdomain).copied().unwrap_or([160, 160, 160]);
+        let mut d = String::new();
+        for lp in &face.loops {
+            for (i, p) in lp.iter().enumerate() {
+                let _ = write!(
+                    d,
+                    "{}{} {}",
+                    if i == 0 { 'M' } else { 'L' },
+                    num(p[0]),
+                    num(p[1])
+                );
+            }
+            d.push('Z');
+        }
+        let _ = writeln!(
+            out,
+            r##"<path class="section" fill="#{:02x}{:02x}{:02x}" d="{d}"/>"##,
+            c[0], c[1], c[2]
+        );
+    }
+    let _ = writeln!(out, "</g>");
 }
 
 fn num(v: f64) -> String {

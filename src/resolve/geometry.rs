@@ -42,6 +42,7 @@ pub enum Geometry {
     },
     Polyline {
         points: Vec<Point3>,
+        crack: bool,
     },
     /// A bounded solid (3D) or region (2D).
     Solid(SolidShape),
@@ -95,8 +96,9 @@ impl Geometry {
                 points: points.iter().map(|p| map.to_global(p)).collect(),
                 partial: partial.clone(),
             },
-            Geometry::Polyline { points } => Geometry::Polyline {
+            Geometry::Polyline { points, crack } => Geometry::Polyline {
                 points: points.iter().map(|p| map.to_global(p)).collect(),
+                crack: *crack,
             },
             Geometry::Solid(shape) => Geometry::Solid(transform_shape(shape, map)),
             Geometry::Surface(Surface::Plane { origin, normal }) => {

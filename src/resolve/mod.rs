@@ -21,7 +21,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::Document;
 use crate::expr::Expr;
 use crate::span::{SourceFile, Span};
-use std::collections::HashMap;
+use foldhash::HashMap;
 
 /// One object of the document after resolution.
 #[derive(Debug, Clone, PartialEq)]

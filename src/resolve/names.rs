@@ -4,7 +4,7 @@
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::Document;
 use crate::span::{SourceFile, Span};
-use std::collections::HashMap;
+use foldhash::HashMap;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Definition {

@@ -9,7 +9,7 @@ use super::values::{Ctx, Values};
 use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::doc::{Axis, CoordinateSystem, Document, Number, Object, PointSpec, Ref, VectorSpec};
 use crate::geom::{Frame, Point3, Vec3};
-use std::collections::HashMap;
+use foldhash::{HashMap, HashMapExt};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum FrameState {

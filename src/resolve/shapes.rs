@@ -186,7 +186,7 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             sides.as_ref()?,
             frame,
         ),
-        ObjectKind::PolyLine { segments } => {
+        ObjectKind::PolyLine { segments, crack } => {
             let mut points: Vec<Point3> = Vec::new();
             for (k, (begin, end)) in segments.iter().enumerate() {
                 let b = r.point(begin.as_ref()?, frame, false)?;
@@ -216,7 +216,10 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
                 }
                 points.push(e);
             }
-            Some(Geometry::Polyline { points })
+            Some(Geometry::Polyline {
+                points,
+                crack: *crack,
+            })
         }
         ObjectKind::TruncatedCone {
             bottom_center,

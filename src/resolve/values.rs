@@ -6,7 +6,8 @@ use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::doc::{Axis, Document, Number};
 use crate::expr::{self, EvalError, Expr};
 use crate::span::Span;
-use std::collections::{BTreeMap, HashMap, HashSet};
+use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
+use std::collections::BTreeMap;
 
 /// Where a number is used: basis coordinates are allowed only as coordinates
 /// of their own axis.

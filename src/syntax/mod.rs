@@ -2,6 +2,9 @@
 //! owned element tree with byte spans on every name and value, refusing DTDs,
 //! over-deep nesting and oversized input before any later stage sees them.
 
+// User-controlled bytes and values: no panicking index (docs/reliability.md).
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
+
 mod tree;
 
 pub use tree::{Attribute, Element};

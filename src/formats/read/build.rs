@@ -8,7 +8,6 @@ use super::clean;
 use crate::diag::{Code, Diagnostic};
 use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain};
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
 
 /// Elements of one named group.
 #[derive(Debug, Clone, Default)]
@@ -161,9 +160,12 @@ fn attach_fragments(
             continue;
         };
         let other = fr.other.as_deref().and_then(|o| index.get(o).copied());
-        mesh.subdomains[sub as usize].faces.push((face, true));
-        if let Some(o) = other {
-            mesh.subdomains[o as usize].faces.push((face, false));
+        // The index maps names to positions in `mesh.subdomains`.
+        if let Some(s) = mesh.subdomains.get_mut(sub as usize) {
+            s.faces.push((face, true));
+        }
+        if let Some(s) = other.and_then(|o| mesh.subdomains.get_mut(o as usize)) {
+            s.faces.push((face, false));
         }
         mesh.fragments.push(MeshFragment {
             name: fr.group.clone(),
@@ -188,58 +190,64 @@ pub fn chains(segments: &[[u32; 2]]) -> Vec<Vec<u32>> {
     out
 }
 
-/// FxHash's multiply-rotate: the node maps hash millions of keys, where
+/// foldhash with a fixed seed: the node maps hash millions of keys, where
 /// SipHash's protection against chosen keys is not needed (input files only
-/// choose coordinates, and a slow map is the worst they can cause).
-#[derive(Default, Clone, Copy)]
-pub struct FastHasher(u64);
-
-impl Hasher for FastHasher {
-    fn finish(&self) -> u64 {
-        // The product's high bits are the well-mixed ones; the map indexes by
-        // the low bits (as rustc-hash does). Coordinates read as f32 have 29
-        // zero low bits, which without this would collide.
-        self.0.rotate_left(26)
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for chunk in bytes.chunks(8) {
-            let mut word = [0u8; 8];
-            word[..chunk.len()].copy_from_slice(chunk);
-            self.write_u64(u64::from_le_bytes(word));
-        }
-    }
-
-    fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-
-    fn write_u32(&mut self, v: u32) {
-        self.write_u64(u64::from(v));
-    }
-}
-
-pub type FastMap<K, V> = HashMap<K, V, BuildHasherDefault<FastHasher>>;
+/// choose coordinates, and a slow map is the worst they can cause). A plain
+/// multiply-rotate hash was tried: coordinates read as f32 leave 29 low bits
+/// zero, and its bucket tags collided so often that key compares took half
+/// of an STL conversion.
+pub type FastMap<K, V> = HashMap<K, V, foldhash::fast::FixedState>;
 
 /// Merges nodes with bit-identical coordinates (−0 equals 0), for formats
 /// that repeat a vertex per triangle (STL).
-#[derive(Default)]
+///
+/// A small direct-mapped cache of recent vertices sits in front of the map:
+/// neighbouring triangles share corners, so most repeats are found there,
+/// and the map (far larger than the processor's caches on big files) is
+/// touched about once per distinct node. Same nodes, same order.
 pub struct NodeDedup {
     map: FastMap<[u64; 3], u32>,
+    recent: Vec<([u64; 3], u32)>,
+}
+
+/// Entries of [`NodeDedup`]'s cache (a power of two; 128 kB).
+const RECENT: usize = 1 << 12;
+
+impl Default for NodeDedup {
+    fn default() -> NodeDedup {
+        NodeDedup::with_capacity(0)
+    }
 }
 
 impl NodeDedup {
     pub fn with_capacity(n: usize) -> NodeDedup {
         let mut map = FastMap::default();
         map.reserve(n);
-        NodeDedup { map }
+        NodeDedup {
+            map,
+            recent: vec![([0; 3], u32::MAX); RECENT],
+        }
     }
 
     pub fn node(&mut self, nodes: &mut Vec<[f64; 3]>, p: [f64; 3]) -> u32 {
         let key = p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
-        *self.map.entry(key).or_insert_with(|| {
+        // The high bits of a multiply mix all of the key's bits.
+        let mix = (key[0] ^ key[1].rotate_left(21) ^ key[2].rotate_left(42))
+            .wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        let slot = (mix >> 52) as usize & (RECENT - 1);
+        if let Some(&(cached, id)) = self.recent.get(slot)
+            && id != u32::MAX
+            && cached == key
+        {
+            return id;
+        }
+        let id = *self.map.entry(key).or_insert_with(|| {
             nodes.push(p);
             (nodes.len() - 1) as u32
-        })
+        });
+        if let Some(entry) = self.recent.get_mut(slot) {
+            *entry = (key, id);
+        }
+        id
     }
 }

@@ -6,6 +6,7 @@
 
 use crate::diag::{Code, Diagnostic};
 use crate::mesh::Mesh;
+use rayon::slice::ParallelSliceMut;
 
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct EdgeCounts {
@@ -97,12 +98,17 @@ fn diagonal(mesh: &Mesh) -> f64 {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in &mesh.nodes {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
+        for ((l, h), &v) in lo.iter_mut().zip(hi.iter_mut()).zip(p) {
+            *l = l.min(v);
+            *h = h.max(v);
         }
     }
-    let d: f64 = (0..3).map(|k| (hi[k] - lo[k]).powi(2)).sum::<f64>().sqrt();
+    let d: f64 = lo
+        .iter()
+        .zip(&hi)
+        .map(|(l, h)| (h - l).powi(2))
+        .sum::<f64>()
+        .sqrt();
     if d.is_finite() { d } else { 0.0 }
 }
 
@@ -116,8 +122,7 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || twice_area(nodes, *t) <= area_floor {
             out.degenerate += 1;
         }
-        for k in 0..3 {
-            let (a, b) = (t[k], t[(k + 1) % 3]);
+        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
             if a == b {
                 continue;
             }
@@ -125,14 +130,15 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
             half.push((u64::from(lo) << 33) | (u64::from(hi) << 1) | dir);
         }
     }
-    half.sort_unstable();
+    // Plain integers: the parallel sort gives the same order on any thread count.
+    half.par_sort_unstable();
     let mut i = 0;
-    while i < half.len() {
-        let key = half[i] >> 1;
+    while let Some(&first) = half.get(i) {
+        let key = first >> 1;
         let mut j = i;
         let (mut forward, mut backward) = (0usize, 0usize);
-        while j < half.len() && half[j] >> 1 == key {
-            if half[j] & 1 == 0 {
+        while let Some(&h) = half.get(j).filter(|&&h| h >> 1 == key) {
+            if h & 1 == 0 {
                 forward += 1;
             } else {
                 backward += 1;

@@ -72,13 +72,14 @@ fn apply(loaded: &mut Loaded, doc: &FragDocument, file: &str) -> Result<(), Diag
             .get(&face.name)
             .or_else(|| by_name.get(&format!("face {i}")))
             .copied();
+        let count = |m: usize| mesh.faces.get(m).map_or(0, |f| f.triangles.len());
         match found {
-            Some(m) if mesh.faces[m].triangles.len() == face.triangles => {
+            Some(m) if count(m) == face.triangles => {
                 map.push(Some(m as u32));
             }
             None if face.triangles == 0 => map.push(None),
             other => {
-                let has = other.map_or(0, |m| mesh.faces[m].triangles.len());
+                let has = other.map_or(0, count);
                 return Err(Diagnostic::new(
                     Code::FragMeshMismatch,
                     None,
@@ -91,9 +92,9 @@ fn apply(loaded: &mut Loaded, doc: &FragDocument, file: &str) -> Result<(), Diag
             }
         }
     }
-    for (i, face) in doc.faces.iter().enumerate() {
-        if let Some(m) = map[i] {
-            mesh.faces[m as usize].name = face.name.clone();
+    for (face, m) in doc.faces.iter().zip(&map) {
+        if let Some(f) = m.and_then(|m| mesh.faces.get_mut(m as usize)) {
+            f.name = face.name.clone();
         }
     }
     mesh.dimension = doc.dimension;
@@ -153,7 +154,9 @@ fn apply_by_fragment(loaded: &mut Loaded, doc: &FragDocument) -> bool {
     let mut faces = Vec::new();
     for fr in &doc.fragments {
         match by_name.get(fr.name.as_str()) {
-            Some(&m) if mesh.faces[m].triangles.len() == fr.elements => faces.push(Some(m as u32)),
+            Some(&m) if mesh.faces.get(m).map(|f| f.triangles.len()) == Some(fr.elements) => {
+                faces.push(Some(m as u32))
+            }
             None if fr.elements == 0 => faces.push(None),
             _ => return false,
         }
@@ -178,11 +181,12 @@ fn apply_by_fragment(loaded: &mut Loaded, doc: &FragDocument) -> bool {
     mesh.fragments.clear();
     for (fr, face) in doc.fragments.iter().zip(faces) {
         let Some(face) = face else { continue };
-        mesh.subdomains[fr.subdomain as usize]
-            .faces
-            .push((face, true));
-        if let Some(o) = fr.other {
-            mesh.subdomains[o as usize].faces.push((face, false));
+        // Both indices were checked against the subdomain count above.
+        if let Some(s) = mesh.subdomains.get_mut(fr.subdomain as usize) {
+            s.faces.push((face, true));
+        }
+        if let Some(s) = fr.other.and_then(|o| mesh.subdomains.get_mut(o as usize)) {
+            s.faces.push((face, false));
         }
         mesh.fragments.push(MeshFragment {
             name: fr.name.clone(),

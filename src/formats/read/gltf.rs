@@ -64,11 +64,7 @@ pub fn read(bytes: &[u8], folder: &Path) -> Result<Builder, Vec<Diagnostic>> {
 /// The JSON chunk, its byte offset, and the BIN chunk of a GLB.
 #[allow(clippy::type_complexity)]
 fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<usize>, Option<&[u8]>), Vec<Diagnostic>> {
-    let u32_at = |at: usize| -> Option<u32> {
-        bytes
-            .get(at..at + 4)
-            .map(|b| u32::from_le_bytes([b[0], b[1], b[2], b[3]]))
-    };
+    let u32_at = |at: usize| -> Option<u32> { super::bytes_at(bytes, at).map(u32::from_le_bytes) };
     let fail = |at: usize, code: Code, msg: String| Err(vec![error_at_byte(code, at, msg)]);
     let Some(version) = u32_at(4) else {
         return fail(
@@ -114,28 +110,27 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<usize>, Option<&[u8]>), Vec<
         );
     }
     let json_end = 20 + json_len as usize;
-    if json_end > bytes.len() {
+    let Some(json) = bytes.get(20..json_end) else {
         return fail(
             12,
             Code::MeshTruncated,
             format!("the JSON chunk of {json_len} bytes runs past the end of the file"),
         );
-    }
-    let json = &bytes[20..json_end];
+    };
     let mut bin = None;
     if json_end + 8 <= bytes.len() {
         let len = u32_at(json_end).unwrap_or(0) as usize;
         let kind = u32_at(json_end + 4).unwrap_or(0);
         if kind == 0x004E_4942 {
             let start = json_end + 8;
-            if start + len > bytes.len() {
+            let Some(chunk) = bytes.get(start..start + len) else {
                 return fail(
                     json_end,
                     Code::MeshTruncated,
                     format!("the BIN chunk of {len} bytes runs past the end of the file"),
                 );
-            }
-            bin = Some(&bytes[start..start + len]);
+            };
+            bin = Some(chunk);
         }
     }
     Ok((json, Some(20), bin))
@@ -145,7 +140,10 @@ fn split_glb(bytes: &[u8]) -> Result<(&[u8], Option<usize>, Option<&[u8]>), Vec<
 fn offset_of(text: &[u8], line: usize, column: usize) -> usize {
     let mut offset = 0;
     for _ in 1..line {
-        match text[offset..].iter().position(|&b| b == b'\n') {
+        match text
+            .get(offset..)
+            .and_then(|t| t.iter().position(|&b| b == b'\n'))
+        {
             Some(i) => offset += i + 1,
             None => break,
         }
@@ -308,7 +306,12 @@ impl<'a> Reader<'a> {
                             }
                         }
                     }
-                    (0..nodes.len()).filter(|&i| !child[i]).collect()
+                    child
+                        .iter()
+                        .enumerate()
+                        .filter(|&(_, &c)| !c)
+                        .map(|(i, _)| i)
+                        .collect()
                 }
             };
         let mut visited = vec![false; nodes.len()];
@@ -316,7 +319,11 @@ impl<'a> Reader<'a> {
         while let Some((index, parent)) = stack.pop() {
             let path = format!("nodes[{index}]");
             let node = nodes.get(index).ok_or_else(|| bad(&path, "no such node"))?;
-            if std::mem::replace(&mut visited[index], true) {
+            // `index` names an existing node (checked above), so `visited` has it.
+            if visited
+                .get_mut(index)
+                .is_some_and(|v| std::mem::replace(v, true))
+            {
                 return Err(bad(
                     &path,
                     "the node is reached twice: the node hierarchy must be a forest",
@@ -392,8 +399,9 @@ impl<'a> Reader<'a> {
             let positions = self.floats(pos as usize, 3)?;
             let local: Vec<u32> = positions
                 .chunks_exact(3)
+                .filter_map(super::array)
                 .map(|p| {
-                    let q = apply(world, [p[0], p[1], p[2]]);
+                    let q = apply(world, p);
                     self.dedup.node(&mut self.b.nodes, q)
                 })
                 .collect();
@@ -410,42 +418,52 @@ impl<'a> Reader<'a> {
                             ),
                         ));
                     }
-                    idx.into_iter().map(|i| local[i as usize]).collect()
+                    // Every index was checked against `local` just above.
+                    idx.into_iter()
+                        .filter_map(|i| local.get(i as usize).copied())
+                        .collect()
                 }
                 None => local,
             };
             let mode = uint(prim, "mode", &ppath)?.unwrap_or(4);
-            let group = &mut self.b.groups[g];
+            let Some(group) = self.b.groups.get_mut(g) else {
+                continue;
+            };
             match mode {
                 0 => group.points.extend_from_slice(&indices),
                 1 => group
                     .lines
-                    .extend(indices.chunks_exact(2).map(|l| [l[0], l[1]])),
+                    .extend(indices.chunks_exact(2).filter_map(super::array::<u32, 2>)),
                 2 | 3 => {
                     self.converted += 1;
-                    group.lines.extend(indices.windows(2).map(|l| [l[0], l[1]]));
-                    if mode == 2 && indices.len() > 2 {
-                        group.lines.push([indices[indices.len() - 1], indices[0]]);
+                    group
+                        .lines
+                        .extend(indices.windows(2).filter_map(super::array::<u32, 2>));
+                    if let (true, Some(&first), Some(&last)) = (
+                        mode == 2 && indices.len() > 2,
+                        indices.first(),
+                        indices.last(),
+                    ) {
+                        group.lines.push([last, first]);
                     }
                 }
-                4 => group.triangles.extend(indices.chunks_exact(3).map(|t| {
-                    if flip {
-                        [t[0], t[2], t[1]]
-                    } else {
-                        [t[0], t[1], t[2]]
-                    }
-                })),
+                4 => group.triangles.extend(
+                    indices
+                        .chunks_exact(3)
+                        .filter_map(super::array::<u32, 3>)
+                        .map(|[a, b, c]| if flip { [a, c, b] } else { [a, b, c] }),
+                ),
                 5 | 6 => {
                     self.converted += 1;
-                    for i in 0..indices.len().saturating_sub(2) {
+                    let first = indices.first().copied().unwrap_or(0);
+                    for (i, w) in indices.windows(3).enumerate() {
+                        let Some([a, b, c]) = super::array::<u32, 3>(w) else {
+                            continue;
+                        };
                         let t = if mode == 5 {
-                            if i % 2 == 0 {
-                                [indices[i], indices[i + 1], indices[i + 2]]
-                            } else {
-                                [indices[i + 1], indices[i], indices[i + 2]]
-                            }
+                            if i % 2 == 0 { [a, b, c] } else { [b, a, c] }
                         } else {
-                            [indices[0], indices[i + 1], indices[i + 2]]
+                            [first, b, c]
                         };
                         group
                             .triangles
@@ -542,13 +560,10 @@ impl<'a> Reader<'a> {
                 ),
             ));
         }
-        Ok((
-            &data[view_offset + offset..view_end],
-            stride,
-            count,
-            ctype,
-            ty,
-        ))
+        let Some(elements) = data.get(view_offset + offset..view_end) else {
+            return Err(bad(&path, "the accessor starts past its buffer view's end"));
+        };
+        Ok((elements, stride, count, ctype, ty))
     }
 
     fn floats(&self, index: usize, components: usize) -> Result<Vec<f64>, Diagnostic> {
@@ -563,7 +578,8 @@ impl<'a> Reader<'a> {
         for i in 0..count {
             for c in 0..components {
                 let at = i * stride + 4 * c;
-                let v = f32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]);
+                // `accessor` checked that every element lies inside `data`.
+                let v = f32::from_le_bytes(super::bytes_at(data, at).unwrap_or([0; 4]));
                 if !v.is_finite() {
                     return Err(Diagnostic::new(
                         Code::MeshNonFinite,
@@ -590,10 +606,13 @@ impl<'a> Reader<'a> {
         Ok((0..count)
             .map(|i| {
                 let at = i * stride;
+                // `accessor` checked that every element lies inside `data`.
                 match ctype {
-                    5121 | 5120 => u32::from(data[at]),
-                    5123 | 5122 => u32::from(u16::from_le_bytes([data[at], data[at + 1]])),
-                    _ => u32::from_le_bytes([data[at], data[at + 1], data[at + 2], data[at + 3]]),
+                    5121 | 5120 => u32::from(data.get(at).copied().unwrap_or(0)),
+                    5123 | 5122 => u32::from(u16::from_le_bytes(
+                        super::bytes_at(data, at).unwrap_or([0; 2]),
+                    )),
+                    _ => u32::from_le_bytes(super::bytes_at(data, at).unwrap_or([0; 4])),
                 }
             })
             .collect())
@@ -626,15 +645,18 @@ fn percent_decode(s: &str) -> String {
     let b = s.as_bytes();
     let mut out = Vec::with_capacity(b.len());
     let mut i = 0;
-    while i < b.len() {
-        if b[i] == b'%' && i + 2 < b.len() {
-            if let Ok(v) = u8::from_str_radix(&s[i + 1..i + 3], 16) {
+    while let Some(&c) = b.get(i) {
+        if c == b'%' {
+            let hex = s
+                .get(i + 1..i + 3)
+                .and_then(|h| u8::from_str_radix(h, 16).ok());
+            if let Some(v) = hex {
                 out.push(v);
                 i += 3;
                 continue;
             }
         }
-        out.push(b[i]);
+        out.push(c);
         i += 1;
     }
     String::from_utf8_lossy(&out).into_owned()
@@ -665,6 +687,7 @@ fn numbers<const N: usize>(
 }
 
 /// A node's matrix (column-major in the file) or T·R·S.
+#[allow(clippy::indexing_slicing)] // fixed-size arrays, loop bounds are their lengths
 fn local_transform(node: &Value, path: &str) -> Result<M4, Diagnostic> {
     if let Some(m) = numbers::<16>(node, "matrix", path)? {
         let mut out = [[0.0; 4]; 4];
@@ -706,6 +729,7 @@ fn local_transform(node: &Value, path: &str) -> Result<M4, Diagnostic> {
     Ok(out)
 }
 
+#[allow(clippy::indexing_slicing)] // fixed-size arrays, loop bounds are their lengths
 fn mul(a: &M4, b: &M4) -> M4 {
     let mut out = [[0.0; 4]; 4];
     for i in 0..4 {
@@ -717,11 +741,8 @@ fn mul(a: &M4, b: &M4) -> M4 {
 }
 
 fn apply(m: &M4, p: [f64; 3]) -> [f64; 3] {
-    let mut out = [0.0; 3];
-    for (i, o) in out.iter_mut().enumerate() {
-        *o = m[i][0] * p[0] + m[i][1] * p[1] + m[i][2] * p[2] + m[i][3];
-    }
-    out
+    let [r0, r1, r2, _] = m;
+    [r0, r1, r2].map(|r| r[0] * p[0] + r[1] * p[1] + r[2] * p[2] + r[3])
 }
 
 fn det3(m: &M4) -> f64 {

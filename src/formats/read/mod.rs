@@ -11,6 +11,9 @@
 //! message. Readers never panic and never allocate more than the file's
 //! size justifies.
 
+// User-controlled bytes and values: no panicking index (docs/reliability.md).
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
+
 mod base64;
 pub mod build;
 pub mod clean;
@@ -152,6 +155,13 @@ pub fn load_bytes(
     Ok(loaded)
 }
 
+/// Reads a `.frag.xml` from bytes already in memory; `frag_path` places it, so
+/// the mesh file it names is read from `frag_path`'s folder (the fuzz target's
+/// entry, which needs no file for the description itself).
+pub fn load_frag_bytes(frag_path: &Path, bytes: &[u8]) -> Result<Loaded, Vec<Diagnostic>> {
+    frag::load(frag_path, bytes)
+}
+
 type Parsed = (Builder, Option<bool>);
 
 fn parse(format: ReadFormat, bytes: &[u8], folder: &Path) -> Result<Parsed, Vec<Diagnostic>> {
@@ -176,7 +186,7 @@ pub fn detect(path: &Path, bytes: &[u8]) -> Option<ReadFormat> {
     if bytes.starts_with(b"glTF") {
         return Some(ReadFormat::Glb);
     }
-    let head = &bytes[..bytes.len().min(512)];
+    let head = bytes.get(..512).unwrap_or(bytes);
     let head_text = String::from_utf8_lossy(head);
     let trimmed = head_text.trim_start();
     if trimmed.starts_with("$MeshFormat") {
@@ -212,4 +222,15 @@ pub(crate) fn error_at(
 /// look for lines), the offset in the message.
 pub(crate) fn error_at_byte(code: Code, offset: usize, message: impl Into<String>) -> Diagnostic {
     Diagnostic::new(code, None, format!("at byte {offset}: {}", message.into()))
+}
+
+/// The `N` bytes at `at`, or `None` when they run past the end.
+pub(crate) fn bytes_at<const N: usize>(data: &[u8], at: usize) -> Option<[u8; N]> {
+    data.get(at..)?.first_chunk::<N>().copied()
+}
+
+/// A slice as an array of its length (`None` for any other length); with
+/// `chunks_exact(N)` it never fails.
+pub(crate) fn array<T: Copy, const N: usize>(s: &[T]) -> Option<[T; N]> {
+    s.try_into().ok()
 }

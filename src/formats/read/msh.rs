@@ -54,8 +54,9 @@ impl NodeIndex {
             if t >= self.dense.len() {
                 self.dense.resize(t + 1, NONE);
             }
-            let old = std::mem::replace(&mut self.dense[t], index);
-            old == NONE
+            self.dense
+                .get_mut(t)
+                .is_some_and(|slot| std::mem::replace(slot, index) == NONE)
         } else {
             self.sparse.insert(tag, index).is_none()
         }
@@ -138,9 +139,13 @@ impl<'a> Reader<'a> {
             if t.text.first() != Some(&b'$') {
                 return Err(syntax(t, "a section such as `$Nodes`"));
             }
-            let name = t.lossy()[1..].to_string();
+            let name = t.lossy().get(1..).unwrap_or_default().to_string();
             let end = format!("$End{name}");
-            self.section_closed = self.s.bytes[self.s.pos..]
+            self.section_closed = self
+                .s
+                .bytes
+                .get(self.s.pos..)
+                .unwrap_or_default()
                 .windows(end.len())
                 .any(|w| w == end.as_bytes());
             self.section_start();
@@ -234,10 +239,10 @@ impl<'a> Reader<'a> {
     /// After a section's name line: skips the one line end before binary data.
     fn section_start(&mut self) {
         let b = self.s.bytes;
-        while self.s.pos < b.len() && (b[self.s.pos] == b' ' || b[self.s.pos] == b'\r') {
+        while matches!(b.get(self.s.pos), Some(b' ' | b'\r')) {
             self.s.pos += 1;
         }
-        if self.s.pos < b.len() && b[self.s.pos] == b'\n' {
+        if b.get(self.s.pos) == Some(&b'\n') {
             self.s.pos += 1;
         }
     }
@@ -248,7 +253,7 @@ impl<'a> Reader<'a> {
 
     fn skip_section(&mut self, name: &str, start: Token) -> Result<(), Diagnostic> {
         let end = format!("$End{name}");
-        let rest = &self.s.bytes[self.s.pos..];
+        let rest = self.s.bytes.get(self.s.pos..).unwrap_or_default();
         match rest.windows(end.len()).position(|w| w == end.as_bytes()) {
             Some(i) => {
                 self.s.pos += i + end.len();
@@ -275,7 +280,7 @@ impl<'a> Reader<'a> {
 
     fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], Diagnostic> {
         let b = self.s.bytes;
-        if self.s.pos + n > b.len() {
+        let Some(out) = b.get(self.s.pos..).and_then(|rest| rest.get(..n)) else {
             return Err(error_at_byte(
                 Code::MeshTruncated,
                 b.len(),
@@ -284,8 +289,7 @@ impl<'a> Reader<'a> {
             .with_help(
                 "the file is truncated: write it again, or check that the copy is complete",
             ));
-        }
-        let out = &b[self.s.pos..self.s.pos + n];
+        };
         self.s.pos += n;
         Ok(out)
     }
@@ -294,7 +298,7 @@ impl<'a> Reader<'a> {
     fn here(&mut self) -> usize {
         if !self.binary {
             let b = self.s.bytes;
-            while self.s.pos < b.len() && b[self.s.pos].is_ascii_whitespace() {
+            while b.get(self.s.pos).is_some_and(u8::is_ascii_whitespace) {
                 self.s.pos += 1;
             }
         }
@@ -303,7 +307,7 @@ impl<'a> Reader<'a> {
 
     fn raw_i32(&mut self) -> Result<i32, Diagnostic> {
         let b = self.take(4, "a 4-byte integer")?;
-        Ok(i32::from_le_bytes([b[0], b[1], b[2], b[3]]))
+        Ok(i32::from_le_bytes(super::array(b).unwrap_or([0; 4])))
     }
 
     /// An `int` (tags, dimensions, types).
@@ -572,7 +576,9 @@ impl<'a> Reader<'a> {
                 .unwrap_or_else(|| format!("physical {dim}:{p}")),
             None => format!(
                 "{} {entity}",
-                ["point", "curve", "surface", "volume"][dim.clamp(0, 3) as usize]
+                ["point", "curve", "surface", "volume"]
+                    .get(dim.clamp(0, 3) as usize)
+                    .unwrap_or(&"volume")
             ),
         };
         let g = self.b.group(&name);
@@ -581,16 +587,19 @@ impl<'a> Reader<'a> {
     }
 
     fn add_element(&mut self, kind: Kind, name: &'static str, corners: &[u32], group: usize) {
-        let g = &mut self.b.groups[group];
-        match kind {
-            Kind::Point => g.points.push(corners[0]),
-            Kind::Line => g.lines.push([corners[0], corners[1]]),
-            Kind::Triangle => g.triangles.push([corners[0], corners[1], corners[2]]),
-            Kind::Quad => {
-                g.triangles.push([corners[0], corners[1], corners[2]]);
-                g.triangles.push([corners[0], corners[2], corners[3]]);
+        let Some(g) = self.b.groups.get_mut(group) else {
+            return;
+        };
+        // The element's node count per type is checked where it is read.
+        match (kind, corners) {
+            (Kind::Point, &[a, ..]) => g.points.push(a),
+            (Kind::Line, &[a, b, ..]) => g.lines.push([a, b]),
+            (Kind::Triangle, &[a, b, c, ..]) => g.triangles.push([a, b, c]),
+            (Kind::Quad, &[a, b, c, d, ..]) => {
+                g.triangles.push([a, b, c]);
+                g.triangles.push([a, c, d]);
             }
-            Kind::Volume(_) => {}
+            _ => {}
         }
         let high_order = matches!(
             (kind, corners.len()),
@@ -632,9 +641,10 @@ impl<'a> Reader<'a> {
             }
             let group = self.group_for(dim, physicals.first().copied(), entity);
             if let Kind::Triangle | Kind::Quad = kind {
-                self.b.groups[group]
-                    .triangles
-                    .reserve(n * if kind == Kind::Quad { 2 } else { 1 });
+                if let Some(g) = self.b.groups.get_mut(group) {
+                    g.triangles
+                        .reserve(n * if kind == Kind::Quad { 2 } else { 1 });
+                }
             }
             for _ in 0..n {
                 self.size("an element tag")?;

@@ -71,21 +71,26 @@ fn read_inner(bytes: &[u8]) -> Result<Builder, Diagnostic> {
                     ));
                 }
                 let g = *group.get_or_insert_with(|| b.group("unnamed"));
-                let target = &mut b.groups[g];
+                let Some(target) = b.groups.get_mut(g) else {
+                    continue;
+                };
                 match t.text {
                     b"f" => {
                         if corners.len() > 3 {
                             ignored.polygons += 1;
                         }
-                        for k in 1..corners.len() - 1 {
-                            target
-                                .triangles
-                                .push([corners[0], corners[k], corners[k + 1]]);
+                        // A fan from the first corner (at least 3, checked above).
+                        if let Some((&first, rest)) = corners.split_first() {
+                            target.triangles.extend(
+                                rest.windows(2)
+                                    .filter_map(super::array::<u32, 2>)
+                                    .map(|[a, c]| [first, a, c]),
+                            );
                         }
                     }
                     b"l" => target
                         .lines
-                        .extend(corners.windows(2).map(|w| [w[0], w[1]])),
+                        .extend(corners.windows(2).filter_map(super::array::<u32, 2>)),
                     _ => target.points.extend_from_slice(&corners),
                 }
             }

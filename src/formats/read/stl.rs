@@ -15,10 +15,8 @@ pub fn looks_like_stl(bytes: &[u8]) -> bool {
 }
 
 fn binary_size_matches(bytes: &[u8]) -> bool {
-    bytes.len() >= 84 && {
-        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
-        84 + 50 * n == bytes.len() as u64
-    }
+    super::bytes_at(bytes, 80)
+        .is_some_and(|n| 84 + 50 * u64::from(u32::from_le_bytes(n)) == bytes.len() as u64)
 }
 
 fn ascii_start(bytes: &[u8]) -> bool {
@@ -26,9 +24,10 @@ fn ascii_start(bytes: &[u8]) -> bool {
         .iter()
         .position(|b| !b.is_ascii_whitespace())
         .unwrap_or(0);
-    let head = &bytes[start..bytes.len().min(start + 5)];
+    let head = bytes.get(start..).unwrap_or_default();
+    let head = head.get(..5).unwrap_or(head);
     head.eq_ignore_ascii_case(b"solid")
-        && (bytes.len() < 84 || !bytes[..bytes.len().min(1000)].contains(&0))
+        && (bytes.len() < 84 || !bytes.get(..1000).unwrap_or(bytes).contains(&0))
 }
 
 pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
@@ -38,7 +37,7 @@ pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
     if ascii_start(bytes) {
         return Ok((read_ascii(bytes).map_err(|d| vec![d])?, Some(false)));
     }
-    if bytes.len() < 84 {
+    let Some(count) = super::bytes_at(bytes, 80) else {
         return Err(vec![error_at_byte(
             Code::MeshTruncated,
             bytes.len(),
@@ -47,8 +46,8 @@ pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
                 bytes.len()
             ),
         )]);
-    }
-    let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as u64;
+    };
+    let n = u64::from(u32::from_le_bytes(count));
     Err(vec![
         error_at_byte(
             Code::StlSizeMismatch,
@@ -64,25 +63,22 @@ pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
 }
 
 fn read_binary(bytes: &[u8]) -> Result<Builder, Vec<Diagnostic>> {
-    let n = (bytes.len() - 84) / 50;
+    let records = bytes.get(84..).unwrap_or_default();
+    let n = records.len() / 50;
     let mut b = Builder::new();
     // About half as many nodes as triangles in a closed surface.
     let mut dedup = NodeDedup::with_capacity(n / 2 + 16);
     b.nodes.reserve(n / 2 + 16);
     let mut triangles = Vec::with_capacity(n);
     let mut attributes = 0usize;
-    for (i, record) in bytes[84..].chunks_exact(50).enumerate() {
+    for (i, record) in records.chunks_exact(50).enumerate() {
         let mut tri = [0u32; 3];
         for (k, slot) in tri.iter_mut().enumerate() {
             let mut p = [0.0f64; 3];
             for (c, value) in p.iter_mut().enumerate() {
                 let at = 12 + 12 * k + 4 * c;
-                let v = f32::from_le_bytes([
-                    record[at],
-                    record[at + 1],
-                    record[at + 2],
-                    record[at + 3],
-                ]);
+                // A record is 50 bytes: `at + 4` is at most 48.
+                let v = f32::from_le_bytes(super::bytes_at(record, at).unwrap_or([0; 4]));
                 if !v.is_finite() {
                     return Err(vec![error_at_byte(
                         Code::MeshNonFinite,
@@ -97,7 +93,7 @@ fn read_binary(bytes: &[u8]) -> Result<Builder, Vec<Diagnostic>> {
             }
             *slot = dedup.node(&mut b.nodes, p);
         }
-        if record[48] != 0 || record[49] != 0 {
+        if record.get(48..).is_some_and(|a| a.iter().any(|&x| x != 0)) {
             attributes += 1;
         }
         triangles.push(tri);
@@ -110,7 +106,9 @@ fn read_binary(bytes: &[u8]) -> Result<Builder, Vec<Diagnostic>> {
         );
     }
     let g = b.group("surface");
-    b.groups[g].triangles = triangles;
+    if let Some(group) = b.groups.get_mut(g) {
+        group.triangles = triangles;
+    }
     Ok(b)
 }
 
@@ -169,7 +167,9 @@ fn read_ascii(bytes: &[u8]) -> Result<Builder, Diagnostic> {
                 });
             }
             keyword(&mut s, "endfacet")?;
-            b.groups[g].triangles.push(tri);
+            if let Some(group) = b.groups.get_mut(g) {
+                group.triangles.push(tri);
+            }
         }
     }
     Ok(b)

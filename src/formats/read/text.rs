@@ -40,18 +40,18 @@ impl<'a> Scanner<'a> {
     /// The next token, skipping whitespace and line ends; `None` at the end.
     pub fn next_token(&mut self) -> Option<Token<'a>> {
         let b = self.bytes;
-        while self.pos < b.len() && b[self.pos].is_ascii_whitespace() {
+        while b.get(self.pos).is_some_and(u8::is_ascii_whitespace) {
             self.pos += 1;
-        }
-        if self.pos >= b.len() {
-            return None;
         }
         let start = self.pos;
-        while self.pos < b.len() && !b[self.pos].is_ascii_whitespace() {
-            self.pos += 1;
-        }
+        let rest = b.get(start..).filter(|r| !r.is_empty())?;
+        let len = rest
+            .iter()
+            .position(u8::is_ascii_whitespace)
+            .unwrap_or(rest.len());
+        self.pos += len;
         Some(Token {
-            text: &b[start..self.pos],
+            text: rest.get(..len).unwrap_or(rest),
             start,
         })
     }
@@ -59,10 +59,13 @@ impl<'a> Scanner<'a> {
     /// The next token on the current line only.
     pub fn next_on_line(&mut self) -> Option<Token<'a>> {
         let b = self.bytes;
-        while self.pos < b.len() && b[self.pos] != b'\n' && b[self.pos].is_ascii_whitespace() {
+        while b
+            .get(self.pos)
+            .is_some_and(|&c| c != b'\n' && c.is_ascii_whitespace())
+        {
             self.pos += 1;
         }
-        if self.pos >= b.len() || b[self.pos] == b'\n' {
+        if b.get(self.pos).is_none_or(|&c| c == b'\n') {
             return None;
         }
         self.next_token()
@@ -70,7 +73,7 @@ impl<'a> Scanner<'a> {
 
     /// Skips to just after the next line end.
     pub fn skip_line(&mut self) {
-        while self.pos < self.bytes.len() && self.bytes[self.pos] != b'\n' {
+        while self.bytes.get(self.pos).is_some_and(|&c| c != b'\n') {
             self.pos += 1;
         }
         if self.pos < self.bytes.len() {
@@ -81,20 +84,15 @@ impl<'a> Scanner<'a> {
     /// The rest of the current line (without its line end), and moves past it.
     pub fn rest_of_line(&mut self) -> Token<'a> {
         let start = self.pos;
-        while self.pos < self.bytes.len() && self.bytes[self.pos] != b'\n' {
+        while self.bytes.get(self.pos).is_some_and(|&c| c != b'\n') {
             self.pos += 1;
         }
-        let mut end = self.pos;
-        while end > start && self.bytes[end - 1].is_ascii_whitespace() {
-            end -= 1;
-        }
+        let line = self.bytes.get(start..self.pos).unwrap_or_default();
+        let text = line.trim_ascii_end();
         if self.pos < self.bytes.len() {
             self.pos += 1;
         }
-        Token {
-            text: &self.bytes[start..end],
-            start,
-        }
+        Token { text, start }
     }
 
     /// The next token, or an error saying what was expected at the end of the file.

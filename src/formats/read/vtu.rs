@@ -209,13 +209,13 @@ impl Reader<'_> {
             .or_else(|| cell_data.keys().next().cloned());
 
         let mut b = Builder::new();
-        b.nodes = coords.chunks_exact(3).map(|p| [p[0], p[1], p[2]]).collect();
+        b.nodes = coords.chunks_exact(3).filter_map(super::array).collect();
         let mut groups: BTreeMap<(usize, i64), usize> = BTreeMap::new();
         let mut dropped: BTreeMap<&str, usize> = BTreeMap::new();
         let mut split = 0usize;
         let mut start = 0usize;
-        for i in 0..n_cells {
-            let end = offsets[i];
+        // `offsets`, `types` and every cell data array have n_cells entries (checked above).
+        for (i, (&end, &t)) in offsets.iter().zip(&types).enumerate() {
             if end < start as i64 || end as usize > connectivity.len() {
                 return Err(err(
                     oa,
@@ -227,7 +227,7 @@ impl Reader<'_> {
                 ));
             }
             let end = end as usize;
-            let ids = &connectivity[start..end];
+            let ids = connectivity.get(start..end).unwrap_or_default();
             start = end;
             let mut nodes = Vec::with_capacity(ids.len());
             for &v in ids {
@@ -248,14 +248,20 @@ impl Reader<'_> {
                     .find_map(|(k, (name, _, _))| {
                         cell_data
                             .get(*name)
-                            .map(|v| v[i])
+                            .and_then(|v| v.get(i).copied())
                             .filter(|&v| v >= 0)
                             .map(|v| (k, v))
                     })
                     .unwrap_or((usize::MAX, 0))
             } else {
                 match &generic {
-                    Some(name) => (0, cell_data[name][i]),
+                    Some(name) => (
+                        0,
+                        cell_data
+                            .get(name)
+                            .and_then(|v| v.get(i).copied())
+                            .unwrap_or(0),
+                    ),
                     None => (usize::MAX, 0),
                 }
             };
@@ -268,7 +274,6 @@ impl Reader<'_> {
                     g
                 }
             };
-            let t = types[i];
             let need = match t {
                 1 => Some(1),
                 3 | 21 => Some(2),
@@ -288,28 +293,45 @@ impl Reader<'_> {
                     ));
                 }
             }
-            let group = &mut b.groups[g];
+            let Some(group) = b.groups.get_mut(g) else {
+                continue;
+            };
+            // Quads and quadratic cells: the first `need` nodes are the corners (checked above).
+            let corners = match need {
+                Some(k) if matches!(t, 9 | 21 | 22 | 23 | 28) => nodes.get(..k).unwrap_or(&nodes),
+                _ => nodes.as_slice(),
+            };
             match t {
                 1 | 2 => group.points.extend_from_slice(&nodes),
                 3 | 4 | 21 => {
-                    let corners = if t == 21 { &nodes[..2] } else { &nodes[..] };
-                    group.lines.extend(corners.windows(2).map(|w| [w[0], w[1]]));
+                    group
+                        .lines
+                        .extend(corners.windows(2).filter_map(super::array::<u32, 2>));
                 }
-                5 | 22 => group.triangles.push([nodes[0], nodes[1], nodes[2]]),
+                5 | 22 => {
+                    if let &[a, b, c, ..] = corners {
+                        group.triangles.push([a, b, c]);
+                    }
+                }
                 6 => {
                     split += 1;
-                    for k in 0..nodes.len().saturating_sub(2) {
-                        let (a, c) = if k % 2 == 0 { (k, k + 1) } else { (k + 1, k) };
-                        group.triangles.push([nodes[a], nodes[c], nodes[k + 2]]);
+                    for (k, w) in nodes.windows(3).enumerate() {
+                        if let &[a, b, c] = w {
+                            group
+                                .triangles
+                                .push(if k % 2 == 0 { [a, b, c] } else { [b, a, c] });
+                        }
                     }
                 }
                 7 | 9 | 23 | 28 => {
                     split += 1;
-                    let corners = if t == 7 { &nodes[..] } else { &nodes[..4] };
-                    for k in 1..corners.len().saturating_sub(1) {
-                        group
-                            .triangles
-                            .push([corners[0], corners[k], corners[k + 1]]);
+                    // A fan from the first corner.
+                    if let Some((&first, rest)) = corners.split_first() {
+                        group.triangles.extend(
+                            rest.windows(2)
+                                .filter_map(super::array::<u32, 2>)
+                                .map(|[a, c]| [first, a, c]),
+                        );
                     }
                 }
                 10 | 24 => *dropped.entry("tetrahedra").or_default() += 1,
@@ -489,11 +511,12 @@ fn group_name(
         return "vtu".to_string();
     }
     if geomc {
-        let (_, label, kind) = GEOMC_ARRAYS[key.0];
-        if let Some(name) = names.get(&kind).and_then(|m| m.get(&key.1)) {
-            return name.clone();
+        if let Some(&(_, label, kind)) = GEOMC_ARRAYS.get(key.0) {
+            if let Some(name) = names.get(&kind).and_then(|m| m.get(&key.1)) {
+                return name.clone();
+            }
+            return format!("{label} {}", key.1);
         }
-        return format!("{label} {}", key.1);
     }
     let array = generic.unwrap_or("group");
     if array == "gmsh:physical" {

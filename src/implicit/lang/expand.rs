@@ -138,7 +138,14 @@ pub fn read_geom(program: &Program, diags: &mut Diagnostics) -> Geom {
                             ),
                         ));
                     }
-                    geom.cells[(field.as_bytes()[1] - b'x') as usize] = v as usize;
+                    let axis = match field.as_str() {
+                        "nx" => 0,
+                        "ny" => 1,
+                        _ => 2,
+                    };
+                    if let Some(cells) = geom.cells.get_mut(axis) {
+                        *cells = v as usize;
+                    }
                     values.insert(field.clone(), v);
                 }
                 "optiterations" => {
@@ -163,11 +170,18 @@ pub fn read_geom(program: &Program, diags: &mut Diagnostics) -> Geom {
                             format!("Geom.{field} = {v}: give a finite number"),
                         ));
                     }
-                    let axis = (field.as_bytes()[0] - b'x') as usize;
-                    if field.ends_with("min") {
-                        geom.min[axis] = v;
+                    let axis = match field.as_bytes().first() {
+                        Some(b'x') => 0,
+                        Some(b'y') => 1,
+                        _ => 2,
+                    };
+                    let bound = if field.ends_with("min") {
+                        geom.min.get_mut(axis)
                     } else {
-                        geom.max[axis] = v;
+                        geom.max.get_mut(axis)
+                    };
+                    if let Some(bound) = bound {
+                        *bound = v;
                     }
                     values.insert(field.clone(), v);
                 }
@@ -189,9 +203,8 @@ pub fn read_geom(program: &Program, diags: &mut Diagnostics) -> Geom {
             diags.push(d);
         }
     }
-    for axis in 0..3 {
-        if geom.min[axis] >= geom.max[axis] {
-            let name = ["x", "y", "z"][axis];
+    for ((name, &lo), &hi) in ["x", "y", "z"].into_iter().zip(&geom.min).zip(&geom.max) {
+        if lo >= hi {
             let span = program
                 .geom
                 .iter()
@@ -202,7 +215,7 @@ pub fn read_geom(program: &Program, diags: &mut Diagnostics) -> Geom {
                 span,
                 format!(
                     "Geom.{name}_min = {} is not below Geom.{name}_max = {}",
-                    geom.min[axis], geom.max[axis]
+                    lo, hi
                 ),
             ));
         }
@@ -260,7 +273,7 @@ pub fn expand(program: &Program, geom: &Geom, diags: &mut Diagnostics) -> Option
             ));
         }
         for (i, (p, span)) in f.params.iter().enumerate() {
-            if f.params[..i].iter().any(|(q, _)| q == p) {
+            if f.params.iter().take(i).any(|(q, _)| q == p) {
                 diags.push(err(
                     Code::RfsDuplicate,
                     *span,
@@ -599,51 +612,51 @@ impl<'p> Expander<'p> {
             "ceil" => Some(Unary::Ceil),
             _ => None,
         };
-        let arity = |n: usize| -> Result<(), Diagnostic> {
-            if a.len() == n {
-                Ok(())
-            } else {
-                Err(err(
-                    Code::RfsArity,
-                    span,
-                    format!(
-                        "Math.{name} takes {n} argument{}, got {}",
-                        if n == 1 { "" } else { "s" },
-                        a.len()
-                    ),
-                ))
-            }
+        let wrong_arity = |n: usize| {
+            err(
+                Code::RfsArity,
+                span,
+                format!(
+                    "Math.{name} takes {n} argument{}, got {}",
+                    if n == 1 { "" } else { "s" },
+                    a.len()
+                ),
+            )
         };
         if let Some(u) = unary {
-            arity(1)?;
-            return Ok(self.ctx.unary(u, a[0]));
+            let &[x] = a else {
+                return Err(wrong_arity(1));
+            };
+            return Ok(self.ctx.unary(u, x));
         }
-        match name {
-            "pow" | "atan2" => {
-                arity(2)?;
+        match (name, a.split_first()) {
+            ("pow" | "atan2", _) => {
+                let &[x, y] = a else {
+                    return Err(wrong_arity(2));
+                };
                 let op = if name == "pow" {
                     Binary::Pow
                 } else {
                     Binary::Atan2
                 };
-                Ok(self.ctx.binary(op, a[0], a[1]))
+                Ok(self.ctx.binary(op, x, y))
             }
-            "min" | "max" if !a.is_empty() => {
+            ("min" | "max", Some((&first, rest))) => {
                 let op = if name == "min" {
                     Binary::Min
                 } else {
                     Binary::Max
                 };
-                Ok(a[1..]
+                Ok(rest
                     .iter()
-                    .fold(a[0], |acc, &x| self.ctx.binary(op, acc, x)))
+                    .fold(first, |acc, &x| self.ctx.binary(op, acc, x)))
             }
-            "min" | "max" => Err(err(
+            ("min" | "max", None) => Err(err(
                 Code::RfsArity,
                 span,
                 format!("Math.{name} needs at least one argument"),
             )),
-            _ => {
+            (_, _) => {
                 let mut d = err(
                     Code::RfsUnknownName,
                     callee_span,

@@ -29,21 +29,23 @@ pub struct LexError {
 pub fn lex(text: &str) -> Result<Vec<Token>, LexError> {
     let bytes = text.as_bytes();
     let mut out = Vec::new();
+    // Out of range reads as 0, which no token contains.
+    let at = |k: usize| bytes.get(k).copied().unwrap_or(0);
+    let rest = |k: usize| text.get(k..).unwrap_or_default();
     let mut i = 0;
-    while i < bytes.len() {
-        let c = bytes[i];
+    while let Some(&c) = bytes.get(i) {
         if c.is_ascii_whitespace() {
             i += 1;
             continue;
         }
-        if text[i..].starts_with("//") {
-            while i < bytes.len() && bytes[i] != b'\n' {
+        if rest(i).starts_with("//") {
+            while i < bytes.len() && at(i) != b'\n' {
                 i += 1;
             }
             continue;
         }
-        if text[i..].starts_with("/*") {
-            let Some(end) = text[i + 2..].find("*/") else {
+        if rest(i).starts_with("/*") {
+            let Some(end) = rest(i + 2).find("*/") else {
                 return Err(LexError {
                     span: Span::new(i, i + 2),
                     message: "comment opened here is never closed with */".into(),
@@ -54,22 +56,22 @@ pub fn lex(text: &str) -> Result<Vec<Token>, LexError> {
         }
         let start = i;
         if c.is_ascii_digit() || (c == b'.' && bytes.get(i + 1).is_some_and(u8::is_ascii_digit)) {
-            while i < bytes.len() && (bytes[i].is_ascii_digit() || bytes[i] == b'.') {
+            while at(i).is_ascii_digit() || at(i) == b'.' {
                 i += 1;
             }
-            if i < bytes.len() && (bytes[i] == b'e' || bytes[i] == b'E') {
+            if at(i) == b'e' || at(i) == b'E' {
                 let mut k = i + 1;
-                if k < bytes.len() && (bytes[k] == b'+' || bytes[k] == b'-') {
+                if at(k) == b'+' || at(k) == b'-' {
                     k += 1;
                 }
-                if k < bytes.len() && bytes[k].is_ascii_digit() {
+                if at(k).is_ascii_digit() {
                     i = k;
-                    while i < bytes.len() && bytes[i].is_ascii_digit() {
+                    while at(i).is_ascii_digit() {
                         i += 1;
                     }
                 }
             }
-            let s = &text[start..i];
+            let s = text.get(start..i).unwrap_or_default();
             let v: f64 = s.parse().map_err(|_| LexError {
                 span: Span::new(start, i),
                 message: format!("'{s}' is not a number"),
@@ -81,25 +83,23 @@ pub fn lex(text: &str) -> Result<Vec<Token>, LexError> {
             continue;
         }
         if c.is_ascii_alphabetic() || c == b'_' || c == b'$' {
-            while i < bytes.len()
-                && (bytes[i].is_ascii_alphanumeric() || bytes[i] == b'_' || bytes[i] == b'$')
-            {
+            while at(i).is_ascii_alphanumeric() || at(i) == b'_' || at(i) == b'$' {
                 i += 1;
             }
             out.push(Token {
-                tok: Tok::Ident(text[start..i].to_string()),
+                tok: Tok::Ident(text.get(start..i).unwrap_or_default().to_string()),
                 span: Span::new(start, i),
             });
             continue;
         }
         if c == b'"' || c == b'\'' {
-            let Some(len) = text[i + 1..].find(c as char) else {
+            let Some(len) = rest(i + 1).find(c as char) else {
                 return Err(LexError {
                     span: Span::new(i, i + 1),
                     message: "string is never closed".into(),
                 });
             };
-            let s = &text[i + 1..i + 1 + len];
+            let s = rest(i + 1).get(..len).unwrap_or_default();
             if s.contains('\n') {
                 return Err(LexError {
                     span: Span::new(i, i + 1),
@@ -121,7 +121,7 @@ pub fn lex(text: &str) -> Result<Vec<Token>, LexError> {
             });
             continue;
         }
-        let ch = text[i..].chars().next().unwrap_or('?');
+        let ch = rest(i).chars().next().unwrap_or('?');
         return Err(LexError {
             span: Span::new(i, i + ch.len_utf8()),
             message: format!("unexpected character '{ch}'"),

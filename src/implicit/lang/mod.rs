@@ -1,6 +1,9 @@
 //! Paper 001's modelling language (`.rfs` files): lexer → parser → expansion
 //! of the result function into one IR expression.
 
+// User-controlled bytes and values: no panicking index (docs/reliability.md).
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
+
 pub mod ast;
 pub mod expand;
 pub mod lexer;
@@ -33,15 +36,8 @@ pub fn compile(source: &SourceFile) -> (Option<ImplicitModel>, Diagnostics) {
         }
     };
     let geom = expand::read_geom(&program, &mut diags);
-    if geom.optiterations > 0 {
-        if let Some(span) = geom.optiterations_span {
-            diags.push(Diagnostic::new(
-                Code::RfsOptimizeIgnored,
-                span,
-                format!("Geom.optiterations = {}: mesh optimisation is not implemented yet; triangles are written as polygonized", geom.optiterations),
-            ));
-        }
-    }
+    // Geom.optiterations is applied by `ImplicitModel::polygonize` (W131 is
+    // no longer emitted).
     let expanded = if diags.has_errors() {
         None
     } else {

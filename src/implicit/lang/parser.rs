@@ -58,12 +58,18 @@ pub fn parse(toks: &[Token]) -> Result<Program, ParseError> {
 }
 
 impl Parser<'_> {
+    /// The current token; the lexer ends every list with `Eof`, and the
+    /// parser never moves past it, so the fallbacks are never taken.
     fn peek(&self) -> &Tok {
-        &self.toks[self.pos].tok
+        static EOF: Tok = Tok::Eof;
+        self.toks.get(self.pos).map_or(&EOF, |t| &t.tok)
     }
 
     fn span(&self) -> Span {
-        self.toks[self.pos].span
+        self.toks
+            .get(self.pos)
+            .or(self.toks.last())
+            .map_or(Span::new(0, 0), |t| t.span)
     }
 
     fn describe(&self) -> String {
@@ -281,7 +287,10 @@ impl Parser<'_> {
                         self.expect(',')?;
                     }
                 }
-                let end = self.toks[self.pos - 1].span.end as usize;
+                let end = self
+                    .toks
+                    .get(self.pos.wrapping_sub(1))
+                    .map_or(span.end, |t| t.span.end) as usize;
                 Ok(Expr::Call {
                     callee,
                     callee_span,

@@ -1,0 +1,307 @@
+//! Implicit solids in the domain XML (issue 5): `<rfunction>` trees of
+//! R-operations over paper 001's primitives and formulas, `<function>`s with
+//! named arguments, `<level_surface>` f(u, v, w) = c and `<density_volume>`
+//! samples. The driver takes these elements (and the subdomains that use
+//! them) out of the tree before the boundary-representation pipeline, and
+//! lowers them here into [`ImplicitSubdomain`]s that compile polygonizes.
+
+pub mod density;
+pub mod mesh;
+mod overlap;
+mod paths;
+mod settings;
+mod tree;
+
+use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
+use crate::implicit::ImplicitModel;
+use crate::implicit::ir::{Ctx, Node, NodeId};
+use crate::implicit::polygonize::{self, Grid, Options, Surface};
+use crate::span::{SourceFile, Span};
+use crate::syntax::Element;
+use std::collections::{BTreeSet, HashMap, HashSet};
+use std::path::PathBuf;
+
+/// The elements this module owns.
+pub const ELEMENTS: [&str; 4] = ["rfunction", "function", "level_surface", "density_volume"];
+/// The elements that define a named solid.
+const SOLIDS: [&str; 3] = ["rfunction", "level_surface", "density_volume"];
+
+/// What the driver took out of the element tree.
+#[derive(Debug, Default)]
+pub struct Extracted<'s> {
+    pub defs: Vec<Element<'s>>,
+    pub subdomains: Vec<Element<'s>>,
+}
+
+impl Extracted<'_> {
+    pub fn is_empty(&self) -> bool {
+        self.defs.is_empty() && self.subdomains.is_empty()
+    }
+}
+
+/// Moves the implicit definitions, and every subdomain whose solid tree
+/// names one of them, out of `root`.
+pub fn extract<'s>(root: &mut Element<'s>) -> Extracted<'s> {
+    let names: HashSet<String> = root
+        .children
+        .iter()
+        .filter(|c| SOLIDS.contains(&c.name))
+        .filter_map(|c| c.attribute("name"))
+        .map(|a| a.value.trim().to_string())
+        .collect();
+    let mut out = Extracted::default();
+    if !root.children.iter().any(|c| ELEMENTS.contains(&c.name)) {
+        return out;
+    }
+    for child in std::mem::take(&mut root.children) {
+        if ELEMENTS.contains(&child.name) {
+            out.defs.push(child);
+        } else if child.name == "subdomain" && names_any(&child, &names) {
+            out.subdomains.push(child);
+        } else {
+            root.children.push(child);
+        }
+    }
+    out
+}
+
+/// Whether a `<solid ref>` below `e` names one of `names`.
+fn names_any(e: &Element, names: &HashSet<String>) -> bool {
+    let mut stack = vec![e];
+    while let Some(e) = stack.pop() {
+        if e.name == "solid"
+            && e.attribute("ref")
+                .is_some_and(|r| names.contains(r.value.trim()))
+        {
+            return true;
+        }
+        stack.extend(e.children.iter());
+    }
+    false
+}
+
+/// What lowering needs from the rest of the front end.
+pub struct Env<'a> {
+    pub source: &'a SourceFile,
+    /// Parameter values in force (after `--set`).
+    pub parameters: &'a [(String, f64)],
+    /// The folder data files are read from (the XML file's folder).
+    pub folder: PathBuf,
+    /// Further folders `--allow-path` opened.
+    pub allowed: &'a [PathBuf],
+    /// Names the rest of the file defines (for duplicate checks).
+    pub taken: &'a dyn Fn(&str) -> bool,
+}
+
+/// An implicit solid ready to polygonize.
+#[derive(Debug, Clone)]
+pub enum ImplicitSolid {
+    /// f > 0 inside, on the model's Geom grid.
+    Function(ImplicitModel),
+    /// Samples minus the level (x fastest), one per grid point.
+    Samples { grid: Grid, values: Vec<f64> },
+}
+
+/// A subdomain whose solid is implicit.
+#[derive(Debug, Clone)]
+pub struct ImplicitSubdomain {
+    pub name: String,
+    pub material: Option<String>,
+    pub span: Span,
+    pub solid: ImplicitSolid,
+}
+
+impl ImplicitSubdomain {
+    /// The boundary surface: on the solid's own grid, or `cells` per axis for functions.
+    pub fn polygonize(&self, cells: Option<usize>) -> Surface {
+        match &self.solid {
+            ImplicitSolid::Function(model) => model.polygonize(cells.map(|n| [n; 3])),
+            ImplicitSolid::Samples { grid, values } => {
+                polygonize::polygonize_samples(values.clone(), grid, &Options::default())
+            }
+        }
+    }
+}
+
+/// The result of lowering: the subdomains and the parameters the implicit
+/// elements use (so they are not reported unused).
+#[derive(Debug, Default)]
+pub struct Lowered {
+    pub subdomains: Vec<ImplicitSubdomain>,
+    pub used_parameters: BTreeSet<String>,
+}
+
+/// A named solid while lowering.
+enum Def {
+    Function(ImplicitModel),
+    Samples(Grid, Vec<f64>),
+    /// Defined, but with errors (already reported).
+    Failed,
+}
+
+/// Lowers the extracted elements.
+pub fn lower(ex: &Extracted, env: &Env, diags: &mut Diagnostics) -> Lowered {
+    let mut out = Lowered::default();
+    let functions = tree::collect_functions(&ex.defs, diags);
+    let mut defs: HashMap<String, Def> = HashMap::new();
+    for e in ex.defs.iter().filter(|e| SOLIDS.contains(&e.name)) {
+        let Some(name_attr) = e.attribute("name") else {
+            continue;
+        };
+        let name = name_attr.value.trim().to_string();
+        if defs.contains_key(&name) || (env.taken)(&name) {
+            diags.push(Diagnostic::new(
+                Code::DuplicateName,
+                name_attr.value_span,
+                format!("the name '{name}' is defined twice"),
+            ));
+            continue;
+        }
+        let def = match e.name {
+            "rfunction" => tree::rfunction(e, env, &functions, &mut out.used_parameters, diags),
+            "level_surface" => tree::level_surface(e, env, &mut out.used_parameters, diags),
+            _ => density::read(e, env, &mut out.used_parameters, diags)
+                .map(|(grid, values)| Def::Samples(grid, values)),
+        };
+        defs.insert(name, def.unwrap_or(Def::Failed));
+    }
+    for s in &ex.subdomains {
+        let Some(name) = s.attribute("name") else {
+            continue;
+        };
+        let Some(root) = s.children.first() else {
+            continue;
+        };
+        let solid = match subdomain_solid(root, &defs, diags) {
+            Some(solid) => solid,
+            None => continue,
+        };
+        out.subdomains.push(ImplicitSubdomain {
+            name: name.value.trim().to_string(),
+            material: s.attribute("material").map(|a| a.value.to_string()),
+            span: s.name_span,
+            solid,
+        });
+    }
+    overlap::check(&out.subdomains, diags);
+    out
+}
+
+/// The solid of one subdomain tree: a density volume alone, or R-operations
+/// over functions.
+fn subdomain_solid(
+    root: &Element,
+    defs: &HashMap<String, Def>,
+    diags: &mut Diagnostics,
+) -> Option<ImplicitSolid> {
+    if let Some(r) = root.attribute("ref").filter(|_| root.name == "solid") {
+        if let Some(Def::Samples(grid, values)) = defs.get(r.value.trim()) {
+            return Some(ImplicitSolid::Samples {
+                grid: *grid,
+                values: values.clone(),
+            });
+        }
+    }
+    let mut ctx = Ctx::new();
+    let (root, geom) = combine(root, defs, &mut ctx, diags)?;
+    Some(ImplicitSolid::Function(ImplicitModel { geom, ctx, root }))
+}
+
+/// A subdomain's boolean tree as R-operations (in the first leaf's system);
+/// the grid covers the result (the union of boxes for a union, the first
+/// operand's box for a difference) with the finest cells of the operands.
+fn combine(
+    e: &Element,
+    defs: &HashMap<String, Def>,
+    ctx: &mut Ctx,
+    diags: &mut Diagnostics,
+) -> Option<(NodeId, crate::implicit::Geom)> {
+    if e.name == "solid" {
+        let r = e.attribute("ref")?;
+        let name = r.value.trim();
+        return match defs.get(name) {
+            Some(Def::Function(m)) => Some((import(ctx, &m.ctx, m.root), m.geom.clone())),
+            Some(Def::Failed) => None,
+            Some(Def::Samples(..)) => {
+                diags.push(Diagnostic::new(
+                    Code::ImplicitMixedTree,
+                    r.value_span,
+                    format!("the density volume '{name}' is used inside a boolean; it can only be a subdomain's whole solid"),
+                ));
+                None
+            }
+            None => {
+                let mut d = Diagnostic::new(
+                    Code::ImplicitMixedTree,
+                    r.value_span,
+                    format!(
+                        "'{name}' is not an implicit solid, and this subdomain combines it with implicit ones"
+                    ),
+                );
+                if let Some(s) = did_you_mean(name, defs.keys().map(String::as_str)) {
+                    d = d.with_help(format!(
+                        "did you mean '{s}'? otherwise write the primitive inside the <rfunction>"
+                    ));
+                }
+                diags.push(d);
+                None
+            }
+        };
+    }
+    let parts: Vec<Option<(NodeId, crate::implicit::Geom)>> = e
+        .children
+        .iter()
+        .map(|c| combine(c, defs, ctx, diags))
+        .collect();
+    let parts: Vec<(NodeId, crate::implicit::Geom)> = parts.into_iter().collect::<Option<_>>()?;
+    let (first, rest) = parts.split_first()?;
+    let sys = first.1.rsystem;
+    let mut geom = first.1.clone();
+    let mut f = first.0;
+    for (g, other) in rest {
+        f = match e.name {
+            "union" => sys.or(ctx, f, *g),
+            "intersection" => sys.and(ctx, f, *g),
+            _ => sys.difference(ctx, f, *g),
+        };
+        for axis in 0..3 {
+            if e.name == "union" {
+                geom.min[axis] = geom.min[axis].min(other.min[axis]);
+                geom.max[axis] = geom.max[axis].max(other.max[axis]);
+            }
+            geom.cells[axis] = geom.cells[axis].max(other.cells[axis]);
+        }
+    }
+    Some((f, geom))
+}
+
+/// Copies the expression `root` of `src` into `dst` (hash-consed again, so
+/// shared parts stay shared).
+pub fn import(dst: &mut Ctx, src: &Ctx, root: NodeId) -> NodeId {
+    let mut map: Vec<NodeId> = Vec::with_capacity(root as usize + 1);
+    for node in src.nodes.iter().take(root as usize + 1) {
+        let m = |i: NodeId| map[i as usize];
+        let id = match *node {
+            Node::Const(bits) => dst.constant(f64::from_bits(bits)),
+            Node::Var(axis) => dst.var(axis),
+            Node::Unary(op, a) => {
+                let a = m(a);
+                dst.unary(op, a)
+            }
+            Node::Binary(op, a, b) => {
+                let (a, b) = (m(a), m(b));
+                dst.binary(op, a, b)
+            }
+            Node::RAnd(a, b, alpha) => {
+                let (a, b) = (m(a), m(b));
+                dst.r_and(a, b, f64::from_bits(alpha))
+            }
+            Node::ROr(a, b, alpha) => {
+                let (a, b) = (m(a), m(b));
+                dst.r_or(a, b, f64::from_bits(alpha))
+            }
+        };
+        map.push(id);
+    }
+    map[root as usize]
+}
