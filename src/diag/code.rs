@@ -348,6 +348,12 @@ codes! {
     // ---- mesh-perf: locate, volume cells (issues 3, 4) ----
     LocateBadPoint = "E504", Error, "bad row in a points file",
         "geomc locate reads one point per row: 2 or 3 finite numbers separated by commas or spaces (x,y or x,y,z). A first row of column names (x,y,z) is allowed; empty rows and rows starting with # are skipped. Fix or remove the row named.";
+
+    // ---- trimmed parametric surfaces (issue 9, branch trim) ----
+    TrimmedCarrierInvalid = "E740", Error, "invalid parametric surface",
+        "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
+    TrimmedUnknownVariable = "E741", Error, "unknown variable in a surface or trim expression",
+        "The coordinates of a parametric_surface are expressions in u and v, and a trim's equation is an expression in the global x, y and z; other names must be parameters or basis coordinates. Rename the variable or define the parameter.";
 }
 
 impl Code {
