@@ -172,6 +172,8 @@ codes! {
         "A point value with two coordinates is a line parallel to the missing axis, and one with one coordinate is a plane perpendicular to its axis (paper 000). Where a single point is needed, the missing coordinates are taken as 0.";
     EmptySubdomainList = "W009", Warning, "model has no subdomains",
         "The file defines geometry but no <subdomain>, so it describes no computational domain: no boundary fragments are derived and compile meshes each solid on its own. Add <subdomain> elements to describe the domain.";
+    RepeatedFace = "W010", Warning, "face listed more than once in a subdomain",
+        "A subdomain's faces= list names the same face twice (directly, or once by name and once through a list such as box.faces). A closed shell uses each face once, so the repeat is ignored. Remove the repeated name.";
     // ---- implicit solids and the .rfs language (issue 5) ----
     RfsSyntax = "E600", Error, "syntax error in an .rfs program",
         "The .rfs file (paper 001's modelling language) could not be read at this position. A program is a list of `Geom.<field> = value;` settings and `function name(a, b) { var v = …; return …; }` definitions; expressions use + - * / %, parentheses, numbers, names, library calls such as Ball(x, y, z, r, x0, y0, z0) and Math.<name>(…). Fix the text at the position shown.";
