@@ -2,8 +2,9 @@
 //! trims and surface coordinates evaluate like R-functions (tapes, shared
 //! subexpressions, constant folding).
 
-use crate::expr::{BinaryOp, Expr, ExprKind, Function};
-use crate::implicit::ir::{Binary, Ctx, NodeId, Unary};
+use crate::expr::{BinaryOp, Expr, ExprKind};
+use crate::implicit::expr_ops;
+use crate::implicit::ir::{Ctx, NodeId};
 
 /// Builds `expr` into `ctx`; the names in `vars` are coordinates 0, 1, 2.
 /// Other names (parameters are already folded) are an error naming them.
@@ -25,47 +26,18 @@ pub fn build(ctx: &mut Ctx, expr: &Expr, vars: &[&str]) -> Result<NodeId, String
                 return Ok(ctx.square(x));
             }
             let y = build(ctx, b, vars)?;
-            let op = match op {
-                BinaryOp::Add => Binary::Add,
-                BinaryOp::Sub => Binary::Sub,
-                BinaryOp::Mul => Binary::Mul,
-                BinaryOp::Div => Binary::Div,
-                BinaryOp::Pow => Binary::Pow,
-            };
-            ctx.binary(op, x, y)
+            ctx.binary(expr_ops::binary(*op), x, y)
         }
         ExprKind::Call(f, args) => {
             let mut ids = Vec::with_capacity(args.len());
             for a in args {
                 ids.push(build(ctx, a, vars)?);
             }
-            let first = ids
-                .first()
-                .copied()
-                .unwrap_or_else(|| ctx.constant(f64::NAN));
-            let unary = match f {
-                Function::Sqrt => Unary::Sqrt,
-                Function::Sin => Unary::Sin,
-                Function::Cos => Unary::Cos,
-                Function::Tan => Unary::Tan,
-                Function::Asin => Unary::Asin,
-                Function::Acos => Unary::Acos,
-                Function::Atan => Unary::Atan,
-                Function::Exp => Unary::Exp,
-                Function::Ln => Unary::Ln,
-                Function::Abs => Unary::Abs,
-                Function::Min | Function::Max => {
-                    let op = if *f == Function::Min {
-                        Binary::Min
-                    } else {
-                        Binary::Max
-                    };
-                    return Ok(ids[1..]
-                        .iter()
-                        .fold(first, |acc, &b| ctx.binary(op, acc, b)));
-                }
-            };
-            ctx.unary(unary, first)
+            // The parser checks arity; an empty call is NaN, never a panic.
+            match expr_ops::apply(ctx, *f, &ids) {
+                Some(id) => id,
+                None => ctx.constant(f64::NAN),
+            }
         }
     })
 }
