@@ -25,6 +25,7 @@ pub mod render;
 pub mod resolve;
 pub mod span;
 pub mod syntax;
+pub mod trimmed;
 pub mod valid;
 
 /// A number as messages show it: no trailing zeros, exponent form only for

@@ -28,6 +28,9 @@ pub fn run(args: &Args) -> i32 {
     if super::convert::is_mesh_file(&args.file) {
         return super::convert::inspect(&args.file, args.format);
     }
+    if super::rfs::is_rfs(&args.file) {
+        return super::rfs::inspect(&args.file, args.format);
+    }
     let options = match args.input.to_options() {
         Ok(o) => o,
         Err(diagnostics) => {

@@ -188,3 +188,28 @@ pub fn compile(
     }
     (messages, ok)
 }
+
+/// `geomc inspect MODEL.rfs`: the polygonized surface on the program's own
+/// grid, reported as `inspect` reports a mesh file (counts, groups, bounding
+/// box, watertightness), so a user can check a model before compiling it.
+pub fn inspect(input: &Path, format: super::Format) -> i32 {
+    let (messages, loaded) = load(input, false, None, &RfsLimits::default());
+    eprint!("{messages}");
+    let mesh = match loaded {
+        Ok((mesh, _)) => mesh,
+        Err(code) => return code,
+    };
+    let report = geomc::formats::read::clean::check(&mesh);
+    let loaded = geomc::formats::read::Loaded {
+        mesh,
+        warnings: Vec::new(),
+        report,
+        binary: None,
+    };
+    let report = geomc::convert::inspect::MeshReport::of(&loaded, "rfs");
+    match format {
+        super::Format::Human => super::out(&report.render_text()),
+        super::Format::Json => super::out(&format!("{}\n", report.render_json())),
+    }
+    super::EXIT_OK
+}

@@ -172,6 +172,8 @@ codes! {
         "A point value with two coordinates is a line parallel to the missing axis, and one with one coordinate is a plane perpendicular to its axis (paper 000). Where a single point is needed, the missing coordinates are taken as 0.";
     EmptySubdomainList = "W009", Warning, "model has no subdomains",
         "The file defines geometry but no <subdomain>, so it describes no computational domain: no boundary fragments are derived and compile meshes each solid on its own. Add <subdomain> elements to describe the domain.";
+    RepeatedFace = "W010", Warning, "face listed more than once in a subdomain",
+        "A subdomain's faces= list names the same face twice (directly, or once by name and once through a list such as box.faces). A closed shell uses each face once, so the repeat is ignored. Remove the repeated name.";
     // ---- implicit solids and the .rfs language (issue 5) ----
     RfsSyntax = "E600", Error, "syntax error in an .rfs program",
         "The .rfs file (paper 001's modelling language) could not be read at this position. A program is a list of `Geom.<field> = value;` settings and `function name(a, b) { var v = …; return …; }` definitions; expressions use + - * / %, parentheses, numbers, names, library calls such as Ball(x, y, z, r, x0, y0, z0) and Math.<name>(…). Fix the text at the position shown.";
@@ -199,8 +201,8 @@ codes! {
         "Every function must end with `return <expression>;`. Add the return statement.";
     RfsUnknownGeomField = "W130", Warning, "unknown Geom field",
         "This Geom field is not one geomc uses (dimension, x_min, x_max, y_min, y_max, z_min, z_max, nx, ny, nz, name, optiterations, rsystem, alpha); it is ignored. Check the spelling.";
-    RfsOptimizeIgnored = "W131", Warning, "mesh optimisation iterations not applied",
-        "Geom.optiterations asks for mesh optimisation (edge flips and smoothing); this geomc does not implement it yet, so the marching-cubes triangles are written as they are.";
+    RfsOptimizeIgnored = "W131", Warning, "mesh optimisation iterations not applied (retired: optimisation is applied)",
+        "Retired: earlier versions warned that Geom.optiterations was not applied. geomc now applies it (edge flips and tangential smoothing with re-projection onto the surface), so this warning is no longer given; the code keeps its meaning and is not reused.";
 
     // ---- compile (issue 3) ----
     InternalMeshingFailure = "E500", Error, "internal meshing failure",
@@ -348,6 +350,12 @@ codes! {
     // ---- mesh-perf: locate, volume cells (issues 3, 4) ----
     LocateBadPoint = "E504", Error, "bad row in a points file",
         "geomc locate reads one point per row: 2 or 3 finite numbers separated by commas or spaces (x,y or x,y,z). A first row of column names (x,y,z) is allowed; empty rows and rows starting with # are skipped. Fix or remove the row named.";
+
+    // ---- trimmed parametric surfaces (issue 9, branch trim) ----
+    TrimmedCarrierInvalid = "E740", Error, "invalid parametric surface",
+        "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
+    TrimmedUnknownVariable = "E741", Error, "unknown variable in a surface or trim expression",
+        "The coordinates of a parametric_surface are expressions in u and v, and a trim's equation is an expression in the global x, y and z; other names must be parameters or basis coordinates. Rename the variable or define the parameter.";
 }
 
 impl Code {

@@ -237,6 +237,35 @@ impl Builder<'_> {
                     .map(|r| self.points_named(r, "node"))
                     .collect(),
             },
+            "bezier_surface" | "cone_surface" | "parametric_surface" => {
+                let carrier = match e.name {
+                    "bezier_surface" => CarrierSpec::Bezier {
+                        rows: e
+                            .children_named("row")
+                            .map(|r| self.points_named(r, "node"))
+                            .collect(),
+                    },
+                    "cone_surface" => CarrierSpec::Cone {
+                        bottom_radius: self.number(e, "bottom_radius"),
+                        top_radius: self.number(e, "top_radius"),
+                        length: self.number(e, "length"),
+                        from_angle: self.number(e, "from_angle"),
+                        to_angle: self.number(e, "to_angle"),
+                    },
+                    _ => CarrierSpec::Expressions {
+                        xyz: ["x", "y", "z"].map(|a| self.number(e, a)),
+                        rect: ["u_min", "u_max", "v_min", "v_max"].map(|a| self.number(e, a)),
+                    },
+                };
+                let trim = e.children_named("trim").next().map(|t| TrimSpec {
+                    equation: self.number(t, "equation"),
+                    negative: t
+                        .attribute("material")
+                        .is_some_and(|a| a.value.trim() == "negative"),
+                    span: t.name_span,
+                });
+                ObjectKind::Trimmed(Box::new(TrimmedSpec { carrier, trim }))
+            }
             "transform" => ObjectKind::Transform {
                 target: self.reference(e, "ref"),
                 steps: self.steps(e),

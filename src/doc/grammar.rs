@@ -406,6 +406,64 @@ pub static PATCH9: Rule = Rule {
     content: Content::Sequence(&[exactly(&PATCH_ROW, 3)]),
 };
 
+// ---- trimmed parametric surfaces (paper 002) ----
+
+/// Where the surface keeps material: F(x, y, z) ≥ 0 (`positive`, the
+/// default) or ≤ 0 (`negative`), F in global coordinates.
+pub static TRIM: Rule = leaf(
+    "trim",
+    &[
+        req("equation", Expr),
+        opt("material", AttrKind::Enum(&["positive", "negative"])),
+    ],
+);
+pub static BEZIER_NODE: Rule = leaf("node", POINT_ATTRS);
+pub static BEZIER_ROW: Rule = Rule {
+    name: "row",
+    attrs: &[],
+    any_attrs: false,
+    content: Content::Sequence(&[many(&BEZIER_NODE, 2)]),
+};
+/// A tensor-product Bezier surface: rows along u, nodes along v.
+pub static BEZIER_SURFACE: Rule = Rule {
+    name: "bezier_surface",
+    attrs: NAMED,
+    any_attrs: false,
+    content: Content::Sequence(&[many(&BEZIER_ROW, 2), maybe(&TRIM)]),
+};
+/// Paper 002's truncated cone about the local y axis (angles in degrees).
+pub static CONE_SURFACE: Rule = Rule {
+    name: "cone_surface",
+    attrs: &[
+        req("name", Name),
+        opt("cs", Ref),
+        req("bottom_radius", Expr),
+        req("top_radius", Expr),
+        req("length", Expr),
+        opt("from_angle", Expr),
+        opt("to_angle", Expr),
+    ],
+    any_attrs: false,
+    content: Content::Sequence(&[maybe(&TRIM)]),
+};
+/// x(u, v), y(u, v), z(u, v) over [u_min, u_max] × [v_min, v_max].
+pub static PARAMETRIC_SURFACE: Rule = Rule {
+    name: "parametric_surface",
+    attrs: &[
+        req("name", Name),
+        opt("cs", Ref),
+        req("x", Expr),
+        req("y", Expr),
+        req("z", Expr),
+        req("u_min", Expr),
+        req("u_max", Expr),
+        req("v_min", Expr),
+        req("v_max", Expr),
+    ],
+    any_attrs: false,
+    content: Content::Sequence(&[maybe(&TRIM)]),
+};
+
 // ---- transforms and replication ----
 
 pub static SHIFT: Rule = leaf("shift", VECTOR_ATTRS);
@@ -923,6 +981,9 @@ pub static GEOMETRY: Rule = Rule {
             &CONIC_ARC,
             &DESARGUES_ARC,
             &PATCH9,
+            &BEZIER_SURFACE,
+            &CONE_SURFACE,
+            &PARAMETRIC_SURFACE,
             &TRANSFORM,
             &REPLICATE,
             &SURFACE,

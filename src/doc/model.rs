@@ -295,6 +295,8 @@ pub enum ObjectKind {
     Patch9 {
         rows: Vec<Vec<PointSpec>>,
     },
+    /// A parametric surface of paper 002, meshed as a face of its own.
+    Trimmed(Box<TrimmedSpec>),
     /// Loops of edge references; the first is the outer loop.
     Face {
         surface: Option<Ref>,
@@ -335,6 +337,11 @@ impl ObjectKind {
                 PcCurveKind::Desargues => "desargues_arc",
             },
             ObjectKind::Patch9 { .. } => "patch9",
+            ObjectKind::Trimmed(spec) => match spec.carrier {
+                CarrierSpec::Bezier { .. } => "bezier_surface",
+                CarrierSpec::Cone { .. } => "cone_surface",
+                CarrierSpec::Expressions { .. } => "parametric_surface",
+            },
         }
     }
 }
@@ -387,4 +394,37 @@ pub struct Document {
     pub objects: Vec<Object>,
     pub subdomains: Vec<SubdomainDef>,
     pub boundaries: Vec<BoundaryDef>,
+}
+
+/// The carrier of a trimmed surface as written.
+#[derive(Debug, Clone, PartialEq)]
+pub enum CarrierSpec {
+    /// Rows of control points (rows along u, nodes along v).
+    Bezier { rows: Vec<Vec<PointSpec>> },
+    Cone {
+        bottom_radius: Option<Number>,
+        top_radius: Option<Number>,
+        length: Option<Number>,
+        from_angle: Option<Number>,
+        to_angle: Option<Number>,
+    },
+    /// x, y, z, then u_min, u_max, v_min, v_max.
+    Expressions {
+        xyz: [Option<Number>; 3],
+        rect: [Option<Number>; 4],
+    },
+}
+
+/// `<trim equation="F" material="positive|negative"/>`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrimSpec {
+    pub equation: Option<Number>,
+    pub negative: bool,
+    pub span: Span,
+}
+
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrimmedSpec {
+    pub carrier: CarrierSpec,
+    pub trim: Option<TrimSpec>,
 }

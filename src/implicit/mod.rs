@@ -4,6 +4,7 @@
 //! ([`tape`]), interval pruning ([`interval`]) and paper 004's watertight
 //! polygonization ([`polygonize`]) into geomc's mesh IR.
 
+pub mod expr_ops;
 pub mod interval;
 pub mod ir;
 pub mod lang;

@@ -166,6 +166,8 @@ pub struct Model {
     /// The absolute geometric tolerance used by the checks (1e-6 of the
     /// bounding-box diagonal, at least 1e-12).
     pub tolerance: f64,
+    /// Paper 002's trimmed parametric surfaces, each meshed as a face of its own.
+    pub trimmed: Vec<crate::trimmed::TrimmedSurface>,
 }
 
 impl Model {
@@ -182,6 +184,7 @@ impl Model {
             polylines: Vec::new(),
             parameters: Vec::new(),
             tolerance: 1e-12,
+            trimmed: Vec::new(),
         }
     }
 
@@ -221,6 +224,9 @@ impl Model {
             if let crate::geom::Surface::Patch9(patch) = &face.surface {
                 patch.rows.iter().flatten().for_each(|p| bbox.include(p));
             }
+        }
+        for s in &self.trimmed {
+            s.samples(8).iter().for_each(|p| bbox.include(p));
         }
         bbox
     }

@@ -694,11 +694,28 @@ fn explicit_shell(
     refs: &[crate::doc::Ref],
     diags: &mut Diagnostics,
 ) -> Option<Vec<OrientedFace>> {
-    let mut faces = Vec::new();
+    let mut faces: Vec<FaceId> = Vec::new();
+    let mut seen: BTreeSet<FaceId> = BTreeSet::new();
     let mut ok = true;
     for r in refs {
         match lookup_entities(&entities.faces, &r.text) {
-            Some(ids) => faces.extend(ids),
+            Some(ids) => {
+                for id in ids {
+                    if !seen.insert(id) {
+                        // A shell uses each face once; a repeat is a slip, not a second sheet.
+                        diags.push(
+                            Diagnostic::new(
+                                Code::RepeatedFace,
+                                r.span,
+                                format!("face '{}' is already in this subdomain's faces= list; the repeat is ignored", r.text),
+                            )
+                            .with_help("remove the repeated name"),
+                        );
+                    } else {
+                        faces.push(id);
+                    }
+                }
+            }
             None => {
                 unknown_entity(r, "face", entities, diags);
                 ok = false;
@@ -708,7 +725,6 @@ fn explicit_shell(
     if !ok {
         return None;
     }
-    faces.dedup();
     Some(orient_shell(model, &faces))
 }
 

@@ -181,6 +181,7 @@ fn tolerance(resolved: &Resolved) -> f64 {
             Geometry::Vertex(p) => bbox.include(p),
             Geometry::PointCurve(c) => c.samples(32).iter().for_each(|p| bbox.include(p)),
             Geometry::Patch(patch) => patch.rows.iter().flatten().for_each(|p| bbox.include(p)),
+            Geometry::Trimmed(s) => s.samples(8).iter().for_each(|p| bbox.include(p)),
             Geometry::Group(members) => members.iter().for_each(|m| visit(m, bbox)),
             _ => {}
         }
@@ -216,6 +217,7 @@ fn lower_free(
         Geometry::PointCurve(curve) => model
             .polylines
             .push(point_calculus::standalone(name, curve)),
+        Geometry::Trimmed(surface) => model.trimmed.push((**surface).clone()),
         Geometry::Solid(shape) => {
             let id = lower_solid(model, source_map, welder, name, shape, span);
             entities

@@ -34,6 +34,8 @@ mod guard;
 mod quadratic;
 mod report;
 mod size;
+mod trimmed;
+pub use trimmed::TrimmedReport;
 
 pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
 pub use guard::panics_are_caught;
@@ -210,6 +212,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         || "the assembly of the mesh".to_string(),
         || {
             let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
+            trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
             crack::open(model, &mut mesh);
             if options.order == 2 {
                 quadratic::elevate(model, &edge_nodes, &mut mesh);

@@ -35,6 +35,8 @@ pub struct MeshReport {
     pub max_aspect_ratio: f64,
     pub mean_aspect_ratio: f64,
     pub subdomains: Vec<SubdomainReport>,
+    /// Paper 002's trimmed surfaces, one per surface (issue 9).
+    pub trimmed: Vec<super::trimmed::TrimmedReport>,
 }
 
 #[derive(Debug, Clone, PartialEq, Serialize)]
@@ -183,6 +185,7 @@ impl MeshReport {
                 0.0
             },
             subdomains,
+            trimmed: super::trimmed::reports(model, tolerance, max_edge, min_angle_target),
         }
     }
 
@@ -223,6 +226,22 @@ impl MeshReport {
                 let bar = "#".repeat((40 * n).div_ceil(most.max(1)));
                 let _ = writeln!(s, "  [{lo:>2}, {:>2}{close} {n:>9} {bar}", lo + BIN_DEGREES);
             }
+        }
+        for t in &self.trimmed {
+            let _ = writeln!(
+                s,
+                "trimmed surface {}: {} triangles, min angle {}°, area {}, max centroid-to-surface distance {}",
+                t.name,
+                t.triangles,
+                fixed(t.min_angle, 2),
+                sig(t.area),
+                sci(t.max_centroid_distance)
+            );
+            let _ = writeln!(
+                s,
+                "  smallest angle per triangle: {:?} (5° bins)",
+                t.min_angle_histogram
+            );
         }
         if !self.subdomains.is_empty() {
             let _ = writeln!(s, "subdomains (mesh | exact | relative error):");

@@ -63,6 +63,8 @@ pub enum Geometry {
     PointCurve(PcCurve),
     /// Paper 003's 9-point patch.
     Patch(Box<Patch9>),
+    /// Paper 002's parametric surface with its trim.
+    Trimmed(Box<crate::trimmed::TrimmedSurface>),
     /// Members of a replicate: `name[1]` … `name[n]`.
     Group(Vec<Geometry>),
 }
@@ -81,6 +83,7 @@ impl Geometry {
             Geometry::Face { .. } => "face",
             Geometry::PointCurve(c) => c.element(),
             Geometry::Patch(_) => "patch9",
+            Geometry::Trimmed(_) => "trimmed surface",
             Geometry::Group(_) => "replicated group",
         }
     }

@@ -8,6 +8,7 @@ mod objects;
 mod point_calculus;
 mod polygons;
 mod shapes;
+mod trimmed;
 mod values;
 
 pub use geometry::{Geometry, LineCarrier, Link};

@@ -403,6 +403,7 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             discriminant,
         } => super::point_calculus::curve(r, object, *kind, points, discriminant.as_ref(), frame),
         ObjectKind::Patch9 { rows } => super::point_calculus::patch(r, object, rows, frame),
+        ObjectKind::Trimmed(spec) => super::trimmed::surface(r, object, spec, frame),
         ObjectKind::Surface(spec) => surface(r, spec.as_ref()?, object, frame),
         ObjectKind::Line(spec) => line(r, spec.as_ref()?, object, frame),
         ObjectKind::Vertex(spec) => vertex(r, spec.as_ref()?, object, frame),

@@ -90,6 +90,11 @@ impl Values {
         }
     }
 
+    /// True for a parameter or basis coordinate.
+    pub fn knows(&self, name: &str) -> bool {
+        self.sources.contains_key(name)
+    }
+
     pub fn is_parameter(&self, name: &str) -> bool {
         matches!(self.sources.get(name), Some(Source::Parameter { .. }))
     }

@@ -6,9 +6,10 @@
 use super::{Def, Env, paths, settings};
 use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::doc::grammar::R_TREE;
-use crate::expr::{BinaryOp, Expr, ExprKind, Function};
+use crate::expr::{Expr, ExprKind};
 use crate::implicit::ImplicitModel;
-use crate::implicit::ir::{Binary, Ctx, NodeId, Unary};
+use crate::implicit::expr_ops;
+use crate::implicit::ir::{Ctx, NodeId};
 use crate::implicit::lang;
 use crate::implicit::library;
 use crate::implicit::rfs::RSystem;
@@ -232,57 +233,20 @@ impl<'e, 'a, 's> Lowerer<'e, 'a, 's> {
             ExprKind::Binary(op, a, b) => {
                 let a = self.expr(a, scope)?;
                 let b = self.expr(b, scope)?;
-                let op = match op {
-                    BinaryOp::Add => Binary::Add,
-                    BinaryOp::Sub => Binary::Sub,
-                    BinaryOp::Mul => Binary::Mul,
-                    BinaryOp::Div => Binary::Div,
-                    BinaryOp::Pow => Binary::Pow,
-                };
-                self.ctx.binary(op, a, b)
+                self.ctx.binary(expr_ops::binary(*op), a, b)
             }
             ExprKind::Call(f, args) => {
                 let mut ids = Vec::with_capacity(args.len());
                 for a in args {
                     ids.push(self.expr(a, scope)?);
                 }
-                let unary = match f {
-                    Function::Sqrt => Unary::Sqrt,
-                    Function::Sin => Unary::Sin,
-                    Function::Cos => Unary::Cos,
-                    Function::Tan => Unary::Tan,
-                    Function::Asin => Unary::Asin,
-                    Function::Acos => Unary::Acos,
-                    Function::Atan => Unary::Atan,
-                    Function::Exp => Unary::Exp,
-                    Function::Ln => Unary::Ln,
-                    Function::Abs => Unary::Abs,
-                    Function::Min | Function::Max => {
-                        let op = if *f == Function::Min {
-                            Binary::Min
-                        } else {
-                            Binary::Max
-                        };
-                        let (first, rest) = ids.split_first().ok_or_else(|| {
-                            Diagnostic::new(
-                                Code::WrongArgumentCount,
-                                e.span,
-                                "min/max need arguments",
-                            )
-                        })?;
-                        return Ok(rest
-                            .iter()
-                            .fold(*first, |acc, &x| self.ctx.binary(op, acc, x)));
-                    }
-                };
-                let a = *ids.first().ok_or_else(|| {
+                expr_ops::apply(&mut self.ctx, *f, &ids).ok_or_else(|| {
                     Diagnostic::new(
                         Code::WrongArgumentCount,
                         e.span,
-                        "a function needs its argument",
+                        format!("{}() needs an argument", f.name()),
                     )
-                })?;
-                self.ctx.unary(unary, a)
+                })?
             }
         })
     }

@@ -1,0 +1,136 @@
+//! Parametric surfaces trimmed by implicit functions (paper 002): a surface
+//! R(u, v) over a parameter rectangle, kept where the trim F(R(u, v)) has the
+//! material sign. `boundary.rs` finds the trim curve by marching squares in
+//! (u, v); `triangulate.rs` meshes the kept part with a constrained Delaunay
+//! triangulation refined by 3D criteria; `measure.rs` has the quality figures.
+
+mod boundary;
+mod chart;
+mod measure;
+pub mod program;
+mod triangulate;
+
+pub use measure::{TrimmedQuality, centroid_distance};
+pub use triangulate::{TrimSettings, TrimmedMesh, mesh_trimmed};
+
+use crate::geom::{Frame, Point3, Vec3};
+use crate::implicit::ir::{Ctx, NodeId};
+use crate::implicit::tape::Ssa;
+
+/// The carrier surface in its local frame.
+#[derive(Debug, Clone, PartialEq)]
+pub enum Carrier {
+    /// Tensor-product Bezier: `rows[i][j]`, i along u, j along v, u, v ∈ [0, 1].
+    Bezier { rows: Vec<Vec<Point3>> },
+    /// Paper 002's truncated cone about the local y axis: x = r(u) cos v,
+    /// y = u, z = r(u) sin v, r(u) = r1 + (r2 − r1) u / l.
+    Cone { r1: f64, r2: f64, length: f64 },
+    /// x(u, v), y(u, v), z(u, v) as programs in the variables u (0) and v (1).
+    Expressions { xyz: Box<[Ssa; 3]> },
+}
+
+/// The trim: F over global x, y, z; material where F ≥ 0, or F ≤ 0 when `negative`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Trim {
+    pub program: Ssa,
+    pub negative: bool,
+}
+
+impl Trim {
+    pub fn new(ctx: &Ctx, root: NodeId, negative: bool) -> Trim {
+        Trim {
+            program: Ssa::from_ctx(ctx, root),
+            negative,
+        }
+    }
+}
+
+/// One trimmed surface of the model.
+#[derive(Debug, Clone, PartialEq)]
+pub struct TrimmedSurface {
+    pub name: String,
+    pub carrier: Carrier,
+    /// Local → global placement (the element's cs=).
+    pub frame: Frame,
+    /// u_min, u_max, v_min, v_max.
+    pub rect: [f64; 4],
+    pub trim: Option<Trim>,
+}
+
+impl TrimmedSurface {
+    /// R(u, v) in global coordinates (NaN when an expression fails).
+    pub fn point(&self, u: f64, v: f64) -> Point3 {
+        let local = match &self.carrier {
+            Carrier::Bezier { rows } => bezier(rows, u, v),
+            Carrier::Cone { r1, r2, length } => {
+                let r = r1 + (r2 - r1) * u / length;
+                Point3::new(r * v.cos(), u, r * v.sin())
+            }
+            Carrier::Expressions { xyz } => {
+                let p = [u, v, 0.0];
+                Point3::new(
+                    xyz[0].eval_point(p),
+                    xyz[1].eval_point(p),
+                    xyz[2].eval_point(p),
+                )
+            }
+        };
+        self.frame.to_global(&local)
+    }
+
+    /// Surface points on an (n + 1) × (n + 1) parameter grid.
+    pub fn samples(&self, n: usize) -> Vec<Point3> {
+        let [u0, u1, v0, v1] = self.rect;
+        let mut out = Vec::with_capacity((n + 1) * (n + 1));
+        for i in 0..=n {
+            for j in 0..=n {
+                let t = (i as f64 / n as f64, j as f64 / n as f64);
+                out.push(self.point(u0 + (u1 - u0) * t.0, v0 + (v1 - v0) * t.1));
+            }
+        }
+        out
+    }
+
+    /// The partial derivatives (R_u, R_v) by central differences.
+    pub fn tangents(&self, u: f64, v: f64) -> (Vec3, Vec3) {
+        let hu = 1e-6 * (self.rect[1] - self.rect[0]);
+        let hv = 1e-6 * (self.rect[3] - self.rect[2]);
+        let du = (self.point(u + hu, v) - self.point(u - hu, v)) / (2.0 * hu);
+        let dv = (self.point(u, v + hv) - self.point(u, v - hv)) / (2.0 * hv);
+        (du, dv)
+    }
+
+    /// W(u, v): the trim value with the material sign positive (1 without a trim).
+    pub fn material(&self, u: f64, v: f64) -> f64 {
+        match &self.trim {
+            None => 1.0,
+            Some(t) => {
+                let p = self.point(u, v);
+                let f = t.program.eval_point([p.x, p.y, p.z]);
+                if t.negative { -f } else { f }
+            }
+        }
+    }
+}
+
+/// De Casteljau in v within each row, then in u across the results.
+fn bezier(rows: &[Vec<Point3>], u: f64, v: f64) -> Point3 {
+    let column: Vec<Point3> = rows.iter().map(|row| de_casteljau(row, v)).collect();
+    de_casteljau(&column, u)
+}
+
+fn de_casteljau(points: &[Point3], t: f64) -> Point3 {
+    let mut work: Vec<Point3> = points.to_vec();
+    let n = work.len();
+    for level in 1..n {
+        for i in 0..n - level {
+            work[i] = work[i] + (work[i + 1] - work[i]) * t;
+        }
+    }
+    work.first()
+        .copied()
+        .unwrap_or(Point3::new(f64::NAN, f64::NAN, f64::NAN))
+}
+
+#[cfg(test)]
+mod tests;
