@@ -680,3 +680,21 @@ fn geomc_compile_meshes_an_rfs_file_and_refuses_a_bad_one() {
     );
     assert!(!out.exists(), "no output for a failed compile");
 }
+
+/// Found by the `rfs_language` fuzz target (30-minute run, 2026-11-26): a
+/// function that is NaN on part of the box (sqrt of a negative) crosses
+/// "zero" between a NaN sample and a positive one; root refinement then
+/// carried the NaN into its bracket and `f64::clamp` panicked.
+#[test]
+fn a_function_that_is_nan_on_part_of_the_box_polygonizes_without_panic() {
+    let model = compile("function r_main(x, y, z) { return Math.sqrt(x + 0.03) - 0.1 * y; }");
+    let surface = model.polygonize(Some([8, 8, 8]));
+    // Every vertex that was written is a real point of the box.
+    assert!(!surface.triangles.is_empty());
+    for p in &surface.positions {
+        assert!(
+            p.iter().all(|c| c.is_finite() && (-1.0..=1.0).contains(c)),
+            "{p:?}"
+        );
+    }
+}

@@ -412,8 +412,11 @@ fn refine(tape: &Tape, edges: &[usize], ends: &[Ends], t: &mut [f64], iterations
     for _ in 0..iterations {
         for m in 0..n {
             let d = fr[m] - fl[m];
-            s[m] = if d != 0.0 {
-                ((tl[m] * fr[m] - tr[m] * fl[m]) / d).clamp(tl[m], tr[m])
+            let guess = (tl[m] * fr[m] - tr[m] * fl[m]) / d;
+            // A function that is NaN somewhere (sqrt of a negative, 0/0) must not
+            // poison the bracket: bisect instead, so tl and tr stay finite.
+            s[m] = if d != 0.0 && guess.is_finite() {
+                guess.max(tl[m]).min(tr[m])
             } else {
                 0.5 * (tl[m] + tr[m])
             };
