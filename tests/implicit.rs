@@ -3,9 +3,12 @@
 //! right Euler characteristic, marching-cubes face ambiguities one by one,
 //! and `.rfs` diagnostics with exact codes and positions.
 
+mod implicit_common;
+
 use geomc::implicit::polygonize::{self, Grid, Options, Surface, cell_links};
 use geomc::implicit::{ImplicitModel, lang};
 use geomc::span::SourceFile;
+use implicit_common::{area, volume};
 use std::collections::HashMap;
 
 const SEVEN_BALLS: &str = include_str!("../fixtures/rfs/seven_balls.rfs");
@@ -34,35 +37,6 @@ fn diagnostics(text: &str) -> Vec<(String, u32, u32, String)> {
             )
         })
         .collect()
-}
-
-fn volume(s: &Surface) -> f64 {
-    s.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| s.positions[i as usize]);
-            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-                + a[2] * (b[0] * c[1] - b[1] * c[0]))
-                / 6.0
-        })
-        .sum()
-}
-
-fn area(s: &Surface) -> f64 {
-    s.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| s.positions[i as usize]);
-            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
-        })
-        .sum()
 }
 
 /// Checks that the mesh is closed, edge- and vertex-manifold and consistently

@@ -4,10 +4,13 @@
 //! creases), keep crease vertices on the crease, and do not spoil volumes.
 //! The 256³ volume figure is in benches/implicit.rs (too slow for debug tests).
 
+mod implicit_common;
+
 use geomc::implicit::optimize::min_angle;
 use geomc::implicit::polygonize::Surface;
 use geomc::implicit::{ImplicitModel, lang};
 use geomc::span::SourceFile;
+use implicit_common::volume;
 use std::collections::HashMap;
 
 const SEVEN_BALLS: &str = include_str!("../fixtures/rfs/seven_balls.rfs");
@@ -22,18 +25,6 @@ fn with_iterations(text: &str, iterations: u32) -> ImplicitModel {
     let mut model = compile(text);
     model.geom.optiterations = iterations;
     model
-}
-
-fn volume(s: &Surface) -> f64 {
-    s.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| s.positions[i as usize]);
-            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-                + a[2] * (b[0] * c[1] - b[1] * c[0]))
-                / 6.0
-        })
-        .sum()
 }
 
 fn smallest_angle(s: &Surface) -> f64 {

@@ -4,9 +4,12 @@
 //! NRRD files (an analytic ball sampled here, meshed, and compared with the
 //! exact volume and area); `compile --section`. Tolerances are stated per test.
 
+mod implicit_common;
+
 use geomc::driver::{Checked, Options, check_file};
 use geomc::implicit::polygonize::Surface;
 use geomc::implicit::xml::{ImplicitSolid, ImplicitSubdomain};
+use implicit_common::{area, volume};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
@@ -47,35 +50,6 @@ fn codes(c: &Checked) -> Vec<(String, u32, u32)> {
 fn valid(c: &Checked) -> &[ImplicitSubdomain] {
     assert!(c.is_valid(), "{:#?}", c.diagnostics.items);
     &c.implicit
-}
-
-fn volume(s: &Surface) -> f64 {
-    s.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| s.positions[i as usize]);
-            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
-                + a[2] * (b[0] * c[1] - b[1] * c[0]))
-                / 6.0
-        })
-        .sum()
-}
-
-fn area(s: &Surface) -> f64 {
-    s.triangles
-        .iter()
-        .map(|t| {
-            let [a, b, c] = t.map(|i| s.positions[i as usize]);
-            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
-            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
-            let n = [
-                u[1] * v[2] - u[2] * v[1],
-                u[2] * v[0] - u[0] * v[2],
-                u[0] * v[1] - u[1] * v[0],
-            ];
-            0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
-        })
-        .sum()
 }
 
 fn rel(a: f64, b: f64) -> f64 {

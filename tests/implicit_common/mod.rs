@@ -1,0 +1,34 @@
+//! Measures of a polygonized surface shared by the implicit tests.
+#![allow(dead_code)] // each test binary uses its own subset
+
+use geomc::implicit::polygonize::Surface;
+
+/// Enclosed volume by the divergence theorem (outward-oriented triangles).
+pub fn volume(s: &Surface) -> f64 {
+    s.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| s.positions[i as usize]);
+            (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                / 6.0
+        })
+        .sum()
+}
+
+pub fn area(s: &Surface) -> f64 {
+    s.triangles
+        .iter()
+        .map(|t| {
+            let [a, b, c] = t.map(|i| s.positions[i as usize]);
+            let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+            let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+            let n = [
+                u[1] * v[2] - u[2] * v[1],
+                u[2] * v[0] - u[0] * v[2],
+                u[0] * v[1] - u[1] * v[0],
+            ];
+            0.5 * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+        })
+        .sum()
+}
