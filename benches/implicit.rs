@@ -9,7 +9,8 @@
 //! of the same given samples. Also dense f32 evaluation throughput of M1.
 //!
 //! Run: `cargo bench --bench implicit` (add `-- --quick` for 128 cells,
-//! `-- --no-fidget` to skip the slow peer). Without `--bench` (as under
+//! `-- --no-fidget` to skip the slow peer, `-- --no-dense` to skip the dense
+//! evaluation of M2 and M3, `-- --model M1` to mesh only M1). Without `--bench` (as under
 //! `cargo test --all-targets`) a 32-cell smoke run without peers.
 
 use geomc::implicit::ir::{Binary, Ctx, Node, NodeId, Unary};
@@ -92,26 +93,67 @@ fn m3() -> Ssa {
     Ssa::from_ctx(&ctx, f.expect("1000 balls"))
 }
 
+/// FNV-1a over the mesh's position bits and indices: equal digests before
+/// and after a speed change show the change kept the meshes byte-identical.
+fn digest(s: &polygonize::Surface) -> u64 {
+    let words = s.positions.iter().flat_map(|p| p.map(f64::to_bits));
+    let ids = s.triangles.iter().flat_map(|t| t.map(u64::from));
+    words.chain(ids).fold(0xcbf2_9ce4_8422_2325, |h, w| {
+        (h ^ w).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 /// A model's name and its builder.
 type Model = (&'static str, fn() -> Ssa);
 
-fn median(mut runs: Vec<Duration>) -> Duration {
-    runs.sort();
-    runs[runs.len() / 2]
+/// CPU time used so far by all threads of this process (Linux
+/// `/proc/self/task/*/schedstat`; 0 elsewhere). On a machine shared with
+/// other builds the wall time swings with the load; the CPU time much less.
+fn cpu_time() -> Duration {
+    let tasks = std::fs::read_dir("/proc/self/task").into_iter().flatten();
+    let ns: u64 = tasks
+        .flatten()
+        .filter_map(|t| std::fs::read_to_string(t.path().join("schedstat")).ok())
+        .filter_map(|s| s.split_whitespace().next()?.parse::<u64>().ok())
+        .sum();
+    Duration::from_nanos(ns)
 }
+
+/// CPU time of the median-wall-time run, printed by `time`'s callers.
+static LAST_CPU: std::sync::Mutex<Duration> = std::sync::Mutex::new(Duration::ZERO);
 
 fn time<T>(reps: usize, mut f: impl FnMut() -> T) -> (Duration, T) {
     let mut last = None;
-    let runs = (0..reps)
+    let mut runs: Vec<(Duration, Duration)> = (0..reps)
         .map(|_| {
-            let start = Instant::now();
+            let (start, cpu) = (Instant::now(), cpu_time());
             let r = f();
             let t = start.elapsed();
+            let c = cpu_time().saturating_sub(cpu);
             last = Some(r);
-            t
+            (t, c)
         })
         .collect();
-    (median(runs), last.expect("at least one run"))
+    runs.sort();
+    let (wall, cpu) = runs[runs.len() / 2];
+    if let Ok(mut l) = LAST_CPU.lock() {
+        *l = cpu;
+    }
+    (wall, last.expect("at least one run"))
+}
+
+/// The CPU seconds of the last `time` call.
+fn last_cpu() -> f64 {
+    LAST_CPU
+        .lock()
+        .map(|l| *l)
+        .unwrap_or_default()
+        .as_secs_f64()
+}
+
+/// " (cpu 1.234 s)": the CPU time of the last `time` call.
+fn cpu() -> String {
+    format!(" (cpu {:.3} s)", last_cpu())
 }
 
 /// The same function as a fidget tree, negated (fidget's inside is f < 0).
@@ -177,6 +219,39 @@ fn fidget_mesh(ssa: &Ssa, depth: u8) -> usize {
     octree.walk_dual().triangles.len()
 }
 
+/// fidget's JIT float-slice evaluator on every point of the grid, a z plane
+/// per call, planes spread over rayon's pool as for geomc: (seconds, the
+/// samples with geomc's sign convention, inside > 0).
+fn fidget_dense(ssa: &Ssa, grid: &Grid) -> (Duration, Vec<f32>) {
+    use fidget::jit::JitShape;
+    use rayon::prelude::*;
+    let shape = JitShape::from(to_fidget(ssa));
+    let [xs, ys, zs] = [0, 1, 2].map(|a| grid.coords(a));
+    let plane = xs.len() * ys.len();
+    let px: Vec<f32> = (0..plane).map(|p| xs[p % xs.len()] as f32).collect();
+    let py: Vec<f32> = (0..plane).map(|p| ys[p / xs.len()] as f32).collect();
+    let mut values = vec![0.0f32; plane * zs.len()];
+    let (start, cpu) = (Instant::now(), cpu_time());
+    values.par_chunks_mut(plane).enumerate().for_each_init(
+        || {
+            let tape = shape.float_slice_tape(Default::default());
+            (JitShape::new_float_slice_eval(), tape, vec![0.0f32; plane])
+        },
+        |(eval, tape, pz), (k, out)| {
+            pz.fill(zs[k] as f32);
+            let v = eval.eval(tape, &px, &py, pz).expect("x, y, z only");
+            for (o, &v) in out.iter_mut().zip(v) {
+                *o = -v;
+            }
+        },
+    );
+    let wall = start.elapsed();
+    if let Ok(mut l) = LAST_CPU.lock() {
+        *l = cpu_time().saturating_sub(cpu);
+    }
+    (wall, values)
+}
+
 /// VTK flying edges on `values` through the Python peer: (seconds, triangles),
 /// or None when Python or `vtk` is missing.
 fn vtk_flying_edges(values: &[f32], n: usize, threads: usize, reps: usize) -> Option<(f64, u64)> {
@@ -215,6 +290,7 @@ fn main() {
     let smoke = !args.iter().any(|a| a == "--bench");
     let quick = args.iter().any(|a| a == "--quick");
     let with_fidget = !smoke && !args.iter().any(|a| a == "--no-fidget");
+    let no_dense = smoke || args.iter().any(|a| a == "--no-dense");
     let (n, reps) = match (smoke, quick) {
         (true, _) => (32, 1),
         (false, true) => (128, 3),
@@ -236,29 +312,43 @@ fn main() {
         ("M2 gyroid in ball", m2),
         ("M3 1,000 balls", m3),
     ];
+    // `--model M2`: only that model's meshing (for profiling).
+    let only = args
+        .iter()
+        .position(|a| a == "--model")
+        .and_then(|p| args.get(p + 1));
     for (name, build) in models {
+        if only.is_some_and(|m| !name.starts_with(m.as_str())) {
+            continue;
+        }
         let (t, s) = time(reps, || {
             let ssa = build();
             polygonize::polygonize(&ssa, &grid, &Options::default())
         });
         println!(
-            "{name}: geomc {:.3} s, {} triangles, {} of {} blocks pruned",
+            "{name}: geomc whole path {:.3} s{}, {} triangles (digest {:016x}), {} of {} blocks pruned",
             t.as_secs_f64(),
+            cpu(),
             s.triangles.len(),
+            digest(&s),
             s.pruned_blocks,
             s.blocks
         );
+        let t_cpu = last_cpu();
         let ssa = build();
         // Contouring only, on the same densely sampled field as VTK.
         let values = polygonize::sample_grid(&ssa, &grid);
+        let mut copies = vec![values.clone(); reps];
         let (tc, sc) = time(reps, || {
-            let v: Vec<f64> = values.iter().map(|&v| v as f64).collect();
-            polygonize::polygonize_samples(v, &grid, &Options::default())
+            let v = copies.pop().expect("one copy per run");
+            polygonize::polygonize_samples_f32(v, &grid, &Options::default())
         });
         print!(
-            "  contouring the sampled field: geomc {:.3} s ({} triangles)",
+            "  contouring the sampled field: geomc {:.3} s{} ({} triangles, digest {:016x})",
             tc.as_secs_f64(),
-            sc.triangles.len()
+            cpu(),
+            sc.triangles.len(),
+            digest(&sc)
         );
         if !smoke {
             match vtk_flying_edges(&values, n, threads, reps) {
@@ -274,15 +364,18 @@ fn main() {
         if with_fidget {
             let (tf, tris) = time(1, || fidget_mesh(&ssa, depth));
             println!(
-                "  fidget depth {depth}: {:.3} s ({tris} triangles), geomc {:.1}x faster",
+                "  fidget depth {depth}: {:.3} s{} ({tris} triangles), geomc {:.1}x faster ({:.1}x in CPU time)",
                 tf.as_secs_f64(),
-                tf.as_secs_f64() / t.as_secs_f64()
+                cpu(),
+                tf.as_secs_f64() / t.as_secs_f64(),
+                last_cpu() / t_cpu
             );
         }
     }
     let ssa = m1();
     let tape = geomc::implicit::rows::RowTape::new(&ssa);
     let (t, v) = time(reps.max(3), || polygonize::sample_grid(&ssa, &grid));
+    let m1_cpu = last_cpu();
     assert_eq!(v.len(), (n + 1).pow(3));
     let points = ((n + 1) as f64).powi(3);
     let rate = points / t.as_secs_f64();
@@ -291,7 +384,7 @@ fn main() {
     // 2 FMA pipes: 2 × 2 × 8 lanes × 2 flops × 2.6 GHz = 166 GFLOP/s.
     let flops = rate * 50.0;
     println!(
-        "dense M1 evaluation (f32 lanes, {} lane instructions per point): {:.1} M points/s ({:.3} s for {:.1} M points); {:.1} GFLOP/s = {:.1}% of the 166 GFLOP/s f32 AVX2 FMA peak",
+        "dense M1 evaluation (f32 lanes, {} lane instructions per point): {:.1} M points/s ({:.3} s, cpu {m1_cpu:.3} s, for {:.1} M points); {:.1} GFLOP/s = {:.1}% of the 166 GFLOP/s f32 AVX2 FMA peak",
         tape.lane_len(),
         rate / 1e6,
         t.as_secs_f64(),
@@ -299,6 +392,47 @@ fn main() {
         flops / 1e9,
         flops / 166e9 * 100.0
     );
+    // Dense evaluation of every model by both evaluators in this run (one
+    // geomc run for M2 and M3, whose dense loops are not the product path).
+    for (name, build) in models {
+        if no_dense && !name.starts_with("M1") {
+            continue;
+        }
+        let ssa = build();
+        let (tg, v) = if name.starts_with("M1") {
+            (t, v.clone())
+        } else {
+            time(1, || polygonize::sample_grid(&ssa, &grid))
+        };
+        let g_cpu = if name.starts_with("M1") {
+            m1_cpu
+        } else {
+            last_cpu()
+        };
+        print!(
+            "dense {name}: geomc {:.1} M points/s ({:.3} s, cpu {g_cpu:.3} s)",
+            points / tg.as_secs_f64() / 1e6,
+            tg.as_secs_f64()
+        );
+        if with_fidget {
+            let (tf, fv) = fidget_dense(&ssa, &grid);
+            // The same points in f32: how many samples the two disagree on in sign.
+            let differ = fv
+                .iter()
+                .zip(&v)
+                .filter(|(a, b)| (**a > 0.0) != (**b > 0.0))
+                .count();
+            print!(
+                "; fidget JIT {:.1} M points/s ({:.3} s{}): geomc {:.1}x faster ({:.1}x in CPU time); {differ} samples differ in sign",
+                points / tf.as_secs_f64() / 1e6,
+                tf.as_secs_f64(),
+                cpu(),
+                tf.as_secs_f64() / tg.as_secs_f64(),
+                last_cpu() / g_cpu
+            );
+        }
+        println!();
+    }
     if let Ok(load) = std::fs::read_to_string("/proc/loadavg") {
         println!("load average at end: {}", load.trim());
     }

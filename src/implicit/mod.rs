@@ -14,6 +14,7 @@ pub mod polygonize;
 pub mod rfs;
 pub mod rows;
 pub mod section;
+pub mod signs;
 pub mod tape;
 pub mod xml;
 

@@ -23,7 +23,8 @@
 
 use super::interval::{self, Interval, Sign};
 use super::rows::RowTape;
-use super::tape::{Ssa, Tape};
+use super::signs::{self, SignRows};
+use super::tape::{AxisTape, BATCH, Ssa, Tape, Workspace};
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -87,6 +88,8 @@ const BS: usize = 8;
 /// tape samples the grid.
 struct Kernel {
     tape: Tape,
+    /// The tape split along x, y and z for root finding on grid edges.
+    along: [AxisTape; 3],
     rows: RowTape,
 }
 
@@ -176,6 +179,7 @@ fn classify_region(
     if extent[axis] <= 1 {
         let kernel = Kernel {
             tape: Tape::new(&simpler),
+            along: [0, 1, 2].map(|a| AxisTape::new(&simpler, a)),
             rows: RowTape::new(&simpler),
         };
         return fill(Block::Mixed(Arc::new(kernel)), out);
@@ -212,6 +216,7 @@ fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
     } else {
         let kernel = Arc::new(Kernel {
             tape: Tape::new(ssa),
+            along: [0, 1, 2].map(|a| AxisTape::new(ssa, a)),
             rows: RowTape::new(ssa),
         });
         blocks.fill(Block::Mixed(kernel));
@@ -299,6 +304,7 @@ struct PlaneVertices {
 
 fn plane_vertices(
     field: &Field,
+    signs: &SignRows,
     coords: &[Vec<f64>; 3],
     k: usize,
     options: &Options,
@@ -307,17 +313,28 @@ fn plane_vertices(
     let mut keys = Vec::new();
     let mut ends = Vec::new();
     for j in 0..n1[1] {
-        for i in 0..n1[0] {
-            let v0 = field.values[field.idx(i, j, k)] as f64;
-            for (axis, (ii, jj, kk)) in [(i + 1, j, k), (i, j + 1, k), (i, j, k + 1)]
-                .into_iter()
-                .enumerate()
-            {
-                if ii >= n1[0] || jj >= n1[1] || kk >= n1[2] {
-                    continue;
-                }
-                let v1 = field.values[field.idx(ii, jj, kk)] as f64;
-                if (v0 > 0.0) != (v1 > 0.0) {
+        // Crossed edges from the sign bits: x edges within the row, y and z
+        // edges against the next row and plane (bits past the row are 0).
+        let r = signs.row(j, k);
+        let ry = (j + 1 < n1[1]).then(|| signs.row(j + 1, k));
+        let rz = (k + 1 < n1[2]).then(|| signs.row(j, k + 1));
+        for w in 0..signs.words {
+            let crossed = [
+                (r[w] ^ signs::shifted(r, w)) & signs::low_bits(n1[0] - 1, w),
+                ry.map_or(0, |q| r[w] ^ q[w]),
+                rz.map_or(0, |q| r[w] ^ q[w]),
+            ];
+            for i in signs::bits(crossed[0] | crossed[1] | crossed[2], w) {
+                let v0 = field.values[field.idx(i, j, k)] as f64;
+                let bit = 1u64 << (i % 64);
+                for (axis, (ii, jj, kk)) in [(i + 1, j, k), (i, j + 1, k), (i, j, k + 1)]
+                    .into_iter()
+                    .enumerate()
+                {
+                    if crossed[axis] & bit == 0 {
+                        continue;
+                    }
+                    let v1 = field.values[field.idx(ii, jj, kk)] as f64;
                     keys.push(((j * n1[0] + i) * 3 + axis) as u32);
                     ends.push((
                         [coords[0][i], coords[1][j], coords[2][k]],
@@ -334,31 +351,47 @@ fn plane_vertices(
         .iter()
         .map(|&(_, _, v0, v1)| (v0 / (v0 - v1)).clamp(0.0, 1.0))
         .collect();
-    // Refine with the owning block's program, grouped by block.
-    let mut order: Vec<usize> = (0..keys.len()).collect();
+    // Refine with the owning block's program, grouped by block (a counting
+    // sort: a comparison sort of a plane's edges cost more than the root
+    // finding; the grouping does not change any vertex).
+    let nb = field.nb;
     let block_of = |e: usize| {
         let key = keys[e] as usize / 3;
-        ((key % n1[0]) / BS, (key / n1[0]) / BS)
+        (key / n1[0] / BS) * nb[0] + (key % n1[0]) / BS
     };
-    order.sort_by_key(|&e| block_of(e));
-    let mut start = 0;
-    while start < order.len() {
-        let b = block_of(order[start]);
-        let mut end = start;
-        while end < order.len() && block_of(order[end]) == b {
-            end += 1;
+    let mut first = vec![0u32; nb[0] * nb[1] + 1];
+    for e in 0..keys.len() {
+        first[block_of(e) + 1] += 1;
+    }
+    for b in 0..nb[0] * nb[1] {
+        first[b + 1] += first[b];
+    }
+    let mut order = vec![0usize; keys.len()];
+    let mut next = first.clone();
+    for e in 0..keys.len() {
+        let b = block_of(e);
+        order[next[b] as usize] = e;
+        next[b] += 1;
+    }
+    let (mut ws, mut group) = (Workspace::default(), Vec::new());
+    for b in 0..nb[0] * nb[1] {
+        let (start, end) = (first[b] as usize, first[b + 1] as usize);
+        if start == end {
+            continue;
         }
-        let key = keys[order[start]] as usize / 3;
-        if let Block::Mixed(kernel) = field.block(key % n1[0], key / n1[0], k) {
+        let (bi, bj) = (b % nb[0], b / nb[0]);
+        if let Block::Mixed(kernel) = field.block(bi * BS, bj * BS, k) {
             refine(
-                &kernel.tape,
+                kernel,
+                &mut ws,
+                &mut group,
+                &keys,
                 &order[start..end],
                 &ends,
                 &mut t,
                 options.iterations,
             );
         }
-        start = end;
     }
     let positions = ends
         .iter()
@@ -376,39 +409,104 @@ fn plane_vertices(
     PlaneVertices { keys, positions }
 }
 
+/// Refines one block's crossed edges (`edges` index `keys` and `ends`).
+/// Edges are grouped by axis and evaluated on the block's axis tapes, so the
+/// terms constant along an edge are computed once per edge instead of at
+/// every step; the values, and so the vertices, are bit-identical to the
+/// plain tape's. Coordinates that `p + 0.0` would change (−0.0, NaN) or that
+/// are infinite take the plain tape.
+fn refine(
+    kernel: &Kernel,
+    ws: &mut Workspace,
+    group: &mut Vec<usize>,
+    keys: &[u32],
+    edges: &[usize],
+    ends: &[Ends],
+    t: &mut [f64],
+    iterations: usize,
+) {
+    let plain = |c: f64| c.is_finite() && (c + 0.0).to_bits() == c.to_bits();
+    if !edges.iter().all(|&e| ends[e].0.iter().all(|&c| plain(c))) {
+        let mut ws = kernel.tape.workspace();
+        for chunk in edges.chunks(BATCH) {
+            let eval_at = |s: &[f64], out: &mut [f64]| {
+                let [xs, ys, zs] = [0, 1, 2].map(|a| {
+                    let mut c = [0.0; BATCH];
+                    for ((c, &e), &s) in c.iter_mut().zip(chunk).zip(s) {
+                        let (p0, p1, _, _) = ends[e];
+                        *c = p0[a] + s * (p1[a] - p0[a]);
+                    }
+                    c
+                });
+                let n = chunk.len();
+                kernel.tape.eval(&mut ws, &xs[..n], &ys[..n], &zs[..n], out);
+            };
+            illinois(chunk, ends, t, iterations, eval_at);
+        }
+        return;
+    }
+    for (axis, along) in kernel.along.iter().enumerate() {
+        group.clear();
+        group.extend(edges.iter().filter(|&&e| keys[e] as usize % 3 == axis));
+        if group.is_empty() {
+            continue;
+        }
+        along.prepare(ws, group.len().min(BATCH));
+        for chunk in group.chunks(BATCH) {
+            let n = chunk.len();
+            let fixed = [0, 1, 2].map(|b| {
+                let mut c = [0.0; BATCH];
+                for (c, &e) in c.iter_mut().zip(chunk) {
+                    *c = ends[e].0[b];
+                }
+                c
+            });
+            along.setup(ws, [&fixed[0][..n], &fixed[1][..n], &fixed[2][..n]]);
+            let eval_at = |s: &[f64], out: &mut [f64]| {
+                let mut coord = [0.0; BATCH];
+                for ((c, &e), &s) in coord.iter_mut().zip(chunk).zip(s) {
+                    let (p0, p1, _, _) = ends[e];
+                    *c = p0[axis] + s * (p1[axis] - p0[axis]);
+                }
+                along.eval(ws, &coord[..n], out);
+            };
+            illinois(chunk, ends, t, iterations, eval_at);
+        }
+    }
+}
+
 type Ends = ([f64; 3], [f64; 3], f64, f64);
 
-/// Illinois false position on each edge, batched over one block's edges.
-fn refine(tape: &Tape, edges: &[usize], ends: &[Ends], t: &mut [f64], iterations: usize) {
-    let n = edges.len();
-    let mut ws = tape.workspace();
-    let point = |e: usize, s: f64, a: usize| {
-        let (p0, p1, _, _) = ends[e];
-        p0[a] + s * (p1[a] - p0[a])
-    };
-    let eval_at = |ws: &mut _, s: &[f64], out: &mut [f64]| {
-        let xs: Vec<f64> = edges.iter().zip(s).map(|(&e, &s)| point(e, s, 0)).collect();
-        let ys: Vec<f64> = edges.iter().zip(s).map(|(&e, &s)| point(e, s, 1)).collect();
-        let zs: Vec<f64> = edges.iter().zip(s).map(|(&e, &s)| point(e, s, 2)).collect();
-        tape.eval(ws, &xs, &ys, &zs, out);
-    };
-    let (mut tl, mut tr) = (vec![0.0; n], vec![1.0; n]);
-    let (mut fl, mut fr) = (vec![0.0; n], vec![0.0; n]);
-    eval_at(&mut ws, &tl, &mut fl);
-    eval_at(&mut ws, &tr, &mut fr);
+/// Illinois false position on each edge, batched: `eval_at(s, out)` gives f
+/// at parameter s[m] along edge `edges[m]`.
+fn illinois(
+    edges: &[usize],
+    ends: &[Ends],
+    t: &mut [f64],
+    iterations: usize,
+    mut eval_at: impl FnMut(&[f64], &mut [f64]),
+) {
+    // At most BATCH edges (callers chunk): working arrays on the stack.
+    let n = edges.len().min(BATCH);
+    let (mut tl, mut tr) = ([0.0; BATCH], [1.0; BATCH]);
+    let (mut fl, mut fr) = ([0.0; BATCH], [0.0; BATCH]);
+    eval_at(&tl[..n], &mut fl[..n]);
+    eval_at(&tr[..n], &mut fr[..n]);
     // Edges whose exact end values do not bracket (a capped box sample, a
     // pruned neighbour) keep the linear guess.
-    let ok: Vec<bool> = (0..n)
-        .map(|m| {
-            let (_, _, v0, v1) = ends[edges[m]];
-            (fl[m] > 0.0) == (v0 > 0.0)
-                && (fr[m] > 0.0) == (v1 > 0.0)
-                && (fl[m] > 0.0) != (fr[m] > 0.0)
-        })
-        .collect();
-    let mut side = vec![0i8; n];
-    let mut s: Vec<f64> = (0..n).map(|m| t[edges[m]]).collect();
-    let mut fs = vec![0.0; n];
+    let mut ok = [false; BATCH];
+    for m in 0..n {
+        let (_, _, v0, v1) = ends[edges[m]];
+        ok[m] = (fl[m] > 0.0) == (v0 > 0.0)
+            && (fr[m] > 0.0) == (v1 > 0.0)
+            && (fl[m] > 0.0) != (fr[m] > 0.0);
+    }
+    let mut side = [0i8; BATCH];
+    let mut s = [0.0; BATCH];
+    for m in 0..n {
+        s[m] = t[edges[m]];
+    }
+    let mut fs = [0.0; BATCH];
     for _ in 0..iterations {
         for m in 0..n {
             let d = fr[m] - fl[m];
@@ -421,7 +519,7 @@ fn refine(tape: &Tape, edges: &[usize], ends: &[Ends], t: &mut [f64], iterations
                 0.5 * (tl[m] + tr[m])
             };
         }
-        eval_at(&mut ws, &s, &mut fs);
+        eval_at(&s[..n], &mut fs[..n]);
         for m in 0..n {
             if (fs[m] > 0.0) == (fl[m] > 0.0) {
                 tl[m] = s[m];
@@ -544,27 +642,56 @@ pub fn cell_links(v: &[f64; 8]) -> [u8; 12] {
     next
 }
 
+/// A cell's cycles, kept on the stack (the polygonizer calls this for every
+/// crossed cell): at most 12 crossed edges, so at most 12 cycles.
+#[derive(Debug, Clone, Copy)]
+pub struct Cycles {
+    edges: [u8; 12],
+    /// Cycle c is `edges[ends[c]..ends[c + 1]]`.
+    ends: [u8; 13],
+    count: usize,
+}
+
+impl Cycles {
+    pub fn len(&self) -> usize {
+        self.count
+    }
+    pub fn is_empty(&self) -> bool {
+        self.count == 0
+    }
+    pub fn iter(&self) -> impl Iterator<Item = &[u8]> {
+        (0..self.count).map(|c| &self.edges[self.ends[c] as usize..self.ends[c + 1] as usize])
+    }
+}
+
 /// The cycles of a cell, each as its cell edges in the order that gives
 /// outward-facing triangles.
-pub fn cell_cycles(v: &[f64; 8]) -> Vec<Vec<u8>> {
+pub fn cell_cycles(v: &[f64; 8]) -> Cycles {
     let next = cell_links(v);
     let mut seen = [false; 12];
-    let mut cycles = Vec::new();
+    let mut cycles = Cycles {
+        edges: [0; 12],
+        ends: [0; 13],
+        count: 0,
+    };
+    let mut len = 0usize;
     for e in 0..12u8 {
         if next[e as usize] == u8::MAX || seen[e as usize] {
             continue;
         }
-        let mut cycle = Vec::new();
+        let start = len;
         let mut cur = e;
         while !seen[cur as usize] && next[cur as usize] != u8::MAX {
             seen[cur as usize] = true;
-            cycle.push(cur);
+            cycles.edges[len] = cur;
+            len += 1;
             cur = next[cur as usize];
         }
         // The links run with the inside on their left seen from outside the
         // cell; reversed, the polygon's normal points out of the solid.
-        cycle.reverse();
-        cycles.push(cycle);
+        cycles.edges[start..len].reverse();
+        cycles.count += 1;
+        cycles.ends[cycles.count] = len as u8;
     }
     cycles
 }
@@ -650,7 +777,6 @@ pub fn polygonize_samples(values: Vec<f64>, grid: &Grid, options: &Options) -> S
         n1[0] * n1[1] * n1[2],
         "one sample per grid point"
     );
-    let nb = n1.map(|n| n.div_ceil(BS));
     // To f32 keeping each sign (a tiny positive value must not round to 0).
     let values = values
         .iter()
@@ -659,6 +785,22 @@ pub fn polygonize_samples(values: Vec<f64>, grid: &Grid, options: &Options) -> S
             w => w,
         })
         .collect();
+    polygonize_samples_f32(values, grid, options)
+}
+
+/// [`polygonize_samples`] on f32 samples (as a CT volume or
+/// [`sample_grid`] gives them), without the conversion.
+///
+/// # Panics
+/// If `values` does not hold one value per grid point (a caller bug).
+pub fn polygonize_samples_f32(values: Vec<f32>, grid: &Grid, options: &Options) -> Surface {
+    let n1 = grid.cells.map(|n| n + 1);
+    assert_eq!(
+        values.len(),
+        n1[0] * n1[1] * n1[2],
+        "one sample per grid point"
+    );
+    let nb = n1.map(|n| n.div_ceil(BS));
     let mut field = Field {
         n1,
         values,
@@ -672,9 +814,10 @@ pub fn polygonize_samples(values: Vec<f64>, grid: &Grid, options: &Options) -> S
 fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
     let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
     let n1 = field.n1;
+    let signs = SignRows::new(&field.values, n1);
     let planes: Vec<PlaneVertices> = (0..n1[2])
         .into_par_iter()
-        .map(|k| plane_vertices(field, &coords, k, options))
+        .map(|k| plane_vertices(field, &signs, &coords, k, options))
         .collect();
     let mut offsets = Vec::with_capacity(planes.len());
     let mut total = 0u32;
@@ -711,7 +854,20 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
                 let mut centres = Vec::new();
                 let mut ids = Vec::with_capacity(12);
                 for j in 0..grid.cells[1] {
-                    for i in 0..grid.cells[0] {
+                    let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)]
+                        .map(|(j, k)| signs.row(j, k));
+                    // Cells whose eight corners do not all share one sign:
+                    // some corner inside (OR) and not all inside (AND).
+                    let mixed = (0..signs.words).map(|w| {
+                        let (mut all, mut any) = (u64::MAX, 0u64);
+                        for r in rows {
+                            let (a, b) = (r[w], signs::shifted(r, w));
+                            all &= a & b;
+                            any |= a | b;
+                        }
+                        (any & !all & signs::low_bits(grid.cells[0], w), w)
+                    });
+                    for i in mixed.flat_map(|(m, w)| signs::bits(m, w)) {
                         match field.block(i, j, k) {
                             Block::Outside => continue,
                             Block::Inside if !(options.close_at_box && touches_box(i, j, k)) => {
@@ -727,9 +883,9 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
                         if v.iter().all(|&x| (x > 0.0) == first) {
                             continue;
                         }
-                        for cycle in cell_cycles(&v) {
+                        for cycle in cell_cycles(&v).iter() {
                             ids.clear();
-                            for &e in &cycle {
+                            for &e in cycle {
                                 let (a, b) = EDGES[e as usize];
                                 let axis = (a ^ b).trailing_zeros() as usize;
                                 let (a, dz) = (a as usize, (a as usize >> 2) & 1);
@@ -739,7 +895,7 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
                             if ids.contains(&u32::MAX) {
                                 continue;
                             }
-                            triangulate(&cycle, &ids, &positions, &mut tris, &mut centres);
+                            triangulate(cycle, &ids, &positions, &mut tris, &mut centres);
                         }
                     }
                 }

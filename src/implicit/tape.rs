@@ -228,10 +228,16 @@ impl Tape {
         }
     }
 
-    /// Runs the instructions over the first `len` lanes (a short last batch
-    /// or a small group of edges must not pay for a full batch).
     fn run(&self, buf: &mut [f64], len: usize) {
-        for ins in &self.instrs {
+        run(&self.instrs, buf, len);
+    }
+}
+
+/// Runs the instructions over the first `len` lanes (a short last batch
+/// or a small group of edges must not pay for a full batch).
+fn run(instrs: &[Instr], buf: &mut [f64], len: usize) {
+    {
+        for ins in instrs {
             let (o, a, b) = io(buf, ins.out as usize, ins.a as usize, ins.b as usize);
             let (o, a, b) = (&mut o[..len], &a[..len], &b[..len]);
             match ins.op {
@@ -262,7 +268,161 @@ impl Tape {
     }
 }
 
+/// The tape split for points on segments parallel to one axis (the grid
+/// edges whose crossings root finding refines): the instructions that do
+/// not depend on that coordinate run once per segment (`setup`), the others
+/// at every step. For M2's gyroid along an x edge, four of its six sines and
+/// cosines are setup. The operations and their inputs are the same as
+/// [`Tape`]'s, so the values are bit-identical.
+#[derive(Debug, Clone, PartialEq)]
+pub struct AxisTape {
+    axis: usize,
+    setup: Vec<Instr>,
+    step: Vec<Instr>,
+    consts: Vec<(u32, f64)>,
+    vars: [Option<u32>; 3],
+    slots: usize,
+    out: u32,
+}
+
+impl AxisTape {
+    pub fn new(ssa: &Ssa, axis: usize) -> AxisTape {
+        let n = ssa.ops.len();
+        let mut varies = vec![false; n];
+        let mut last_use = vec![usize::MAX; n];
+        for (i, op) in ssa.ops.iter().enumerate() {
+            varies[i] = match *op {
+                Node::Var(a) => a as usize == axis,
+                _ => children(op).any(|c| varies[c as usize]),
+            };
+            for c in children(op) {
+                last_use[c as usize] = i;
+            }
+        }
+        let mut slot_of = vec![0u32; n];
+        let mut free: Vec<u32> = Vec::new();
+        let mut slots = 0u32;
+        let mut tape = AxisTape {
+            axis,
+            setup: Vec::new(),
+            step: Vec::new(),
+            consts: Vec::new(),
+            vars: [None; 3],
+            slots: 0,
+            out: 0,
+        };
+        for (i, op) in ssa.ops.iter().enumerate() {
+            // Everything that does not vary along the axis keeps its slot for
+            // the whole segment; varying results reuse freed slots.
+            let fixed = !varies[i] || matches!(op, Node::Var(_));
+            let out = match if fixed { None } else { free.pop() } {
+                Some(s) => s,
+                None => {
+                    slots += 1;
+                    slots - 1
+                }
+            };
+            slot_of[i] = out;
+            match *op {
+                Node::Const(bits) => tape.consts.push((out, f64::from_bits(bits))),
+                Node::Var(a) => tape.vars[a as usize] = Some(out),
+                _ => {
+                    let mut args = children(op);
+                    let a = args.next().map_or(out, |c| slot_of[c as usize]);
+                    let b = args.next().map_or(a, |c| slot_of[c as usize]);
+                    let ins = Instr {
+                        op: op_of(op),
+                        out,
+                        a,
+                        b,
+                    };
+                    if varies[i] {
+                        tape.step.push(ins);
+                    } else {
+                        tape.setup.push(ins);
+                    }
+                }
+            }
+            let mut seen = [u32::MAX; 2];
+            for (k, c) in children(op).enumerate() {
+                let c = c as usize;
+                if last_use[c] == i && varies[c] && !seen.contains(&(c as u32)) {
+                    free.push(slot_of[c]);
+                }
+                seen[k] = c as u32;
+            }
+        }
+        tape.slots = slots as usize;
+        tape.out = slot_of[n - 1];
+        tape
+    }
+
+    /// The axis the segments run along.
+    pub fn axis(&self) -> usize {
+        self.axis
+    }
+
+    pub fn workspace(&self) -> Workspace {
+        let mut ws = Workspace { buf: Vec::new() };
+        self.prepare(&mut ws, BATCH);
+        ws
+    }
+
+    /// Makes `ws` (from any tape) this tape's workspace, reusing its memory:
+    /// a block's few edges must not pay for allocating and zeroing a fresh
+    /// workspace (that cost more than the root finding itself).
+    /// Only the first `lanes` lanes get the constants: set up and evaluate
+    /// at most that many segments per call.
+    pub fn prepare(&self, ws: &mut Workspace, lanes: usize) {
+        let len = self.slots.max(1) * BATCH;
+        if ws.buf.len() < len {
+            ws.buf.resize(len, 0.0);
+        }
+        for &(s, v) in &self.consts {
+            ws.buf[s as usize * BATCH..][..lanes.min(BATCH)].fill(v);
+        }
+    }
+
+    /// Sets up up to [`BATCH`] segments: `fixed[b][m]` is segment m's
+    /// coordinate on axis b (the entry for the segment axis is ignored).
+    pub fn setup(&self, ws: &mut Workspace, fixed: [&[f64]; 3]) {
+        let len = fixed[(self.axis + 1) % 3].len();
+        for (b, src) in fixed.into_iter().enumerate() {
+            if let (Some(s), true) = (self.vars[b], b != self.axis) {
+                ws.buf[s as usize * BATCH..][..len].copy_from_slice(src);
+            }
+        }
+        run(&self.setup, &mut ws.buf, len);
+    }
+
+    /// f at the set-up segments' points with coordinate `along[m]` on the
+    /// axis, into `out`.
+    pub fn eval(&self, ws: &mut Workspace, along: &[f64], out: &mut [f64]) {
+        let len = along.len();
+        if let Some(s) = self.vars[self.axis] {
+            ws.buf[s as usize * BATCH..][..len].copy_from_slice(along);
+        }
+        run(&self.step, &mut ws.buf, len);
+        out[..len].copy_from_slice(&ws.buf[self.out as usize * BATCH..][..len]);
+    }
+}
+
+fn op_of(op: &Node) -> Op {
+    match *op {
+        Node::Unary(u, _) => Op::Unary(u),
+        Node::Binary(bin, _, _) => Op::Binary(bin),
+        Node::RAnd(_, _, al) if f64::from_bits(al) == 0.0 => Op::RvAnd,
+        Node::ROr(_, _, al) if f64::from_bits(al) == 0.0 => Op::RvOr,
+        Node::RAnd(_, _, al) => Op::RAnd(f64::from_bits(al)),
+        Node::ROr(_, _, al) => Op::ROr(f64::from_bits(al)),
+        Node::Const(_) | Node::Var(_) => {
+            unreachable!("constants and coordinates have no instruction")
+        }
+    }
+}
+
 /// Scratch memory for one thread.
+#[derive(Default)]
 pub struct Workspace {
     buf: Vec<f64>,
 }
@@ -356,6 +516,46 @@ mod tests {
             assert!((out[i] - want).abs() < 1e-14, "{i}: {} vs {want}", out[i]);
         }
         assert!(tape.slots < ctx.nodes.len());
+    }
+
+    #[test]
+    fn axis_tapes_give_the_tape_values_bit_for_bit() {
+        let mut ctx = Ctx::new();
+        let (x, y, z) = (ctx.var(0), ctx.var(1), ctx.var(2));
+        let six = ctx.constant(6.0);
+        let sx = ctx.mul(six, x);
+        let sy = ctx.mul(six, y);
+        let a = ctx.unary(Unary::Sin, sx);
+        let b = ctx.unary(Unary::Cos, sy);
+        let ab = ctx.mul(a, b);
+        let zz = ctx.square(z);
+        let c = ctx.sub(ab, zz);
+        let d = ctx.r_or(c, b, 0.0);
+        let root = ctx.r_and(d, zz, 0.5);
+        let ssa = Ssa::from_ctx(&ctx, root);
+        let tape = Tape::new(&ssa);
+        let n = 100;
+        let p: [Vec<f64>; 3] =
+            [0.37, 0.11, 0.73].map(|w| (0..n).map(|i| (i as f64 * w).sin()).collect());
+        for axis in 0..3 {
+            let along = AxisTape::new(&ssa, axis);
+            assert!(
+                along.step.len() < tape.len(),
+                "axis {axis} setup is not empty"
+            );
+            let mut ws = along.workspace();
+            along.setup(&mut ws, [&p[0], &p[1], &p[2]]);
+            for shift in [0.0, 0.25, -0.5] {
+                let moved: Vec<f64> = p[axis].iter().map(|v| v + shift).collect();
+                let mut q = p.clone();
+                q[axis] = moved.clone();
+                let (mut want, mut got) = (vec![0.0; n], vec![0.0; n]);
+                tape.eval(&mut tape.workspace(), &q[0], &q[1], &q[2], &mut want);
+                along.eval(&mut ws, &moved, &mut got);
+                let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&got), bits(&want), "axis {axis} shift {shift}");
+            }
+        }
     }
 
     #[test]
