@@ -34,7 +34,7 @@ fn mesh_with_line(points: &[(f64, f64)]) -> Result<geomc::mesh::Mesh, MeshError>
 fn refused_as_touching(result: Result<geomc::mesh::Mesh, MeshError>) {
     match result {
         Err(MeshError::Face { face, reason }) => {
-            assert_eq!(face, "thin.region");
+            assert_eq!(face, "sliver");
             assert!(reason.contains("touches or crosses"), "{reason}");
             assert!(reason.contains("`probe`"), "{reason}");
         }
