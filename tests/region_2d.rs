@@ -189,6 +189,10 @@ fn diagnostics_for_empty_cut_and_sampled_regions() {
         <disk r="0.5" x0="5" y0="5"/> </rfunction>
       <subdomain name="far"> <solid ref="far"/> </subdomain>"#;
     assert_eq!(codes(empty), vec![Code::RegionEmpty]);
+    // f = −x² is zero along x = 0 only: a line, no area.
+    let line = r#"<rfunction name="line" nx="8" ny="8"> <formula value="-x*x"/> </rfunction>
+      <subdomain name="line"> <solid ref="line"/> </subdomain>"#;
+    assert_eq!(codes(line), vec![Code::RegionEmpty]);
     // The disk sticks out of its box on the right: the side x = 0.5 bounds it.
     let cut = r#"<rfunction name="half" nx="32" ny="32" x_min="-1.5" x_max="0.5" y_min="-1.5" y_max="1.5">
         <disk r="1" x0="0" y0="0"/> </rfunction>

@@ -361,7 +361,7 @@ codes! {
     RegionContour = "E540", Error, "2D R-function region has no simple boundary",
         "In a dimension=\"2\" model, an implicit subdomain is the region f(x, y) >= 0 inside its box (x_min..y_max), and its boundary is the zero contour traced on the nx x ny grid. The contour found branches or crosses itself (two pieces of the region touch at a point, or the grid is too coarse to separate them). Move the pieces apart, or use more cells (nx, ny).";
     RegionEmpty = "E541", Error, "2D R-function region is empty",
-        "No sample of the nx x ny grid over the box (x_min..x_max, y_min..y_max) has f(x, y) >= 0, so the region has no area. Check the box against where the region lies, and use more cells for thin regions.";
+        "The region f(x, y) >= 0 has no area on the nx x ny grid over its box (x_min..x_max, y_min..y_max): no sample is inside, or f reaches zero only at points or along lines. Check the box against where the region lies, and use more cells for thin regions.";
     RegionNotFunction = "E542", Error, "density volume in a 2D model",
         "A dimension=\"2\" model takes implicit regions given by functions (<rfunction>, <level_surface>, evaluated at z = 0). A <density_volume> is a 3D grid of samples and has no planar region; use it in a 3D model.";
     RegionCutByBox = "W151", Warning, "2D R-function region reaches its box",

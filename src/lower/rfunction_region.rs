@@ -87,6 +87,7 @@ pub fn trace(f: &ImplicitModel, s: &TrimmedSurface) -> Result<(Vec<Vec<[f64; 2]>
     let tolerance = CHORD_FRACTION * (x1 - x0).hypot(y1 - y0);
     b.refine_chords(s, tolerance, f64::INFINITY);
     let cut = b.loops.iter().flatten().any(|&p| b.sides[p] != 0);
+    let min_area = (1e-6 * (x1 - x0).hypot(y1 - y0)).powi(2);
     let loops = b
         .loops
         .iter()
@@ -99,8 +100,22 @@ pub fn trace(f: &ImplicitModel, s: &TrimmedSurface) -> Result<(Vec<Vec<[f64; 2]>
             }
             points
         })
+        // A loop without area (f ≥ 0 only on a point or a line, where f
+        // touches zero from below) bounds nothing.
+        .filter(|points: &Vec<[f64; 2]>| shoelace(points).abs() > min_area)
         .collect();
     Ok((loops, cut))
+}
+
+/// Twice the signed area of a closed polygon.
+fn shoelace(points: &[[f64; 2]]) -> f64 {
+    let n = points.len();
+    (0..n)
+        .map(|k| {
+            let (a, b) = (points[k], points[(k + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum()
 }
 
 /// Most length ratio of neighbouring contour segments after [`grade`].
@@ -202,7 +217,7 @@ fn add_region(
                 Code::RegionEmpty,
                 sub.span,
                 format!(
-                    "region '{}' has no point with f >= 0 on its grid over x {}..{}, y {}..{}",
+                    "region '{}' has no area where f >= 0 on its grid over x {}..{}, y {}..{}",
                     sub.name, f.geom.min[0], f.geom.max[0], f.geom.min[1], f.geom.max[1]
                 ),
             )
