@@ -207,7 +207,10 @@ fn scikit_fem_sees_different_values_on_the_two_crack_sides() {
     // The hot side (x < 1) is warmer than 1/2, the cold side cooler.
     assert!(left > 0.6 && right < 0.4, "crack middle: {left} | {right}");
     assert!(left - right > 0.25, "jump {}", left - right);
-    assert!(antisymmetry < 0.02, "u_left + u_right - 1 = {antisymmetry} at the middle");
+    assert!(
+        antisymmetry < 0.02,
+        "u_left + u_right - 1 = {antisymmetry} at the middle"
+    );
     assert!(pairs >= 5, "{pairs} duplicated node pairs");
     // The maximum principle.
     assert!(lo >= -1e-12 && hi <= 1.0 + 1e-12, "u in [{lo}, {hi}]");
@@ -215,5 +218,8 @@ fn scikit_fem_sees_different_values_on_the_two_crack_sides() {
     // to about 1%).
     let (fine_left, fine_right, ..) = solve("0.001");
     let (jump, fine_jump) = (left - right, fine_left - fine_right);
-    assert!((jump - fine_jump).abs() < 0.02, "jump {jump} then {fine_jump}");
+    assert!(
+        (jump - fine_jump).abs() < 0.02,
+        "jump {jump} then {fine_jump}"
+    );
 }

@@ -67,7 +67,11 @@ fn line_through_the_polygon_between_its_probes_is_refused() {
 #[test]
 fn line_clearly_outside_stays_free_and_line_inside_is_followed() {
     let free = mesh_with_line(&[(2.0, 1.0), (6.0, 1.0)]).expect("meshes");
-    assert_eq!(free.polylines[0].nodes.len(), 2, "a free line keeps its two nodes");
+    assert_eq!(
+        free.polylines[0].nodes.len(),
+        2,
+        "a free line keeps its two nodes"
+    );
     let inside = mesh_with_line(&[(1.0, 0.1), (5.0, 0.1)]).expect("meshes");
     let nodes = &inside.polylines[0].nodes;
     // Followed by the triangulation: every consecutive pair is a triangle edge.

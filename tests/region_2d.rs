@@ -39,11 +39,14 @@ const PAIR: &str = r#"
 
 fn mesh(body: &str, options: &MeshOptions) -> Mesh {
     let checked = check_source(
-        SourceFile::new("t.xml", &model_xml(body)),
+        SourceFile::new("t.xml", model_xml(body)),
         &Options::default(),
     );
     assert!(checked.is_valid(), "{:#?}", checked.diagnostics.items);
-    assert!(checked.implicit.is_empty(), "2D regions leave nothing to polygonize");
+    assert!(
+        checked.implicit.is_empty(),
+        "2D regions leave nothing to polygonize"
+    );
     let model = checked.lowered.expect("a model").model;
     mesh_model(&model, options).expect("meshes")
 }
@@ -57,7 +60,10 @@ fn at_30_degrees(max_area: Option<f64>) -> MeshOptions {
 }
 
 fn triangles(m: &Mesh) -> Vec<[u32; 3]> {
-    m.faces.iter().flat_map(|f| f.triangles.iter().copied()).collect()
+    m.faces
+        .iter()
+        .flat_map(|f| f.triangles.iter().copied())
+        .collect()
 }
 
 fn area(m: &Mesh) -> f64 {
@@ -87,7 +93,11 @@ fn min_angle(m: &Mesh) -> f64 {
 
 /// The nodes of the boundary: every node of an edge polyline, once.
 fn boundary_nodes(m: &Mesh) -> Vec<[f64; 3]> {
-    let mut ids: Vec<u32> = m.edges.iter().flat_map(|e| e.nodes.iter().copied()).collect();
+    let mut ids: Vec<u32> = m
+        .edges
+        .iter()
+        .flat_map(|e| e.nodes.iter().copied())
+        .collect();
     ids.sort_unstable();
     ids.dedup();
     ids.into_iter().map(|n| m.nodes[n as usize]).collect()
@@ -109,19 +119,30 @@ fn disk_region_has_pi_area_30_degrees_and_nodes_on_the_circle() {
     let nodes = boundary_nodes(&m);
     for p in &nodes {
         let r = p[0].hypot(p[1]);
-        assert!((r - 1.0).abs() < 1e-9, "boundary node off the circle: r = {r}");
+        assert!(
+            (r - 1.0).abs() < 1e-9,
+            "boundary node off the circle: r = {r}"
+        );
     }
     // A closed loop: as many segments as nodes. The chord tolerance is
     // 0.5e-3 of the box diagonal (3√2): chords of 2√(2·tol) = 0.130 need at
     // least 48 segments; grading (neighbours within 1.5×) adds some, never
     // triples them.
     assert_eq!(boundary_segments(&m), nodes.len());
-    assert!((48..=144).contains(&nodes.len()), "{} boundary nodes", nodes.len());
+    assert!(
+        (48..=144).contains(&nodes.len()),
+        "{} boundary nodes",
+        nodes.len()
+    );
     // One subdomain with its material, one exterior fragment over every edge.
     assert_eq!(m.subdomains.len(), 1);
     assert_eq!(m.subdomains[0].name, "inside");
     assert_eq!(m.subdomains[0].material.as_deref(), Some("steel"));
-    let outer: Vec<_> = m.fragments.iter().filter(|f| f.name == "inside|exterior").collect();
+    let outer: Vec<_> = m
+        .fragments
+        .iter()
+        .filter(|f| f.name == "inside|exterior")
+        .collect();
     assert_eq!(outer.len(), 1);
     assert_eq!(outer[0].edges.len(), m.edges.len());
     // The area limit holds.
@@ -136,9 +157,19 @@ fn annulus_region_has_two_loops_on_their_circles() {
     assert!((a - exact).abs() / exact < 2e-3, "area {a} against {exact}");
     assert!(min_angle(&m) >= 30.0 - 1e-9, "min angle {}", min_angle(&m));
     let nodes = boundary_nodes(&m);
-    let outer = nodes.iter().filter(|p| (p[0].hypot(p[1]) - 1.0).abs() < 1e-9).count();
-    let inner = nodes.iter().filter(|p| (p[0].hypot(p[1]) - 0.5).abs() < 1e-9).count();
-    assert_eq!(outer + inner, nodes.len(), "every boundary node on one of the circles");
+    let outer = nodes
+        .iter()
+        .filter(|p| (p[0].hypot(p[1]) - 1.0).abs() < 1e-9)
+        .count();
+    let inner = nodes
+        .iter()
+        .filter(|p| (p[0].hypot(p[1]) - 0.5).abs() < 1e-9)
+        .count();
+    assert_eq!(
+        outer + inner,
+        nodes.len(),
+        "every boundary node on one of the circles"
+    );
     assert!(outer > inner && inner >= 24, "outer {outer}, inner {inner}");
 }
 
@@ -177,7 +208,7 @@ fn region_beside_a_kernel_circle_and_with_a_size_field() {
 
 fn codes(body: &str) -> Vec<Code> {
     let checked = check_source(
-        SourceFile::new("t.xml", &model_xml(body)),
+        SourceFile::new("t.xml", model_xml(body)),
         &Options::default(),
     );
     checked.diagnostics.items.iter().map(|d| d.code).collect()

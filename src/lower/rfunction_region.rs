@@ -12,19 +12,19 @@
 //! treat it like any kernel region.
 
 use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::geom::Frame;
 use crate::geom::{Curve, Point3, Surface, Vec3};
 use crate::implicit::ImplicitModel;
 use crate::implicit::ir::Ctx;
 use crate::implicit::tape::Ssa;
 use crate::implicit::xml::{ImplicitSolid, ImplicitSubdomain};
-use crate::ir::{Origin, SourceMap};
 use crate::ir::{
     Edge, EdgeId, Face, FaceId, Model, OrientedEdge, Subdomain, SubdomainCells, SubdomainId,
     Vertex, VertexId,
 };
+use crate::ir::{Origin, SourceMap};
 use crate::trimmed::boundary::{self, Boundary};
 use crate::trimmed::{Carrier, Trim, TrimmedSurface};
-use crate::geom::Frame;
 
 /// The chordal tolerance of a traced contour, as a fraction of its box's
 /// diagonal: half the mesher's default (1e-3), as for model edges.
@@ -72,10 +72,13 @@ pub fn region_surface(name: &str, f: &ImplicitModel) -> TrimmedSurface {
     }
 }
 
+/// Closed loops of points (x, y); the last joins the first.
+pub type Loops = Vec<Vec<[f64; 2]>>;
+
 /// The region's boundary loops in (x, y), each with the region on its left
 /// (outer loops counter-clockwise, holes clockwise), and whether the box
 /// cuts the region.
-pub fn trace(f: &ImplicitModel, s: &TrimmedSurface) -> Result<(Vec<Vec<[f64; 2]>>, bool), String> {
+pub fn trace(f: &ImplicitModel, s: &TrimmedSurface) -> Result<(Loops, bool), String> {
     let [nx, ny] = [f.geom.cells[0], f.geom.cells[1]];
     let mut b: Boundary = boundary::trace(s, [nx, ny])?;
     let [x0, x1, y0, y1] = s.rect;
@@ -132,7 +135,9 @@ fn grade(s: &TrimmedSurface, points: &mut Vec<[f64; 2]>, mut sides: Vec<u8>) {
     // Each pass halves segments; 40 passes cover any ratio a grid gives.
     for _ in 0..40 {
         let n = points.len();
-        let lengths: Vec<f64> = (0..n).map(|k| len(points[k], points[(k + 1) % n])).collect();
+        let lengths: Vec<f64> = (0..n)
+            .map(|k| len(points[k], points[(k + 1) % n]))
+            .collect();
         let mut out = Vec::with_capacity(2 * n);
         let mut out_sides = Vec::with_capacity(2 * n);
         let mut split = false;
@@ -194,10 +199,11 @@ fn add_region(
     diags: &mut Diagnostics,
 ) {
     let surface = region_surface(&sub.name, f);
-    let (loops, cut) = match trace(f, &surface) {
-        Ok(traced) => traced,
-        Err(reason) => {
-            diags.push(
+    let (loops, cut) =
+        match trace(f, &surface) {
+            Ok(traced) => traced,
+            Err(reason) => {
+                diags.push(
                 Diagnostic::new(
                     Code::RegionContour,
                     sub.span,
@@ -208,9 +214,9 @@ fn add_region(
                     f.geom.cells[0], f.geom.cells[1]
                 )),
             );
-            return;
-        }
-    };
+                return;
+            }
+        };
     if loops.is_empty() {
         diags.push(
             Diagnostic::new(
@@ -245,7 +251,7 @@ fn add_region(
                 name: format!("{}.contour[{}].v{}", sub.name, l + 1, k + 1),
                 position: Point3::new(p[0], p[1], 0.0),
             });
-            source_map.vertices.insert(id, origin.clone());
+            source_map.vertices.insert(id, origin);
         }
         let n = points.len();
         let mut lp = Vec::with_capacity(n);
@@ -261,7 +267,7 @@ fn add_region(
                 begin: VertexId(a as u32),
                 end: VertexId(b as u32),
             });
-            source_map.edges.insert(id, origin.clone());
+            source_map.edges.insert(id, origin);
             lp.push(OrientedEdge {
                 edge: id,
                 forward: true,
@@ -279,7 +285,7 @@ fn add_region(
         reversed: false,
         loops: face_loops,
     });
-    source_map.faces.insert(face, origin.clone());
+    source_map.faces.insert(face, origin);
     let id = SubdomainId(model.subdomains.len() as u32);
     model.subdomains.push(Subdomain {
         name: sub.name.clone(),

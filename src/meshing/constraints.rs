@@ -117,22 +117,21 @@ fn touches(loops: &[Vec<Point3>], line: &[Point3], probes: &[Point3], tolerance:
             .iter()
             .flat_map(|lp| (0..lp.len()).map(move |k| (&lp[k], &lp[(k + 1) % lp.len()])))
     };
-    if probes.iter().any(|p| {
-        loop_segments().any(|(a, b)| polygon::segment_distance(p, a, b) <= tolerance)
-    }) {
+    if probes
+        .iter()
+        .any(|p| loop_segments().any(|(a, b)| polygon::segment_distance(p, a, b) <= tolerance))
+    {
         return true;
     }
-    line.windows(2).any(|w| {
-        loop_segments().any(|(a, b)| segments_cross(&w[0], &w[1], a, b))
-    })
+    line.windows(2)
+        .any(|w| loop_segments().any(|(a, b)| segments_cross(&w[0], &w[1], a, b)))
 }
 
 /// Proper crossing of segments p–q and a–b (each strictly separates the
 /// other's ends).
 fn segments_cross(p: &Point3, q: &Point3, a: &Point3, b: &Point3) -> bool {
-    let orient = |u: &Point3, v: &Point3, w: &Point3| {
-        (v.x - u.x) * (w.y - u.y) - (v.y - u.y) * (w.x - u.x)
-    };
+    let orient =
+        |u: &Point3, v: &Point3, w: &Point3| (v.x - u.x) * (w.y - u.y) - (v.y - u.y) * (w.x - u.x);
     let (d1, d2) = (orient(p, q, a), orient(p, q, b));
     let (d3, d4) = (orient(a, b, p), orient(a, b, q));
     d1 * d2 < 0.0 && d3 * d4 < 0.0
