@@ -128,7 +128,9 @@ fn decode_triangulate(data: &[u8]) -> Triangulate {
         .fold(0.0, f64::max);
     let options = geomc::meshing::MeshOptions {
         min_angle_degrees: [0.0, 15.0, 20.0, 25.0][usize::from(flags & 3)],
-        max_area: Some((extent * extent / f64::from(8 + (flags >> 2 & 15) * 32)).max(1e-6)),
+        max_area: Some(
+            (extent * extent / f64::from(8 + u16::from(flags >> 2 & 15) * 32)).max(1e-6),
+        ),
         order: 1 + (flags >> 2 & 1),
         ..geomc::meshing::MeshOptions::default()
     };
@@ -341,6 +343,32 @@ fn a_poly_line_touching_the_boundary_is_refused_not_meshed_non_conforming() {
                 );
             }
             other => panic!("{}: expected a refusal, got {other:?}", path.display()),
+        }
+    }
+}
+
+/// Flags whose area bits are 8 or more overflowed the target's own u8
+/// arithmetic (`8 + bits * 32`) in the debug-assertion build (found by
+/// `triangulate`, 2026-11-26): the divisor is now computed in u16, and the
+/// input meshes to a sane mesh.
+#[test]
+fn large_area_bits_decode_without_overflow_and_mesh() {
+    let found = inputs("triangulate_harness");
+    assert_eq!(found.len(), 1, "triangulate_harness regression inputs");
+    for (path, bytes) in &found {
+        assert_eq!(bytes.first(), Some(&119), "{}", path.display());
+        let input = decode_triangulate(bytes);
+        // 119 = 0b01_1101_11: one segment, area bits 13, min angle 25°.
+        let extent = 4.0;
+        assert_eq!(input.options.max_area, Some(extent * extent / 424.0));
+        assert_eq!(input.options.min_angle_degrees, 25.0);
+        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
+        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let valid = checked.is_valid();
+        if let Some(lowered) = checked.lowered.filter(|_| valid)
+            && let Ok(mesh) = geomc::meshing::mesh_model(&lowered.model, &input.options)
+        {
+            geomc::meshing::sanity_check(&mesh).expect("a sane mesh");
         }
     }
 }
