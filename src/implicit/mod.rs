@@ -6,6 +6,7 @@
 
 pub mod expr_ops;
 pub mod interval;
+pub mod interfaces;
 pub mod ir;
 pub mod lang;
 pub mod library;
@@ -15,6 +16,7 @@ pub mod rfs;
 pub mod rows;
 pub mod section;
 pub mod tape;
+pub mod weld;
 pub mod xml;
 
 use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};
