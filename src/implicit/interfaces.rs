@@ -103,7 +103,10 @@ pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
                     lo[(d + 2) % 3] = o >> 1;
                     let mut hi = lo;
                     hi[d] = 1;
-                    (lo[0] | lo[1] << 1 | lo[2] << 2, hi[0] | hi[1] << 1 | hi[2] << 2)
+                    (
+                        lo[0] | lo[1] << 1 | lo[2] << 2,
+                        hi[0] | hi[1] << 1 | hi[2] << 2,
+                    )
                 };
                 let mut en = [u32::MAX; 12];
                 for d in 0..3 {
@@ -117,16 +120,29 @@ pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
                         let key = (idx(pu[0], pu[1], pu[2]) as u64) * 3 + d as u64;
                         en[d * 4 + o] = *edge_nodes.entry(key).or_insert_with(|| {
                             let f = deciding(a, b);
-                            out.positions
-                                .push(edge_root(f, at(pu[0], pu[1], pu[2]), at(pw[0], pw[1], pw[2])));
+                            out.positions.push(edge_root(
+                                f,
+                                at(pu[0], pu[1], pu[2]),
+                                at(pw[0], pw[1], pw[2]),
+                            ));
                             (out.positions.len() - 1) as u32
                         });
                     }
                 }
                 let box_of = |c: &[usize]| -> ([f64; 3], [f64; 3]) {
-                    let ps: Vec<[f64; 3]> = c.iter().map(|&c| { let q = corner(c); at(q[0], q[1], q[2]) }).collect();
-                    let lo = std::array::from_fn(|a| ps.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min));
-                    let hi = std::array::from_fn(|a| ps.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max));
+                    let ps: Vec<[f64; 3]> = c
+                        .iter()
+                        .map(|&c| {
+                            let q = corner(c);
+                            at(q[0], q[1], q[2])
+                        })
+                        .collect();
+                    let lo = std::array::from_fn(|a| {
+                        ps.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min)
+                    });
+                    let hi = std::array::from_fn(|a| {
+                        ps.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max)
+                    });
                     (lo, hi)
                 };
                 // The point of a set of corners: the mean of their crossed
@@ -258,7 +274,11 @@ fn project(f: &Ssa, p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> [f64; 3] {
         }
         q = next;
     }
-    if q.iter().all(|c| c.is_finite()) { q } else { p }
+    if q.iter().all(|c| c.is_finite()) {
+        q
+    } else {
+        p
+    }
 }
 
 /// The root of `f` on the segment p0–p1 (f changes sign between them), by

@@ -5,8 +5,8 @@
 //! polygonization ([`polygonize`]) into geomc's mesh IR.
 
 pub mod expr_ops;
-pub mod interval;
 pub mod interfaces;
+pub mod interval;
 pub mod ir;
 pub mod lang;
 pub mod library;

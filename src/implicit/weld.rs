@@ -288,7 +288,9 @@ mod tests {
             triangles,
             ..Surface::default()
         };
-        let at: Vec<u64> = (0..12).map(|v| if (3..9).contains(&v) { 5 } else { NONE }).collect();
+        let at: Vec<u64> = (0..12)
+            .map(|v| if (3..9).contains(&v) { 5 } else { NONE })
+            .collect();
         weld_at_samples(&mut s, &at);
         assert_eq!((s.positions.len(), s.triangles.len()), (8, 8));
         assert!(bad_edges(&s.triangles).is_empty());
