@@ -15,9 +15,12 @@
 //! - An edge point is the root, along the edge, of the function of the
 //!   solid at one end (the lower-numbered solid when both ends are solids:
 //!   its f is > 0 at its end and ≤ 0 at the other), by false position.
-//! - Face and cell points are the mean of their edge points, then moved
-//!   onto the surface by Newton steps along the gradient when only two
-//!   labels meet there (kept inside the face or cell).
+//! - Face and cell points are dual contouring's: the least-squares meeting
+//!   point of the edge points' tangent planes (about their mean, small
+//!   eigenvalues dropped), kept inside the face or cell, so creases (a
+//!   box's edges) and junction curves (where three labels meet: the rim of
+//!   a pin leaving a block) are kept; where only two labels meet, the point
+//!   is then moved onto the surface by Newton steps along the gradient.
 //!
 //! Limitation: a cell face whose corners alternate between two labels
 //! (a, b, a, b) makes the two diagonal octants touch along one segment, a
@@ -51,41 +54,69 @@ impl Interfaces {
     }
 }
 
+/// One solid: f > 0 inside, within its box.
+#[derive(Debug, Clone)]
+pub struct Solid {
+    pub ssa: Ssa,
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
 /// Root-finding iterations per edge and Newton steps per face or cell point.
 const ROOT_ITERATIONS: usize = 40;
 const NEWTON_STEPS: usize = 4;
+/// Face and cell points stay this fraction of the cell inside their face
+/// or cell.
+const INSET: f64 = 1e-3;
 
-/// Meshes the labelled partition of the grid by `solids` (f > 0 inside).
-pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
+/// Meshes the labelled partition of the grid by `solids` (f > 0 inside
+/// their boxes). Samples on the grid's box are exterior, so every solid is
+/// closed against the box where it leaves it.
+pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
     let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
     let n1 = grid.cells.map(|n| n + 1);
     let at = |i: usize, j: usize, k: usize| [coords[0][i], coords[1][j], coords[2][k]];
     let samples: Vec<Vec<f32>> = solids
         .iter()
-        .map(|s| super::polygonize::sample_grid(s, grid))
+        .map(|s| super::polygonize::sample_grid(&s.ssa, grid))
         .collect();
     let idx = |i: usize, j: usize, k: usize| (k * n1[1] + j) * n1[0] + i;
-    let labels: Vec<u32> = (0..n1[0] * n1[1] * n1[2])
-        .map(|p| {
-            samples
-                .iter()
-                .position(|v| v[p] > 0.0)
-                .map_or(0, |s| s as u32 + 1)
-        })
-        .collect();
+    let mut labels = vec![0u32; n1[0] * n1[1] * n1[2]];
+    for k in 1..n1[2].saturating_sub(1) {
+        for j in 1..n1[1].saturating_sub(1) {
+            for i in 1..n1[0].saturating_sub(1) {
+                let p = at(i, j, k);
+                let p_idx = idx(i, j, k);
+                labels[p_idx] = solids
+                    .iter()
+                    .zip(&samples)
+                    .position(|(s, v)| {
+                        v[p_idx] > 0.0 && (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a])
+                    })
+                    .map_or(0, |s| s as u32 + 1);
+            }
+        }
+    }
     let label_at = |c: [usize; 3]| labels[idx(c[0], c[1], c[2])];
     let mut out = Interfaces::default();
+    // Unit normals of the edge points (zero for face and cell points).
+    let mut normals: Vec<[f64; 3]> = Vec::new();
+    let spacing = (0..3)
+        .map(|a| (grid.max[a] - grid.min[a]) / grid.cells[a].max(1) as f64)
+        .fold(f64::INFINITY, f64::min);
     let mut edge_nodes: HashMap<u64, u32> = HashMap::new();
     let mut face_nodes: HashMap<u64, u32> = HashMap::new();
     let mut patches: HashMap<(u32, u32), Vec<[u32; 3]>> = HashMap::new();
-    // The function deciding the surface between two labels.
-    let deciding = |a: u32, b: u32| -> Option<&Ssa> {
+    // The solid whose function decides the surface between two labels.
+    let deciding_index = |a: u32, b: u32| -> Option<usize> {
         let s = match (a, b) {
             (0, s) | (s, 0) => s,
             (a, b) => a.min(b),
         };
-        solids.get(s.checked_sub(1)? as usize)
+        let s = s.checked_sub(1)? as usize;
+        (s < solids.len()).then_some(s)
     };
+    let deciding = |a: u32, b: u32| deciding_index(a, b).map(|s| &solids[s].ssa);
     let cells = grid.cells;
     for k in 0..cells[2] {
         for j in 0..cells[1] {
@@ -120,11 +151,9 @@ pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
                         let key = (idx(pu[0], pu[1], pu[2]) as u64) * 3 + d as u64;
                         en[d * 4 + o] = *edge_nodes.entry(key).or_insert_with(|| {
                             let f = deciding(a, b);
-                            out.positions.push(edge_root(
-                                f,
-                                at(pu[0], pu[1], pu[2]),
-                                at(pw[0], pw[1], pw[2]),
-                            ));
+                            let p = edge_root(f, at(pu[0], pu[1], pu[2]), at(pw[0], pw[1], pw[2]));
+                            out.positions.push(p);
+                            normals.push(f.map_or([0.0; 3], |f| unit_gradient(f, p, spacing)));
                             (out.positions.len() - 1) as u32
                         });
                     }
@@ -140,34 +169,58 @@ pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
                     let lo = std::array::from_fn(|a| {
                         ps.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min)
                     });
-                    let hi = std::array::from_fn(|a| {
+                    let hi: [f64; 3] = std::array::from_fn(|a| {
                         ps.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max)
                     });
+                    let lo: [f64; 3] = lo;
+                    // Inset by INSET of the size: a point clamped onto the
+                    // box would be collinear with the edge points there.
+                    let d: [f64; 3] = std::array::from_fn(|a| INSET * (hi[a] - lo[a]));
+                    let lo = std::array::from_fn(|a| lo[a] + d[a]);
+                    let hi = std::array::from_fn(|a| hi[a] - d[a]);
                     (lo, hi)
                 };
                 // The point of a set of corners: the mean of their crossed
                 // edges' points, projected when two labels meet there.
-                let mut centre = |edges: &[usize], corners: &[usize], positions: &[[f64; 3]]| {
-                    let pts: Vec<[f64; 3]> = edges
+                let centre = |edges: &[usize],
+                              corners: &[usize],
+                              positions: &[[f64; 3]],
+                              normals: &[[f64; 3]]| {
+                    let crossed: Vec<usize> = edges
                         .iter()
                         .filter(|&&e| en[e] != u32::MAX)
-                        .map(|&e| positions[en[e] as usize])
+                        .map(|&e| en[e] as usize)
                         .collect();
+                    let pts: Vec<[f64; 3]> = crossed.iter().map(|&v| positions[v]).collect();
                     let mean: [f64; 3] = std::array::from_fn(|a| {
                         pts.iter().map(|p| p[a]).sum::<f64>() / pts.len().max(1) as f64
                     });
                     let mut ls: Vec<u32> = corners.iter().map(|&c| l[c]).collect();
                     ls.sort_unstable();
                     ls.dedup();
-                    match (ls.len(), deciding(ls[0], *ls.last().unwrap_or(&0))) {
-                        (2, Some(f)) => {
-                            let (lo, hi) = box_of(corners);
-                            project(f, mean, lo, hi)
+                    // The functions whose zero sets meet here: one on a
+                    // surface (project onto it), more on a junction.
+                    let mut fs: Vec<usize> = Vec::new();
+                    for (x, &a) in ls.iter().enumerate() {
+                        for &b in &ls[x + 1..] {
+                            if let Some(f) = deciding_index(a, b) {
+                                if !fs.contains(&f) {
+                                    fs.push(f);
+                                }
+                            }
                         }
-                        _ => mean,
+                    }
+                    let (lo, hi) = box_of(corners);
+                    let planes: Vec<([f64; 3], [f64; 3])> = crossed
+                        .iter()
+                        .map(|&v| (positions[v], normals[v]))
+                        .collect();
+                    let q = qef_point(&planes, mean, lo, hi);
+                    match fs[..] {
+                        [f] => project(&solids[f].ssa, q, lo, hi),
+                        _ => q,
                     }
                 };
-                let _ = &mut centre;
                 // Face (n, s): normal n, offset s; its edges (d, o) with d ≠ n.
                 let face_edges = |n: usize, s: usize| -> Vec<usize> {
                     (0..3)
@@ -196,8 +249,9 @@ pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
                         fnode[n * 2 + s] = match face_nodes.get(&key) {
                             Some(&node) => node,
                             None => {
-                                let p = centre(&fe, &face_corners(n, s), &out.positions);
+                                let p = centre(&fe, &face_corners(n, s), &out.positions, &normals);
                                 out.positions.push(p);
+                                normals.push([0.0; 3]);
                                 let node = (out.positions.len() - 1) as u32;
                                 face_nodes.insert(key, node);
                                 node
@@ -207,8 +261,9 @@ pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
                 }
                 let all: Vec<usize> = (0..12).collect();
                 let corners: Vec<usize> = (0..8).collect();
-                let p = centre(&all, &corners, &out.positions);
+                let p = centre(&all, &corners, &out.positions, &normals);
                 out.positions.push(p);
+                normals.push([0.0; 3]);
                 let c = (out.positions.len() - 1) as u32;
                 for d in 0..3 {
                     let (d1, d2) = ((d + 1) % 3, (d + 2) % 3);
@@ -239,11 +294,128 @@ pub fn polygonize_labels(solids: &[Ssa], grid: &Grid) -> Interfaces {
     }
     let mut pairs: Vec<_> = patches.into_iter().collect();
     pairs.sort_by_key(|(pair, _)| *pair);
+    merge_coincident(&mut out.positions, &mut pairs);
     out.patches = pairs
         .into_iter()
         .map(|(pair, triangles)| Patch { pair, triangles })
         .collect();
     out
+}
+
+/// Nodes at one point joined by an edge (an edge point on a sample, a face
+/// or cell point clamped onto it) become one node; the triangles that
+/// collapse are dropped and unused nodes removed (order kept).
+fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [((u32, u32), Vec<[u32; 3]>)]) {
+    let n = positions.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            x = parent[x as usize];
+        }
+        x
+    }
+    let mut any = false;
+    for (_, tris) in pairs.iter() {
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if positions[a as usize] == positions[b as usize] {
+                    let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                    parent[ra.max(rb) as usize] = ra.min(rb);
+                    any = true;
+                }
+            }
+        }
+    }
+    if !any {
+        return;
+    }
+    let root: Vec<u32> = (0..n as u32).map(|v| find(&mut parent, v)).collect();
+    let mut used = vec![false; n];
+    for (_, tris) in pairs.iter_mut() {
+        tris.retain_mut(|t| {
+            *t = t.map(|v| root[v as usize]);
+            t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
+        });
+        for t in tris.iter() {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+    }
+    let mut new_id = vec![u32::MAX; n];
+    let mut kept = Vec::with_capacity(n);
+    for (v, p) in positions.iter().enumerate() {
+        if used[v] {
+            new_id[v] = kept.len() as u32;
+            kept.push(*p);
+        }
+    }
+    *positions = kept;
+    for (_, tris) in pairs.iter_mut() {
+        for t in tris.iter_mut() {
+            *t = t.map(|v| new_id[v as usize]);
+        }
+    }
+}
+
+/// The unit gradient of f at p by central differences (zero where it is
+/// not finite or vanishes).
+fn unit_gradient(f: &Ssa, p: [f64; 3], spacing: f64) -> [f64; 3] {
+    let h = spacing * 1e-4;
+    let g: [f64; 3] = std::array::from_fn(|a| {
+        let (mut up, mut down) = (p, p);
+        up[a] += h;
+        down[a] -= h;
+        (f.eval_point(up) - f.eval_point(down)) / (2.0 * h)
+    });
+    let n = g.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if n.is_finite() && n > 0.0 {
+        g.map(|x| x / n)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Dual contouring's point: the least-squares meeting point of the tangent
+/// planes (point, unit normal) of the edge points, solved about their mean
+/// with small eigenvalues dropped (a flat surface keeps the mean along
+/// it, a crease or junction curve pulls the point onto the curve), kept in
+/// the box [lo, hi].
+fn qef_point(
+    planes: &[([f64; 3], [f64; 3])],
+    mean: [f64; 3],
+    lo: [f64; 3],
+    hi: [f64; 3],
+) -> [f64; 3] {
+    use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+    let mut ata = Matrix3::<f64>::zeros();
+    let mut atb = Vector3::<f64>::zeros();
+    for (p, n) in planes {
+        let n = Vector3::from(*n);
+        let d = n.dot(&(Vector3::from(*p) - Vector3::from(mean)));
+        ata += n * n.transpose();
+        atb += n * d;
+    }
+    let eig = SymmetricEigen::new(ata);
+    let top = eig.eigenvalues.iter().fold(0.0f64, |m, &v| m.max(v.abs()));
+    if !(top.is_finite() && top > 0.0) {
+        return mean;
+    }
+    let mut x = Vector3::<f64>::zeros();
+    for k in 0..3 {
+        let v = eig.eigenvalues[k];
+        if v.abs() > 0.1 * top {
+            let e = eig.eigenvectors.column(k);
+            x += e * (e.dot(&atb) / v);
+        }
+    }
+    let q: [f64; 3] = std::array::from_fn(|a| (mean[a] + x[a]).clamp(lo[a], hi[a]));
+    if q.iter().all(|c| c.is_finite()) {
+        q
+    } else {
+        mean
+    }
 }
 
 /// Newton steps from `p` towards f = 0 along the gradient, kept in the box

@@ -6,6 +6,7 @@
 //! lowers them here into [`ImplicitSubdomain`]s that compile polygonizes.
 
 pub mod density;
+pub mod joint;
 pub mod mesh;
 mod overlap;
 mod paths;
