@@ -10,6 +10,7 @@ pub mod joint;
 pub mod mesh;
 mod overlap;
 mod paths;
+pub mod report;
 mod settings;
 mod tree;
 
