@@ -162,3 +162,43 @@ fn seven_balls_at_20_cells_have_no_degenerate_triangles() {
         assert!(nodes_on_samples(&s, 0.1) >= 6);
     }
 }
+
+/// The seven balls written by `geomc compile` as MSH at 20³ (aligned) and
+/// at 32³ (not): gmsh reads the surface, and its 3D mesher fills the volume
+/// (tests/tools/check_mesh.py --tetra; ./scripts/test.sh installs gmsh).
+#[test]
+fn gmsh_tetrahedralizes_the_seven_balls() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let rfs = dir.path().join("balls.rfs");
+    std::fs::write(&rfs, SEVEN_BALLS).expect("write the listing");
+    for cells in ["20", "32"] {
+        let msh = dir.path().join(format!("balls{cells}.msh"));
+        let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
+            .args(["compile", "-q", "--cells", cells, "-o"])
+            .arg(&msh)
+            .arg(&rfs)
+            .output()
+            .expect("run geomc");
+        assert!(
+            run.status.success(),
+            "{}",
+            String::from_utf8_lossy(&run.stderr)
+        );
+        let tools = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/tools");
+        let out = std::process::Command::new("python3")
+            .arg(tools.join("check_mesh.py"))
+            .arg(&msh)
+            .arg("--tetra")
+            .output()
+            .expect("run check_mesh.py");
+        assert!(
+            out.status.success(),
+            "{}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        assert_eq!(report["tetra"]["ok"], true, "{cells}: {report}");
+        let tets = report["tetra"]["tetrahedra"]["balls"].as_u64().unwrap_or(0);
+        assert!(tets > 1000, "{cells}: {tets} tetrahedra: {report}");
+    }
+}
