@@ -302,10 +302,13 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
     out
 }
 
+/// The triangles between one pair of labels.
+type PairTriangles = ((u32, u32), Vec<[u32; 3]>);
+
 /// Nodes at one point joined by an edge (an edge point on a sample, a face
 /// or cell point clamped onto it) become one node; the triangles that
 /// collapse are dropped and unused nodes removed (order kept).
-fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [((u32, u32), Vec<[u32; 3]>)]) {
+fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [PairTriangles]) {
     let n = positions.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
