@@ -4,7 +4,7 @@
 //! error ≤ 0.05%), and the same with no optimisation for comparison; also
 //! the mesh's closedness and the number of degenerate triangles (0).
 //!
-//! Run: `cargo bench --bench implicit_quality`. Without `--bench` (as under
+//! Run: `cargo bench --bench implicit_accuracy`. Without `--bench` (as under
 //! `cargo test --all-targets`) the same checks at 32 cells, where only the
 //! volume bound is looser (1%).
 
