@@ -164,14 +164,14 @@ fn seven_balls_at_20_cells_have_no_degenerate_triangles() {
 }
 
 /// The seven balls written by `geomc compile` as MSH at 20³ (aligned) and
-/// at 32³ (not): gmsh reads the surface, and its 3D mesher fills the volume
+/// at 48³ (not): gmsh reads the surface, and its 3D mesher fills the volume
 /// (tests/tools/check_mesh.py --tetra; ./scripts/test.sh installs gmsh).
 #[test]
 fn gmsh_tetrahedralizes_the_seven_balls() {
     let dir = tempfile::tempdir().expect("temp dir");
     let rfs = dir.path().join("balls.rfs");
     std::fs::write(&rfs, SEVEN_BALLS).expect("write the listing");
-    for cells in ["20", "32"] {
+    for cells in ["20", "48"] {
         let msh = dir.path().join(format!("balls{cells}.msh"));
         let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
             .args(["compile", "-q", "--cells", cells, "-o"])
