@@ -256,13 +256,37 @@ fn load_input(
     let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
         return Err(EXIT_INVALID);
     };
-    mesh_model(&lowered.model, mesh_options).map_err(|e| {
+    let model = &lowered.model;
+    // A model of implicit subdomains only has nothing for the face mesher.
+    let implicit_only = !checked.implicit.is_empty()
+        && model.vertices.is_empty()
+        && model.edges.is_empty()
+        && model.faces.is_empty()
+        && model.point_sets.is_empty();
+    let meshed = if implicit_only {
+        Ok(Mesh {
+            dimension: 3,
+            ..Default::default()
+        })
+    } else {
+        mesh_model(model, mesh_options)
+    };
+    let mut mesh = meshed.map_err(|e| {
         fail(Failure {
             code: Code::RenderInputFailed,
             message: format!("{}: {e}", path.display()),
             exit: EXIT_INVALID,
         })
-    })
+    })?;
+    // Implicit subdomains are not in the model: polygonized as compile does.
+    let limit = super::limits::MAX_GRID_CELLS;
+    match super::implicit::add_to_mesh(&mut mesh, &checked, None, None, true, limit) {
+        Ok(_) => Ok(mesh),
+        Err(messages) => {
+            eprint!("{messages}");
+            Err(EXIT_INVALID)
+        }
+    }
 }
 
 /// A mesh file in any format geomc reads (its own codes on failure).

@@ -5,6 +5,7 @@
 //! polygonization ([`polygonize`]) into geomc's mesh IR.
 
 pub mod expr_ops;
+pub mod interfaces;
 pub mod interval;
 pub mod ir;
 pub mod lang;
@@ -15,6 +16,7 @@ pub mod rfs;
 pub mod rows;
 pub mod section;
 pub mod tape;
+pub mod weld;
 pub mod xml;
 
 use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};

@@ -6,9 +6,11 @@
 //! lowers them here into [`ImplicitSubdomain`]s that compile polygonizes.
 
 pub mod density;
+pub mod joint;
 pub mod mesh;
 mod overlap;
 mod paths;
+pub mod report;
 mod settings;
 mod tree;
 
