@@ -44,6 +44,7 @@ impl MeshWriter for Gltf {
         groups::check(mesh)?;
         let doc = Document::of(mesh, self.name());
         let mut warnings = doc.warnings.clone();
+        warnings.extend(groups::dropped_volumes(self.name(), mesh));
         if options.encoding.is_some() {
             warnings.push(warning(
                 self.name(),

@@ -73,6 +73,14 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
             ));
         }
     }
+    for v in &mesh.volumes {
+        if v.nodes.len() % v.kind.corners() != 0 || !v.nodes.iter().all(node_ok) {
+            return bad(format!(
+                "volume `{}` has a cell with a node out of range or missing",
+                v.name
+            ));
+        }
+    }
     for p in mesh.polylines.iter().chain(&mesh.point_sets) {
         if !p.nodes.iter().all(node_ok) {
             return bad(format!("`{}` refers to a node out of range", p.name));
@@ -382,4 +390,29 @@ pub(crate) fn bounds(
             [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
         )
     }))
+}
+
+/// The warning of a surface format given a mesh with volume cells: they are
+/// not written (only the mesh's surface triangles are), said with counts.
+pub(crate) fn dropped_volumes(format: &'static str, mesh: &Mesh) -> Option<super::Warning> {
+    if mesh.volumes.is_empty() {
+        return None;
+    }
+    Some(super::warning(
+        format,
+        format!(
+            "{format} holds surfaces only: {} in {} not written (convert to .msh or .vtu to keep them)",
+            crate::mesh::volume::describe(&mesh.volumes),
+            super::count(
+                {
+                    let mut names: Vec<&str> =
+                        mesh.volumes.iter().map(|v| v.name.as_str()).collect();
+                    names.sort_unstable();
+                    names.dedup();
+                    names.len()
+                },
+                "volume group"
+            )
+        ),
+    ))
 }
