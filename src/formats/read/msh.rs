@@ -151,13 +151,8 @@ impl<'a> Reader<'a> {
             }
             let name = t.lossy().get(1..).unwrap_or_default().to_string();
             let end = format!("$End{name}");
-            self.section_closed = self
-                .s
-                .bytes
-                .get(self.s.pos..)
-                .unwrap_or_default()
-                .windows(end.len())
-                .any(|w| w == end.as_bytes());
+            let rest = self.s.bytes.get(self.s.pos..).unwrap_or_default();
+            self.section_closed = memchr::memmem::find(rest, end.as_bytes()).is_some();
             self.section_start();
             match name.as_str() {
                 "PhysicalNames" => self.physical_names()?,
@@ -264,7 +259,7 @@ impl<'a> Reader<'a> {
     fn skip_section(&mut self, name: &str, start: Token) -> Result<(), Diagnostic> {
         let end = format!("$End{name}");
         let rest = self.s.bytes.get(self.s.pos..).unwrap_or_default();
-        match rest.windows(end.len()).position(|w| w == end.as_bytes()) {
+        match memchr::memmem::find(rest, end.as_bytes()) {
             Some(i) => {
                 self.s.pos += i + end.len();
                 Ok(())
