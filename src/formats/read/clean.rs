@@ -125,7 +125,13 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
         [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]
             .into_iter()
             .filter(move |&(a, b)| a != b && (a as usize) < n && (b as usize) < n)
-            .map(|(a, b)| if a < b { (a, b << 1) } else { (b, (a << 1) | 1) })
+            .map(|(a, b)| {
+                if a < b {
+                    (a, b << 1)
+                } else {
+                    (b, (a << 1) | 1)
+                }
+            })
     };
     let mut start = vec![0u32; n + 1];
     for t in triangles {

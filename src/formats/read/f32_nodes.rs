@@ -120,7 +120,12 @@ mod tests {
         }
         assert_eq!(nodes.len(), 10_000);
         assert_eq!(ids[..10_000], ids[10_000..]);
-        assert!(ids[..10_000].iter().enumerate().all(|(i, &id)| id as usize == i));
+        assert!(
+            ids[..10_000]
+                .iter()
+                .enumerate()
+                .all(|(i, &id)| id as usize == i)
+        );
         assert_eq!(nodes[3], [0.75, -0.75, 0.0]);
     }
 }

@@ -4,11 +4,11 @@
 //! ASCII `solid NAME` is a group; binary STL is one group, `surface`. Nodes
 //! with identical coordinates are merged (STL repeats them per triangle).
 
-use super::build::{Builder, NodeDedup};
-use super::f32_nodes::F32Nodes;
-use super::error_at_byte;
-use super::text::{Scanner, real, syntax};
 use super::ReadFormat;
+use super::build::{Builder, NodeDedup};
+use super::error_at_byte;
+use super::f32_nodes::F32Nodes;
+use super::text::{Scanner, real, syntax};
 use crate::diag::{Code, Diagnostic};
 use std::io::{Read, Seek, SeekFrom};
 use std::path::Path;
