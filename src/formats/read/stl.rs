@@ -170,8 +170,8 @@ impl BinaryStl {
                 )]);
             }
             let mut tri = [0u32; 3];
-            for (c, slot) in tri.iter_mut().enumerate() {
-                let p = [coords[3 * c], coords[3 * c + 1], coords[3 * c + 2]];
+            for (slot, p) in tri.iter_mut().zip(coords.chunks_exact(3)) {
+                let p = [p.first(), p.get(1), p.get(2)].map(|v| v.copied().unwrap_or(0.0));
                 *slot = self.nodes.node(&mut self.b.nodes, p);
             }
             if r.get(48..).is_some_and(|a| a.iter().any(|&x| x != 0)) {

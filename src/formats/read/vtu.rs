@@ -368,7 +368,7 @@ impl Reader<'_> {
                         for (slot, &from) in corners.iter_mut().zip(order) {
                             *slot = nodes.get(from).copied().unwrap_or(0);
                         }
-                        group.add_cell(kind, &corners[..order.len()]);
+                        group.add_cell(kind, corners.get(..order.len()).unwrap_or_default());
                         if nodes.len() > kind.corners() {
                             *reduced.entry(kind.plural()).or_default() += 1;
                         }
