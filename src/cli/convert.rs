@@ -136,6 +136,7 @@ fn is_empty(mesh: &geomc::mesh::Mesh) -> bool {
         && mesh.polylines.iter().all(|p| p.nodes.is_empty())
         && mesh.point_sets.iter().all(|p| p.nodes.is_empty())
         && mesh.edges.iter().all(|e| e.nodes.len() < 2)
+        && mesh.volumes.iter().all(|v| v.nodes.is_empty())
 }
 
 pub fn run(args: &Args) -> i32 {
@@ -244,8 +245,13 @@ pub fn run(args: &Args) -> i32 {
                 eprint!("{}", render_human(&source, &d));
             }
             let mesh = &loaded.mesh;
+            let cells = if mesh.volumes.is_empty() || !writer.keeps_volume_cells() {
+                String::new()
+            } else {
+                format!(", {}", geomc::mesh::volume::describe(&mesh.volumes))
+            };
             eprintln!(
-                "geomc: wrote {} ({} nodes, {} triangles, {} groups)",
+                "geomc: wrote {} ({} nodes, {} triangles{cells}, {} groups)",
                 args.output.display(),
                 mesh.nodes.len(),
                 mesh.faces.iter().map(|f| f.triangles.len()).sum::<usize>(),

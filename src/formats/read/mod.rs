@@ -17,6 +17,7 @@
 mod base64;
 pub mod build;
 pub mod clean;
+mod f32_nodes;
 mod frag;
 mod gltf;
 mod msh;
@@ -107,6 +108,13 @@ pub fn load_mesh(path: &Path) -> Result<Loaded, Vec<Diagnostic>> {
 
 /// [`load_mesh`] with the format forced (`--from`).
 pub fn load_mesh_as(path: &Path, format: Option<ReadFormat>) -> Result<Loaded, Vec<Diagnostic>> {
+    if matches!(format, None | Some(ReadFormat::Stl))
+        && let Some(read) = stl::read_binary_file(path, format.is_some())
+    {
+        let mut loaded = read?.finish()?;
+        loaded.binary = Some(true);
+        return Ok(loaded);
+    }
     let bytes = std::fs::read(path).map_err(|e| {
         vec![Diagnostic::new(
             Code::MeshReadFailed,
