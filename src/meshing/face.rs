@@ -726,7 +726,14 @@ struct Coarse<'a> {
 impl Coarse<'_> {
     fn is(
         &self,
-        f: spade::handles::FaceHandle<'_, spade::handles::InnerTag, Point2<f64>, (), spade::CdtEdge<()>, ()>,
+        f: spade::handles::FaceHandle<
+            '_,
+            spade::handles::InnerTag,
+            Point2<f64>,
+            (),
+            spade::CdtEdge<()>,
+            (),
+        >,
         positions: &[Point3],
     ) -> bool {
         let [a, b, c] = f.vertices().map(|v| v.fix().index());

@@ -355,7 +355,11 @@ fn assemble(
         .iter()
         .map(|e| e.points.len().saturating_sub(2))
         .sum();
-    let loose: usize = model.point_sets.iter().map(|s| s.points.len()).sum::<usize>()
+    let loose: usize = model
+        .point_sets
+        .iter()
+        .map(|s| s.points.len())
+        .sum::<usize>()
         + lines.iter().map(Vec::len).sum::<usize>();
     let mut nodes: Vec<[f64; 3]> =
         Vec::with_capacity(model.vertices.len() + on_edges + interior + loose);
