@@ -91,6 +91,8 @@ impl Entities {
     }
 }
 
+/// Reads the document's subdomains and boundaries; every object comes from
+/// `resolved` (the driver drops the document's objects before lowering).
 pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
@@ -147,7 +149,6 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
         }
     }
     explicit::lower_topology(
-        doc,
         resolved,
         &mut model,
         &mut source_map,
