@@ -103,6 +103,13 @@ pub(super) fn lower_topology(
             e,
         );
     }
+    // An edge that did not lower was reported where it failed; the faces,
+    // subdomains and boundaries naming it must not repeat that as E200.
+    for (i, object) in resolved.objects.iter().enumerate() {
+        if matches!(object.geometry, Some(Geometry::Edge { .. })) && !edge_of.contains_key(&i) {
+            entities.failed.insert(object.name.clone());
+        }
+    }
     for object in &resolved.objects {
         let Some(Geometry::Face {
             surface,
@@ -151,6 +158,8 @@ pub(super) fn lower_topology(
             }
         }
         if !complete || chained.is_empty() {
+            // One of its edges failed and was reported; so is this face, then.
+            entities.failed.insert(object.name.clone());
             continue;
         }
         check_edges_on_surface(
