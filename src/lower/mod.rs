@@ -148,13 +148,7 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
             ),
         }
     }
-    explicit::lower_topology(
-        resolved,
-        &mut model,
-        &mut source_map,
-        &mut entities,
-        diags,
-    );
+    explicit::lower_topology(resolved, &mut model, &mut source_map, &mut entities, diags);
     let named_lists =
         !doc.boundaries.is_empty() || doc.subdomains.iter().any(|s| s.faces.is_some());
     if named_lists {
