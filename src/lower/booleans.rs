@@ -325,8 +325,9 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
     let key = |v: f64| (v / cell).floor() as i64;
     // A sorted list of (cell, box) instead of a map of cells: boxes sharing a
     // cell are adjacent after sorting, and nothing is allocated per cell.
-    // The cell range of each placeable box and how many cells it covers.
-    let ranges: Vec<Option<([i64; 3], [i64; 3], i128)>> = boxes
+    // The cell range (lowest, highest) of each placeable box and how many cells it covers.
+    type CellRange = ([i64; 3], [i64; 3], i128);
+    let ranges: Vec<Option<CellRange>> = boxes
         .iter()
         .map(|b| {
             let finite = [b.min, b.max]
