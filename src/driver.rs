@@ -162,9 +162,14 @@ fn run(
     // Everything later reads the resolved objects, not the document's: on large
     // files they are a fifth of the peak memory while the model is lowered.
     document.objects = Vec::new();
-    let lowered = lower::lower(&document, &resolved, diags);
+    let mut lowered = lower::lower(&document, &resolved, diags);
     if !extracted.is_empty() {
         *implicit = lower_implicit(source, options, &extracted, &resolved, diags);
+    }
+    if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
+        // 2D R-function regions become model entities (issue 6).
+        let (model, map) = (&mut lowered.model, &mut lowered.source_map);
+        lower::rfunction_region::add_regions(model, map, implicit, diags);
     }
     drop(resolved);
     diags.extend(crate::valid::check_topology(
