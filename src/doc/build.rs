@@ -20,6 +20,11 @@ pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Do
         title: root.attribute("name").map(|a| a.value.to_string()),
         ..Document::default()
     };
+    // One object or subdomain per top-level element in large files: sized once
+    // instead of grown by doubling (each growth copies and touches fresh pages).
+    let subdomains = root.children_named("subdomain").count();
+    doc.subdomains.reserve(subdomains);
+    doc.objects.reserve(root.children.len() - subdomains);
     for element in &root.children {
         b.top_level(element, &mut doc);
     }
@@ -111,7 +116,7 @@ impl Builder<'_> {
                     if let Some(name) = self.name(e) {
                         doc.objects.push(Object {
                             name,
-                            cs: self.reference(e, "cs"),
+                            cs: self.reference(e, "cs").map(Box::new),
                             kind,
                             span: e.name_span,
                         });
@@ -549,8 +554,8 @@ impl Builder<'_> {
             x: self.number(e, "x"),
             y: self.number(e, "y"),
             z: self.number(e, "z"),
-            point: self.reference(e, "point"),
-            tag: e.name.to_string(),
+            point: self.reference(e, "point").map(Box::new),
+            tag: point_tag(e.name),
             span: e.name_span,
         }
     }
@@ -580,6 +585,33 @@ impl Builder<'_> {
         e.children_named(name)
             .next()
             .and_then(|c| self.number(c, "value"))
+    }
+}
+
+/// The tag of a point-valued element without allocating for the usual ones.
+fn point_tag(name: &str) -> std::borrow::Cow<'static, str> {
+    const TAGS: &[&str] = &[
+        "center",
+        "first_point",
+        "second_point",
+        "bottom_center",
+        "top_center",
+        "base_point",
+        "vertex",
+        "radius_vertex",
+        "origin",
+        "begin_point",
+        "end_point",
+        "apex",
+        "near",
+        "point_a",
+        "point_b",
+        "point_c",
+        "point_d",
+    ];
+    match TAGS.iter().find(|&&t| t == name) {
+        Some(t) => std::borrow::Cow::Borrowed(t),
+        None => std::borrow::Cow::Owned(name.to_string()),
     }
 }
 

@@ -39,9 +39,10 @@ pub struct PointSpec {
     pub x: Option<Number>,
     pub y: Option<Number>,
     pub z: Option<Number>,
-    pub point: Option<Ref>,
-    /// The element's tag, for messages.
-    pub tag: String,
+    /// Boxed: most points give coordinates, and a point is stored per corner.
+    pub point: Option<Box<Ref>>,
+    /// The element's tag, for messages (borrowed for the grammar's point elements).
+    pub tag: std::borrow::Cow<'static, str>,
     /// The element's name in its start tag.
     pub span: Span,
 }
@@ -349,7 +350,8 @@ impl ObjectKind {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Object {
     pub name: Name,
-    pub cs: Option<Ref>,
+    /// Boxed: most objects have none.
+    pub cs: Option<Box<Ref>>,
     pub kind: ObjectKind,
     /// The element's name in its start tag.
     pub span: Span,

@@ -4,7 +4,7 @@
 
 use super::Entities;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::doc::{Document, ObjectKind};
+use crate::doc::Document;
 use crate::geom::{Curve, Point3, SolidShape, Surface, Vec3};
 use crate::ir::{
     Boundary, Dimension, Edge, EdgeId, Face, Model, OrientedEdge, Origin, SourceMap, Vertex,
@@ -16,7 +16,6 @@ use foldhash::{HashMap, HashMapExt};
 use std::f64::consts::TAU;
 
 pub(super) fn lower_topology(
-    doc: &Document,
     resolved: &Resolved,
     model: &mut Model,
     source_map: &mut SourceMap,
@@ -111,8 +110,13 @@ pub(super) fn lower_topology(
             entities.failed.insert(object.name.clone());
         }
     }
-    for (i, object) in resolved.objects.iter().enumerate() {
-        let Some(Geometry::Face { surface, loops }) = &object.geometry else {
+    for object in &resolved.objects {
+        let Some(Geometry::Face {
+            surface,
+            loops,
+            loop_spans,
+        }) = &object.geometry
+        else {
             continue;
         };
         let surface = match resolved
@@ -158,16 +162,12 @@ pub(super) fn lower_topology(
             entities.failed.insert(object.name.clone());
             continue;
         }
-        let loop_spans = match &doc.objects[i].kind {
-            ObjectKind::Face { loop_spans, .. } => loop_spans.clone(),
-            _ => Vec::new(),
-        };
         check_edges_on_surface(
             model,
             &chained,
             &surface,
             &object.name,
-            &loop_spans,
+            loop_spans,
             object.span,
             diags,
         );
