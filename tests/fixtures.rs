@@ -86,6 +86,9 @@ const NOT_COVERED_BY_FIXTURES: &[&str] = &[
     "E801", // mesh over --max-triangles
     "E802", // a mesh file holding nothing
     "E803", // an implicit solid without surface on its grid
+    // ---- read limits (issue 10, branch render-harden): tests/limits.rs ----
+    "E804", // glTF buffers over --max-file-size
+    "E805", // glTF accessor elements over --max-mesh-elements
 ];
 
 /// Command-line options an `args:` header may name, and whether each takes a value.

@@ -356,6 +356,12 @@ codes! {
         "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
     TrimmedUnknownVariable = "E741", Error, "unknown variable in a surface or trim expression",
         "The coordinates of a parametric_surface are expressions in u and v, and a trim's equation is an expression in the global x, y and z; other names must be parameters or basis coordinates. Rename the variable or define the parameter.";
+
+    // ---- render speed and hardening limits (issues 8 and 10, branch render-harden) ----
+    GltfBuffersTooLarge = "E804", Error, "glTF buffers over the size limit",
+        "The buffers of a glTF or GLB (its binary chunk, data URIs and buffer files) together hold more bytes than --max-file-size allows, so geomc stops before reading more. Raise the limit with --max-file-size BYTES if the file is trusted.";
+    GltfTooManyElements = "E805", Error, "glTF accessors decode too many elements",
+        "The primitives of a glTF or GLB make the reader decode more accessor elements than --max-mesh-elements allows (an accessor shared by many primitives counts each time it is used), which would take memory out of proportion to the file. Raise the limit with --max-mesh-elements N if the file is trusted.";
 }
 
 impl Code {
