@@ -161,9 +161,14 @@ fn run(
     // which keeps the peak memory of large files down.
     drop(root);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
-    let lowered = lower::lower(&document, &resolved, diags);
+    let mut lowered = lower::lower(&document, &resolved, diags);
     if !extracted.is_empty() {
         *implicit = lower_implicit(source, options, &extracted, &resolved, diags);
+    }
+    if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
+        // 2D R-function regions become model entities (issue 6).
+        let (model, map) = (&mut lowered.model, &mut lowered.source_map);
+        lower::rfunction_region::add_regions(model, map, implicit, diags);
     }
     drop(resolved);
     diags.extend(crate::valid::check_topology(
@@ -250,6 +255,11 @@ fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnos
     } else {
         Default::default()
     };
+    // A subdomain that failed to lower was reported; the faces it would have
+    // bounded must not be called stray on top of that.
+    if model.subdomains.len() < document.subdomains.len() {
+        return;
+    }
     for (b, def) in model.boundaries.iter().zip(&document.boundaries) {
         let stray_face = b.faces.iter().find(|f| !bounding.contains(&f.index()));
         let stray_edge = b

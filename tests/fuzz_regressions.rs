@@ -316,6 +316,35 @@ fn a_thin_spike_leaves_the_rest_of_the_face_at_the_minimum_angle() {
     assert!(worst < 180.0, "no triangle was checked");
 }
 
+/// A poly_line from one side of a triangle to another, its start 0.0039
+/// above the corner on one side and its end on the other (found by
+/// `triangulate`, 2026-11-26): the triangulation split the boundary where
+/// the boundary's line elements did not, so a boundary segment had one
+/// triangle. A poly_line touching its region's boundary is now refused.
+#[test]
+fn a_poly_line_touching_the_boundary_is_refused_not_meshed_non_conforming() {
+    let found = inputs("triangulate_touching");
+    assert_eq!(found.len(), 1, "triangulate_touching regression inputs");
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        assert_eq!(input.polygon, [[0.0, 0.0], [4.0, 0.0], [0.0, 3.0]]);
+        assert_eq!(input.segments, [[[0.0, 0.00390625], [3.6875, 0.0]]]);
+        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
+        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let lowered = checked.lowered.expect("the front end accepts it");
+        match geomc::meshing::mesh_model(&lowered.model, &input.options) {
+            Err(geomc::meshing::MeshError::Face { face, reason }) => {
+                assert_eq!(face, "inside", "{}", path.display());
+                assert!(
+                    reason.contains("poly_line `cut` touches or crosses its boundary"),
+                    "{reason}"
+                );
+            }
+            other => panic!("{}: expected a refusal, got {other:?}", path.display()),
+        }
+    }
+}
+
 #[path = "../fuzz/shared/density_case.rs"]
 mod density_case;
 
@@ -381,7 +410,19 @@ fn density_volume_case_reads_every_layout() {
     }
     // A header that does not end, and a raw volume one byte short.
     let checked = density_case::check(dir.path(), b"NRRD0004\ntype: uchar\n");
-    assert!(checked.diagnostics.items.iter().any(|d| d.code.as_str() == "E621"));
+    assert!(
+        checked
+            .diagnostics
+            .items
+            .iter()
+            .any(|d| d.code.as_str() == "E621")
+    );
     let checked = density_case::check(dir.path(), b"type=\"u8\" dims=\"3 3 3\"\n\x00\x01");
-    assert!(checked.diagnostics.items.iter().any(|d| d.code.as_str() == "E620"));
+    assert!(
+        checked
+            .diagnostics
+            .items
+            .iter()
+            .any(|d| d.code.as_str() == "E620")
+    );
 }

@@ -265,7 +265,8 @@ fn gltf_accessors_shared_by_many_primitives_hit_the_element_limit() {
     let run = geomc(&["convert", i, o, "--max-mesh-elements", "100"]);
     assert_refused(&run, "E805", "--max-mesh-elements", &out);
     assert!(
-        run.stderr.contains("elements read to 102, over the limit of 100"),
+        run.stderr
+            .contains("elements read to 102, over the limit of 100"),
         "{}",
         run.stderr
     );
@@ -363,8 +364,21 @@ fn render_and_inspect_mesh_honour_the_triangle_limit() {
     // An absurd tolerance is refused from the estimate, before meshing.
     let run = geomc(&["render", &xml, "-o", p, "--tolerance", "1e-9"]);
     assert_refused(&run, "E801", "--max-triangles", &png);
-    assert!(run.stderr.contains("would have at least about"), "{}", run.stderr);
-    let run = geomc(&["render", &xml, "-o", p, "--tolerance", "2%", "--max-triangles", "50"]);
+    assert!(
+        run.stderr.contains("would have at least about"),
+        "{}",
+        run.stderr
+    );
+    let run = geomc(&[
+        "render",
+        &xml,
+        "-o",
+        p,
+        "--tolerance",
+        "2%",
+        "--max-triangles",
+        "50",
+    ]);
     assert_refused(&run, "E801", "--max-triangles", &png);
     let run = geomc(&["render", &xml, "-o", p, "--tolerance", "2%"]);
     assert_eq!(run.code, Some(0), "{}", run.stderr);
@@ -386,12 +400,28 @@ fn render_and_inspect_mesh_honour_the_triangle_limit() {
     let run = geomc(&["inspect", &xml, "--mesh", "--tolerance", "1e-9"]);
     assert_eq!(run.code, Some(1), "{}", run.stderr);
     assert!(run.stderr.contains("error[E801]") && run.stderr.contains("--max-triangles"));
-    let run = geomc(&["inspect", &xml, "--mesh", "--tolerance", "2%", "--max-triangles", "50"]);
+    let run = geomc(&[
+        "inspect",
+        &xml,
+        "--mesh",
+        "--tolerance",
+        "2%",
+        "--max-triangles",
+        "50",
+    ]);
     assert_eq!(run.code, Some(1), "{}", run.stderr);
     let counted = counted_triangles(&run.stderr);
     assert!(counted > 50, "{counted}");
     let limit = counted.to_string();
-    let run = geomc(&["inspect", &xml, "--mesh", "--tolerance", "2%", "--max-triangles", &limit]);
+    let run = geomc(&[
+        "inspect",
+        &xml,
+        "--mesh",
+        "--tolerance",
+        "2%",
+        "--max-triangles",
+        &limit,
+    ]);
     assert_eq!(run.code, Some(0), "{}", run.stderr);
 }
 

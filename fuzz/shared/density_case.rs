@@ -21,7 +21,10 @@ pub fn check(dir: &Path, data: &[u8]) -> geomc::driver::Checked {
     } else {
         let split = data.iter().position(|&b| b == b'\n').unwrap_or(data.len());
         let _ = std::fs::write(dir.join("vol.raw"), data.get(split + 1..).unwrap_or(&[]));
-        ("vol.raw", String::from_utf8_lossy(&data[..split]).into_owned())
+        (
+            "vol.raw",
+            String::from_utf8_lossy(&data[..split]).into_owned(),
+        )
     };
     let xml = format!(
         "<geometry version=\"1\">\n  <density_volume name=\"v\" file=\"{file}\" level=\"0.5\" {attributes}/>\n  <subdomain name=\"s\"> <solid ref=\"v\"/> </subdomain>\n</geometry>\n"

@@ -277,8 +277,11 @@ fn load_input(
         // The file was read within its limits; drawing it is bounded too.
         let triangles: u64 = mesh.faces.iter().map(|f| f.triangles.len() as u64).sum();
         if triangles > limits.budget.max_triangles {
-            let d = super::limits::too_many_triangles(triangles, limits.budget.max_triangles, false);
-            return Err(refuse(d.with_help("raise the limit with --max-triangles N")));
+            let d =
+                super::limits::too_many_triangles(triangles, limits.budget.max_triangles, false);
+            return Err(refuse(
+                d.with_help("raise the limit with --max-triangles N"),
+            ));
         }
         return Ok(mesh);
     }

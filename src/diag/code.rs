@@ -357,6 +357,15 @@ codes! {
     TrimmedUnknownVariable = "E741", Error, "unknown variable in a surface or trim expression",
         "The coordinates of a parametric_surface are expressions in u and v, and a trim's equation is an expression in the global x, y and z; other names must be parameters or basis coordinates. Rename the variable or define the parameter.";
 
+    // ---- twod: 2D R-function regions (issue 6, branch twod) ----
+    RegionContour = "E540", Error, "2D R-function region has no simple boundary",
+        "In a dimension=\"2\" model, an implicit subdomain is the region f(x, y) >= 0 inside its box (x_min..y_max), and its boundary is the zero contour traced on the nx x ny grid. The contour found branches or crosses itself (two pieces of the region touch at a point, or the grid is too coarse to separate them). Move the pieces apart, or use more cells (nx, ny).";
+    RegionEmpty = "E541", Error, "2D R-function region is empty",
+        "The region f(x, y) >= 0 has no area on the nx x ny grid over its box (x_min..x_max, y_min..y_max): no sample is inside, or f reaches zero only at points or along lines. Check the box against where the region lies, and use more cells for thin regions.";
+    RegionNotFunction = "E542", Error, "density volume in a 2D model",
+        "A dimension=\"2\" model takes implicit regions given by functions (<rfunction>, <level_surface>, evaluated at z = 0). A <density_volume> is a 3D grid of samples and has no planar region; use it in a 3D model.";
+    RegionCutByBox = "W151", Warning, "2D R-function region reaches its box",
+        "Part of the region f(x, y) >= 0 lies on the sides of its box (x_min..x_max, y_min..y_max), so the box cuts it and its sides become boundary. Enlarge the box if the region should have its own boundary there.";
     // ---- render speed and hardening limits (issues 8 and 10, branch render-harden) ----
     GltfBuffersTooLarge = "E804", Error, "glTF buffers over the size limit",
         "The buffers of a glTF or GLB (its binary chunk, data URIs and buffer files) together hold more bytes than --max-file-size allows, so geomc stops before reading more. Raise the limit with --max-file-size BYTES if the file is trusted.";

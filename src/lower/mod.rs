@@ -8,6 +8,7 @@ mod brep;
 mod explicit;
 mod point_calculus;
 mod prune;
+pub mod rfunction_region;
 mod weld;
 mod winding;
 

@@ -41,7 +41,15 @@ pub fn render(
                 y0,
                 edges: &[],
             };
-            resolve_rows(scene, proj, &samples, ss, background, band * BAND_PIXELS, out);
+            resolve_rows(
+                scene,
+                proj,
+                &samples,
+                ss,
+                background,
+                band * BAND_PIXELS,
+                out,
+            );
         });
     Image {
         width: width as u32,

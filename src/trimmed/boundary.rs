@@ -497,7 +497,7 @@ impl Boundary {
 
 /// Moves `m` onto W = 0 across the chord a–b (root finding along the chord's
 /// normal in (u, v)); `m` itself when no root is near.
-pub(super) fn project(s: &TrimmedSurface, m: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+pub(crate) fn project(s: &TrimmedSurface, m: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     let d = [b[0] - a[0], b[1] - a[1]];
     let len = d[0].hypot(d[1]);
     if len == 0.0 {

@@ -4,7 +4,7 @@
 //! (u, v); `triangulate.rs` meshes the kept part with a constrained Delaunay
 //! triangulation refined by 3D criteria; `measure.rs` has the quality figures.
 
-mod boundary;
+pub(crate) mod boundary;
 mod chart;
 mod measure;
 pub mod program;

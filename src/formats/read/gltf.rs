@@ -270,7 +270,11 @@ impl<'a> Reader<'a> {
                         ));
                     }
                     let file = folder.join(&name);
-                    check_named_file(&file, &format!("{path}: the buffer file"), self.limits.max_file_size)?;
+                    check_named_file(
+                        &file,
+                        &format!("{path}: the buffer file"),
+                        self.limits.max_file_size,
+                    )?;
                     std::borrow::Cow::Owned(std::fs::read(&file).map_err(|e| {
                         Diagnostic::new(
                             Code::MeshReadFailed,
