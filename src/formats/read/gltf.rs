@@ -520,21 +520,6 @@ impl<'a> Reader<'a> {
             return Err(bad(&path, "sparse accessors are not read"));
         }
         let count = uint(acc, "count", &path)?.unwrap_or(0);
-        // An accessor shared by many primitives is decoded once per use: the
-        // sum, not the file, bounds the memory.
-        let decoded = self.elements.get().saturating_add(count as u64);
-        if decoded > self.limits.max_elements {
-            return Err(Diagnostic::new(
-                Code::GltfTooManyElements,
-                None,
-                format!(
-                    "{path}: decoding its {count} elements would bring the accessor elements read to {decoded}, over the limit of {}",
-                    self.limits.max_elements
-                ),
-            )
-            .with_help("raise the limit with --max-mesh-elements N"));
-        }
-        self.elements.set(decoded);
         let ctype = acc
             .get("componentType")
             .and_then(Value::as_u64)
@@ -601,6 +586,22 @@ impl<'a> Reader<'a> {
         let Some(elements) = data.get(view_offset + offset..view_end) else {
             return Err(bad(&path, "the accessor starts past its buffer view's end"));
         };
+        // A count the data cannot hold was refused above (E523). An accessor
+        // shared by many primitives is decoded once per use: the sum, not the
+        // file, bounds the memory.
+        let decoded = self.elements.get().saturating_add(count as u64);
+        if decoded > self.limits.max_elements {
+            return Err(Diagnostic::new(
+                Code::GltfTooManyElements,
+                None,
+                format!(
+                    "{path}: decoding its {count} elements would bring the accessor elements read to {decoded}, over the limit of {}",
+                    self.limits.max_elements
+                ),
+            )
+            .with_help("raise the limit with --max-mesh-elements N"));
+        }
+        self.elements.set(decoded);
         Ok((elements, stride, count, ctype, ty))
     }
 
