@@ -18,6 +18,8 @@ pub struct Options {
     pub limits: Limits,
     /// Folders besides the input's own from which data files may be read (`--allow-path`).
     pub allowed_paths: Vec<std::path::PathBuf>,
+    /// Size bounds of one attribute expression (`--max-expression-nodes`, `--max-expression-depth`).
+    pub expressions: crate::expr::ExprLimits,
 }
 
 /// The outcome of checking one source.
@@ -154,7 +156,7 @@ fn run(
     doc::structure::check(&root, &grammar::GEOMETRY, diags);
     // Implicit solids and the subdomains using them take their own path.
     let extracted = crate::implicit::xml::extract(&mut root);
-    let mut document = doc::build(source, &root, diags);
+    let mut document = doc::build_with(source, &root, diags, &options.expressions);
     // Each stage's input is dropped as soon as the next no longer needs it,
     // which keeps the peak memory of large files down.
     drop(root);

@@ -95,6 +95,9 @@ const NOT_COVERED_BY_FIXTURES: &[&str] = &[
     "E541", // empty region
     "E542", // density volume in a 2D model
     "W151", // region reaches its box
+    // ---- read limits (issue 10, branch render-harden): tests/limits.rs ----
+    "E804", // glTF buffers over --max-file-size
+    "E805", // glTF accessor elements over --max-mesh-elements
 ];
 
 /// Command-line options an `args:` header may name, and whether each takes a value.

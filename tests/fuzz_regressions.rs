@@ -372,3 +372,85 @@ fn large_area_bits_decode_without_overflow_and_mesh() {
         }
     }
 }
+
+#[path = "../fuzz/shared/density_case.rs"]
+mod density_case;
+
+/// The `density_volume` target's case (fuzz/shared/density_case.rs): the
+/// volume file written beside a domain naming it, checked, and an accepted
+/// volume polygonized. The seeds come along: valid volumes of every type and
+/// layout must be accepted and give a closed surface's triangles.
+#[test]
+fn density_volume_crashes_stay_fixed() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    for (path, bytes) in inputs("density_volume") {
+        let checked = density_case::check(dir.path(), &bytes);
+        for d in &checked.diagnostics.items {
+            let _ = geomc::diag::render_human(&checked.source, d);
+        }
+        for subdomain in &checked.implicit {
+            let surface = subdomain.polygonize(None);
+            assert!(
+                surface
+                    .triangles
+                    .iter()
+                    .flatten()
+                    .all(|&i| (i as usize) < surface.positions.len()),
+                "{}",
+                path.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn density_volume_case_reads_every_layout() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    // A 3 x 3 x 3 volume, 100 at the centre and 0 elsewhere: level 0.5 cuts
+    // every grid edge leaving the centre, so the surface is one closed shell
+    // inside the grid: non-empty, every edge shared by two triangles. Raw,
+    // NRRD with attached data and NRRD with a detached data file alike.
+    let mut u8s = vec![0u8; 27];
+    u8s[13] = 100;
+    let mut raw = b"type=\"u8\" dims=\"3 3 3\"\n".to_vec();
+    raw.extend_from_slice(&u8s);
+    let mut attached =
+        b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 3 3\nencoding: raw\n\n".to_vec();
+    attached.extend_from_slice(&u8s);
+    let mut detached =
+        b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 3 3\nencoding: raw\ndata file: data.raw\n\n"
+            .to_vec();
+    detached.extend_from_slice(&u8s);
+    for case in [raw, attached, detached] {
+        let checked = density_case::check(dir.path(), &case);
+        assert!(checked.is_valid(), "{:?}", checked.diagnostics.items);
+        assert_eq!(checked.implicit.len(), 1);
+        let surface = checked.implicit[0].polygonize(None);
+        assert!(!surface.triangles.is_empty());
+        let mut edges = std::collections::BTreeMap::new();
+        for t in &surface.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                *edges.entry((a, b)).or_insert(0) += 1;
+            }
+        }
+        assert!(edges.values().all(|&n| n == 2), "an open surface");
+    }
+    // A header that does not end, and a raw volume one byte short.
+    let checked = density_case::check(dir.path(), b"NRRD0004\ntype: uchar\n");
+    assert!(
+        checked
+            .diagnostics
+            .items
+            .iter()
+            .any(|d| d.code.as_str() == "E621")
+    );
+    let checked = density_case::check(dir.path(), b"type=\"u8\" dims=\"3 3 3\"\n\x00\x01");
+    assert!(
+        checked
+            .diagnostics
+            .items
+            .iter()
+            .any(|d| d.code.as_str() == "E620")
+    );
+}

@@ -366,6 +366,11 @@ codes! {
         "A dimension=\"2\" model takes implicit regions given by functions (<rfunction>, <level_surface>, evaluated at z = 0). A <density_volume> is a 3D grid of samples and has no planar region; use it in a 3D model.";
     RegionCutByBox = "W151", Warning, "2D R-function region reaches its box",
         "Part of the region f(x, y) >= 0 lies on the sides of its box (x_min..x_max, y_min..y_max), so the box cuts it and its sides become boundary. Enlarge the box if the region should have its own boundary there.";
+    // ---- render speed and hardening limits (issues 8 and 10, branch render-harden) ----
+    GltfBuffersTooLarge = "E804", Error, "glTF buffers over the size limit",
+        "The buffers of a glTF or GLB (its binary chunk, data URIs and buffer files) together hold more bytes than --max-file-size allows, so geomc stops before reading more. Raise the limit with --max-file-size BYTES if the file is trusted.";
+    GltfTooManyElements = "E805", Error, "glTF accessors decode too many elements",
+        "The primitives of a glTF or GLB make the reader decode more accessor elements than --max-mesh-elements allows (an accessor shared by many primitives counts each time it is used), which would take memory out of proportion to the file. Raise the limit with --max-mesh-elements N if the file is trusted.";
 }
 
 impl Code {

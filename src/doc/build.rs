@@ -5,13 +5,27 @@
 
 use super::model::*;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::expr::{self, ParseError};
+use crate::expr::{self, ExprLimits, ParseError};
 use crate::span::{SourceFile, Span};
 use crate::syntax::{Attribute, Element};
 
 /// Builds the typed document from a structurally checked tree.
 pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Document {
-    let mut b = Builder { source, diags };
+    build_with(source, root, diags, &ExprLimits::default())
+}
+
+/// [`build`] with the expression size bounds given (`--max-expression-*`).
+pub fn build_with(
+    source: &SourceFile,
+    root: &Element,
+    diags: &mut Diagnostics,
+    limits: &ExprLimits,
+) -> Document {
+    let mut b = Builder {
+        source,
+        diags,
+        limits: *limits,
+    };
     let mut doc = Document {
         dimension: match root.attribute("dimension").map(|a| a.value.trim()) {
             Some("2") => 2,
@@ -38,12 +52,19 @@ pub fn parse_attribute_expr(
     attr: &Attribute,
     diags: &mut Diagnostics,
 ) -> Option<crate::expr::Expr> {
-    Builder { source, diags }.parse_number(attr).expr
+    Builder {
+        source,
+        diags,
+        limits: ExprLimits::default(),
+    }
+    .parse_number(attr)
+    .expr
 }
 
 struct Builder<'a> {
     source: &'a SourceFile,
     diags: &'a mut Diagnostics,
+    limits: ExprLimits,
 }
 
 impl Builder<'_> {
@@ -457,7 +478,7 @@ impl Builder<'_> {
             0
         };
         let fix = |span: Span| if exact { span } else { attr.value_span };
-        match expr::parse(&attr.value, base) {
+        match expr::parse_with(&attr.value, base, &self.limits) {
             Ok(mut expr) => {
                 if !exact {
                     relocate(&mut expr, attr.value_span);
@@ -501,9 +522,12 @@ impl Builder<'_> {
                     ParseError::TooLarge { span } => Diagnostic::new(
                         Code::ExpressionTooLarge,
                         fix(span),
-                        format!("the expression in {}= exceeds the limit of 10,000 nodes or 256 levels of nesting", attr.name),
+                        format!(
+                            "the expression in {}= exceeds the limit of {} nodes or {} levels of nesting",
+                            attr.name, self.limits.max_nodes, self.limits.max_depth
+                        ),
                     )
-                    .with_help("split it into parameters"),
+                    .with_help("split it into parameters, or raise the limits with --max-expression-nodes N and --max-expression-depth N"),
                 };
                 self.diags.push(d);
                 Number {
