@@ -8,6 +8,7 @@ mod boundary;
 mod chart;
 mod measure;
 pub mod program;
+mod split;
 mod triangulate;
 
 pub use measure::{TrimmedQuality, centroid_distance};
