@@ -113,10 +113,19 @@ pub(super) fn surface(
             (
                 Carrier::Sphere { radius },
                 *frame,
-                [l0.to_radians(), l1.to_radians(), a0.to_radians(), a1.to_radians()],
+                [
+                    l0.to_radians(),
+                    l1.to_radians(),
+                    a0.to_radians(),
+                    a1.to_radians(),
+                ],
             )
         }
-        CarrierSpec::Torus { radii, tube, angles } => {
+        CarrierSpec::Torus {
+            radii,
+            tube,
+            angles,
+        } => {
             let major = r.number(radii[0].as_ref()?)?;
             let minor = r.number(radii[1].as_ref()?)?;
             let t0 = r.number(tube[0].as_ref()?)?;
@@ -137,7 +146,12 @@ pub(super) fn surface(
             (
                 Carrier::Torus { major, minor },
                 *frame,
-                [t0.to_radians(), t1.to_radians(), a0.to_radians(), a1.to_radians()],
+                [
+                    t0.to_radians(),
+                    t1.to_radians(),
+                    a0.to_radians(),
+                    a1.to_radians(),
+                ],
             )
         }
         CarrierSpec::Expressions { xyz, rect } => {
@@ -189,9 +203,15 @@ fn optional(r: &mut Resolver, n: &Option<Number>, default: f64) -> Option<f64> {
 fn trim(r: &mut Resolver, t: &TrimSpec, name: &str) -> Option<Trim> {
     let Some(equation) = t.equation.as_ref().filter(|_| !t.tree) else {
         let (what, help) = if t.tree {
-            ("both equation= and an R-function tree", "keep one of the two")
+            (
+                "both equation= and an R-function tree",
+                "keep one of the two",
+            )
         } else {
-            ("neither equation= nor an R-function tree", "give equation=\"F(x, y, z)\" or one tree such as <union>")
+            (
+                "neither equation= nor an R-function tree",
+                "give equation=\"F(x, y, z)\" or one tree such as <union>",
+            )
         };
         r.diags.push(
             Diagnostic::new(

@@ -425,6 +425,21 @@ impl Boundary {
                     last = q;
                 }
             }
+            // A contour point just before a side point (the trim reaching
+            // the side) would make a sliver there: drop it too.
+            let mut k = 1;
+            while k + 1 < kept.len() && kept.len() > 3 {
+                let (p, q) = (kept[k], kept[k + 1]);
+                let (a, b) = (self.points[p], self.points[q]);
+                if self.sides[p] == 0
+                    && self.sides[q] != 0
+                    && (s.point(a[0], a[1]) - s.point(b[0], b[1])).norm() < delta
+                {
+                    kept.remove(k);
+                } else {
+                    k += 1;
+                }
+            }
             // The closing edge: drop the last contour point if it is too close to the first.
             if kept.len() > 3 {
                 let (f, l) = (kept[0], kept[kept.len() - 1]);

@@ -29,7 +29,13 @@ pub(super) struct Nodes {
 impl Nodes {
     /// Side bits and seam twins of the boundary points (`handles[p]` is the
     /// vertex of boundary point p).
-    pub fn mark_boundary(&mut self, b: &Boundary, handles: &[usize], periodic: bool, rect: [f64; 4]) {
+    pub fn mark_boundary(
+        &mut self,
+        b: &Boundary,
+        handles: &[usize],
+        periodic: bool,
+        rect: [f64; 4],
+    ) {
         self.sides = vec![0; self.uv.len()];
         for (p, &h) in handles.iter().enumerate() {
             if let (Some(slot), Some(&bits)) = (self.sides.get_mut(h), b.sides.get(p)) {
@@ -121,7 +127,11 @@ pub(super) fn split_constraint(
         return false;
     };
     if let Some((tx, ty)) = twins {
-        let v = if seam & V_MIN != 0 { s.rect[3] } else { s.rect[2] };
+        let v = if seam & V_MIN != 0 {
+            s.rect[3]
+        } else {
+            s.rect[2]
+        };
         let bits = (common & (U_MIN | U_MAX)) | (seam ^ (V_MIN | V_MAX));
         let Some(m) = split_at(cdt, arc, s, nodes, tx, ty, [uv[0], v], bits) else {
             undo(cdt, nodes, x, y);

@@ -373,8 +373,9 @@ fn periodic_trimmed_cylinder_at_fine_sizes() {
     let s = pierced_cylinder();
     let exact = pierced_area();
     for size in [0.04, 0.02] {
+        // A tolerance loose enough for the size to govern (r = 0.3).
         let settings = TrimSettings {
-            tolerance: 0.001,
+            tolerance: 0.005,
             min_angle: 25.0,
             max_edge: size,
         };
@@ -387,7 +388,11 @@ fn periodic_trimmed_cylinder_at_fine_sizes() {
         assert!(q.min_angle >= 25.0, "size {size}: {q:?}");
         assert!(min_area(&m) > 1e-4 * size * size, "size {size}");
         assert!(q.max_centroid_distance <= settings.tolerance, "{q:?}");
-        assert!((q.area - exact).abs() / exact < 3e-3, "{} vs {exact}", q.area);
+        assert!(
+            (q.area - exact).abs() / exact < 3e-3,
+            "{} vs {exact}",
+            q.area
+        );
         let d = density(m.triangles.len(), q.area, size);
         assert!((2.0..=3.6).contains(&d), "size {size}: density {d}");
     }
@@ -505,7 +510,7 @@ fn fine(max_edge: f64) -> TrimSettings {
 
 #[test]
 fn sphere_zone_with_two_caps_cut_out() {
-    // Latitudes ±60° of the unit sphere, a full turn: 2π(sin 60° − sin(−60°));
+    // Latitudes ±30° of the unit sphere, a full turn: 2π(sin 30° − sin(−30°));
     // the cylinder y² + z² < 0.09 takes two caps of height 1 − √0.91 each,
     // one across the seam.
     let s = TrimmedSurface {
@@ -513,8 +518,8 @@ fn sphere_zone_with_two_caps_cut_out() {
         carrier: Carrier::Sphere { radius: 1.0 },
         frame: Frame::identity(),
         rect: [
-            (-60f64).to_radians(),
-            60f64.to_radians(),
+            (-30f64).to_radians(),
+            30f64.to_radians(),
             0.0,
             std::f64::consts::TAU,
         ],
@@ -527,8 +532,12 @@ fn sphere_zone_with_two_caps_cut_out() {
     assert_eq!(m.boundary.len(), 5);
     let q = m.quality(&s);
     let tau = std::f64::consts::TAU;
-    let exact = tau * 3f64.sqrt() - 2.0 * tau * (1.0 - 0.91f64.sqrt());
-    assert!((q.area - exact).abs() / exact < 3e-3, "{} vs {exact}", q.area);
+    let exact = tau - 2.0 * tau * (1.0 - 0.91f64.sqrt());
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
     assert!(q.min_angle >= 20.0, "{q:?}");
     assert!(q.max_centroid_distance <= 0.002, "{q:?}");
     for p in &m.nodes {
@@ -558,7 +567,11 @@ fn torus_outer_half_area() {
     assert_eq!(m.boundary.len(), 2);
     let q = m.quality(&s);
     let exact = std::f64::consts::TAU * minor * (std::f64::consts::PI * major + 2.0 * minor);
-    assert!((q.area - exact).abs() / exact < 3e-3, "{} vs {exact}", q.area);
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
     assert!(q.min_angle >= 20.0, "{q:?}");
     // With the cylinder y² + z² < 0.09 cut out: two holes, on the outer
     // equator at v = 0 (across the seam) and v = π; their nodes on the cylinder.
@@ -607,12 +620,22 @@ fn cylinder_in_a_local_frame_cut_by_a_global_plane() {
     assert_eq!(m.boundary.len(), 2);
     let q = m.quality(&s);
     let exact = std::f64::consts::TAU * 0.5 * 1.5;
-    assert!((q.area - exact).abs() / exact < 3e-3, "{} vs {exact}", q.area);
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
     assert!(q.min_angle >= 20.0, "{q:?}");
-    let (lo, hi) = m.nodes.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
-        (a.0.min(p.x), a.1.max(p.x))
-    });
-    assert!((lo - 1.5).abs() < 1e-8 && (hi - 3.0).abs() < 1e-8, "{lo} {hi}");
+    let (lo, hi) = m
+        .nodes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+            (a.0.min(p.x), a.1.max(p.x))
+        });
+    assert!(
+        (lo - 1.5).abs() < 1e-8 && (hi - 3.0).abs() < 1e-8,
+        "{lo} {hi}"
+    );
     for p in &m.nodes {
         assert!(((p.y - 2.0).hypot(p.z - 3.0) - 0.5).abs() < 1e-9, "{p}");
     }

@@ -12,7 +12,7 @@ use super::chart::ArcChart;
 use super::split::{Cdt, Nodes, split_constraint};
 use crate::geom::{Point3, Vec3};
 use spade::{AngleLimit, Point2, RefinementParameters, Triangulation};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Refinement rounds before the result is taken as it is.
 const MAX_PASSES: usize = 40;
@@ -118,8 +118,7 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     nodes.mark_boundary(&b, &handles, periodic, s.rect);
     // Spade stops after this many insertions (triangles of side ~h cover the
     // surface about 2·area/h² times over; room for grading near the trim).
-    let budget =
-        ((8.0 * lu * lv / (h * h)) as usize + 4 * nodes.uv.len() + 1000).min(MAX_VERTICES);
+    let budget = ((8.0 * lu * lv / (h * h)) as usize + 4 * nodes.uv.len() + 1000).min(MAX_VERTICES);
     // Spade refines by angle in the chart and never splits a constraint
     // edge: boundary splits are made here, on the true boundary (split.rs).
     let params = RefinementParameters::<f64>::new()
@@ -131,6 +130,9 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     // Triangles this small are left as they are (next to small input angles).
     let floor = (0.02 * h).min(tol);
     let fixed = nodes.uv.len();
+    // Triangles found fine stay fine while they exist (their nodes and
+    // the criteria do not change): they are not measured again.
+    let mut fine: HashSet<[usize; 3]> = HashSet::new();
     for pass in 0..=MAX_PASSES {
         let last = pass == MAX_PASSES;
         let round = if last {
@@ -157,6 +159,11 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             if last {
                 continue;
             }
+            let mut key = t;
+            key.sort_unstable();
+            if fine.contains(&key) {
+                continue;
+            }
             let p = t.map(|i| nodes.xyz[i]);
             let q = t.map(|i| nodes.uv[i]);
             let constraints: Vec<(usize, usize)> = f
@@ -168,9 +175,14 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             // Two constraint edges meet at an input angle: the angle test
             // cannot be met there.
             let angles = constraints.len() < 2;
-            if let Some(split) = needs_split(s, &p, &q, &settings, floor, angles) {
-                if let Some(a) = choose(&cdt, &arc, &nodes, split, &constraints, t[0], floor) {
-                    actions.push(a);
+            match needs_split(s, &p, &q, &settings, floor, angles) {
+                Some(split) => {
+                    if let Some(a) = choose(&cdt, &arc, &nodes, split, &constraints, t[0], floor) {
+                        actions.push(a);
+                    }
+                }
+                None => {
+                    fine.insert(key);
                 }
             }
         }
@@ -217,20 +229,6 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     let mut remap: Vec<usize> = (0..nodes.uv.len()).collect();
     if periodic {
         weld_seam(&nodes, &mut remap, &mut boundary_chains);
-    }
-    if std::env::var("GEOMC_TRIM_DEBUG").is_ok() {
-        for t in &inner {
-            let p = t.map(|i| nodes.xyz[i]);
-            if min_angle(&p) < 15.0 {
-                eprintln!(
-                    "bad {:.2}: {:?} sides {:?} fixed {:?}",
-                    min_angle(&p),
-                    t.map(|i| nodes.uv[i]),
-                    t.map(|i| nodes.sides[i]),
-                    t.map(|i| i < fixed)
-                );
-            }
-        }
     }
     let (uvs, points3) = (nodes.uv, nodes.xyz);
     Ok(assemble(&uvs, &points3, &inner, &remap, &boundary_chains))
@@ -292,7 +290,7 @@ fn needs_split(
     let radius = circle.map_or(f64::INFINITY, |c| (c - p[0]).norm());
     let on_surface = s.point(centroid_uv[0], centroid_uv[1]);
     let mut coarse = (on_surface - centroid).norm() > settings.tolerance
-        || radius > size_radius() * settings.max_edge;
+        || radius > SIZE_RADIUS * settings.max_edge;
     if !coarse {
         for k in 0..3 {
             let (a, b) = (q[k], q[(k + 1) % 3]);
@@ -328,14 +326,6 @@ fn needs_split(
     })
 }
 
-/// The circumradius bound, in units of the requested edge length.
-fn size_radius() -> f64 {
-    std::env::var("GEOMC_TRIM_K")
-        .ok()
-        .and_then(|k| k.parse().ok())
-        .unwrap_or(SIZE_RADIUS)
-}
-
 /// Ruppert's choice: the circumcentre, unless it encroaches on a boundary
 /// edge (falls in its diametral circle) or lies beyond the boundary; then
 /// that boundary edge is split instead.
@@ -358,9 +348,7 @@ fn choose(
             .iter()
             .map(|c| (c[0] - mid[0]).hypot(c[1] - mid[1]))
             .fold(0.0, f64::max);
-    let splittable = |(x, y): (usize, usize)| {
-        (nodes.xyz[x] - nodes.xyz[y]).norm() > 2.0 * floor
-    };
+    let splittable = |(x, y): (usize, usize)| (nodes.xyz[x] - nodes.xyz[y]).norm() > 2.0 * floor;
     let longest_constraint = || {
         constraints
             .iter()
@@ -450,8 +438,7 @@ fn weld_seam(nodes: &Nodes, remap: &mut [usize], chains: &mut Vec<Vec<usize>>) {
             remap[a] = b;
         }
     }
-    let along_seam =
-        |x: usize, y: usize| nodes.sides[x] & nodes.sides[y] & (V_MIN | V_MAX) != 0;
+    let along_seam = |x: usize, y: usize| nodes.sides[x] & nodes.sides[y] & (V_MIN | V_MAX) != 0;
     let mut out = Vec::new();
     for chain in chains.drain(..) {
         // Cut the closed chain at segments along the seam; rotate so a cut
