@@ -262,6 +262,11 @@ fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnos
     } else {
         Default::default()
     };
+    // A subdomain that failed to lower was reported; the faces it would have
+    // bounded must not be called stray on top of that.
+    if model.subdomains.len() < document.subdomains.len() {
+        return;
+    }
     for (b, def) in model.boundaries.iter().zip(&document.boundaries) {
         let stray_face = b.faces.iter().find(|f| !bounding.contains(&f.index()));
         let stray_edge = b

@@ -104,6 +104,13 @@ pub(super) fn lower_topology(
             e,
         );
     }
+    // An edge that did not lower was reported where it failed; the faces,
+    // subdomains and boundaries naming it must not repeat that as E200.
+    for (i, object) in resolved.objects.iter().enumerate() {
+        if matches!(object.geometry, Some(Geometry::Edge { .. })) && !edge_of.contains_key(&i) {
+            entities.failed.insert(object.name.clone());
+        }
+    }
     for (i, object) in resolved.objects.iter().enumerate() {
         let Some(Geometry::Face { surface, loops }) = &object.geometry else {
             continue;
@@ -147,6 +154,8 @@ pub(super) fn lower_topology(
             }
         }
         if !complete || chained.is_empty() {
+            // One of its edges failed and was reported; so is this face, then.
+            entities.failed.insert(object.name.clone());
             continue;
         }
         let loop_spans = match &doc.objects[i].kind {
