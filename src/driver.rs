@@ -166,7 +166,9 @@ fn run(
     document.objects = Vec::new();
     let mut lowered = lower::lower(&document, &resolved, diags);
     if !extracted.is_empty() {
-        *implicit = lower_implicit(source, options, &extracted, &resolved, diags);
+        let (subdomains, trims) = lower_implicit(source, options, &extracted, &resolved, diags);
+        *implicit = subdomains;
+        set_trims(&mut lowered.model, trims);
     }
     if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
         // 2D R-function regions become model entities (issue 6).
@@ -198,7 +200,10 @@ fn lower_implicit(
     extracted: &crate::implicit::xml::Extracted,
     resolved: &resolve::Resolved,
     diags: &mut Diagnostics,
-) -> Vec<ImplicitSubdomain> {
+) -> (
+    Vec<ImplicitSubdomain>,
+    Vec<crate::implicit::xml::LoweredTrim>,
+) {
     let folder = Path::new(&source.name)
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -218,7 +223,16 @@ fn lower_implicit(
                 .span
                 .is_some_and(|s| out.used_parameters.contains(source.snippet(s).trim()))
     });
-    out.subdomains
+    (out.subdomains, out.trims)
+}
+
+/// Gives each trimmed surface whose `<trim>` holds an R-function tree its F.
+fn set_trims(model: &mut crate::ir::Model, trims: Vec<crate::implicit::xml::LoweredTrim>) {
+    for t in trims {
+        for s in model.trimmed.iter_mut().filter(|s| s.name == t.surface) {
+            s.trim = Some(crate::trimmed::Trim::new(&t.ctx, t.root, t.negative));
+        }
+    }
 }
 
 /// Whole-model warnings: no subdomains, boundaries on no subdomain.

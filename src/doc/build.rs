@@ -263,7 +263,8 @@ impl Builder<'_> {
                     .map(|r| self.points_named(r, "node"))
                     .collect(),
             },
-            "bezier_surface" | "cone_surface" | "parametric_surface" => {
+            "bezier_surface" | "cone_surface" | "parametric_surface" | "sphere_surface"
+            | "torus_surface" => {
                 let carrier = match e.name {
                     "bezier_surface" => CarrierSpec::Bezier {
                         rows: e
@@ -278,6 +279,16 @@ impl Builder<'_> {
                         from_angle: self.number(e, "from_angle"),
                         to_angle: self.number(e, "to_angle"),
                     },
+                    "sphere_surface" => CarrierSpec::Sphere {
+                        radius: self.number(e, "radius"),
+                        latitudes: ["from_latitude", "to_latitude"].map(|a| self.number(e, a)),
+                        angles: ["from_angle", "to_angle"].map(|a| self.number(e, a)),
+                    },
+                    "torus_surface" => CarrierSpec::Torus {
+                        radii: ["major_radius", "minor_radius"].map(|a| self.number(e, a)),
+                        tube: ["from_tube_angle", "to_tube_angle"].map(|a| self.number(e, a)),
+                        angles: ["from_angle", "to_angle"].map(|a| self.number(e, a)),
+                    },
                     _ => CarrierSpec::Expressions {
                         xyz: ["x", "y", "z"].map(|a| self.number(e, a)),
                         rect: ["u_min", "u_max", "v_min", "v_max"].map(|a| self.number(e, a)),
@@ -285,6 +296,7 @@ impl Builder<'_> {
                 };
                 let trim = e.children_named("trim").next().map(|t| TrimSpec {
                     equation: self.number(t, "equation"),
+                    tree: !t.children.is_empty(),
                     negative: t
                         .attribute("material")
                         .is_some_and(|a| a.value.trim() == "negative"),

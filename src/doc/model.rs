@@ -341,6 +341,8 @@ impl ObjectKind {
             ObjectKind::Trimmed(spec) => match spec.carrier {
                 CarrierSpec::Bezier { .. } => "bezier_surface",
                 CarrierSpec::Cone { .. } => "cone_surface",
+                CarrierSpec::Sphere { .. } => "sphere_surface",
+                CarrierSpec::Torus { .. } => "torus_surface",
                 CarrierSpec::Expressions { .. } => "parametric_surface",
             },
         }
@@ -410,6 +412,18 @@ pub enum CarrierSpec {
         from_angle: Option<Number>,
         to_angle: Option<Number>,
     },
+    /// Radius; latitudes and angles (from, to), degrees.
+    Sphere {
+        radius: Option<Number>,
+        latitudes: [Option<Number>; 2],
+        angles: [Option<Number>; 2],
+    },
+    /// Major and minor radii; tube angles and angles (from, to), degrees.
+    Torus {
+        radii: [Option<Number>; 2],
+        tube: [Option<Number>; 2],
+        angles: [Option<Number>; 2],
+    },
     /// x, y, z, then u_min, u_max, v_min, v_max.
     Expressions {
         xyz: [Option<Number>; 3],
@@ -421,6 +435,8 @@ pub enum CarrierSpec {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrimSpec {
     pub equation: Option<Number>,
+    /// An R-function tree is the trim (lowered with the implicit solids).
+    pub tree: bool,
     pub negative: bool,
     pub span: Span,
 }
