@@ -18,6 +18,9 @@ mkdir -p corpus/rfs_language
 cp ../fixtures/rfs/*.rfs corpus/rfs_language/ 2>/dev/null || true
 # The triangulator: the 2D fixtures' polygons in the target's byte encoding.
 python3 triangulate_seeds.py ../fixtures/valid corpus/triangulate
+# The density-volume reader: the fixtures' raw and NRRD files in the
+# target's encoding (see shared/density_case.rs), and a few written here.
+python3 density_seeds.py ../fixtures corpus/density_volume
 # The mesh readers start from files geomc writes (the examples and the valid
 # fixtures compiled to each format); read_frag from the .frag.xml written with
 # each, its mesh files kept in frag_meshes/ where the target looks for them.

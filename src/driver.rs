@@ -18,6 +18,8 @@ pub struct Options {
     pub limits: Limits,
     /// Folders besides the input's own from which data files may be read (`--allow-path`).
     pub allowed_paths: Vec<std::path::PathBuf>,
+    /// Size bounds of one attribute expression (`--max-expression-nodes`, `--max-expression-depth`).
+    pub expressions: crate::expr::ExprLimits,
 }
 
 /// The outcome of checking one source.
@@ -154,14 +156,24 @@ fn run(
     doc::structure::check(&root, &grammar::GEOMETRY, diags);
     // Implicit solids and the subdomains using them take their own path.
     let extracted = crate::implicit::xml::extract(&mut root);
-    let document = doc::build(source, &root, diags);
+    let mut document = doc::build_with(source, &root, diags, &options.expressions);
     // Each stage's input is dropped as soon as the next no longer needs it,
     // which keeps the peak memory of large files down.
     drop(root);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
-    let lowered = lower::lower(&document, &resolved, diags);
+    // Everything later reads the resolved objects, not the document's: on large
+    // files they are a fifth of the peak memory while the model is lowered.
+    document.objects = Vec::new();
+    let mut lowered = lower::lower(&document, &resolved, diags);
     if !extracted.is_empty() {
-        *implicit = lower_implicit(source, options, &extracted, &resolved, diags);
+        let (subdomains, trims) = lower_implicit(source, options, &extracted, &resolved, diags);
+        *implicit = subdomains;
+        set_trims(&mut lowered.model, trims);
+    }
+    if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
+        // 2D R-function regions become model entities (issue 6).
+        let (model, map) = (&mut lowered.model, &mut lowered.source_map);
+        lower::rfunction_region::add_regions(model, map, implicit, diags);
     }
     drop(resolved);
     diags.extend(crate::valid::check_topology(
@@ -188,7 +200,10 @@ fn lower_implicit(
     extracted: &crate::implicit::xml::Extracted,
     resolved: &resolve::Resolved,
     diags: &mut Diagnostics,
-) -> Vec<ImplicitSubdomain> {
+) -> (
+    Vec<ImplicitSubdomain>,
+    Vec<crate::implicit::xml::LoweredTrim>,
+) {
     let folder = Path::new(&source.name)
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
@@ -208,7 +223,16 @@ fn lower_implicit(
                 .span
                 .is_some_and(|s| out.used_parameters.contains(source.snippet(s).trim()))
     });
-    out.subdomains
+    (out.subdomains, out.trims)
+}
+
+/// Gives each trimmed surface whose `<trim>` holds an R-function tree its F.
+fn set_trims(model: &mut crate::ir::Model, trims: Vec<crate::implicit::xml::LoweredTrim>) {
+    for t in trims {
+        for s in model.trimmed.iter_mut().filter(|s| s.name == t.surface) {
+            s.trim = Some(crate::trimmed::Trim::new(&t.ctx, t.root, t.negative));
+        }
+    }
 }
 
 /// Whole-model warnings: no subdomains, boundaries on no subdomain.
@@ -223,6 +247,10 @@ fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnos
             )
             .with_help("add <subdomain name=\"…\"><solid ref=\"…\"/></subdomain> to describe the domain"),
         );
+    }
+    if model.boundaries.is_empty() {
+        // Nothing to check below; the face sets are large on big models.
+        return;
     }
     let bounding: std::collections::BTreeSet<usize> = model
         .subdomains
@@ -248,6 +276,11 @@ fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnos
     } else {
         Default::default()
     };
+    // A subdomain that failed to lower was reported; the faces it would have
+    // bounded must not be called stray on top of that.
+    if model.subdomains.len() < document.subdomains.len() {
+        return;
+    }
     for (b, def) in model.boundaries.iter().zip(&document.boundaries) {
         let stray_face = b.faces.iter().find(|f| !bounding.contains(&f.index()));
         let stray_edge = b

@@ -209,3 +209,26 @@ fn inspect_prints_matrices_on_request() {
         assert!(text.contains(title), "{title} missing:\n{text}");
     }
 }
+
+#[test]
+fn a_failed_edge_is_reported_once_without_follow_on_errors() {
+    // The faces using the edge, the subdomain using those faces and the
+    // boundaries naming them all fail with it; only the cause is reported.
+    let out = geomc(&[
+        "validate",
+        "--format",
+        "json",
+        "fixtures/hostile/xml/explicit_edge_degenerate.xml",
+    ]);
+    assert_eq!(out.status.code(), Some(1));
+    let value: serde_json::Value = serde_json::from_str(&stdout(&out)).expect("JSON");
+    let codes: Vec<&str> = value
+        .as_array()
+        .expect("an array")
+        .iter()
+        .filter_map(|d| d["code"].as_str())
+        .collect();
+    assert_eq!(codes, ["E400"]);
+    assert_eq!(value[0]["line"], 13);
+    assert_eq!(value[0]["column"], 4);
+}

@@ -9,6 +9,8 @@ mod writers_common;
 use geomc::diag::Code;
 use geomc::formats::read::{Loaded, load_mesh};
 use geomc::formats::{Encoding, WriteOptions, write_mesh_file};
+use geomc::mesh::CellKind;
+use geomc::mesh::volume::cell_volume;
 use serde_json::Value;
 use std::collections::BTreeMap;
 use std::path::Path;
@@ -51,6 +53,15 @@ fn volume(l: &Loaded) -> f64 {
         .sum()
 }
 
+/// The volume of every volume cell, summed.
+fn cells_volume(l: &Loaded) -> f64 {
+    l.mesh
+        .volumes
+        .iter()
+        .flat_map(|v| v.cells().map(|c| cell_volume(v.kind, &l.mesh.nodes, c)))
+        .sum()
+}
+
 #[test]
 fn meshes_made_by_gmsh_meshio_and_trimesh_read_correctly() {
     let dir = tempfile::tempdir().expect("temp dir");
@@ -70,19 +81,25 @@ fn meshes_made_by_gmsh_meshio_and_trimesh_read_correctly() {
         // The box's boundary is closed and outward: volume 1 × 2 × 3.
         assert!(l.report.whole.watertight(), "{name}: {:?}", l.report.whole);
         assert!((volume(&l) - 6.0).abs() < 1e-9, "{name}: {}", volume(&l));
+        // The tetrahedra are kept, in the physical volume `solid`, and fill the box.
         let tets = f["tetrahedra"].as_u64().unwrap_or(0);
-        let w: Vec<&str> = l
-            .warnings
+        let kept: Vec<(&str, CellKind, usize)> = l
+            .mesh
+            .volumes
             .iter()
-            .filter(|d| d.code == Code::InputNotCarried)
-            .map(|d| d.message.as_str())
+            .map(|v| (v.name.as_str(), v.kind, v.count()))
             .collect();
         assert_eq!(
-            w,
-            [format!(
-                "volume cells are not kept (geomc converts surface meshes): {tets} tetrahedra"
-            )],
+            kept,
+            [("solid", CellKind::Tetrahedron, tets as usize)],
             "{name}"
+        );
+        let v = cells_volume(&l);
+        assert!((v - 6.0).abs() < 1e-9, "{name}: tetrahedra fill {v}");
+        assert!(
+            !l.warnings.iter().any(|d| d.code == Code::InputNotCarried),
+            "{name}: {:?}",
+            l.warnings
         );
     }
 
@@ -100,6 +117,16 @@ fn meshes_made_by_gmsh_meshio_and_trimesh_read_correctly() {
             "{name}"
         );
         assert!((volume(&l) - 6.0).abs() < 1e-9, "{name}");
+        // meshio's tetrahedra, tagged with the physical volume's number 3.
+        let tets = facts["gmsh41.msh"]["tetrahedra"].as_u64().unwrap_or(0) as usize;
+        let kept: Vec<(&str, usize)> = l
+            .mesh
+            .volumes
+            .iter()
+            .map(|v| (v.name.as_str(), v.count()))
+            .collect();
+        assert_eq!(kept, [("gmsh:physical 3:3", tets)], "{name}");
+        assert!((cells_volume(&l) - 6.0).abs() < 1e-9, "{name}");
     }
 
     for name in ["trimesh_bin.stl", "trimesh_ascii.stl", "trimesh.obj"] {

@@ -128,7 +128,9 @@ fn decode_triangulate(data: &[u8]) -> Triangulate {
         .fold(0.0, f64::max);
     let options = geomc::meshing::MeshOptions {
         min_angle_degrees: [0.0, 15.0, 20.0, 25.0][usize::from(flags & 3)],
-        max_area: Some((extent * extent / f64::from(8 + (flags >> 2 & 15) * 32)).max(1e-6)),
+        max_area: Some(
+            (extent * extent / f64::from(8 + u16::from(flags >> 2 & 15) * 32)).max(1e-6),
+        ),
         order: 1 + (flags >> 2 & 1),
         ..geomc::meshing::MeshOptions::default()
     };
@@ -314,4 +316,141 @@ fn a_thin_spike_leaves_the_rest_of_the_face_at_the_minimum_angle() {
     let (triangles, worst) = mesh_thin("spike", &input).expect("the spike meshes");
     assert!(triangles >= 200, "{triangles} triangles");
     assert!(worst < 180.0, "no triangle was checked");
+}
+
+/// A poly_line from one side of a triangle to another, its start 0.0039
+/// above the corner on one side and its end on the other (found by
+/// `triangulate`, 2026-11-26): the triangulation split the boundary where
+/// the boundary's line elements did not, so a boundary segment had one
+/// triangle. A poly_line touching its region's boundary is now refused.
+#[test]
+fn a_poly_line_touching_the_boundary_is_refused_not_meshed_non_conforming() {
+    let found = inputs("triangulate_touching");
+    assert_eq!(found.len(), 1, "triangulate_touching regression inputs");
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        assert_eq!(input.polygon, [[0.0, 0.0], [4.0, 0.0], [0.0, 3.0]]);
+        assert_eq!(input.segments, [[[0.0, 0.00390625], [3.6875, 0.0]]]);
+        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
+        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let lowered = checked.lowered.expect("the front end accepts it");
+        match geomc::meshing::mesh_model(&lowered.model, &input.options) {
+            Err(geomc::meshing::MeshError::Face { face, reason }) => {
+                assert_eq!(face, "inside", "{}", path.display());
+                assert!(
+                    reason.contains("poly_line `cut` touches or crosses its boundary"),
+                    "{reason}"
+                );
+            }
+            other => panic!("{}: expected a refusal, got {other:?}", path.display()),
+        }
+    }
+}
+
+/// Flags whose area bits are 8 or more overflowed the target's own u8
+/// arithmetic (`8 + bits * 32`) in the debug-assertion build (found by
+/// `triangulate`, 2026-11-26): the divisor is now computed in u16, and the
+/// input meshes to a sane mesh.
+#[test]
+fn large_area_bits_decode_without_overflow_and_mesh() {
+    let found = inputs("triangulate_harness");
+    assert_eq!(found.len(), 1, "triangulate_harness regression inputs");
+    for (path, bytes) in &found {
+        assert_eq!(bytes.first(), Some(&119), "{}", path.display());
+        let input = decode_triangulate(bytes);
+        // 119 = 0b01_1101_11: one segment, area bits 13, min angle 25°.
+        let extent = 4.0;
+        assert_eq!(input.options.max_area, Some(extent * extent / 424.0));
+        assert_eq!(input.options.min_angle_degrees, 25.0);
+        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
+        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let valid = checked.is_valid();
+        if let Some(lowered) = checked.lowered.filter(|_| valid)
+            && let Ok(mesh) = geomc::meshing::mesh_model(&lowered.model, &input.options)
+        {
+            geomc::meshing::sanity_check(&mesh).expect("a sane mesh");
+        }
+    }
+}
+
+#[path = "../fuzz/shared/density_case.rs"]
+mod density_case;
+
+/// The `density_volume` target's case (fuzz/shared/density_case.rs): the
+/// volume file written beside a domain naming it, checked, and an accepted
+/// volume polygonized. The seeds come along: valid volumes of every type and
+/// layout must be accepted and give a closed surface's triangles.
+#[test]
+fn density_volume_crashes_stay_fixed() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    for (path, bytes) in inputs("density_volume") {
+        let checked = density_case::check(dir.path(), &bytes);
+        for d in &checked.diagnostics.items {
+            let _ = geomc::diag::render_human(&checked.source, d);
+        }
+        for subdomain in &checked.implicit {
+            let surface = subdomain.polygonize(None);
+            assert!(
+                surface
+                    .triangles
+                    .iter()
+                    .flatten()
+                    .all(|&i| (i as usize) < surface.positions.len()),
+                "{}",
+                path.display()
+            );
+        }
+    }
+}
+
+#[test]
+fn density_volume_case_reads_every_layout() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    // A 3 x 3 x 3 volume, 100 at the centre and 0 elsewhere: level 0.5 cuts
+    // every grid edge leaving the centre, so the surface is one closed shell
+    // inside the grid: non-empty, every edge shared by two triangles. Raw,
+    // NRRD with attached data and NRRD with a detached data file alike.
+    let mut u8s = vec![0u8; 27];
+    u8s[13] = 100;
+    let mut raw = b"type=\"u8\" dims=\"3 3 3\"\n".to_vec();
+    raw.extend_from_slice(&u8s);
+    let mut attached =
+        b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 3 3\nencoding: raw\n\n".to_vec();
+    attached.extend_from_slice(&u8s);
+    let mut detached =
+        b"NRRD0004\ntype: uchar\ndimension: 3\nsizes: 3 3 3\nencoding: raw\ndata file: data.raw\n\n"
+            .to_vec();
+    detached.extend_from_slice(&u8s);
+    for case in [raw, attached, detached] {
+        let checked = density_case::check(dir.path(), &case);
+        assert!(checked.is_valid(), "{:?}", checked.diagnostics.items);
+        assert_eq!(checked.implicit.len(), 1);
+        let surface = checked.implicit[0].polygonize(None);
+        assert!(!surface.triangles.is_empty());
+        let mut edges = std::collections::BTreeMap::new();
+        for t in &surface.triangles {
+            for k in 0..3 {
+                let (a, b) = (t[k].min(t[(k + 1) % 3]), t[k].max(t[(k + 1) % 3]));
+                *edges.entry((a, b)).or_insert(0) += 1;
+            }
+        }
+        assert!(edges.values().all(|&n| n == 2), "an open surface");
+    }
+    // A header that does not end, and a raw volume one byte short.
+    let checked = density_case::check(dir.path(), b"NRRD0004\ntype: uchar\n");
+    assert!(
+        checked
+            .diagnostics
+            .items
+            .iter()
+            .any(|d| d.code.as_str() == "E621")
+    );
+    let checked = density_case::check(dir.path(), b"type=\"u8\" dims=\"3 3 3\"\n\x00\x01");
+    assert!(
+        checked
+            .diagnostics
+            .items
+            .iter()
+            .any(|d| d.code.as_str() == "E620")
+    );
 }

@@ -619,8 +619,9 @@ fn a_cylinder_through_a_box_must_be_carved_out_of_it() {
     let block = subs[1].polygonize(None);
     assert_watertight(&pin);
     assert_watertight(&block);
-    // Each is its own closed surface (the interface is meshed twice, not yet
-    // shared): the pin is the whole cylinder, the block the box minus it.
+    // Each polygonized alone is its own closed surface: the pin is the whole
+    // cylinder, the block the box minus it (compile meshes the two together
+    // with one shared interface: tests/implicit_interfaces.rs).
     // Rims and box edges are chamfered by the cells: 1.5%.
     let cylinder = PI * 0.09 * 1.8;
     let block_exact = 1.44 - PI * 0.09;

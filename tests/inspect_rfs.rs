@@ -53,3 +53,25 @@ fn inspect_refuses_a_broken_program_with_its_location() {
     assert!(stderr.contains("bad.rfs:1:32: error[E600]"), "{stderr}");
     assert!(out.stdout.is_empty());
 }
+
+#[test]
+fn a_section_plane_outside_the_box_is_warned_with_its_code_and_the_file_still_written() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let out_path = dir.path().join("balls.stl");
+    let out = geomc(&[
+        "compile",
+        "fixtures/rfs/seven_balls.rfs",
+        "-o",
+        out_path.to_str().expect("utf-8 path"),
+        "--section",
+        "z=5",
+    ]);
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert_eq!(out.status.code(), Some(0), "{stderr}");
+    assert!(
+        stderr.contains("warning[W133]: the section plane does not cut the surface of 'balls'"),
+        "{stderr}"
+    );
+    assert!(stderr.contains("move the --section plane"), "{stderr}");
+    assert!(out_path.exists());
+}

@@ -5,7 +5,7 @@
 use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, Format, out};
 use geomc::convert::{ConvertOptions, apply, inspect::MeshReport};
 use geomc::diag::{Code, Diagnostic, render_human};
-use geomc::formats::read::{ReadFormat, load_mesh_as};
+use geomc::formats::read::{ReadFormat, ReadLimits, load_mesh_limited};
 use geomc::formats::{
     Encoding, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic, writer_for_path,
 };
@@ -52,6 +52,9 @@ pub struct Args {
     /// Largest accepted input file, in bytes.
     #[arg(long, value_name = "BYTES", default_value_t = super::limits::MAX_FILE_SIZE)]
     max_file_size: u64,
+    /// Most glTF accessor elements decoded (shared accessors count per use).
+    #[arg(long, value_name = "N", default_value_t = geomc::formats::read::MAX_ELEMENTS)]
+    max_mesh_elements: u64,
 }
 
 fn non_negative(s: &str) -> Result<f64, String> {
@@ -119,8 +122,12 @@ fn read_format(name: Option<&str>) -> Result<Option<ReadFormat>, i32> {
     }
 }
 
-fn load(path: &Path, from: Option<ReadFormat>) -> Result<geomc::formats::read::Loaded, i32> {
-    load_mesh_as(path, from).map_err(|diagnostics| {
+fn load(
+    path: &Path,
+    from: Option<ReadFormat>,
+    limits: &ReadLimits,
+) -> Result<geomc::formats::read::Loaded, i32> {
+    load_mesh_limited(path, from, limits).map_err(|diagnostics| {
         report(path, &diagnostics);
         if diagnostics.iter().any(|d| d.code == Code::MeshReadFailed) {
             EXIT_USAGE
@@ -136,6 +143,7 @@ fn is_empty(mesh: &geomc::mesh::Mesh) -> bool {
         && mesh.polylines.iter().all(|p| p.nodes.is_empty())
         && mesh.point_sets.iter().all(|p| p.nodes.is_empty())
         && mesh.edges.iter().all(|e| e.nodes.len() < 2)
+        && mesh.volumes.iter().all(|v| v.nodes.is_empty())
 }
 
 pub fn run(args: &Args) -> i32 {
@@ -174,7 +182,11 @@ pub fn run(args: &Args) -> i32 {
         report(&args.input, &[d]);
         return EXIT_INVALID;
     }
-    let mut loaded = match load(&args.input, from) {
+    let limits = ReadLimits {
+        max_file_size: args.max_file_size,
+        max_elements: args.max_mesh_elements,
+    };
+    let mut loaded = match load(&args.input, from, &limits) {
         Ok(l) => l,
         Err(code) => return code,
     };
@@ -244,8 +256,13 @@ pub fn run(args: &Args) -> i32 {
                 eprint!("{}", render_human(&source, &d));
             }
             let mesh = &loaded.mesh;
+            let cells = if mesh.volumes.is_empty() || !writer.keeps_volume_cells() {
+                String::new()
+            } else {
+                format!(", {}", geomc::mesh::volume::describe(&mesh.volumes))
+            };
             eprintln!(
-                "geomc: wrote {} ({} nodes, {} triangles, {} groups)",
+                "geomc: wrote {} ({} nodes, {} triangles{cells}, {} groups)",
                 args.output.display(),
                 mesh.nodes.len(),
                 mesh.faces.iter().map(|f| f.triangles.len()).sum::<usize>(),
@@ -297,7 +314,7 @@ pub fn is_mesh_file(path: &Path) -> bool {
 
 /// `geomc inspect MESHFILE`.
 pub fn inspect(path: &Path, format: Format) -> i32 {
-    let loaded = match load(path, None) {
+    let loaded = match load(path, None, &ReadLimits::default()) {
         Ok(l) => l,
         Err(code) => return code,
     };

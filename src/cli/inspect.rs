@@ -67,6 +67,10 @@ pub fn run(args: &Args) -> i32 {
     match args.format {
         Format::Human => {
             let mut text = report.render_text(&lowered.model, args.matrices);
+            if !checked.implicit.is_empty() {
+                let entries = geomc::implicit::xml::report::entries(&checked.implicit);
+                text.push_str(&geomc::implicit::xml::report::render_text(&entries));
+            }
             if let Some(mesh) = &mesh_report {
                 text.push('\n');
                 text.push_str(&mesh.render_text());
@@ -75,6 +79,9 @@ pub fn run(args: &Args) -> i32 {
         }
         Format::Json => {
             let mut json = report.render_json(&lowered.model, args.matrices);
+            if !checked.implicit.is_empty() {
+                json = with_implicit_json(&json, &checked.implicit);
+            }
             if let Some(mesh) = &mesh_report {
                 json = super::inspect_mesh::with_mesh_json(&json, mesh);
             }
@@ -82,4 +89,14 @@ pub fn run(args: &Args) -> i32 {
         }
     }
     EXIT_OK
+}
+
+/// The report's JSON with the implicit subdomains added (`implicit_subdomains`).
+fn with_implicit_json(json: &str, implicit: &[geomc::implicit::xml::ImplicitSubdomain]) -> String {
+    let entries = geomc::implicit::xml::report::entries(implicit);
+    let mut value: serde_json::Value = serde_json::from_str(json).unwrap_or_default();
+    if let (Some(obj), Ok(list)) = (value.as_object_mut(), serde_json::to_value(entries)) {
+        obj.insert("implicit_subdomains".into(), list);
+    }
+    serde_json::to_string_pretty(&value).unwrap_or_default()
 }

@@ -14,11 +14,25 @@ pub fn report(checked: &Checked, lowered: &Lowered, args: &MeshArgs) -> Result<M
         report_usage(&[d]);
         EXIT_USAGE
     })?;
+    // Refused before meshing spends the memory, then counted, as compile does.
+    let max = args.max_triangles;
+    let estimate = super::limits::estimate_triangles(&lowered.model, &options);
+    if estimate > max {
+        let d = super::limits::too_many_triangles(estimate, max, true);
+        eprint!("{}", render_human(&checked.source, &d));
+        return Err(EXIT_INVALID);
+    }
     let mesh = mesh_model(&lowered.model, &options).map_err(|e| {
         let diagnostic = e.to_diagnostic(&lowered.model, &lowered.source_map);
         eprint!("{}", render_human(&checked.source, &diagnostic));
         EXIT_INVALID
     })?;
+    let triangles: u64 = mesh.faces.iter().map(|f| f.triangles.len() as u64).sum();
+    if triangles > max {
+        let d = super::limits::too_many_triangles(triangles, max, false);
+        eprint!("{}", render_human(&checked.source, &d));
+        return Err(EXIT_INVALID);
+    }
     Ok(MeshReport::of(
         &lowered.model,
         &mesh,

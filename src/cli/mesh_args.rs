@@ -29,6 +29,9 @@ pub struct MeshArgs {
         allow_hyphen_values = true
     )]
     pub min_angle: f64,
+    /// Most triangles in the mesh (estimated before meshing, counted after).
+    #[arg(long, value_name = "N", default_value_t = super::limits::MAX_TRIANGLES)]
+    pub max_triangles: u64,
     #[command(flatten)]
     pub solver: SolverMeshArgs,
 }

@@ -4,6 +4,7 @@
 mod compile;
 mod convert;
 mod explain;
+mod expr_limits;
 mod implicit;
 mod inspect;
 mod inspect_mesh;
@@ -75,6 +76,8 @@ pub struct InputOptions {
     /// Also read data files (density volumes, .rfs) from this folder (repeatable).
     #[arg(long = "allow-path", value_name = "DIR")]
     pub allow_path: Vec<std::path::PathBuf>,
+    #[command(flatten)]
+    pub expressions: expr_limits::ExprLimitArgs,
 }
 
 impl InputOptions {
@@ -99,6 +102,7 @@ impl InputOptions {
                 max_nodes: self.max_nodes,
             },
             allowed_paths: self.allow_path.clone(),
+            expressions: self.expressions.limits(),
         })
     }
 }

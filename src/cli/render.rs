@@ -4,7 +4,7 @@
 use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, InputOptions, report_usage};
 use geomc::diag::{Code, Diagnostic, render_human};
 use geomc::driver::check_file;
-use geomc::formats::read::load_mesh;
+use geomc::formats::read::{ReadLimits, load_mesh_limited};
 use geomc::formats::{WriteError, write_atomic};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, Tolerance, mesh_model};
@@ -78,6 +78,17 @@ pub struct Args {
     quiet: bool,
     #[command(flatten)]
     input_options: InputOptions,
+    #[command(flatten)]
+    budget: super::limits::Budget,
+    /// Most glTF accessor elements decoded (shared accessors count per use).
+    #[arg(long, value_name = "N", default_value_t = geomc::formats::read::MAX_ELEMENTS)]
+    max_mesh_elements: u64,
+}
+
+/// What an input may cost before it is drawn (issue 10).
+struct InputLimits {
+    read: ReadLimits,
+    budget: super::limits::Budget,
 }
 
 /// A failure with its code, printed as `geomc: error[E72x]: …`.
@@ -185,7 +196,21 @@ pub fn run(args: &Args) -> i32 {
         }
     };
     pool.install(|| {
-        let mesh = match load_input(&args.input, &driver_options, &mesh_options, args.quiet) {
+        let limits = InputLimits {
+            read: ReadLimits {
+                max_file_size: args.input_options.max_file_size as u64,
+                max_elements: args.max_mesh_elements,
+            },
+            budget: args.budget,
+        };
+        let loaded = load_input(
+            &args.input,
+            &driver_options,
+            &mesh_options,
+            &limits,
+            args.quiet,
+        );
+        let mesh = match loaded {
             Ok(mesh) => mesh,
             Err(exit) => return exit,
         };
@@ -221,11 +246,16 @@ fn load_input(
     path: &Path,
     options: &geomc::driver::Options,
     mesh_options: &MeshOptions,
+    limits: &InputLimits,
     quiet: bool,
 ) -> Result<Mesh, i32> {
     let fail = |f: Failure| {
         report(&f);
         f.exit
+    };
+    let refuse = |d: Diagnostic| {
+        report_usage(&[d]);
+        EXIT_INVALID
     };
     let name = path
         .file_name()
@@ -233,13 +263,27 @@ fn load_input(
         .unwrap_or("")
         .to_ascii_lowercase();
     if name.ends_with(".rfs") {
-        let (messages, loaded) =
-            super::rfs::load(path, quiet, None, &super::rfs::RfsLimits::default());
+        let rfs_limits = super::rfs::RfsLimits {
+            budget: limits.budget,
+            max_file_size: limits.read.max_file_size,
+        };
+        let (messages, loaded) = super::rfs::load(path, quiet, None, &rfs_limits);
         eprint!("{messages}");
         return loaded.map(|(mesh, _)| mesh);
     }
     if !name.ends_with(".xml") || name.ends_with(".frag.xml") {
-        return load_mesh_file(path, quiet);
+        super::limits::check_file_size(path, limits.read.max_file_size).map_err(refuse)?;
+        let mesh = load_mesh_file(path, &limits.read, quiet)?;
+        // The file was read within its limits; drawing it is bounded too.
+        let triangles: u64 = mesh.faces.iter().map(|f| f.triangles.len() as u64).sum();
+        if triangles > limits.budget.max_triangles {
+            let d =
+                super::limits::too_many_triangles(triangles, limits.budget.max_triangles, false);
+            return Err(refuse(
+                d.with_help("raise the limit with --max-triangles N"),
+            ));
+        }
+        return Ok(mesh);
     }
     let checked = match check_file(path, options) {
         Ok(c) => c,
@@ -256,18 +300,56 @@ fn load_input(
     let Some(lowered) = checked.lowered.as_ref().filter(|_| checked.is_valid()) else {
         return Err(EXIT_INVALID);
     };
-    mesh_model(&lowered.model, mesh_options).map_err(|e| {
+    let model = &lowered.model;
+    // Refused before meshing spends the memory, then counted, as compile does.
+    let max = limits.budget.max_triangles;
+    let estimate = super::limits::estimate_triangles(model, mesh_options);
+    if estimate > max {
+        let d = super::limits::too_many_triangles(estimate, max, true);
+        eprint!("{}", render_human(&checked.source, &d));
+        return Err(EXIT_INVALID);
+    }
+    // A model of implicit subdomains only has nothing for the face mesher.
+    let implicit_only = !checked.implicit.is_empty()
+        && model.vertices.is_empty()
+        && model.edges.is_empty()
+        && model.faces.is_empty()
+        && model.point_sets.is_empty();
+    let meshed = if implicit_only {
+        Ok(Mesh {
+            dimension: 3,
+            ..Default::default()
+        })
+    } else {
+        mesh_model(model, mesh_options)
+    };
+    let mut mesh = meshed.map_err(|e| {
         fail(Failure {
             code: Code::RenderInputFailed,
             message: format!("{}: {e}", path.display()),
             exit: EXIT_INVALID,
         })
-    })
+    })?;
+    // Implicit subdomains are not in the model: polygonized as compile does.
+    let limit = super::limits::MAX_GRID_CELLS;
+    if let Err(messages) =
+        super::implicit::add_to_mesh(&mut mesh, &checked, None, None, true, limit)
+    {
+        eprint!("{messages}");
+        return Err(EXIT_INVALID);
+    }
+    let triangles: u64 = mesh.faces.iter().map(|f| f.triangles.len() as u64).sum();
+    if triangles > max {
+        let d = super::limits::too_many_triangles(triangles, max, false);
+        eprint!("{}", render_human(&checked.source, &d));
+        return Err(EXIT_INVALID);
+    }
+    Ok(mesh)
 }
 
 /// A mesh file in any format geomc reads (its own codes on failure).
-fn load_mesh_file(path: &Path, quiet: bool) -> Result<Mesh, i32> {
-    match load_mesh(path) {
+fn load_mesh_file(path: &Path, limits: &ReadLimits, quiet: bool) -> Result<Mesh, i32> {
+    match load_mesh_limited(path, None, limits) {
         Ok(loaded) => {
             if !quiet {
                 let source = SourceFile::new(path.display().to_string(), "");

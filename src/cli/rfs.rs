@@ -136,11 +136,16 @@ pub fn load_with_section(
             plane,
         ) && !quiet
         {
-            messages.push_str(&format!(
-                "{}: warning[W133]: the section plane does not cut the surface of '{}'\n",
-                input.display(),
-                model.name()
-            ));
+            let d = Diagnostic::new(
+                Code::ImplicitSectionEmpty,
+                None,
+                format!(
+                    "the section plane does not cut the surface of '{}'",
+                    model.name()
+                ),
+            )
+            .with_help("move the --section plane into the solid's bounding box, or drop --section");
+            messages.push_str(&render_human(&source, &d));
         }
     }
     (messages, Ok((mesh, surface.triangles.len())))

@@ -83,6 +83,7 @@ pub fn apply(mesh: &mut Mesh, options: &ConvertOptions) -> Result<Applied, Vec<D
                     tri.swap(1, 2);
                 }
             }
+            crate::mesh::volume::permute(&mut mesh.volumes, crate::mesh::CellKind::mirror_order);
             applied
                 .notes
                 .push("the transform mirrors: triangles reversed to keep their orientation".into());
@@ -94,6 +95,12 @@ pub fn apply(mesh: &mut Mesh, options: &ConvertOptions) -> Result<Applied, Vec<D
             "--weld {eps}: {} nodes merged into others, {} collapsed triangles removed",
             w.merged, w.removed_triangles
         ));
+        if w.removed_cells > 0 {
+            applied.notes.push(format!(
+                "--weld {eps}: {} volume cells with merged corners removed",
+                w.removed_cells
+            ));
+        }
     }
     if options.normals {
         let o = orient(mesh);
@@ -105,7 +112,7 @@ pub fn apply(mesh: &mut Mesh, options: &ConvertOptions) -> Result<Applied, Vec<D
     Ok(applied)
 }
 
-/// Keeps the faces, poly_lines and point sets whose names are listed, and
+/// Keeps the faces, poly_lines, point sets and volume groups whose names are listed, and
 /// the fragments and subdomains over kept faces; unused nodes are removed.
 fn keep_groups(mesh: &mut Mesh, names: &[String]) -> Result<(), Vec<Diagnostic>> {
     let known: Vec<&str> = mesh
@@ -115,6 +122,7 @@ fn keep_groups(mesh: &mut Mesh, names: &[String]) -> Result<(), Vec<Diagnostic>>
         .chain(mesh.polylines.iter().map(|p| p.name.as_str()))
         .chain(mesh.point_sets.iter().map(|p| p.name.as_str()))
         .chain(mesh.fragments.iter().map(|f| f.name.as_str()))
+        .chain(mesh.volumes.iter().map(|v| v.name.as_str()))
         .collect();
     let errors: Vec<Diagnostic> = names
         .iter()
@@ -167,6 +175,7 @@ fn keep_groups(mesh: &mut Mesh, names: &[String]) -> Result<(), Vec<Diagnostic>>
     }
     mesh.polylines.retain(|p| keep(&p.name));
     mesh.point_sets.retain(|p| keep(&p.name));
+    mesh.volumes.retain(|v| keep(&v.name));
     mesh.vertices.clear();
     mesh.edges.clear();
     for f in &mut mesh.faces {
@@ -194,6 +203,10 @@ pub fn compact_nodes(mesh: &mut Mesh) {
         .flat_map(|p| &p.nodes)
         .for_each(|&n| mark(n));
     mesh.vertices.iter().for_each(|v| mark(v.node));
+    mesh.volumes
+        .iter()
+        .flat_map(|v| &v.nodes)
+        .for_each(|&n| mark(n));
     if used.iter().all(|&u| u) {
         return;
     }
@@ -226,6 +239,10 @@ pub(crate) fn renumber(mesh: &mut Mesh, map: &[u32]) {
         .flat_map(|p| p.nodes.iter_mut())
         .for_each(m);
     mesh.vertices.iter_mut().for_each(|v| m(&mut v.node));
+    mesh.volumes
+        .iter_mut()
+        .flat_map(|v| v.nodes.iter_mut())
+        .for_each(m);
 }
 
 type M3 = [[f64; 3]; 3];

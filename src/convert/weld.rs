@@ -10,6 +10,8 @@ use crate::mesh::Mesh;
 pub struct Welded {
     pub merged: usize,
     pub removed_triangles: usize,
+    /// Volume cells two of whose corners became one node.
+    pub removed_cells: usize,
 }
 
 pub fn weld(mesh: &mut Mesh, eps: f64) -> Welded {
@@ -75,6 +77,20 @@ pub fn weld(mesh: &mut Mesh, eps: f64) -> Welded {
         for p in &mut mesh.polylines {
             p.nodes.dedup();
         }
+        for v in &mut mesh.volumes {
+            let per = v.kind.corners();
+            let before = v.nodes.len();
+            let mut kept = Vec::with_capacity(before);
+            for cell in v.nodes.chunks_exact(per) {
+                let distinct = (1..per).all(|i| !cell[..i].contains(&cell[i]));
+                if distinct {
+                    kept.extend_from_slice(cell);
+                }
+            }
+            out.removed_cells += (before - kept.len()) / per;
+            v.nodes = kept;
+        }
+        mesh.volumes.retain(|v| !v.nodes.is_empty());
         compact_nodes(mesh);
     }
     out

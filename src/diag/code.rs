@@ -353,9 +353,26 @@ codes! {
 
     // ---- trimmed parametric surfaces (issue 9, branch trim) ----
     TrimmedCarrierInvalid = "E740", Error, "invalid parametric surface",
-        "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
+        "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a sphere_surface a positive radius and -90 < from_latitude < to_latitude < 90; a torus_surface 0 < minor_radius < major_radius and tube angles less than a full turn apart; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
     TrimmedUnknownVariable = "E741", Error, "unknown variable in a surface or trim expression",
         "The coordinates of a parametric_surface are expressions in u and v, and a trim's equation is an expression in the global x, y and z; other names must be parameters or basis coordinates. Rename the variable or define the parameter.";
+    TrimmedTrimForm = "E742", Error, "a trim needs exactly one of equation= and an R-function tree",
+        "A <trim> says where the surface keeps material by F(x, y, z) given either as equation=\"...\" or as one R-function tree child (<union>, <intersection>, <difference>, <formula>, primitives, <call>), as inside <rfunction>. Remove one of the two, or add one.";
+
+    // ---- twod: 2D R-function regions (issue 6, branch twod) ----
+    RegionContour = "E540", Error, "2D R-function region has no simple boundary",
+        "In a dimension=\"2\" model, an implicit subdomain is the region f(x, y) >= 0 inside its box (x_min..y_max), and its boundary is the zero contour traced on the nx x ny grid. The contour found branches or crosses itself (two pieces of the region touch at a point, or the grid is too coarse to separate them). Move the pieces apart, or use more cells (nx, ny).";
+    RegionEmpty = "E541", Error, "2D R-function region is empty",
+        "The region f(x, y) >= 0 has no area on the nx x ny grid over its box (x_min..x_max, y_min..y_max): no sample is inside, or f reaches zero only at points or along lines. Check the box against where the region lies, and use more cells for thin regions.";
+    RegionNotFunction = "E542", Error, "density volume in a 2D model",
+        "A dimension=\"2\" model takes implicit regions given by functions (<rfunction>, <level_surface>, evaluated at z = 0). A <density_volume> is a 3D grid of samples and has no planar region; use it in a 3D model.";
+    RegionCutByBox = "W151", Warning, "2D R-function region reaches its box",
+        "Part of the region f(x, y) >= 0 lies on the sides of its box (x_min..x_max, y_min..y_max), so the box cuts it and its sides become boundary. Enlarge the box if the region should have its own boundary there.";
+    // ---- render speed and hardening limits (issues 8 and 10, branch render-harden) ----
+    GltfBuffersTooLarge = "E804", Error, "glTF buffers over the size limit",
+        "The buffers of a glTF or GLB (its binary chunk, data URIs and buffer files) together hold more bytes than --max-file-size allows, so geomc stops before reading more. Raise the limit with --max-file-size BYTES if the file is trusted.";
+    GltfTooManyElements = "E805", Error, "glTF accessors decode too many elements",
+        "The primitives of a glTF or GLB make the reader decode more accessor elements than --max-mesh-elements allows (an accessor shared by many primitives counts each time it is used), which would take memory out of proportion to the file. Raise the limit with --max-mesh-elements N if the file is trusted.";
 }
 
 impl Code {

@@ -5,13 +5,27 @@
 
 use super::model::*;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::expr::{self, ParseError};
+use crate::expr::{self, ExprLimits, ParseError};
 use crate::span::{SourceFile, Span};
 use crate::syntax::{Attribute, Element};
 
 /// Builds the typed document from a structurally checked tree.
 pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Document {
-    let mut b = Builder { source, diags };
+    build_with(source, root, diags, &ExprLimits::default())
+}
+
+/// [`build`] with the expression size bounds given (`--max-expression-*`).
+pub fn build_with(
+    source: &SourceFile,
+    root: &Element,
+    diags: &mut Diagnostics,
+    limits: &ExprLimits,
+) -> Document {
+    let mut b = Builder {
+        source,
+        diags,
+        limits: *limits,
+    };
     let mut doc = Document {
         dimension: match root.attribute("dimension").map(|a| a.value.trim()) {
             Some("2") => 2,
@@ -20,6 +34,11 @@ pub fn build(source: &SourceFile, root: &Element, diags: &mut Diagnostics) -> Do
         title: root.attribute("name").map(|a| a.value.to_string()),
         ..Document::default()
     };
+    // One object or subdomain per top-level element in large files: sized once
+    // instead of grown by doubling (each growth copies and touches fresh pages).
+    let subdomains = root.children_named("subdomain").count();
+    doc.subdomains.reserve(subdomains);
+    doc.objects.reserve(root.children.len() - subdomains);
     for element in &root.children {
         b.top_level(element, &mut doc);
     }
@@ -33,12 +52,19 @@ pub fn parse_attribute_expr(
     attr: &Attribute,
     diags: &mut Diagnostics,
 ) -> Option<crate::expr::Expr> {
-    Builder { source, diags }.parse_number(attr).expr
+    Builder {
+        source,
+        diags,
+        limits: ExprLimits::default(),
+    }
+    .parse_number(attr)
+    .expr
 }
 
 struct Builder<'a> {
     source: &'a SourceFile,
     diags: &'a mut Diagnostics,
+    limits: ExprLimits,
 }
 
 impl Builder<'_> {
@@ -111,7 +137,7 @@ impl Builder<'_> {
                     if let Some(name) = self.name(e) {
                         doc.objects.push(Object {
                             name,
-                            cs: self.reference(e, "cs"),
+                            cs: self.reference(e, "cs").map(Box::new),
                             kind,
                             span: e.name_span,
                         });
@@ -237,7 +263,8 @@ impl Builder<'_> {
                     .map(|r| self.points_named(r, "node"))
                     .collect(),
             },
-            "bezier_surface" | "cone_surface" | "parametric_surface" => {
+            "bezier_surface" | "cone_surface" | "parametric_surface" | "sphere_surface"
+            | "torus_surface" => {
                 let carrier = match e.name {
                     "bezier_surface" => CarrierSpec::Bezier {
                         rows: e
@@ -252,6 +279,16 @@ impl Builder<'_> {
                         from_angle: self.number(e, "from_angle"),
                         to_angle: self.number(e, "to_angle"),
                     },
+                    "sphere_surface" => CarrierSpec::Sphere {
+                        radius: self.number(e, "radius"),
+                        latitudes: ["from_latitude", "to_latitude"].map(|a| self.number(e, a)),
+                        angles: ["from_angle", "to_angle"].map(|a| self.number(e, a)),
+                    },
+                    "torus_surface" => CarrierSpec::Torus {
+                        radii: ["major_radius", "minor_radius"].map(|a| self.number(e, a)),
+                        tube: ["from_tube_angle", "to_tube_angle"].map(|a| self.number(e, a)),
+                        angles: ["from_angle", "to_angle"].map(|a| self.number(e, a)),
+                    },
                     _ => CarrierSpec::Expressions {
                         xyz: ["x", "y", "z"].map(|a| self.number(e, a)),
                         rect: ["u_min", "u_max", "v_min", "v_max"].map(|a| self.number(e, a)),
@@ -259,6 +296,7 @@ impl Builder<'_> {
                 };
                 let trim = e.children_named("trim").next().map(|t| TrimSpec {
                     equation: self.number(t, "equation"),
+                    tree: !t.children.is_empty(),
                     negative: t
                         .attribute("material")
                         .is_some_and(|a| a.value.trim() == "negative"),
@@ -452,7 +490,7 @@ impl Builder<'_> {
             0
         };
         let fix = |span: Span| if exact { span } else { attr.value_span };
-        match expr::parse(&attr.value, base) {
+        match expr::parse_with(&attr.value, base, &self.limits) {
             Ok(mut expr) => {
                 if !exact {
                     relocate(&mut expr, attr.value_span);
@@ -496,9 +534,12 @@ impl Builder<'_> {
                     ParseError::TooLarge { span } => Diagnostic::new(
                         Code::ExpressionTooLarge,
                         fix(span),
-                        format!("the expression in {}= exceeds the limit of 10,000 nodes or 256 levels of nesting", attr.name),
+                        format!(
+                            "the expression in {}= exceeds the limit of {} nodes or {} levels of nesting",
+                            attr.name, self.limits.max_nodes, self.limits.max_depth
+                        ),
                     )
-                    .with_help("split it into parameters"),
+                    .with_help("split it into parameters, or raise the limits with --max-expression-nodes N and --max-expression-depth N"),
                 };
                 self.diags.push(d);
                 Number {
@@ -549,8 +590,8 @@ impl Builder<'_> {
             x: self.number(e, "x"),
             y: self.number(e, "y"),
             z: self.number(e, "z"),
-            point: self.reference(e, "point"),
-            tag: e.name.to_string(),
+            point: self.reference(e, "point").map(Box::new),
+            tag: point_tag(e.name),
             span: e.name_span,
         }
     }
@@ -580,6 +621,33 @@ impl Builder<'_> {
         e.children_named(name)
             .next()
             .and_then(|c| self.number(c, "value"))
+    }
+}
+
+/// The tag of a point-valued element without allocating for the usual ones.
+fn point_tag(name: &str) -> std::borrow::Cow<'static, str> {
+    const TAGS: &[&str] = &[
+        "center",
+        "first_point",
+        "second_point",
+        "bottom_center",
+        "top_center",
+        "base_point",
+        "vertex",
+        "radius_vertex",
+        "origin",
+        "begin_point",
+        "end_point",
+        "apex",
+        "near",
+        "point_a",
+        "point_b",
+        "point_c",
+        "point_d",
+    ];
+    match TAGS.iter().find(|&&t| t == name) {
+        Some(t) => std::borrow::Cow::Borrowed(t),
+        None => std::borrow::Cow::Owned(name.to_string()),
     }
 }
 

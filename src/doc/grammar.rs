@@ -409,14 +409,21 @@ pub static PATCH9: Rule = Rule {
 // ---- trimmed parametric surfaces (paper 002) ----
 
 /// Where the surface keeps material: F(x, y, z) ≥ 0 (`positive`, the
-/// default) or ≤ 0 (`negative`), F in global coordinates.
-pub static TRIM: Rule = leaf(
-    "trim",
-    &[
-        req("equation", Expr),
+/// default) or ≤ 0 (`negative`), F in global coordinates, given by
+/// `equation=` or by one R-function tree (as in `<rfunction>`).
+pub static TRIM: Rule = Rule {
+    name: "trim",
+    attrs: &[
+        opt("equation", Expr),
         opt("material", AttrKind::Enum(&["positive", "negative"])),
     ],
-);
+    any_attrs: false,
+    content: Content::Choice {
+        options: &R_TREE,
+        min: 0,
+        max: Some(1),
+    },
+};
 pub static BEZIER_NODE: Rule = leaf("node", POINT_ATTRS);
 pub static BEZIER_ROW: Rule = Rule {
     name: "row",
@@ -459,6 +466,41 @@ pub static PARAMETRIC_SURFACE: Rule = Rule {
         req("u_max", Expr),
         req("v_min", Expr),
         req("v_max", Expr),
+    ],
+    any_attrs: false,
+    content: Content::Sequence(&[maybe(&TRIM)]),
+};
+
+/// A sphere patch about the local origin: latitude u from the local xz
+/// plane towards +y, longitude v about the local y axis (degrees). The
+/// poles are left out (a latitude of ±90° is E740).
+pub static SPHERE_SURFACE: Rule = Rule {
+    name: "sphere_surface",
+    attrs: &[
+        req("name", Name),
+        opt("cs", Ref),
+        req("radius", Expr),
+        req("from_latitude", Expr),
+        req("to_latitude", Expr),
+        opt("from_angle", Expr),
+        opt("to_angle", Expr),
+    ],
+    any_attrs: false,
+    content: Content::Sequence(&[maybe(&TRIM)]),
+};
+/// A torus patch about the local y axis: tube angle u, angle v about the
+/// axis (degrees); less than a full turn of the tube.
+pub static TORUS_SURFACE: Rule = Rule {
+    name: "torus_surface",
+    attrs: &[
+        req("name", Name),
+        opt("cs", Ref),
+        req("major_radius", Expr),
+        req("minor_radius", Expr),
+        req("from_tube_angle", Expr),
+        req("to_tube_angle", Expr),
+        opt("from_angle", Expr),
+        opt("to_angle", Expr),
     ],
     any_attrs: false,
     content: Content::Sequence(&[maybe(&TRIM)]),
@@ -984,6 +1026,8 @@ pub static GEOMETRY: Rule = Rule {
             &BEZIER_SURFACE,
             &CONE_SURFACE,
             &PARAMETRIC_SURFACE,
+            &SPHERE_SURFACE,
+            &TORUS_SURFACE,
             &TRANSFORM,
             &REPLICATE,
             &SURFACE,

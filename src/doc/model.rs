@@ -39,9 +39,10 @@ pub struct PointSpec {
     pub x: Option<Number>,
     pub y: Option<Number>,
     pub z: Option<Number>,
-    pub point: Option<Ref>,
-    /// The element's tag, for messages.
-    pub tag: String,
+    /// Boxed: most points give coordinates, and a point is stored per corner.
+    pub point: Option<Box<Ref>>,
+    /// The element's tag, for messages (borrowed for the grammar's point elements).
+    pub tag: std::borrow::Cow<'static, str>,
     /// The element's name in its start tag.
     pub span: Span,
 }
@@ -340,6 +341,8 @@ impl ObjectKind {
             ObjectKind::Trimmed(spec) => match spec.carrier {
                 CarrierSpec::Bezier { .. } => "bezier_surface",
                 CarrierSpec::Cone { .. } => "cone_surface",
+                CarrierSpec::Sphere { .. } => "sphere_surface",
+                CarrierSpec::Torus { .. } => "torus_surface",
                 CarrierSpec::Expressions { .. } => "parametric_surface",
             },
         }
@@ -349,7 +352,8 @@ impl ObjectKind {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Object {
     pub name: Name,
-    pub cs: Option<Ref>,
+    /// Boxed: most objects have none.
+    pub cs: Option<Box<Ref>>,
     pub kind: ObjectKind,
     /// The element's name in its start tag.
     pub span: Span,
@@ -408,6 +412,18 @@ pub enum CarrierSpec {
         from_angle: Option<Number>,
         to_angle: Option<Number>,
     },
+    /// Radius; latitudes and angles (from, to), degrees.
+    Sphere {
+        radius: Option<Number>,
+        latitudes: [Option<Number>; 2],
+        angles: [Option<Number>; 2],
+    },
+    /// Major and minor radii; tube angles and angles (from, to), degrees.
+    Torus {
+        radii: [Option<Number>; 2],
+        tube: [Option<Number>; 2],
+        angles: [Option<Number>; 2],
+    },
     /// x, y, z, then u_min, u_max, v_min, v_max.
     Expressions {
         xyz: [Option<Number>; 3],
@@ -419,6 +435,8 @@ pub enum CarrierSpec {
 #[derive(Debug, Clone, PartialEq)]
 pub struct TrimSpec {
     pub equation: Option<Number>,
+    /// An R-function tree is the trim (lowered with the implicit solids).
+    pub tree: bool,
     pub negative: bool,
     pub span: Span,
 }

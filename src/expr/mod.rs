@@ -9,7 +9,7 @@ mod eval;
 mod parse;
 
 pub use eval::{EvalError, eval};
-pub use parse::{ParseError, parse};
+pub use parse::{ExprLimits, MAX_DEPTH, MAX_NODES, ParseError, parse, parse_with};
 
 use crate::span::Span;
 

@@ -4,10 +4,27 @@
 use super::{BinaryOp, Expr, ExprKind, Function};
 use crate::span::Span;
 
-/// Most nodes one expression may have.
+/// Most nodes one expression may have (the default; `--max-expression-nodes`).
 pub const MAX_NODES: usize = 10_000;
-/// Deepest nesting of one expression.
+/// Deepest nesting of one expression (the default; `--max-expression-depth`).
 pub const MAX_DEPTH: usize = 256;
+
+/// The size bounds of one expression. Parsing, evaluation and dropping
+/// recurse over the tree, so the depth stays bounded even when raised.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ExprLimits {
+    pub max_nodes: usize,
+    pub max_depth: usize,
+}
+
+impl Default for ExprLimits {
+    fn default() -> ExprLimits {
+        ExprLimits {
+            max_nodes: MAX_NODES,
+            max_depth: MAX_DEPTH,
+        }
+    }
+}
 
 #[derive(Debug, Clone, PartialEq)]
 pub enum ParseError {
@@ -42,6 +59,11 @@ enum Token {
 
 /// Parses `text`, whose first byte is at absolute offset `base` in the source file.
 pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
+    parse_with(text, base, &ExprLimits::default())
+}
+
+/// [`parse`] with the size bounds given.
+pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
     let tokens = lex(text, base)?;
     let end = base + text.len();
     let mut parser = Parser {
@@ -49,6 +71,7 @@ pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
         pos: 0,
         nodes: 0,
         end,
+        limits: *limits,
     };
     if parser.tokens.is_empty() {
         return Err(ParseError::Syntax {
@@ -152,6 +175,7 @@ struct Parser {
     pos: usize,
     nodes: usize,
     end: usize,
+    limits: ExprLimits,
 }
 
 /// Binding powers: (left, right). `^` is right-associative and binds tighter
@@ -179,7 +203,7 @@ impl Parser {
 
     fn node(&mut self, span: Span) -> Result<(), ParseError> {
         self.nodes += 1;
-        if self.nodes > MAX_NODES {
+        if self.nodes > self.limits.max_nodes {
             return Err(ParseError::TooLarge { span });
         }
         Ok(())
@@ -202,7 +226,7 @@ impl Parser {
             let span = Span::new(left.span.start as usize, right.span.end as usize);
             self.node(span)?;
             left_depth = left_depth.max(right_depth) + 1;
-            if left_depth > MAX_DEPTH {
+            if left_depth > self.limits.max_depth {
                 return Err(ParseError::TooLarge { span });
             }
             left = Expr {
@@ -220,7 +244,7 @@ impl Parser {
                 message: "expected a number, a name or '(' but the expression ends".into(),
             });
         };
-        if depth > MAX_DEPTH {
+        if depth > self.limits.max_depth {
             return Err(ParseError::TooLarge { span });
         }
         self.node(span)?;

@@ -44,6 +44,7 @@ impl MeshWriter for Gltf {
         groups::check(mesh)?;
         let doc = Document::of(mesh, self.name());
         let mut warnings = doc.warnings.clone();
+        warnings.extend(groups::dropped_volumes(self.name(), mesh));
         if options.encoding.is_some() {
             warnings.push(warning(
                 self.name(),
@@ -255,6 +256,10 @@ impl Document {
     }
 
     fn triangles(&mut self, ex: &groups::Expanded) -> Value {
+        // Positions, normals and indices in one reservation (three would
+        // reallocate and copy the buffer twice).
+        self.buffer
+            .reserve(24 * ex.positions.len() + 12 * ex.triangles.len());
         let position = self.vec3_accessor(ex.positions.iter().map(|p| p.map(|c| c as f32)), true);
         let normal = self.vec3_accessor(ex.normals.iter().map(|n| n.map(|c| c as f32)), false);
         let flat = ex.triangles.as_flattened();

@@ -73,6 +73,14 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
             ));
         }
     }
+    for v in &mesh.volumes {
+        if v.nodes.len() % v.kind.corners() != 0 || !v.nodes.iter().all(node_ok) {
+            return bad(format!(
+                "volume `{}` has a cell with a node out of range or missing",
+                v.name
+            ));
+        }
+    }
     for p in mesh.polylines.iter().chain(&mesh.point_sets) {
         if !p.nodes.iter().all(node_ok) {
             return bad(format!("`{}` refers to a node out of range", p.name));
@@ -275,11 +283,15 @@ fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
         .iter()
         .map(|&(f, _)| mesh.faces[f as usize].triangles.len())
         .sum();
+    // Each node once per face: at most all nodes, at most three per triangle
+    // (reserved at once: growing by doubling copied and touched twice the memory).
+    let vertices = mesh.nodes.len().min(3 * triangles);
     let mut out = Expanded {
         triangles: Vec::with_capacity(triangles),
-        ..Expanded::default()
+        positions: Vec::with_capacity(vertices),
+        nodes: Vec::with_capacity(vertices),
+        normals: Vec::with_capacity(vertices),
     };
-    let mut sums: Vec<[f64; 3]> = Vec::new();
     for &(face, flip) in faces {
         if ex.stamp == u32::MAX - 1 {
             ex.slot.fill((u32::MAX, 0));
@@ -288,7 +300,6 @@ fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
         ex.stamp += 1;
         let stamp = ex.stamp;
         let first = out.positions.len();
-        sums.clear();
         let mut total = [0.0; 3];
         for tri in oriented(mesh, face, flip) {
             let n = triangle_normal(mesh, tri);
@@ -299,19 +310,22 @@ fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
                 if entry.0 != stamp {
                     out.positions.push(mesh.nodes[node as usize]);
                     out.nodes.push(node);
-                    sums.push([0.0; 3]);
+                    // The area-weighted sum of the normals around the node,
+                    // made a unit vector once the face is done.
+                    out.normals.push([0.0; 3]);
                     *entry = (stamp, (out.positions.len() - 1) as u32);
                 }
-                let index = entry.1;
+                let index = entry.1 as usize;
                 // Area weighting: the unnormalised cross product is twice the area.
-                sums[index as usize - first] = add(sums[index as usize - first], n);
-                t[k] = index;
+                out.normals[index] = add(out.normals[index], n);
+                t[k] = entry.1;
             }
             out.triangles.push(t);
         }
         let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
-        out.normals
-            .extend(sums.iter().map(|&s| unit(s).unwrap_or(fallback)));
+        for s in &mut out.normals[first..] {
+            *s = unit(*s).unwrap_or(fallback);
+        }
     }
     out
 }
@@ -382,4 +396,29 @@ pub(crate) fn bounds(
             [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
         )
     }))
+}
+
+/// The warning of a surface format given a mesh with volume cells: they are
+/// not written (only the mesh's surface triangles are), said with counts.
+pub(crate) fn dropped_volumes(format: &'static str, mesh: &Mesh) -> Option<super::Warning> {
+    if mesh.volumes.is_empty() {
+        return None;
+    }
+    Some(super::warning(
+        format,
+        format!(
+            "{format} holds surfaces only: {} in {} not written (convert to .msh or .vtu to keep them)",
+            crate::mesh::volume::describe(&mesh.volumes),
+            super::count(
+                {
+                    let mut names: Vec<&str> =
+                        mesh.volumes.iter().map(|v| v.name.as_str()).collect();
+                    names.sort_unstable();
+                    names.dedup();
+                    names.len()
+                },
+                "volume group"
+            )
+        ),
+    ))
 }

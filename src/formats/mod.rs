@@ -106,6 +106,11 @@ pub trait MeshWriter: Sync {
     ) -> Result<Vec<SideFile>, WriteError> {
         Ok(Vec::new())
     }
+    /// Whether the format holds volume cells (MSH, VTU); the others warn
+    /// that they drop them.
+    fn keeps_volume_cells(&self) -> bool {
+        false
+    }
 }
 
 /// Every writer, in the order `--help` lists them.

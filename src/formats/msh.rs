@@ -7,8 +7,10 @@
 //! (dim 2 in 3D, 1 in 2D), every subdomain (dim 3 in 3D; in 2D its region
 //! faces, dim 2), faces in neither kind of group (dim 2, by face name),
 //! poly_lines (dim 1, as extra curves) and point sets (dim 0, one extra point
-//! entity per point). Elements (15 point, 1 line, 2 triangle; second order: 8
-//! 3-node line, 9 6-node triangle) are written per
+//! entity per point), volume cells read from another file (dim 3, one
+//! entity per group and cell kind). Elements (15 point, 1 line, 2 triangle;
+//! second order: 8 3-node line, 9 6-node triangle; 4 tetrahedron, 5
+//! hexahedron, 6 prism, 7 pyramid) are written per
 //! entity, only for entities in a physical group — what Gmsh itself saves by
 //! default, and what meshio needs to attach groups to every element block.
 
@@ -28,6 +30,10 @@ impl MeshWriter for Msh {
 
     fn extensions(&self) -> &'static [&'static str] {
         &["msh"]
+    }
+
+    fn keeps_volume_cells(&self) -> bool {
+        true
     }
 
     fn write(
@@ -75,6 +81,8 @@ struct Entity {
     /// other (one allocation per entity, not per element).
     elements: Vec<u32>,
     per: usize,
+    /// The Gmsh element type when `per` does not tell it (volume cells).
+    gmsh_type: Option<i32>,
 }
 
 impl Entity {
@@ -91,6 +99,7 @@ impl Entity {
             used: Vec::new(),
             elements: Vec::new(),
             per: 1,
+            gmsh_type: None,
         }
     }
 }
@@ -227,6 +236,22 @@ impl Model {
                     face_grouped[f as usize] = true;
                 }
             }
+        }
+        for v in &mesh.volumes {
+            // One physical group per name, shared with a subdomain of that name.
+            let tag = names
+                .list
+                .iter()
+                .find(|(d, _, n)| *d == 3 && *n == v.name.replace('"', "'"))
+                .map(|(_, t, _)| *t)
+                .unwrap_or_else(|| names.add(3, &v.name));
+            let mut e = Entity::new(volumes.len() + 1);
+            e.physicals.push(tag);
+            e.used = v.nodes.clone();
+            e.elements = v.nodes.clone();
+            e.per = v.kind.corners();
+            e.gmsh_type = Some(v.kind.gmsh_type());
+            volumes.push(e);
         }
         for (i, face) in mesh.faces.iter().enumerate() {
             if !face_grouped[i] {
@@ -597,13 +622,13 @@ fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
     for (dim, e) in blocks {
         // Gmsh element types: 15 point, 1 line, 8 3-node line, 2 triangle,
         // 9 6-node triangle.
-        let kind = match (dim, e.per) {
+        let kind = e.gmsh_type.unwrap_or(match (dim, e.per) {
             (0, _) => 15,
             (1, 3) => 8,
             (1, _) => 1,
             (_, 6) => 9,
             _ => 2,
-        };
+        });
         s.int(dim as i32)?;
         s.int(e.tag)?;
         s.int(kind)?;

@@ -29,7 +29,7 @@ impl MeshWriter for Obj {
         out: &mut dyn Write,
     ) -> Result<Vec<Warning>, WriteError> {
         groups::check(mesh)?;
-        let mut warnings = Vec::new();
+        let mut warnings: Vec<Warning> = groups::dropped_volumes("obj", mesh).into_iter().collect();
         if options.encoding.is_some() {
             warnings.push(warning(
                 "obj",

@@ -35,6 +35,7 @@ impl MeshWriter for Stl {
             })
             .collect();
         let mut warnings = dropped(mesh);
+        warnings.extend(groups::dropped_volumes("stl", mesh));
         match options.encoding.unwrap_or(Encoding::Binary) {
             Encoding::Binary => {
                 if groups.len() > 1 {

@@ -1,8 +1,10 @@
 //! VTK XML unstructured grid (`.vtu`), ASCII (the default) or base64 binary.
 //! Cells: every face's triangles once (5), edges, 2D fragments' edges and
-//! poly_lines as line segments (3), point-set points as vertices (1). Cell data
+//! poly_lines as line segments (3), point-set points as vertices (1), volume
+//! cells (tetrahedra 10, hexahedra 12, wedges 13, pyramids 14). Cell data
 //! (Int32, −1 where it does not apply): `fragment_id`, `subdomain_id`,
-//! `other_subdomain_id`, `face_id`, `edge_id`, `polyline_id`, `point_set_id`.
+//! `other_subdomain_id`, `face_id`, `edge_id`, `polyline_id`, `point_set_id`,
+//! and `volume_id` when the mesh has volume cells (one id per volume name).
 //! In 3D a triangle's `subdomain_id` / `other_subdomain_id` are its fragment's
 //! pair; in 2D a triangle's `subdomain_id` is its region. FieldData arrays
 //! name the ids (`Name="inlet"` holding `[id, field index]`); many readers
@@ -15,7 +17,7 @@ use std::io::Write;
 
 pub(crate) struct Vtu;
 
-const FIELDS: [&str; 7] = [
+const FIELDS: [&str; 8] = [
     "fragment_id",
     "subdomain_id",
     "other_subdomain_id",
@@ -23,12 +25,13 @@ const FIELDS: [&str; 7] = [
     "edge_id",
     "polyline_id",
     "point_set_id",
+    "volume_id",
 ];
 
 struct Cell {
     kind: u8,
     nodes: Vec<u32>,
-    data: [i32; 7],
+    data: [i32; 8],
 }
 
 fn id(i: usize) -> i32 {
@@ -42,6 +45,10 @@ impl MeshWriter for Vtu {
 
     fn extensions(&self) -> &'static [&'static str] {
         &["vtu"]
+    }
+
+    fn keeps_volume_cells(&self) -> bool {
+        true
     }
 
     fn write(
@@ -114,7 +121,7 @@ fn cells(mesh: &Mesh) -> Vec<Cell> {
             cells.push(Cell {
                 kind,
                 nodes,
-                data: [fragment, subdomain, other, id(f), -1, -1, -1],
+                data: [fragment, subdomain, other, id(f), -1, -1, -1, -1],
             });
         }
     }
@@ -126,7 +133,7 @@ fn cells(mesh: &Mesh) -> Vec<Cell> {
             cells.push(Cell {
                 kind,
                 nodes,
-                data: [fragment, subdomain, other, -1, id(e), -1, -1],
+                data: [fragment, subdomain, other, -1, id(e), -1, -1, -1],
             });
         }
     }
@@ -137,7 +144,7 @@ fn cells(mesh: &Mesh) -> Vec<Cell> {
             cells.push(Cell {
                 kind,
                 nodes,
-                data: [-1, -1, -1, -1, -1, id(i), -1],
+                data: [-1, -1, -1, -1, -1, id(i), -1, -1],
             });
         }
     }
@@ -146,11 +153,35 @@ fn cells(mesh: &Mesh) -> Vec<Cell> {
             cells.push(Cell {
                 kind: 1,
                 nodes: vec![n],
-                data: [-1, -1, -1, -1, -1, -1, id(i)],
+                data: [-1, -1, -1, -1, -1, -1, id(i), -1],
+            });
+        }
+    }
+    let names = volume_names(mesh);
+    for v in &mesh.volumes {
+        let volume = names.iter().position(|n| *n == v.name).map_or(-1, id);
+        let order = v.kind.vtk_order();
+        for cell in v.cells() {
+            cells.push(Cell {
+                kind: v.kind.vtk_type(),
+                nodes: order.iter().map(|&i| cell[i]).collect(),
+                data: [-1, -1, -1, -1, -1, -1, -1, volume],
             });
         }
     }
     cells
+}
+
+/// The distinct names of the mesh's volume cell groups, in order: the
+/// values of `volume_id`.
+fn volume_names(mesh: &Mesh) -> Vec<&str> {
+    let mut names: Vec<&str> = Vec::new();
+    for v in &mesh.volumes {
+        if !names.contains(&v.name.as_str()) {
+            names.push(&v.name);
+        }
+    }
+    names
 }
 
 /// A segment as VTK line (3) or, with a mid node, quadratic edge (21).
@@ -194,13 +225,14 @@ fn data_array(
 /// entity and holding `[id, k]`, k the index of its cell-data array in
 /// `FIELDS` (meshio reads these as its `field_data`).
 fn write_names(mesh: &Mesh, out: &mut dyn Write) -> std::io::Result<()> {
-    let lists: [(usize, Vec<&str>); 6] = [
+    let lists: [(usize, Vec<&str>); 7] = [
         (0, mesh.fragments.iter().map(|f| f.name.as_str()).collect()),
         (1, mesh.subdomains.iter().map(|s| s.name.as_str()).collect()),
         (3, mesh.faces.iter().map(|f| f.name.as_str()).collect()),
         (4, mesh.edges.iter().map(|e| e.name.as_str()).collect()),
         (5, mesh.polylines.iter().map(|p| p.name.as_str()).collect()),
         (6, mesh.point_sets.iter().map(|p| p.name.as_str()).collect()),
+        (7, volume_names(mesh)),
     ];
     if lists.iter().all(|(_, names)| names.is_empty()) {
         return Ok(());
@@ -307,7 +339,14 @@ fn write_grid(
     writeln!(out, "      </Cells>")?;
 
     writeln!(out, "      <CellData Scalars=\"{}\">", FIELDS[0])?;
-    for (k, field) in FIELDS.iter().enumerate() {
+    // `volume_id` only when there are volume cells: surface meshes' files
+    // stay as they were.
+    let fields = if mesh.volumes.is_empty() {
+        &FIELDS[..7]
+    } else {
+        &FIELDS[..]
+    };
+    for (k, field) in fields.iter().enumerate() {
         let values: Vec<i32> = cells.iter().map(|c| c.data[k]).collect();
         data_array(
             out,

@@ -5,6 +5,7 @@
 //! polygonization ([`polygonize`]) into geomc's mesh IR.
 
 pub mod expr_ops;
+pub mod interfaces;
 pub mod interval;
 pub mod ir;
 pub mod lang;
@@ -16,6 +17,7 @@ pub mod rows;
 pub mod section;
 pub mod signs;
 pub mod tape;
+pub mod weld;
 pub mod xml;
 
 use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};

@@ -16,7 +16,9 @@
 //!    sharing it agree, and every mesh edge has exactly two triangles.
 //!
 //! Rules: a sample is inside when f > 0; a value exactly 0 counts as outside
-//! (the vertex then sits on that sample). When `close_at_box` is set, samples
+//! (the vertex then sits on that sample, and so do crossings within
+//! `weld::SNAP` of a sample; `weld` makes all the vertices on one sample one
+//! node and drops the triangles that collapse). When `close_at_box` is set, samples
 //! on the box's faces count as at most 0, so a solid leaving the box is capped
 //! on the box face. Triangles are oriented with normals pointing out of the
 //! solid (towards decreasing f).
@@ -25,6 +27,7 @@ use super::interval::{self, Interval, Sign};
 use super::rows::RowTape;
 use super::signs::{self, SignRows};
 use super::tape::{AxisTape, BATCH, Ssa, Tape, Workspace};
+use super::weld;
 use rayon::prelude::*;
 use std::sync::Arc;
 
@@ -300,6 +303,8 @@ struct PlaneVertices {
     /// (j · nx1 + i) · 3 + axis, ascending.
     keys: Vec<u32>,
     positions: Vec<[f64; 3]>,
+    /// The grid sample each vertex sits on, or `weld::NONE`.
+    at_sample: Vec<u64>,
 }
 
 fn plane_vertices(
@@ -393,10 +398,38 @@ fn plane_vertices(
             );
         }
     }
+    // Crossings within weld::SNAP of a sample sit exactly on it (and are
+    // merged into one node by `weld`).
+    let plane = n1[0] * n1[1];
+    let at_sample = keys
+        .iter()
+        .zip(&t)
+        .map(|(&key, &t)| {
+            let base = (key / 3) as usize;
+            let end = match key % 3 {
+                0 => base + 1,
+                1 => base + n1[0],
+                _ => base + plane,
+            };
+            if t <= weld::SNAP {
+                (k * plane + base) as u64
+            } else if t >= 1.0 - weld::SNAP {
+                (k * plane + end) as u64
+            } else {
+                weld::NONE
+            }
+        })
+        .collect();
     let positions = ends
         .iter()
         .zip(&t)
         .map(|(&(p0, p1, _, _), &t)| {
+            if t <= weld::SNAP {
+                return p0;
+            }
+            if t >= 1.0 - weld::SNAP {
+                return p1;
+            }
             [0, 1, 2].map(|a| {
                 if p0[a] == p1[a] {
                     p0[a]
@@ -406,7 +439,11 @@ fn plane_vertices(
             })
         })
         .collect();
-    PlaneVertices { keys, positions }
+    PlaneVertices {
+        keys,
+        positions,
+        at_sample,
+    }
 }
 
 /// Refines one block's crossed edges (`edges` index `keys` and `ends`).
@@ -415,6 +452,7 @@ fn plane_vertices(
 /// every step; the values, and so the vertices, are bit-identical to the
 /// plain tape's. Coordinates that `p + 0.0` would change (−0.0, NaN) or that
 /// are infinite take the plain tape.
+#[allow(clippy::too_many_arguments)] // scratch buffers reused across blocks
 fn refine(
     kernel: &Kernel,
     ws: &mut Workspace,
@@ -829,6 +867,10 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
         .iter()
         .flat_map(|p| p.positions.iter().copied())
         .collect();
+    let at_sample: Vec<u64> = planes
+        .iter()
+        .flat_map(|p| p.at_sample.iter().copied())
+        .collect();
     // Edge key → vertex id for one plane, in a buffer reused per thread
     // (only the entries set are cleared afterwards).
     let fill = |map: &mut Vec<u32>, k: usize, on: bool| {
@@ -925,10 +967,12 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
         .iter()
         .filter(|b| matches!(b, Block::Inside | Block::Outside))
         .count();
-    Surface {
+    let mut surface = Surface {
         positions,
         triangles,
         blocks: field.blocks.len(),
         pruned_blocks,
-    }
+    };
+    weld::weld_at_samples(&mut surface, &at_sample);
+    surface
 }

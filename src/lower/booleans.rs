@@ -55,7 +55,8 @@ pub(super) fn lower_subdomains(
     face_samples: &FaceSamples,
     diags: &mut Diagnostics,
 ) {
-    let mut trees: Vec<(SubdomainId, Built)> = Vec::new();
+    let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(doc.subdomains.len());
+    model.subdomains.reserve(doc.subdomains.len());
     for (def_index, def) in doc.subdomains.iter().enumerate() {
         let id = SubdomainId(model.subdomains.len() as u32);
         let cells = match (&def.faces, &def.tree) {
@@ -317,31 +318,46 @@ fn check_relations(
 /// the median box size; boxes spanning many cells are compared with all.
 fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
     let mut sizes: Vec<f64> = boxes.iter().map(|b| (b.max - b.min).max()).collect();
-    sizes.sort_by(f64::total_cmp);
-    let cell = sizes
-        .get(sizes.len() / 2)
-        .copied()
-        .unwrap_or(1.0)
-        .max(tol * 1e3)
-        .max(f64::MIN_POSITIVE);
+    let middle = sizes.len() / 2;
+    let median =
+        (middle < sizes.len()).then(|| *sizes.select_nth_unstable_by(middle, f64::total_cmp).1);
+    let cell = median.unwrap_or(1.0).max(tol * 1e3).max(f64::MIN_POSITIVE);
     let key = |v: f64| (v / cell).floor() as i64;
     // A sorted list of (cell, box) instead of a map of cells: boxes sharing a
     // cell are adjacent after sorting, and nothing is allocated per cell.
-    let mut cells: Vec<([i64; 3], u32)> = Vec::with_capacity(boxes.len());
+    // The cell range (lowest, highest) of each placeable box and how many cells it covers.
+    type CellRange = ([i64; 3], [i64; 3], i128);
+    let ranges: Vec<Option<CellRange>> = boxes
+        .iter()
+        .map(|b| {
+            let finite = [b.min, b.max]
+                .iter()
+                .all(|p| p.iter().all(|c| c.is_finite()));
+            if b.is_empty() || !finite {
+                // Nothing, or nothing placeable: it cannot overlap anything.
+                return None;
+            }
+            let lo = [key(b.min.x - tol), key(b.min.y - tol), key(b.min.z - tol)];
+            let hi = [key(b.max.x + tol), key(b.max.y + tol), key(b.max.z + tol)];
+            let count = (0..3)
+                .map(|k| (i128::from(hi[k]) - i128::from(lo[k]) + 1).max(0))
+                .fold(1i128, |acc, n| acc.saturating_mul(n));
+            Some((lo, hi, count))
+        })
+        .collect();
+    // Sized exactly: on large models the list has millions of entries.
+    let total: usize = ranges
+        .iter()
+        .flatten()
+        .filter(|r| r.2 <= 64)
+        .map(|r| r.2 as usize)
+        .sum();
+    let mut cells: Vec<([i64; 3], u32)> = Vec::with_capacity(total);
     let mut big = Vec::new();
-    for (i, b) in boxes.iter().enumerate() {
-        let finite = [b.min, b.max]
-            .iter()
-            .all(|p| p.iter().all(|c| c.is_finite()));
-        if b.is_empty() || !finite {
-            // Nothing, or nothing placeable: it cannot overlap anything.
+    for (i, range) in ranges.iter().enumerate() {
+        let Some((lo, hi, count)) = *range else {
             continue;
-        }
-        let lo = [key(b.min.x - tol), key(b.min.y - tol), key(b.min.z - tol)];
-        let hi = [key(b.max.x + tol), key(b.max.y + tol), key(b.max.z + tol)];
-        let count = (0..3)
-            .map(|k| (i128::from(hi[k]) - i128::from(lo[k]) + 1).max(0))
-            .fold(1i128, |acc, n| acc.saturating_mul(n));
+        };
         if count > 64 {
             big.push(i);
             continue;

@@ -4,7 +4,7 @@
 
 use super::Entities;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::doc::{Document, ObjectKind};
+use crate::doc::Document;
 use crate::geom::{Curve, Point3, SolidShape, Surface, Vec3};
 use crate::ir::{
     Boundary, Dimension, Edge, EdgeId, Face, Model, OrientedEdge, Origin, SourceMap, Vertex,
@@ -16,7 +16,6 @@ use foldhash::{HashMap, HashMapExt};
 use std::f64::consts::TAU;
 
 pub(super) fn lower_topology(
-    doc: &Document,
     resolved: &Resolved,
     model: &mut Model,
     source_map: &mut SourceMap,
@@ -104,8 +103,20 @@ pub(super) fn lower_topology(
             e,
         );
     }
+    // An edge that did not lower was reported where it failed; the faces,
+    // subdomains and boundaries naming it must not repeat that as E200.
     for (i, object) in resolved.objects.iter().enumerate() {
-        let Some(Geometry::Face { surface, loops }) = &object.geometry else {
+        if matches!(object.geometry, Some(Geometry::Edge { .. })) && !edge_of.contains_key(&i) {
+            entities.failed.insert(object.name.clone());
+        }
+    }
+    for object in &resolved.objects {
+        let Some(Geometry::Face {
+            surface,
+            loops,
+            loop_spans,
+        }) = &object.geometry
+        else {
             continue;
         };
         let surface = match resolved
@@ -147,18 +158,16 @@ pub(super) fn lower_topology(
             }
         }
         if !complete || chained.is_empty() {
+            // One of its edges failed and was reported; so is this face, then.
+            entities.failed.insert(object.name.clone());
             continue;
         }
-        let loop_spans = match &doc.objects[i].kind {
-            ObjectKind::Face { loop_spans, .. } => loop_spans.clone(),
-            _ => Vec::new(),
-        };
         check_edges_on_surface(
             model,
             &chained,
             &surface,
             &object.name,
-            &loop_spans,
+            loop_spans,
             object.span,
             diags,
         );

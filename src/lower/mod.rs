@@ -8,6 +8,7 @@ mod brep;
 mod explicit;
 mod point_calculus;
 mod prune;
+pub mod rfunction_region;
 mod weld;
 mod winding;
 
@@ -91,6 +92,8 @@ impl Entities {
     }
 }
 
+/// Reads the document's subdomains and boundaries; every object comes from
+/// `resolved` (the driver drops the document's objects before lowering).
 pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
@@ -102,7 +105,12 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
     model.tolerance = tolerance(resolved);
     let mut source_map = SourceMap::default();
     let mut entities = Entities::default();
-    let mut welder = weld::Welder::new(model.tolerance);
+    let expected = expected_entities(resolved);
+    model.vertices.reserve(expected.vertices);
+    model.edges.reserve(expected.edges);
+    model.faces.reserve(expected.faces);
+    model.solids.reserve(expected.solids);
+    let mut welder = weld::Welder::with_capacity(model.tolerance, &expected);
     // Curves that carry edges are part of the topology, not standalone lines.
     let edge_lines = point_calculus::edge_lines(resolved);
     point_calculus::report_unused_patches(resolved, diags);
@@ -141,14 +149,7 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
             ),
         }
     }
-    explicit::lower_topology(
-        doc,
-        resolved,
-        &mut model,
-        &mut source_map,
-        &mut entities,
-        diags,
-    );
+    explicit::lower_topology(resolved, &mut model, &mut source_map, &mut entities, diags);
     let named_lists =
         !doc.boundaries.is_empty() || doc.subdomains.iter().any(|s| s.faces.is_some());
     if named_lists {
@@ -167,6 +168,47 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
     explicit::lower_boundaries(doc, &mut model, &entities, diags);
     prune::prune_interior(&mut model, &mut source_map);
     Lowered { model, source_map }
+}
+
+/// How many entities the primitive solids will lower to at most (before
+/// welding): the model's vectors and the welder's tables are sized once
+/// instead of grown by doubling, which on large files copied hundreds of
+/// megabytes and touched fresh pages at every growth.
+#[derive(Debug, Default, Clone, Copy)]
+pub(crate) struct Expected {
+    pub vertices: usize,
+    pub edges: usize,
+    pub faces: usize,
+    pub solids: usize,
+}
+
+fn expected_entities(resolved: &Resolved) -> Expected {
+    fn visit(g: &Geometry, n: &mut Expected) {
+        match g {
+            Geometry::Solid(shape) => {
+                // A box has the most entities of the canonical primitives;
+                // the round ones have fewer (an estimate is enough).
+                let (v, e, f) = match shape {
+                    SolidShape::Box { .. } => (8, 12, 6),
+                    SolidShape::Polygon { vertices, .. } => (vertices.len(), vertices.len(), 1),
+                    _ => (2, 3, 3),
+                };
+                n.vertices += v;
+                n.edges += e;
+                n.faces += f;
+                n.solids += 1;
+            }
+            Geometry::Group(members) => members.iter().for_each(|m| visit(m, n)),
+            _ => {}
+        }
+    }
+    let mut n = Expected::default();
+    for o in &resolved.objects {
+        if let Some(g) = &o.geometry {
+            visit(g, &mut n);
+        }
+    }
+    n
 }
 
 /// 1e-6 of the diagonal of everything the file places, at least 1e-12.

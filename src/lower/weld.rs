@@ -50,6 +50,13 @@ impl<K> Default for Chains<K> {
 }
 
 impl<K: Hash + Eq> Chains<K> {
+    fn with_capacity(capacity: usize) -> Self {
+        Chains {
+            heads: FastMap::with_capacity_and_hasher(capacity, Default::default()),
+            next: Vec::with_capacity(capacity),
+        }
+    }
+
     fn push(&mut self, key: K, id: u32) {
         if self.next.len() <= id as usize {
             self.next.resize(id as usize + 1, NONE);
@@ -101,6 +108,17 @@ impl Welder {
             faces_by_edges: Chains::default(),
             face_samples: FaceSamples::default(),
             scratch: Vec::new(),
+        }
+    }
+
+    /// A welder whose tables are sized for `expected` entities.
+    pub(crate) fn with_capacity(tol: f64, expected: &super::Expected) -> Welder {
+        Welder {
+            vertex_grid: Chains::with_capacity(expected.vertices),
+            edges_by_ends: Chains::with_capacity(expected.edges),
+            faces_by_edges: Chains::with_capacity(expected.faces),
+            face_samples: FaceSamples(Vec::with_capacity(expected.faces)),
+            ..Welder::new(tol)
         }
     }
 

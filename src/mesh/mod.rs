@@ -11,6 +11,9 @@
 //! faces with `outward` as in the model.
 
 pub mod locate;
+pub mod volume;
+
+pub use volume::{CellKind, MeshVolume};
 
 /// A named point of the model (a topology vertex).
 #[derive(Debug, Clone, PartialEq)]
@@ -76,6 +79,8 @@ pub struct Mesh {
     pub polylines: Vec<MeshPolyline>,
     /// Mid-edge nodes of second-order meshes (`None`: linear elements).
     pub quadratic: Option<QuadraticNodes>,
+    /// Volume cells read from a solver format (geomc's own meshes have none).
+    pub volumes: Vec<MeshVolume>,
 }
 
 /// The extra nodes of 6-node triangles and 3-node lines: one per element

@@ -2,6 +2,14 @@
 //! sensor lines): each poly_line that lies inside one subdomain's region is
 //! handed to that face's triangulation, which must follow it.
 //!
+//! A poly_line belongs to a region when all its points and segment middles
+//! are inside it (even–odd over the face's loops). Any point within the
+//! model tolerance of a loop, or a segment crossing a loop between those
+//! probes, makes it touch the boundary: that is refused rather than decided
+//! by rounding (a line drawn along the slanted side of a thin polygon lies
+//! on it in decimals but a few ulps outside or inside in binary, and the
+//! even–odd test alone put such a line inside).
+//!
 //! # Limitations
 //! - A poly_line must lie strictly inside one region: touching or crossing a
 //!   subdomain boundary is refused. Outside every region it stays a free
@@ -47,6 +55,15 @@ pub(crate) fn assign(
         );
         let mut home = None;
         for (face, loops) in &regions {
+            if touches(loops, points, &probes, model.tolerance) {
+                return Err(MeshError::Face {
+                    face: model.faces[*face].name.clone(),
+                    reason: format!(
+                        "poly_line `{}` touches or crosses its boundary (within the tolerance {:e}); a poly_line constraint must lie strictly inside one subdomain",
+                        line.name, model.tolerance
+                    ),
+                });
+            }
             let inside = probes.iter().filter(|p| in_loops(loops, p)).count();
             if inside == probes.len() {
                 home = Some(*face);
@@ -90,6 +107,34 @@ fn face_polygons(face: &crate::ir::Face, edge_nodes: &[EdgeNodes]) -> Vec<Vec<Po
             points
         })
         .collect()
+}
+
+/// Whether a probe lies within `tolerance` of a loop segment, or a segment
+/// of the line crosses one.
+fn touches(loops: &[Vec<Point3>], line: &[Point3], probes: &[Point3], tolerance: f64) -> bool {
+    let loop_segments = || {
+        loops
+            .iter()
+            .flat_map(|lp| (0..lp.len()).map(move |k| (&lp[k], &lp[(k + 1) % lp.len()])))
+    };
+    if probes
+        .iter()
+        .any(|p| loop_segments().any(|(a, b)| polygon::segment_distance(p, a, b) <= tolerance))
+    {
+        return true;
+    }
+    line.windows(2)
+        .any(|w| loop_segments().any(|(a, b)| segments_cross(&w[0], &w[1], a, b)))
+}
+
+/// Proper crossing of segments p–q and a–b (each strictly separates the
+/// other's ends).
+fn segments_cross(p: &Point3, q: &Point3, a: &Point3, b: &Point3) -> bool {
+    let orient =
+        |u: &Point3, v: &Point3, w: &Point3| (v.x - u.x) * (w.y - u.y) - (v.y - u.y) * (w.x - u.x);
+    let (d1, d2) = (orient(p, q, a), orient(p, q, b));
+    let (d3, d4) = (orient(a, b, p), orient(a, b, q));
+    d1 * d2 < 0.0 && d3 * d4 < 0.0
 }
 
 /// Even–odd over all loops.

@@ -38,6 +38,11 @@ type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 /// Rounds of "refine in the plane, then insert points where the surface is
 /// missed" before giving up on a face's tolerance.
 const MAX_PASSES: usize = 60;
+/// The first area limit of a curved face, in equilateral triangles on a
+/// long boundary segment (`guide_area`): 2–4 made refinement split the
+/// boundary (another meshing round); at 6–8 a sphere face takes 2–3 passes
+/// instead of 9–10, with 8% more triangles at the same tolerance.
+const GUIDE_FACTOR: f64 = 8.0;
 /// Nodes one face may have.
 const MAX_FACE_VERTICES: usize = 2_000_000;
 
@@ -202,17 +207,27 @@ pub(crate) fn mesh_face(
     let fixed = cdt.num_vertices();
 
     let small_angle = has_small_input_angle(&cdt, settings.min_angle);
+    let guide = if small_angle {
+        f64::INFINITY
+    } else {
+        guide_area(&uv_loops, &face.surface)
+    };
     let mut parameters = RefinementParameters::<f64>::new()
         // Spade's peeling takes an open poly_line for a loop: with poly_lines
         // the outside is found here instead (`outside_faces`).
         .exclude_outer_faces(polyline_segments.is_empty())
         .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
-        .with_max_additional_vertices(vertex_budget(&uv_loops, settings, small_angle));
+        .with_max_additional_vertices(vertex_budget(
+            &uv_loops,
+            settings.max_area.min(guide),
+            settings,
+            small_angle,
+        ));
     if settings.keep_boundary {
         parameters = parameters.keep_constraint_edges();
     }
-    if settings.max_area.is_finite() {
-        parameters = parameters.with_max_allowed_area(settings.max_area);
+    if settings.max_area.min(guide).is_finite() {
+        parameters = parameters.with_max_allowed_area(settings.max_area.min(guide));
     }
     // Next to an input angle below the limit no triangle can meet it, and
     // chasing it ran to the vertex budget (a 0.02° sliver took minutes): in
@@ -227,6 +242,14 @@ pub(crate) fn mesh_face(
     // fine: later passes only check the triangles insertions created.
     let mut fine: FineSet = FineSet::default();
     let deviation = Deviation::of(&face.surface);
+    let coarse = Coarse {
+        deviation: &deviation,
+        settings,
+        area_limited: settings.max_area.is_finite()
+            && matches!(face.surface, Surface::Plane { .. }),
+    };
+    // Vertices from this index on have not been checked for boundary splits.
+    let mut unchecked = fixed;
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if small_angle && !result.refinement_complete && !settings.keep_boundary {
@@ -240,27 +263,15 @@ pub(crate) fn mesh_face(
             return mesh_face(model, face, edges, &keep, constraints);
         }
         if !settings.keep_boundary {
-            // Only this pass's vertices: earlier ones were checked in their pass.
-            let new = positions.len().max(fixed);
+            // Only the vertices added since the last check.
             let splits =
-                boundary_splits(&cdt, new, &segments, &polyline_segments).map_err(failed)?;
+                boundary_splits(&cdt, unchecked, &segments, &polyline_segments).map_err(failed)?;
             if !splits.is_empty() {
                 return Ok(Outcome::Split(splits));
             }
         }
-        for v in positions.len()..cdt.num_vertices() {
-            let uv = cdt
-                .vertex(spade::handles::FixedVertexHandle::from_index(v))
-                .position();
-            let p = chart.lift([uv.x, uv.y]).ok_or_else(|| {
-                failed(format!(
-                    "the parameter point ({}, {}) does not lift onto its surface",
-                    uv.x, uv.y
-                ))
-            })?;
-            keys.push(FacePoint::Interior(p));
-            positions.push(p);
-        }
+        unchecked = cdt.num_vertices();
+        lift_new_vertices(&cdt, &chart, &mut keys, &mut positions).map_err(failed)?;
         let mut excluded = vec![false; cdt.num_all_faces()];
         if polyline_segments.is_empty() {
             for f in &result.excluded_faces {
@@ -283,19 +294,7 @@ pub(crate) fn mesh_face(
             if key.is_some_and(|k| fine.contains(&k)) {
                 continue;
             }
-            let [pa, pb, pc] = f.positions();
-            let uv_area =
-                0.5 * ((pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x)).abs();
-            let over_area = settings.max_area.is_finite()
-                && matches!(face.surface, Surface::Plane { .. })
-                && uv_area > settings.max_area;
-            if over_area
-                || too_coarse(
-                    &deviation,
-                    [&positions[a], &positions[b], &positions[c]],
-                    settings,
-                )
-            {
+            if coarse.is(f, &positions) {
                 let [pa, pb, pc] = f.positions();
                 let centroid = point2([(pa.x + pb.x + pc.x) / 3.0, (pa.y + pb.y + pc.y) / 3.0]);
                 // A corner of the triangle is a good start for locating it.
@@ -537,10 +536,15 @@ fn has_small_input_angle(cdt: &Cdt, min_angle: f64) -> bool {
 /// angles there) and 1,000 more instead of the 200,000 floor: segments
 /// meeting at a tiny angle keep encroaching each other, which no area
 /// threshold stops.
-fn vertex_budget(uv_loops: &[Vec<[f64; 2]>], settings: &Settings, small_angle: bool) -> usize {
+fn vertex_budget(
+    uv_loops: &[Vec<[f64; 2]>],
+    max_area: f64,
+    settings: &Settings,
+    small_angle: bool,
+) -> usize {
     let area = uv_loops.iter().map(|lp| shoelace(lp)).sum::<f64>().abs() / 2.0;
-    let for_area = if settings.max_area.is_finite() {
-        2.0 * area / settings.max_area
+    let for_area = if max_area.is_finite() {
+        2.0 * area / max_area
     } else {
         0.0
     };
@@ -551,6 +555,39 @@ fn vertex_budget(uv_loops: &[Vec<[f64; 2]>], settings: &Settings, small_angle: b
     } else {
         for_area.clamp(200_000.0, cap) as usize
     }
+}
+
+/// A first area limit for the angle refinement of a curved face, in chart
+/// units: a multiple of the equilateral triangle on a long boundary
+/// segment. The boundary is discretised to the same tolerance as the
+/// surface, so the interior needs triangles of about that size; spade meets
+/// the limit in the same sweep as the angles, and the chordal passes after
+/// it only finish the places where the chart magnifies. Planes (nothing to
+/// follow) get none.
+fn guide_area(uv_loops: &[Vec<[f64; 2]>], surface: &Surface) -> f64 {
+    if matches!(surface, Surface::Plane { .. }) {
+        return f64::INFINITY;
+    }
+    let mut lengths: Vec<f64> = uv_loops
+        .iter()
+        .flat_map(|lp| {
+            (0..lp.len()).map(move |i| {
+                let (a, b) = (lp[i], lp[(i + 1) % lp.len()]);
+                (b[0] - a[0]).hypot(b[1] - a[1])
+            })
+        })
+        .filter(|l| *l > 0.0 && l.is_finite())
+        .collect();
+    if lengths.len() < 8 {
+        return f64::INFINITY;
+    }
+    // The 90th percentile: a loop's few long straight segments (a seam) are
+    // left out, and where curved edges differ (a cone's two circles) the
+    // coarser one sets the limit, so no part of the face is refined beyond
+    // what its own boundary asks for.
+    let rank = lengths.len() * 9 / 10;
+    let (_, length, _) = lengths.select_nth_unstable_by(rank, f64::total_cmp);
+    GUIDE_FACTOR * 3f64.sqrt() / 4.0 * *length * *length
 }
 
 /// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and
@@ -652,6 +689,68 @@ fn polyline_chain(cdt: &Cdt, fixed: usize, handles: &[usize]) -> Vec<usize> {
     }
     chain.extend(handles.last().copied());
     chain
+}
+
+/// Lifts the vertices the triangulation has beyond `positions` onto the
+/// surface, as interior nodes.
+fn lift_new_vertices(
+    cdt: &Cdt,
+    chart: &Chart,
+    keys: &mut Vec<FacePoint>,
+    positions: &mut Vec<Point3>,
+) -> Result<(), String> {
+    for v in positions.len()..cdt.num_vertices() {
+        let uv = cdt
+            .vertex(spade::handles::FixedVertexHandle::from_index(v))
+            .position();
+        let p = chart.lift([uv.x, uv.y]).ok_or_else(|| {
+            format!(
+                "the parameter point ({}, {}) does not lift onto its surface",
+                uv.x, uv.y
+            )
+        })?;
+        keys.push(FacePoint::Interior(p));
+        positions.push(p);
+    }
+    Ok(())
+}
+
+/// The surface criteria of a face's triangles: area limit (planes), longest
+/// edge and chordal deviation.
+struct Coarse<'a> {
+    deviation: &'a Deviation<'a>,
+    settings: &'a Settings<'a>,
+    area_limited: bool,
+}
+
+impl Coarse<'_> {
+    fn is(
+        &self,
+        f: spade::handles::FaceHandle<
+            '_,
+            spade::handles::InnerTag,
+            Point2<f64>,
+            (),
+            spade::CdtEdge<()>,
+            (),
+        >,
+        positions: &[Point3],
+    ) -> bool {
+        let [a, b, c] = f.vertices().map(|v| v.fix().index());
+        if self.area_limited {
+            let [pa, pb, pc] = f.positions();
+            let uv_area =
+                0.5 * ((pb.x - pa.x) * (pc.y - pa.y) - (pb.y - pa.y) * (pc.x - pa.x)).abs();
+            if uv_area > self.settings.max_area {
+                return true;
+            }
+        }
+        too_coarse(
+            self.deviation,
+            [&positions[a], &positions[b], &positions[c]],
+            self.settings,
+        )
+    }
 }
 
 /// True when a triangle is longer than `max_edge` or strays from the surface

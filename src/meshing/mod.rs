@@ -211,7 +211,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
     guard::guarded(
         || "the assembly of the mesh".to_string(),
         || {
-            let mut mesh = assemble(model, &edge_nodes, &face_meshes, &lines);
+            let mut mesh = assemble(model, &edge_nodes, face_meshes, &lines);
             trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
             crack::open(model, &mut mesh);
             if options.order == 2 {
@@ -335,14 +335,40 @@ fn mesh_faces(
 fn assemble(
     model: &Model,
     edge_nodes: &[EdgeNodes],
-    face_meshes: &[Option<FaceMesh>],
+    face_meshes: Vec<Option<FaceMesh>>,
     lines: &[Vec<crate::geom::Point3>],
 ) -> Mesh {
-    let mut nodes: Vec<[f64; 3]> = model
-        .vertices
+    // The node table is sized once (doubling would briefly hold three times
+    // it), and each face mesh is dropped as soon as it is copied: the
+    // assembled mesh and all the face meshes are never held side by side.
+    let interior: usize = face_meshes
         .iter()
-        .map(|v| [v.position.x, v.position.y, v.position.z])
-        .collect();
+        .flatten()
+        .map(|m| {
+            m.points
+                .iter()
+                .filter(|p| matches!(p, FacePoint::Interior(_)))
+                .count()
+        })
+        .sum();
+    let on_edges: usize = edge_nodes
+        .iter()
+        .map(|e| e.points.len().saturating_sub(2))
+        .sum();
+    let loose: usize = model
+        .point_sets
+        .iter()
+        .map(|s| s.points.len())
+        .sum::<usize>()
+        + lines.iter().map(Vec::len).sum::<usize>();
+    let mut nodes: Vec<[f64; 3]> =
+        Vec::with_capacity(model.vertices.len() + on_edges + interior + loose);
+    nodes.extend(
+        model
+            .vertices
+            .iter()
+            .map(|v| [v.position.x, v.position.y, v.position.z]),
+    );
     let push = |nodes: &mut Vec<[f64; 3]>, p: &crate::geom::Point3| {
         nodes.push([p.x, p.y, p.z]);
         (nodes.len() - 1) as u32
@@ -370,6 +396,7 @@ fn assemble(
     for (face, mesh) in model.faces.iter().zip(face_meshes) {
         let mut triangles = Vec::new();
         if let Some(mesh) = mesh {
+            triangles.reserve_exact(mesh.triangles.len());
             let mut ids: Vec<Option<u32>> = vec![None; mesh.points.len()];
             for t in &mesh.triangles {
                 let mut tri = [0u32; 3];

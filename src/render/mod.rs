@@ -5,6 +5,7 @@
 //! legend. Output is deterministic: the same mesh and options give the same
 //! bytes for any number of threads.
 
+mod bands;
 mod camera;
 mod font;
 mod legend;
@@ -256,10 +257,12 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
     let ss = options.antialias as usize;
     let proj = project(&scene, &camera, ss);
     let (sw, sh) = (options.width as usize * ss, options.height as usize * ss);
-    let zbuf = raster::rasterize(&scene, &proj, sw, sh);
-    let mut mask = Vec::new();
-    if options.edges != Edges::None {
-        mask = vec![false; sw * sh];
+    let mut image = if options.edges == Edges::None {
+        let (w, h) = (options.width as usize, options.height as usize);
+        bands::render(&scene, &proj, w, h, ss, options.background)
+    } else {
+        let zbuf = raster::rasterize(&scene, &proj, sw, sh);
+        let mut mask = vec![false; sw * sh];
         let on_plane = |n: u32| {
             options
                 .section
@@ -281,8 +284,8 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
             scene.groups[scene.face_sides[face][(id & 1) as usize] as usize].cap
         };
         raster::mark_edges(&zbuf, &segments, 0.75 * ss as f32, 0.01, is_cap, &mut mask);
-    }
-    let mut image = resolve::resolve(&scene, &proj, &zbuf, &mask, ss, options.background);
+        resolve::resolve(&scene, &proj, &zbuf, &mask, ss, options.background)
+    };
     let mut entries = Vec::new();
     if options.legend {
         let (e, not_shown) = legend::layout(&scene.groups, options.width, options.height);

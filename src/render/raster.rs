@@ -76,10 +76,11 @@ fn row_range(v: &[[i64; 2]; 3], height: usize) -> Option<(usize, usize)> {
     (first <= last).then_some((first as usize, last as usize))
 }
 
-pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
-    let n_bands = height.div_ceil(BAND);
-    // Binning: for each chunk of triangles, the ids each band must draw.
-    let bins: Vec<Vec<Vec<u32>>> = (0..scene.tris.len().div_ceil(CHUNK))
+/// For each chunk of triangles, the ids each band of `band_rows` sample rows
+/// must draw (front-facing visible sides only, rows clamped to the image).
+pub fn bin(scene: &Scene, proj: &Projected, height: usize, band_rows: usize) -> Vec<Vec<Vec<u32>>> {
+    let n_bands = height.div_ceil(band_rows);
+    (0..scene.tris.len().div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
             let mut bands: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
@@ -92,27 +93,49 @@ pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -
                     continue;
                 }
                 if let Some((first, last)) = row_range(&v, height) {
-                    for band in bands.iter_mut().take(last / BAND + 1).skip(first / BAND) {
+                    for band in bands
+                        .iter_mut()
+                        .take(last / band_rows + 1)
+                        .skip(first / band_rows)
+                    {
                         band.push(tri as u32);
                     }
                 }
             }
             bands
         })
-        .collect();
+        .collect()
+}
+
+/// Draws band `band` (sample rows `ys`, stored from `rows[0]`) from the bins.
+pub fn draw_band(
+    scene: &Scene,
+    proj: &Projected,
+    bins: &[Vec<Vec<u32>>],
+    band: usize,
+    rows: &mut [u64],
+    width: usize,
+    ys: std::ops::Range<usize>,
+) {
+    let (y0, y1) = (ys.start, ys.end);
+    for chunk in bins {
+        for &tri in &chunk[band] {
+            if let Some((v, z, back)) = setup(proj, scene.tris[tri as usize]) {
+                draw(rows, width, y0, y1, v, z, tri * 2 + back);
+            }
+        }
+    }
+}
+
+pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
+    let bins = bin(scene, proj, height, BAND);
     let mut data = vec![EMPTY; width * height];
     data.par_chunks_mut(width * BAND)
         .enumerate()
         .for_each(|(band, rows)| {
             let y0 = band * BAND;
             let y1 = (y0 + BAND).min(height);
-            for chunk in &bins {
-                for &tri in &chunk[band] {
-                    if let Some((v, z, back)) = setup(proj, scene.tris[tri as usize]) {
-                        draw(rows, width, y0, y1, v, z, tri * 2 + back);
-                    }
-                }
-            }
+            draw_band(scene, proj, &bins, band, rows, width, y0..y1);
         });
     ZBuffer {
         width,

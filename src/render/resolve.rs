@@ -96,14 +96,13 @@ fn shade(
 fn uniform(
     scene: &Scene,
     proj: &Projected,
-    zbuf: &ZBuffer,
-    edges: &[bool],
+    samples: &Samples,
     ss: usize,
     px: usize,
     py: usize,
 ) -> Option<[u8; 3]> {
     let (sx, sy) = (px * ss, py * ss);
-    let first = zbuf.data[sy * zbuf.width + sx];
+    let first = samples.value(sx, sy);
     if first == EMPTY {
         return None;
     }
@@ -118,9 +117,8 @@ fn uniform(
     }
     for y in sy..sy + ss {
         for x in sx..sx + ss {
-            let index = y * zbuf.width + x;
-            let value = zbuf.data[index];
-            if value == EMPTY || edges.get(index).copied().unwrap_or(false) {
+            let value = samples.value(x, y);
+            if value == EMPTY || samples.edge(x, y) {
                 return None;
             }
             let id = value & 0xffff_ffff;
@@ -130,6 +128,27 @@ fn uniform(
         }
     }
     Some(shade(scene, proj, first_id, sx, sy, px, py))
+}
+
+/// Samples of sample rows `y0..` (stored from `data[0]`), `width` per row,
+/// and the edge mask of the whole picture (empty: no edges).
+pub struct Samples<'a> {
+    pub data: &'a [u64],
+    pub width: usize,
+    pub y0: usize,
+    pub edges: &'a [bool],
+}
+
+impl Samples<'_> {
+    #[inline]
+    fn value(&self, sx: usize, sy: usize) -> u64 {
+        self.data[(sy - self.y0) * self.width + sx]
+    }
+
+    #[inline]
+    fn edge(&self, sx: usize, sy: usize) -> bool {
+        !self.edges.is_empty() && self.edges[sy * self.width + sx]
+    }
 }
 
 /// Averages `ss`×`ss` samples per pixel over `background`.
@@ -143,61 +162,82 @@ pub fn resolve(
 ) -> Image {
     let width = zbuf.width / ss;
     let height = zbuf.height / ss;
+    let samples = Samples {
+        data: &zbuf.data,
+        width: zbuf.width,
+        y0: 0,
+        edges,
+    };
     let mut rgba = vec![0u8; width * height * 4];
     rgba.par_chunks_mut(width * 4)
         .enumerate()
-        .for_each(|(py, row)| {
-            for px in 0..width {
-                if let Some(color) = uniform(scene, proj, zbuf, edges, ss, px, py) {
-                    row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
-                    continue;
-                }
-                let mut sum = [0u32; 4];
-                let mut last: Option<(u64, [u8; 3])> = None;
-                for sy in py * ss..(py + 1) * ss {
-                    for sx in px * ss..(px + 1) * ss {
-                        let index = sy * zbuf.width + sx;
-                        let (color, alpha) = if edges.get(index).copied().unwrap_or(false) {
-                            ([EDGE_COLOR[0], EDGE_COLOR[1], EDGE_COLOR[2]], 255)
-                        } else {
-                            let value = zbuf.data[index];
-                            if value == EMPTY {
-                                (
-                                    [background[0], background[1], background[2]],
-                                    background[3] as u32,
-                                )
-                            } else {
-                                let id = value & 0xffff_ffff;
-                                let color = match last {
-                                    Some((l, c)) if l == id => c,
-                                    _ => {
-                                        let c = shade(scene, proj, id, sx, sy, px, py);
-                                        last = Some((id, c));
-                                        c
-                                    }
-                                };
-                                (color, 255)
-                            }
-                        };
-                        for c in 0..3 {
-                            sum[c] += color[c] as u32 * alpha;
-                        }
-                        sum[3] += alpha;
-                    }
-                }
-                let n = (ss * ss) as u32;
-                let out = &mut row[px * 4..px * 4 + 4];
-                for c in 0..3 {
-                    if let Some(v) = (sum[c] + sum[3] / 2).checked_div(sum[3]) {
-                        out[c] = v as u8;
-                    }
-                }
-                out[3] = ((sum[3] + n / 2) / n) as u8;
-            }
-        });
+        .for_each(|(py, row)| resolve_rows(scene, proj, &samples, ss, background, py, row));
     Image {
         width: width as u32,
         height: height as u32,
         rgba,
+    }
+}
+
+/// Resolves the pixel rows from `py0` that `out` holds (RGBA, the picture's
+/// width); their samples must be in `samples`.
+pub fn resolve_rows(
+    scene: &Scene,
+    proj: &Projected,
+    samples: &Samples,
+    ss: usize,
+    background: [u8; 4],
+    py0: usize,
+    out: &mut [u8],
+) {
+    let width = samples.width / ss;
+    for (dy, row) in out.chunks_mut(width * 4).enumerate() {
+        let py = py0 + dy;
+        for px in 0..width {
+            if let Some(color) = uniform(scene, proj, samples, ss, px, py) {
+                row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
+                continue;
+            }
+            let mut sum = [0u32; 4];
+            let mut last: Option<(u64, [u8; 3])> = None;
+            for sy in py * ss..(py + 1) * ss {
+                for sx in px * ss..(px + 1) * ss {
+                    let (color, alpha) = if samples.edge(sx, sy) {
+                        ([EDGE_COLOR[0], EDGE_COLOR[1], EDGE_COLOR[2]], 255)
+                    } else {
+                        let value = samples.value(sx, sy);
+                        if value == EMPTY {
+                            (
+                                [background[0], background[1], background[2]],
+                                background[3] as u32,
+                            )
+                        } else {
+                            let id = value & 0xffff_ffff;
+                            let color = match last {
+                                Some((l, c)) if l == id => c,
+                                _ => {
+                                    let c = shade(scene, proj, id, sx, sy, px, py);
+                                    last = Some((id, c));
+                                    c
+                                }
+                            };
+                            (color, 255)
+                        }
+                    };
+                    for c in 0..3 {
+                        sum[c] += color[c] as u32 * alpha;
+                    }
+                    sum[3] += alpha;
+                }
+            }
+            let n = (ss * ss) as u32;
+            let out = &mut row[px * 4..px * 4 + 4];
+            for c in 0..3 {
+                if let Some(v) = (sum[c] + sum[3] / 2).checked_div(sum[3]) {
+                    out[c] = v as u8;
+                }
+            }
+            out[3] = ((sum[3] + n / 2) / n) as u8;
+        }
     }
 }

@@ -58,6 +58,9 @@ pub enum Geometry {
     Face {
         surface: Link,
         loops: Vec<Vec<(Link, Option<String>)>>,
+        /// The span of each loop's edge list, for messages (lowering does not
+        /// read the document's objects, so the driver can drop them).
+        loop_spans: Vec<Span>,
     },
     /// A curve of paper 003 (segment, conic_arc, desargues_arc).
     PointCurve(PcCurve),

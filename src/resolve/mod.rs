@@ -99,7 +99,7 @@ pub fn resolve(
     overrides: &[Override],
     diags: &mut Diagnostics,
 ) -> Resolved {
-    let names = NameTable::build(source, doc, diags);
+    let names = std::rc::Rc::new(NameTable::build(source, doc, diags));
     let pairs: Vec<(String, Expr)> = overrides
         .iter()
         .map(|o| (o.name.clone(), o.value.clone()))
@@ -126,11 +126,7 @@ pub fn resolve(
             diags.push(d);
         }
     }
-    for (name, def) in &names.defs {
-        if def.kind != "parameter" && def.kind != "basis coordinate" {
-            values.other_names.insert(name.clone(), def.kind);
-        }
-    }
+    values.other_names = std::rc::Rc::clone(&names);
     let parameters = values.evaluate_all(diags);
     check_basis_order(doc, &values, diags);
     let mut resolver = objects::Resolver::new(doc, &names, values, diags);

@@ -288,7 +288,7 @@ impl<'a> Resolver<'a> {
     }
 
     fn tag(&self, spec: &PointSpec) -> String {
-        spec.tag.clone()
+        spec.tag.to_string()
     }
 
     /// A point given by reference: a point set (member), or a vertex.

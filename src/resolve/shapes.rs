@@ -419,7 +419,11 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             let end = r.link(end.as_ref()?, &["vertex"])?;
             Some(Geometry::Edge { line, begin, end })
         }
-        ObjectKind::Face { surface, loops, .. } => {
+        ObjectKind::Face {
+            surface,
+            loops,
+            loop_spans,
+        } => {
             let surface = r.link(
                 surface.as_ref()?,
                 &[
@@ -455,6 +459,7 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             ok.then_some(Geometry::Face {
                 surface,
                 loops: out,
+                loop_spans: loop_spans.clone(),
             })
         }
     }

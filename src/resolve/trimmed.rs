@@ -89,6 +89,71 @@ pub(super) fn surface(
                 [0.0, l, a0.to_radians(), a1.to_radians()],
             )
         }
+        CarrierSpec::Sphere {
+            radius,
+            latitudes,
+            angles,
+        } => {
+            let radius = r.number(radius.as_ref()?)?;
+            let l0 = r.number(latitudes[0].as_ref()?)?;
+            let l1 = r.number(latitudes[1].as_ref()?)?;
+            let a0 = optional(r, &angles[0], 0.0)?;
+            let a1 = optional(r, &angles[1], 360.0)?;
+            let ok = radius > 0.0 && -90.0 < l0 && l0 < l1 && l1 < 90.0 && a0 < a1;
+            if !ok {
+                invalid(
+                    r,
+                    format!(
+                        "sphere_surface '{name}': radius {radius}, latitudes {l0}° to {l1}°, angles {a0}° to {a1}°"
+                    ),
+                    "use a positive radius, -90 < from_latitude < to_latitude < 90 (the poles are left out) and from_angle < to_angle",
+                );
+                return None;
+            }
+            (
+                Carrier::Sphere { radius },
+                *frame,
+                [
+                    l0.to_radians(),
+                    l1.to_radians(),
+                    a0.to_radians(),
+                    a1.to_radians(),
+                ],
+            )
+        }
+        CarrierSpec::Torus {
+            radii,
+            tube,
+            angles,
+        } => {
+            let major = r.number(radii[0].as_ref()?)?;
+            let minor = r.number(radii[1].as_ref()?)?;
+            let t0 = r.number(tube[0].as_ref()?)?;
+            let t1 = r.number(tube[1].as_ref()?)?;
+            let a0 = optional(r, &angles[0], 0.0)?;
+            let a1 = optional(r, &angles[1], 360.0)?;
+            let ok = minor > 0.0 && major > minor && t0 < t1 && t1 - t0 < 360.0 && a0 < a1;
+            if !ok {
+                invalid(
+                    r,
+                    format!(
+                        "torus_surface '{name}': radii {major} and {minor}, tube angles {t0}° to {t1}°, angles {a0}° to {a1}°"
+                    ),
+                    "use 0 < minor_radius < major_radius, from_tube_angle < to_tube_angle less than a full turn apart, and from_angle < to_angle",
+                );
+                return None;
+            }
+            (
+                Carrier::Torus { major, minor },
+                *frame,
+                [
+                    t0.to_radians(),
+                    t1.to_radians(),
+                    a0.to_radians(),
+                    a1.to_radians(),
+                ],
+            )
+        }
         CarrierSpec::Expressions { xyz, rect } => {
             let mut bounds = [0.0; 4];
             for (slot, n) in bounds.iter_mut().zip(rect) {
@@ -114,6 +179,8 @@ pub(super) fn surface(
         }
     };
     let trim = match &spec.trim {
+        // The driver sets it from the tree (implicit::xml::lower).
+        Some(t) if t.tree && t.equation.is_none() => None,
         Some(t) => Some(trim(r, t, name)?),
         None => None,
     };
@@ -134,7 +201,28 @@ fn optional(r: &mut Resolver, n: &Option<Number>, default: f64) -> Option<f64> {
 }
 
 fn trim(r: &mut Resolver, t: &TrimSpec, name: &str) -> Option<Trim> {
-    let equation = t.equation.as_ref()?;
+    let Some(equation) = t.equation.as_ref().filter(|_| !t.tree) else {
+        let (what, help) = if t.tree {
+            (
+                "both equation= and an R-function tree",
+                "keep one of the two",
+            )
+        } else {
+            (
+                "neither equation= nor an R-function tree",
+                "give equation=\"F(x, y, z)\" or one tree such as <union>",
+            )
+        };
+        r.diags.push(
+            Diagnostic::new(
+                Code::TrimmedTrimForm,
+                Some(t.span),
+                format!("the trim of '{name}' has {what}"),
+            )
+            .with_help(help),
+        );
+        return None;
+    };
     let mut ctx = Ctx::new();
     let folded = fold(r, equation.expr.as_ref()?, &["x", "y", "z"])?;
     match program::build(&mut ctx, &folded, &["x", "y", "z"]) {

@@ -43,8 +43,9 @@ pub struct Values {
     parameter_order: Vec<String>,
     state: HashMap<String, State>,
     used: HashSet<String>,
-    /// Names of non-numeric objects, to say "wrong kind" instead of "undefined".
-    pub other_names: HashMap<String, &'static str>,
+    /// Every defined name with its kind, to say "wrong kind" instead of
+    /// "undefined" (shared with the resolver, not copied).
+    pub other_names: std::rc::Rc<super::NameTable>,
     stack: Vec<String>,
 }
 
@@ -85,7 +86,7 @@ impl Values {
             parameter_order,
             state: HashMap::new(),
             used: HashSet::new(),
-            other_names: HashMap::new(),
+            other_names: Default::default(),
             stack: Vec::new(),
         }
     }
@@ -193,7 +194,11 @@ impl Values {
             }
             None if name == "pi" => None,
             None => {
-                if let Some(kind) = self.other_names.get(name) {
+                if let Some(kind) = self
+                    .other_names
+                    .kind_of(name)
+                    .filter(|&k| k != "parameter" && k != "basis coordinate")
+                {
                     diags.push(
                         Diagnostic::new(
                             Code::WrongKind,

@@ -78,9 +78,27 @@ fn find_doctype(text: &str) -> Option<usize> {
 }
 
 /// Depth check without recursion, so a hostile file cannot overflow the stack.
+/// Visits elements depth-first, last child first; the stack holds one child
+/// iterator per level, so it stays as small as the nesting.
 fn check_depth(root: roxmltree::Node, limits: &Limits) -> Result<(), Diagnostic> {
-    let mut stack = vec![(root, 1usize)];
-    while let Some((node, depth)) = stack.pop() {
+    let mut stack = vec![root.children().rev()];
+    let mut next = Some(root);
+    loop {
+        let node = match next.take() {
+            Some(node) => node,
+            None => match stack.last_mut() {
+                Some(children) => match children.find(|c| c.is_element()) {
+                    Some(node) => node,
+                    None => {
+                        stack.pop();
+                        continue;
+                    }
+                },
+                None => return Ok(()),
+            },
+        };
+        // The root is level 1 and its children iterator is already on the stack.
+        let depth = if node == root { 1 } else { stack.len() + 1 };
         if depth > limits.max_depth {
             let range = node.range();
             let name_end = range.start + 1 + node.tag_name().name().len();
@@ -95,13 +113,10 @@ fn check_depth(root: roxmltree::Node, limits: &Limits) -> Result<(), Diagnostic>
             )
             .with_help("flatten the nesting, or raise the limit with --max-depth N"));
         }
-        stack.extend(
-            node.children()
-                .filter(|c| c.is_element())
-                .map(|c| (c, depth + 1)),
-        );
+        if node != root {
+            stack.push(node.children().rev());
+        }
     }
-    Ok(())
 }
 
 fn xml_error(source: &SourceFile, error: &roxmltree::Error, limits: &Limits) -> Diagnostic {

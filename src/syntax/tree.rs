@@ -62,10 +62,9 @@ pub(super) fn build<'s>(root: roxmltree::Node<'_, 's>) -> Element<'s> {
             }
             Some(_) => {}
             None => {
-                let Some((_, mut finished)) = stack.pop() else {
+                let Some((_, finished)) = stack.pop() else {
                     unreachable!("the loop only pops a frame it has just seen")
                 };
-                finished.children.shrink_to_fit();
                 match stack.last_mut() {
                     Some(parent) => parent.1.children.push(finished),
                     None => return finished,
@@ -98,7 +97,9 @@ fn shell<'s>(node: roxmltree::Node<'_, 's>) -> Element<'s> {
                 value_span: Span::from_range(a.range_value()),
             })
             .collect(),
-        children: Vec::new(),
+        // Sized exactly: no growth by doubling (the root of a large file has
+        // hundreds of thousands of children).
+        children: Vec::with_capacity(node.children().filter(|c| c.is_element()).count()),
         text: Vec::new(),
     }
 }

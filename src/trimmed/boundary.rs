@@ -406,6 +406,7 @@ impl Boundary {
     /// Drops contour points closer than `delta` (3D) to the last point kept;
     /// points on the rectangle's sides stay (they carry its corners).
     pub fn merge_short(&mut self, s: &TrimmedSurface, delta: f64) {
+        self.merge_side_points(s, delta);
         for lp in &mut self.loops {
             if lp.len() <= 3 {
                 continue;
@@ -424,6 +425,21 @@ impl Boundary {
                     last = q;
                 }
             }
+            // A contour point just before a side point (the trim reaching
+            // the side) would make a sliver there: drop it too.
+            let mut k = 1;
+            while k + 1 < kept.len() && kept.len() > 3 {
+                let (p, q) = (kept[k], kept[k + 1]);
+                let (a, b) = (self.points[p], self.points[q]);
+                if self.sides[p] == 0
+                    && self.sides[q] != 0
+                    && (s.point(a[0], a[1]) - s.point(b[0], b[1])).norm() < delta
+                {
+                    kept.remove(k);
+                } else {
+                    k += 1;
+                }
+            }
             // The closing edge: drop the last contour point if it is too close to the first.
             if kept.len() > 3 {
                 let (f, l) = (kept[0], kept[kept.len() - 1]);
@@ -433,6 +449,40 @@ impl Boundary {
                     kept.pop();
                 }
             }
+            if kept.len() >= 3 {
+                *lp = kept;
+            }
+        }
+    }
+
+    /// Drops grid points on a side closer than `delta` (3D) to a corner or to
+    /// a point where the trim meets the side (they would make slivers there).
+    /// The test looks at both neighbours alike, so the two sides of a
+    /// periodic seam lose the same points.
+    fn merge_side_points(&mut self, s: &TrimmedSurface, delta: f64) {
+        let sides = &self.sides;
+        let points = &self.points;
+        let at = |p: usize| s.point(points[p][0], points[p][1]);
+        for lp in &mut self.loops {
+            let n = lp.len();
+            if n <= 4 {
+                continue;
+            }
+            let plain = |k: usize| {
+                let bits = sides[lp[k]];
+                bits.count_ones() == 1
+                    && sides[lp[(k + n - 1) % n]] & bits != 0
+                    && sides[lp[(k + 1) % n]] & bits != 0
+            };
+            let drop: Vec<bool> = (0..n)
+                .map(|k| {
+                    plain(k)
+                        && [(k + n - 1) % n, (k + 1) % n]
+                            .iter()
+                            .any(|&j| !plain(j) && (at(lp[k]) - at(lp[j])).norm() < delta)
+                })
+                .collect();
+            let kept: Vec<usize> = (0..n).filter(|&k| !drop[k]).map(|k| lp[k]).collect();
             if kept.len() >= 3 {
                 *lp = kept;
             }
@@ -497,7 +547,7 @@ impl Boundary {
 
 /// Moves `m` onto W = 0 across the chord a–b (root finding along the chord's
 /// normal in (u, v)); `m` itself when no root is near.
-pub(super) fn project(s: &TrimmedSurface, m: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
+pub(crate) fn project(s: &TrimmedSurface, m: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
     let d = [b[0] - a[0], b[1] - a[1]];
     let len = d[0].hypot(d[1]);
     if len == 0.0 {

@@ -4,10 +4,11 @@
 //! (u, v); `triangulate.rs` meshes the kept part with a constrained Delaunay
 //! triangulation refined by 3D criteria; `measure.rs` has the quality figures.
 
-mod boundary;
+pub(crate) mod boundary;
 mod chart;
 mod measure;
 pub mod program;
+mod split;
 mod triangulate;
 
 pub use measure::{TrimmedQuality, centroid_distance};
@@ -25,6 +26,12 @@ pub enum Carrier {
     /// Paper 002's truncated cone about the local y axis: x = r(u) cos v,
     /// y = u, z = r(u) sin v, r(u) = r1 + (r2 − r1) u / l.
     Cone { r1: f64, r2: f64, length: f64 },
+    /// A sphere about the local origin: x = ρ cos u cos v, y = ρ sin u,
+    /// z = ρ cos u sin v (u the latitude, v the angle about the local y axis).
+    Sphere { radius: f64 },
+    /// A torus about the local y axis: x = (R + r cos u) cos v, y = r sin u,
+    /// z = (R + r cos u) sin v (u about the tube, v about the axis).
+    Torus { major: f64, minor: f64 },
     /// x(u, v), y(u, v), z(u, v) as programs in the variables u (0) and v (1).
     Expressions { xyz: Box<[Ssa; 3]> },
 }
@@ -65,6 +72,14 @@ impl TrimmedSurface {
             Carrier::Cone { r1, r2, length } => {
                 let r = r1 + (r2 - r1) * u / length;
                 Point3::new(r * v.cos(), u, r * v.sin())
+            }
+            Carrier::Sphere { radius } => {
+                let ring = radius * u.cos();
+                Point3::new(ring * v.cos(), radius * u.sin(), ring * v.sin())
+            }
+            Carrier::Torus { major, minor } => {
+                let ring = major + minor * u.cos();
+                Point3::new(ring * v.cos(), minor * u.sin(), ring * v.sin())
             }
             Carrier::Expressions { xyz } => {
                 let p = [u, v, 0.0];

@@ -269,3 +269,374 @@ fn interstage_cone_with_cut_outs() {
         q.area
     );
 }
+
+/// Smallest 3D triangle area of a mesh.
+fn min_area(m: &TrimmedMesh) -> f64 {
+    m.triangles
+        .iter()
+        .map(|t| {
+            let p = t.map(|i| m.nodes[i as usize]);
+            0.5 * (p[1] - p[0]).cross(&(p[2] - p[0])).norm()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Triangles per area / size²: gmsh makes about 2.4 on these surfaces (an
+/// equilateral triangle of side S covers S²·√3/4, i.e. 2.31 per S²); the
+/// size criterion must stay within 1.5× of that.
+fn density(triangles: usize, area: f64, size: f64) -> f64 {
+    triangles as f64 * size * size / area
+}
+
+#[test]
+fn interstage_counts_follow_the_element_size() {
+    let source = crate::span::SourceFile::new(
+        "trimmed_interstage.xml",
+        include_str!("../../fixtures/valid/trimmed_interstage.xml"),
+    );
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    let model = &checked.lowered.as_ref().expect("lowered").model;
+    let s = &model.trimmed[0];
+    let mut figures = Vec::new();
+    for size in [0.2, 0.1, 0.05] {
+        let settings = TrimSettings {
+            tolerance: 0.0064,
+            min_angle: 20.0,
+            max_edge: size,
+        };
+        let m = mesh_trimmed(s, settings).expect("meshable");
+        check_manifold(&m);
+        let q = m.quality(s);
+        let d = density(m.triangles.len(), q.area, size);
+        figures.push((size, m.triangles.len(), d, q.min_angle));
+        assert!((2.0..=3.6).contains(&d), "{figures:?}");
+        // The seam and the trim curves are split like any boundary: no
+        // triangle is below the threshold, none is flat.
+        assert!(q.min_angle >= 20.0, "{figures:?}");
+        assert!(min_area(&m) > 1e-4 * size * size, "{figures:?}");
+        for t in &m.triangles {
+            let p = t.map(|i| m.nodes[i as usize]);
+            let longest = (0..3)
+                .map(|k| (p[k] - p[(k + 1) % 3]).norm())
+                .fold(0.0, f64::max);
+            assert!(longest < 2.0 * size, "an edge of {longest} at size {size}");
+        }
+    }
+    // Halving the size gives about four times the triangles.
+    let r = figures[2].1 as f64 / figures[1].1 as f64;
+    assert!((3.5..4.5).contains(&r), "{figures:?}");
+}
+
+/// A cylinder r = 0.3, length 0.6 (the cone with equal radii) pierced by
+/// a cylinder y' = (y − 0.3), r 0.15 along x: two holes, one across the seam.
+fn pierced_cylinder() -> TrimmedSurface {
+    let mut c = Ctx::new();
+    let (y, z) = (c.var(1), c.var(2));
+    let mid = c.constant(0.3);
+    let dy = c.sub(y, mid);
+    let (y2, z2) = (c.square(dy), c.square(z));
+    let rr = c.constant(0.15 * 0.15);
+    let sum = c.add(y2, z2);
+    let f = c.sub(rr, sum);
+    TrimmedSurface {
+        name: "pierced".into(),
+        carrier: Carrier::Cone {
+            r1: 0.3,
+            r2: 0.3,
+            length: 0.6,
+        },
+        frame: Frame::identity(),
+        rect: [0.0, 0.6, 0.0, std::f64::consts::TAU],
+        trim: Some(Trim::new(&c, f, true)),
+    }
+}
+
+/// The pierced cylinder's area: 2πrL minus, at each y across a hole, the
+/// arcs where |sin v| < h(y)/r (measure 4·asin(h/r)), by Simpson's rule.
+fn pierced_area() -> f64 {
+    let (r, a) = (0.3f64, 0.15f64);
+    let n = 2000;
+    let step = 2.0 * a / n as f64;
+    let lost = |t: f64| {
+        let h = (a * a - t * t).max(0.0).sqrt();
+        r * 4.0 * (h / r).asin()
+    };
+    let mut sum = lost(-a) + lost(a);
+    for k in 1..n {
+        sum += lost(-a + k as f64 * step) * if k % 2 == 1 { 4.0 } else { 2.0 };
+    }
+    std::f64::consts::TAU * r * 0.6 - sum * step / 3.0
+}
+
+#[test]
+fn periodic_trimmed_cylinder_at_fine_sizes() {
+    let s = pierced_cylinder();
+    let exact = pierced_area();
+    for size in [0.04, 0.02] {
+        // A tolerance loose enough for the size to govern (r = 0.3).
+        let settings = TrimSettings {
+            tolerance: 0.005,
+            min_angle: 25.0,
+            max_edge: size,
+        };
+        let m = mesh_trimmed(&s, settings).expect("meshable");
+        check_manifold(&m);
+        // Two rims, a hole, and the hole across the seam as two open
+        // chains (the seam is welded, its segments are not boundary).
+        assert_eq!(m.boundary.len(), 5, "size {size}");
+        let q = m.quality(&s);
+        assert!(q.min_angle >= 25.0, "size {size}: {q:?}");
+        assert!(min_area(&m) > 1e-4 * size * size, "size {size}");
+        assert!(q.max_centroid_distance <= settings.tolerance, "{q:?}");
+        assert!(
+            (q.area - exact).abs() / exact < 3e-3,
+            "{} vs {exact}",
+            q.area
+        );
+        let d = density(m.triangles.len(), q.area, size);
+        assert!((2.0..=3.6).contains(&d), "size {size}: density {d}");
+    }
+}
+
+/// A flat 2 × 2 square (z = 0) trimmed by the R-function tree `tree`.
+fn square_with_tree(tree: &str, material: &str) -> (TrimmedSurface, crate::diag::Diagnostics) {
+    let text = format!(
+        r#"<geometry version="1">
+  <bezier_surface name="plate">
+    <row> <node x="0" y="0" z="0"/> <node x="0" y="2" z="0"/> </row>
+    <row> <node x="2" y="0" z="0"/> <node x="2" y="2" z="0"/> </row>
+    <trim material="{material}">{tree}</trim>
+  </bezier_surface>
+</geometry>"#
+    );
+    let source = crate::span::SourceFile::new("plate.xml", &text);
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    let model = &checked.lowered.as_ref().expect("lowered").model;
+    (model.trimmed[0].clone(), checked.diagnostics)
+}
+
+fn plate_area(s: &TrimmedSurface) -> (f64, TrimmedMesh) {
+    let settings = TrimSettings {
+        tolerance: 1e-4,
+        min_angle: 20.0,
+        max_edge: 0.05,
+    };
+    let m = mesh_trimmed(s, settings).expect("meshable");
+    check_manifold(&m);
+    let q = m.quality(s);
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    (q.area, m)
+}
+
+#[test]
+fn trim_by_a_union_tree() {
+    // Two disks r = 0.4 at (0.7, 1) and (1.3, 1) cut out: 4 − (2πr² − lens).
+    let (s, diags) = square_with_tree(
+        r#"<union><disk r="0.4" x0="0.7" y0="1"/><disk r="0.4" x0="1.3" y0="1"/></union>"#,
+        "negative",
+    );
+    assert!(!diags.has_errors(), "{diags:?}");
+    assert!(s.trim.is_some());
+    let (r, d) = (0.4f64, 0.6f64);
+    let lens = 2.0 * r * r * (d / (2.0 * r)).acos() - 0.5 * d * (4.0 * r * r - d * d).sqrt();
+    let exact = 4.0 - (2.0 * std::f64::consts::PI * r * r - lens);
+    let (area, m) = plate_area(&s);
+    assert!((area - exact).abs() < 2e-3, "{area} vs {exact}");
+    // The square's outline and one hole (the disks overlap).
+    assert_eq!(m.boundary.len(), 2);
+}
+
+#[test]
+fn trim_by_an_intersection_tree() {
+    // Material inside the disk r = 0.8 and outside the disk r = 0.3: an annulus.
+    let (s, diags) = square_with_tree(
+        r#"<intersection><disk r="0.8" x0="1" y0="1"/><not><disk r="0.3" x0="1" y0="1"/></not></intersection>"#,
+        "positive",
+    );
+    assert!(!diags.has_errors(), "{diags:?}");
+    let exact = std::f64::consts::PI * (0.64 - 0.09);
+    let (area, m) = plate_area(&s);
+    assert!((area - exact).abs() < 2e-3, "{area} vs {exact}");
+    assert_eq!(m.boundary.len(), 2);
+}
+
+#[test]
+fn trim_with_both_forms_is_e742() {
+    let (_, diags) = square_with_tree(r#"<disk r="0.4" x0="1" y0="1"/>"#, "negative");
+    assert!(!diags.has_errors());
+    let text = r#"<geometry version="1">
+  <bezier_surface name="plate">
+    <row> <node x="0" y="0" z="0"/> <node x="0" y="2" z="0"/> </row>
+    <row> <node x="2" y="0" z="0"/> <node x="2" y="2" z="0"/> </row>
+    <trim equation="x" material="negative"><disk r="0.4" x0="1" y0="1"/></trim>
+  </bezier_surface>
+</geometry>"#;
+    let source = crate::span::SourceFile::new("both.xml", text);
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    let codes: Vec<&str> = checked
+        .diagnostics
+        .items
+        .iter()
+        .map(|d| d.code.as_str())
+        .collect();
+    assert!(codes.contains(&"E742"), "{codes:?}");
+    let source = crate::span::SourceFile::new(
+        "neither.xml",
+        text.replace(r#"equation="x" "#, "")
+            .replace(r#"<disk r="0.4" x0="1" y0="1"/>"#, ""),
+    );
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    let codes: Vec<&str> = checked
+        .diagnostics
+        .items
+        .iter()
+        .map(|d| d.code.as_str())
+        .collect();
+    assert_eq!(codes, ["E742"]);
+}
+
+/// F = r² − y² − z² (a cylinder along x), material outside it.
+fn x_cylinder_hole(r: f64) -> Trim {
+    hole(r)
+}
+
+fn fine(max_edge: f64) -> TrimSettings {
+    TrimSettings {
+        tolerance: 0.002,
+        min_angle: 20.0,
+        max_edge,
+    }
+}
+
+#[test]
+fn sphere_zone_with_two_caps_cut_out() {
+    // Latitudes ±30° of the unit sphere, a full turn: 2π(sin 30° − sin(−30°));
+    // the cylinder y² + z² < 0.09 takes two caps of height 1 − √0.91 each,
+    // one across the seam.
+    let s = TrimmedSurface {
+        name: "zone".into(),
+        carrier: Carrier::Sphere { radius: 1.0 },
+        frame: Frame::identity(),
+        rect: [
+            (-30f64).to_radians(),
+            30f64.to_radians(),
+            0.0,
+            std::f64::consts::TAU,
+        ],
+        trim: Some(x_cylinder_hole(0.3)),
+    };
+    let m = mesh_trimmed(&s, fine(0.08)).expect("meshable");
+    check_manifold(&m);
+    // Two rims (the latitude circles), a hole, and the hole across the seam
+    // as two open chains.
+    assert_eq!(m.boundary.len(), 5);
+    let q = m.quality(&s);
+    let tau = std::f64::consts::TAU;
+    let exact = tau - 2.0 * tau * (1.0 - 0.91f64.sqrt());
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    assert!(q.max_centroid_distance <= 0.002, "{q:?}");
+    for p in &m.nodes {
+        assert!((p.coords.norm() - 1.0).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn torus_outer_half_area() {
+    // Tube angles −90° … 90° (the outer half), a full turn about the axis:
+    // area = ∫∫ r (R + r cos u) du dv = 2π r (π R + 2 r).
+    let (major, minor) = (2.0f64, 0.5f64);
+    let mut s = TrimmedSurface {
+        name: "torus".into(),
+        carrier: Carrier::Torus { major, minor },
+        frame: Frame::identity(),
+        rect: [
+            -std::f64::consts::FRAC_PI_2,
+            std::f64::consts::FRAC_PI_2,
+            0.0,
+            std::f64::consts::TAU,
+        ],
+        trim: None,
+    };
+    let m = mesh_trimmed(&s, fine(0.1)).expect("meshable");
+    check_manifold(&m);
+    assert_eq!(m.boundary.len(), 2);
+    let q = m.quality(&s);
+    let exact = std::f64::consts::TAU * minor * (std::f64::consts::PI * major + 2.0 * minor);
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    // With the cylinder y² + z² < 0.09 cut out: two holes, on the outer
+    // equator at v = 0 (across the seam) and v = π; their nodes on the cylinder.
+    s.trim = Some(x_cylinder_hole(0.3));
+    let m = mesh_trimmed(&s, fine(0.1)).expect("meshable");
+    check_manifold(&m);
+    assert_eq!(m.boundary.len(), 5);
+    let on_holes = m
+        .boundary
+        .iter()
+        .flatten()
+        .map(|&i| m.nodes[i as usize])
+        .filter(|p| p.y.abs() < minor - 1e-6)
+        .inspect(|p| assert!((p.y.hypot(p.z) - 0.3).abs() < 1e-8, "{p}"))
+        .count();
+    assert!(on_holes > 20, "{on_holes}");
+    let q = m.quality(&s);
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    assert!(q.area < exact);
+}
+
+#[test]
+fn cylinder_in_a_local_frame_cut_by_a_global_plane() {
+    // The cone with equal radii 0.5 over length 2, its local y axis turned
+    // onto global x and moved to start at x = 1; the trim F = x − 1.5 is in
+    // global coordinates: 1.5 of the length is kept, area 2π·0.5·1.5.
+    let frame = Frame::translation(Vec3::new(1.0, 2.0, 3.0))
+        .compose(&Frame::rotation_degrees(Vec3::new(0.0, 0.0, -90.0)));
+    let mut c = Ctx::new();
+    let x = c.var(0);
+    let k = c.constant(1.5);
+    let f = c.sub(x, k);
+    let s = TrimmedSurface {
+        name: "tube".into(),
+        carrier: Carrier::Cone {
+            r1: 0.5,
+            r2: 0.5,
+            length: 2.0,
+        },
+        frame,
+        rect: [0.0, 2.0, 0.0, std::f64::consts::TAU],
+        trim: Some(Trim::new(&c, f, false)),
+    };
+    let m = mesh_trimmed(&s, fine(0.1)).expect("meshable");
+    check_manifold(&m);
+    assert_eq!(m.boundary.len(), 2);
+    let q = m.quality(&s);
+    let exact = std::f64::consts::TAU * 0.5 * 1.5;
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    let (lo, hi) = m
+        .nodes
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |a, p| {
+            (a.0.min(p.x), a.1.max(p.x))
+        });
+    assert!(
+        (lo - 1.5).abs() < 1e-8 && (hi - 3.0).abs() < 1e-8,
+        "{lo} {hi}"
+    );
+    for p in &m.nodes {
+        assert!(((p.y - 2.0).hypot(p.z - 3.0) - 0.5).abs() < 1e-9, "{p}");
+    }
+}

@@ -7,20 +7,18 @@
 //! the triangle's 3D circumcentre E3 (minimising |R(u, v) − E3|).
 
 use super::TrimmedSurface;
-use super::boundary::{self, Boundary, V_MAX, V_MIN};
+use super::boundary::{self, V_MAX, V_MIN};
 use super::chart::ArcChart;
+use super::split::{Cdt, Nodes, split_constraint};
 use crate::geom::{Point3, Vec3};
-use spade::{
-    AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
-};
-use std::collections::HashMap;
-
-type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+use spade::{AngleLimit, Point2, RefinementParameters, Triangulation};
+use std::collections::{HashMap, HashSet};
 
 /// Refinement rounds before the result is taken as it is.
 const MAX_PASSES: usize = 40;
-/// Passes that also split triangles whose 3D angles are too small.
-const ANGLE_PASSES: usize = 6;
+/// A triangle is split while its 3D circumradius exceeds this many
+/// requested edge lengths (an equilateral triangle of side L has 0.577 L).
+const SIZE_RADIUS: f64 = 0.8;
 /// Nodes one trimmed surface may have.
 const MAX_VERTICES: usize = 4_000_000;
 
@@ -67,9 +65,9 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     let cell = (lu / nu as f64).hypot(lv / nv as f64);
     b.merge_short(s, 0.4 * cell);
     let periodic = is_periodic_v(s, extent);
-    // Boundary edges stay as they are on a periodic surface (both sides of
-    // the seam must match), so they start shorter there.
-    let side = if periodic { 0.5 * h } else { h.max(0.5 * cell) };
+    // Boundary edges start at the element size; refinement splits them
+    // (a seam edge with its twin) where they are encroached.
+    let side = h.max(0.5 * cell);
     b.refine_chords(s, 0.5 * tol, side);
     if b.loops.is_empty() {
         return Err("the trim leaves no material on the surface".into());
@@ -80,7 +78,12 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     };
     let mut cdt = Cdt::new();
     let mut handles = vec![usize::MAX; b.points.len()];
-    let mut uvs: Vec<[f64; 2]> = Vec::new();
+    let mut nodes = Nodes {
+        uv: Vec::new(),
+        xyz: Vec::new(),
+        sides: Vec::new(),
+        twin: HashMap::new(),
+    };
     for lp in &b.loops {
         for &p in lp {
             if handles[p] != usize::MAX {
@@ -89,8 +92,8 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             let h = cdt
                 .insert(chart(b.points[p]))
                 .map_err(|e| format!("a boundary point cannot be triangulated: {e:?}"))?;
-            if h.index() == uvs.len() {
-                uvs.push(b.points[p]);
+            if h.index() == nodes.uv.len() {
+                nodes.uv.push(b.points[p]);
             }
             handles[p] = h.index();
         }
@@ -111,33 +114,34 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             cdt.add_constraint(hx, hy);
         }
     }
+    nodes.xyz = nodes.uv.iter().map(|p| s.point(p[0], p[1])).collect();
+    nodes.mark_boundary(&b, &handles, periodic, s.rect);
     // Spade stops after this many insertions (triangles of side ~h cover the
     // surface about 2·area/h² times over; room for grading near the trim).
-    let budget = ((8.0 * lu * lv / (h * h)) as usize + 4 * uvs.len() + 1000).min(MAX_VERTICES);
-    let mut params = RefinementParameters::<f64>::new()
+    let budget = ((8.0 * lu * lv / (h * h)) as usize + 4 * nodes.uv.len() + 1000).min(MAX_VERTICES);
+    // Spade refines by angle in the chart and never splits a constraint
+    // edge: boundary splits are made here, on the true boundary (split.rs).
+    let params = RefinementParameters::<f64>::new()
         .exclude_outer_faces(true)
         .with_angle_limit(AngleLimit::from_deg((settings.min_angle + 3.0).min(30.0)))
-        .with_max_additional_vertices(budget);
-    // A periodic seam must be split the same way on both sides: keep its
-    // edges (and the trim's) as they are.
-    if periodic {
-        params = params.keep_constraint_edges();
-    }
-    let mut points3: Vec<Point3> = uvs.iter().map(|p| s.point(p[0], p[1])).collect();
+        .with_max_additional_vertices(budget)
+        .keep_constraint_edges();
     let mut inner: Vec<[usize; 3]> = Vec::new();
     // Triangles this small are left as they are (next to small input angles).
     let floor = (0.02 * h).min(tol);
-    let fixed = uvs.len();
-    for pass in 0..MAX_PASSES {
-        let result = cdt.refine(params.clone());
-        for v in uvs.len()..cdt.num_vertices() {
-            let q = cdt
-                .vertex(spade::handles::FixedVertexHandle::from_index(v))
-                .position();
-            let uv = arc.to_param([q.x, q.y]);
-            uvs.push(uv);
-            points3.push(s.point(uv[0], uv[1]));
-        }
+    let fixed = nodes.uv.len();
+    // Triangles found fine stay fine while they exist (their nodes and
+    // the criteria do not change): they are not measured again.
+    let mut fine: HashSet<[usize; 3]> = HashSet::new();
+    for pass in 0..=MAX_PASSES {
+        let last = pass == MAX_PASSES;
+        let round = if last {
+            params.clone().with_max_additional_vertices(0)
+        } else {
+            params.clone()
+        };
+        let result = cdt.refine(round);
+        nodes.sync(&cdt, &arc, s);
         let mut excluded = vec![false; cdt.num_all_faces()];
         for f in &result.excluded_faces {
             if let Some(slot) = excluded.get_mut(f.index()) {
@@ -145,41 +149,69 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             }
         }
         inner.clear();
-        let mut inserts: Vec<([f64; 2], spade::handles::FixedVertexHandle)> = Vec::new();
+        let mut actions: Vec<Action> = Vec::new();
         for f in cdt.inner_faces() {
             if excluded.get(f.fix().index()).copied().unwrap_or(true) {
                 continue;
             }
             let t = f.vertices().map(|v| v.fix().index());
             inner.push(t);
-            let p = t.map(|i| points3[i]);
-            let q = t.map(|i| uvs[i]);
-            // Angles at the boundary follow its discretisation (spade keeps
-            // the constraint edges): the 3D angle test is for the interior,
-            // and for the first passes (later ones only chase the tolerance).
-            let angles = pass < ANGLE_PASSES && t.iter().all(|&i| i >= fixed);
-            if let Some(point) = needs_split(s, &p, &q, &settings, floor, angles) {
-                inserts.push((point, f.vertices()[0].fix()));
+            if last {
+                continue;
+            }
+            let mut key = t;
+            key.sort_unstable();
+            if fine.contains(&key) {
+                continue;
+            }
+            let p = t.map(|i| nodes.xyz[i]);
+            let q = t.map(|i| nodes.uv[i]);
+            let constraints: Vec<(usize, usize)> = f
+                .adjacent_edges()
+                .iter()
+                .filter(|e| cdt.is_constraint_edge(e.as_undirected().fix()))
+                .map(|e| (e.from().fix().index(), e.to().fix().index()))
+                .collect();
+            // Two constraint edges meet at an input angle: the angle test
+            // cannot be met there.
+            let angles = constraints.len() < 2;
+            match needs_split(s, &p, &q, &settings, floor, angles) {
+                Some(split) => {
+                    if let Some(a) = choose(&cdt, &arc, &nodes, split, &constraints, t[0], floor) {
+                        actions.push(a);
+                    }
+                }
+                None => {
+                    fine.insert(key);
+                }
             }
         }
-        if inserts.is_empty() {
+        if actions.is_empty() {
             break;
         }
-        if cdt.num_vertices() + inserts.len() > MAX_VERTICES {
+        if cdt.num_vertices() + actions.len() > MAX_VERTICES {
             return Err(format!(
                 "it needs more than {MAX_VERTICES} nodes for the tolerance"
             ));
         }
-        for (uv, hint) in inserts {
-            if encroaches(&cdt, chart(uv), hint) {
-                continue;
-            }
-            let h = cdt
-                .insert_with_hint(chart(uv), hint)
-                .map_err(|e| format!("a refinement point cannot be inserted: {e:?}"))?;
-            if h.index() == uvs.len() {
-                uvs.push(uv);
-                points3.push(s.point(uv[0], uv[1]));
+        for a in actions {
+            match a {
+                Action::Split(x, y) => {
+                    split_constraint(&mut cdt, &arc, s, &mut nodes, x, y);
+                }
+                Action::Insert { uv, hint, spacing } => {
+                    if !clear(&cdt, chart(uv), hint, spacing) {
+                        continue;
+                    }
+                    let h = cdt
+                        .insert_with_hint(chart(uv), hint)
+                        .map_err(|e| format!("a refinement point cannot be inserted: {e:?}"))?;
+                    if h.index() == nodes.uv.len() {
+                        nodes.uv.push(uv);
+                        nodes.xyz.push(s.point(uv[0], uv[1]));
+                        nodes.sides.push(0);
+                    }
+                }
             }
         }
     }
@@ -193,27 +225,12 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
             c
         })
         .collect();
-    if !periodic {
-        let mut sides = vec![0u8; uvs.len()];
-        for (p, &h) in handles.iter().enumerate() {
-            if h != usize::MAX {
-                sides[h] = b.sides[p];
-            }
-        }
-        snap_splits(
-            &cdt,
-            s,
-            fixed,
-            &sides,
-            &mut boundary_chains,
-            &mut uvs,
-            &mut points3,
-        );
-    }
-    let mut remap: Vec<usize> = (0..uvs.len()).collect();
+    thread_splits(&cdt, fixed, &mut boundary_chains);
+    let mut remap: Vec<usize> = (0..nodes.uv.len()).collect();
     if periodic {
-        weld_seam(&b, &handles, &uvs, s.rect, &mut remap, &mut boundary_chains);
+        weld_seam(&nodes, &mut remap, &mut boundary_chains);
     }
+    let (uvs, points3) = (nodes.uv, nodes.xyz);
     Ok(assemble(&uvs, &points3, &inner, &remap, &boundary_chains))
 }
 
@@ -226,8 +243,30 @@ fn is_periodic_v(s: &TrimmedSurface, extent: f64) -> bool {
     })
 }
 
-/// The parameter point to insert when the triangle is too coarse or too
-/// skinny on the surface, `None` when it is fine.
+/// Where a triangle that is too coarse or too skinny on the surface would be
+/// split.
+struct Split {
+    /// The parameter point nearest the 3D circumcentre, when it is in the
+    /// material and near the triangle (else a boundary edge must be split).
+    circumcentre: Option<[f64; 2]>,
+    centroid: [f64; 2],
+    triangle: [[f64; 2]; 3],
+}
+
+/// What one refinement step does.
+enum Action {
+    Split(usize, usize),
+    Insert {
+        uv: [f64; 2],
+        hint: spade::handles::FixedVertexHandle,
+        spacing: f64,
+    },
+}
+
+/// `None` when the triangle is fine: small enough for the size (its 3D
+/// circumradius at most SIZE_RADIUS × max_edge, so the triangles come out
+/// with edges near max_edge, as other meshers make them), close enough to
+/// the surface, and with its angles above the threshold.
 fn needs_split(
     s: &TrimmedSurface,
     p: &[Point3; 3],
@@ -235,7 +274,7 @@ fn needs_split(
     settings: &TrimSettings,
     floor: f64,
     angles: bool,
-) -> Option<[f64; 2]> {
+) -> Option<Split> {
     let edges = [p[1] - p[0], p[2] - p[1], p[0] - p[2]];
     let lengths = edges.map(|e| e.norm());
     let longest = lengths.iter().cloned().fold(0.0, f64::max);
@@ -247,9 +286,11 @@ fn needs_split(
         (q[0][1] + q[1][1] + q[2][1]) / 3.0,
     ];
     let centroid = Point3::from((p[0].coords + p[1].coords + p[2].coords) / 3.0);
+    let circle = circumcentre(p);
+    let radius = circle.map_or(f64::INFINITY, |c| (c - p[0]).norm());
     let on_surface = s.point(centroid_uv[0], centroid_uv[1]);
-    let mut coarse =
-        (on_surface - centroid).norm() > settings.tolerance || longest > settings.max_edge;
+    let mut coarse = (on_surface - centroid).norm() > settings.tolerance
+        || radius > SIZE_RADIUS * settings.max_edge;
     if !coarse {
         for k in 0..3 {
             let (a, b) = (q[k], q[(k + 1) % 3]);
@@ -265,19 +306,87 @@ fn needs_split(
     if !(coarse || skinny) {
         return None;
     }
-    let target = circumcentre(p).unwrap_or(centroid);
-    let uv = nearest_parameter(s, target, centroid_uv);
     let inside = |uv: [f64; 2]| {
         let [u0, u1, v0, v1] = s.rect;
         uv[0] > u0 && uv[0] < u1 && uv[1] > v0 && uv[1] < v1 && s.material(uv[0], uv[1]) >= 0.0
     };
     // Far from the triangle (beyond twice its parameter size) or out of the
-    // material, the circumcentre is not usable: split at the centroid.
+    // material, the circumcentre is not usable.
     let size = (0..3)
         .map(|k| (q[k][0] - centroid_uv[0]).hypot(q[k][1] - centroid_uv[1]))
         .fold(0.0, f64::max);
-    let near = (uv[0] - centroid_uv[0]).hypot(uv[1] - centroid_uv[1]) <= 2.0 * size;
-    Some(if near && inside(uv) { uv } else { centroid_uv })
+    let circumcentre = circle
+        .map(|c| nearest_parameter(s, c, centroid_uv))
+        .filter(|uv| (uv[0] - centroid_uv[0]).hypot(uv[1] - centroid_uv[1]) <= 2.0 * size)
+        .filter(|&uv| inside(uv));
+    Some(Split {
+        circumcentre,
+        centroid: centroid_uv,
+        triangle: *q,
+    })
+}
+
+/// Ruppert's choice: the circumcentre, unless it encroaches on a boundary
+/// edge (falls in its diametral circle) or lies beyond the boundary; then
+/// that boundary edge is split instead.
+fn choose(
+    cdt: &Cdt,
+    arc: &ArcChart,
+    nodes: &Nodes,
+    split: Split,
+    constraints: &[(usize, usize)],
+    corner: usize,
+    floor: f64,
+) -> Option<Action> {
+    let corners = split.triangle.map(|uv| arc.to_chart(uv));
+    let mid = [
+        (corners[0][0] + corners[1][0] + corners[2][0]) / 3.0,
+        (corners[0][1] + corners[1][1] + corners[2][1]) / 3.0,
+    ];
+    let spacing = 0.3
+        * corners
+            .iter()
+            .map(|c| (c[0] - mid[0]).hypot(c[1] - mid[1]))
+            .fold(0.0, f64::max);
+    let splittable = |(x, y): (usize, usize)| (nodes.xyz[x] - nodes.xyz[y]).norm() > 2.0 * floor;
+    let longest_constraint = || {
+        constraints
+            .iter()
+            .copied()
+            .filter(|&e| splittable(e))
+            .max_by(|a, b| {
+                let la = (nodes.xyz[a.0] - nodes.xyz[a.1]).norm();
+                let lb = (nodes.xyz[b.0] - nodes.xyz[b.1]).norm();
+                la.total_cmp(&lb)
+            })
+    };
+    let hint = spade::handles::FixedVertexHandle::from_index(corner);
+    let candidates = match split.circumcentre {
+        Some(c) => vec![c, split.centroid],
+        None => {
+            if let Some(e) = longest_constraint() {
+                return Some(Action::Split(e.0, e.1));
+            }
+            vec![split.centroid]
+        }
+    };
+    for uv in candidates {
+        match encroached(cdt, chart_point(arc, uv), hint) {
+            Some(Some(e)) => {
+                return splittable(e).then_some(Action::Split(e.0, e.1));
+            }
+            Some(None) => {
+                return Some(Action::Insert { uv, hint, spacing });
+            }
+            None => continue,
+        }
+    }
+    None
+}
+
+fn chart_point(arc: &ArcChart, uv: [f64; 2]) -> Point2<f64> {
+    let c = arc.to_chart(uv);
+    Point2::new(c[0], c[1])
 }
 
 /// The smallest angle of a 3D triangle, degrees.
@@ -321,59 +430,15 @@ pub(crate) fn nearest_parameter(s: &TrimmedSurface, target: Point3, start: [f64;
     uv
 }
 
-/// Merges the nodes of the side v = v_max into those of v = v_min with the
-/// same u, and drops both sides from the boundary chains.
-fn weld_seam(
-    b: &Boundary,
-    handles: &[usize],
-    uvs: &[[f64; 2]],
-    rect: [f64; 4],
-    remap: &mut [usize],
-    chains: &mut Vec<Vec<usize>>,
-) {
-    let eps = 1e-9 * (rect[1] - rect[0]);
-    let mut low: Vec<(f64, usize)> = Vec::new();
-    let mut seam = vec![false; uvs.len()];
-    for (p, &side) in b.sides.iter().enumerate() {
-        let h = handles[p];
-        if h == usize::MAX {
-            continue;
-        }
-        if side & (V_MIN | V_MAX) != 0 {
-            seam[h] = true;
-        }
-        if side & V_MIN != 0 {
-            low.push((uvs[h][0], h));
+/// Merges each node of the side v = v_max into its twin on v = v_min, and
+/// drops both sides from the boundary chains.
+fn weld_seam(nodes: &Nodes, remap: &mut [usize], chains: &mut Vec<Vec<usize>>) {
+    for (&a, &b) in &nodes.twin {
+        if nodes.sides[a] & V_MAX != 0 {
+            remap[a] = b;
         }
     }
-    low.sort_by(|x, y| x.0.total_cmp(&y.0));
-    for (p, &side) in b.sides.iter().enumerate() {
-        let h = handles[p];
-        if h == usize::MAX || side & V_MAX == 0 {
-            continue;
-        }
-        let u = uvs[h][0];
-        let at = low.partition_point(|x| x.0 < u - eps);
-        if let Some(&(lu, lh)) = low.get(at)
-            && (lu - u).abs() <= eps
-        {
-            remap[h] = lh;
-        }
-    }
-    // The side bits of each handle (a handle may come from several points).
-    let mut side_of: HashMap<usize, u8> = HashMap::new();
-    for (&bits, &h) in b.sides.iter().zip(handles) {
-        if h != usize::MAX && seam.get(h).copied().unwrap_or(false) {
-            *side_of.entry(h).or_default() |= bits & (V_MIN | V_MAX);
-        }
-    }
-    let along_seam = |x: usize, y: usize| {
-        let (sx, sy) = (
-            side_of.get(&x).copied().unwrap_or(0),
-            side_of.get(&y).copied().unwrap_or(0),
-        );
-        sx & sy & (V_MIN | V_MAX) != 0
-    };
+    let along_seam = |x: usize, y: usize| nodes.sides[x] & nodes.sides[y] & (V_MIN | V_MAX) != 0;
     let mut out = Vec::new();
     for chain in chains.drain(..) {
         // Cut the closed chain at segments along the seam; rotate so a cut
@@ -442,37 +507,55 @@ fn assemble(
     mesh
 }
 
-/// True when `p` falls on a vertex or edge, or inside the diametral circle
-/// of a constraint edge of the triangle holding it: a point there would
-/// make a sliver against the boundary, which refinement keeps as it is.
-fn encroaches(cdt: &Cdt, p: Point2<f64>, hint: spade::handles::FixedVertexHandle) -> bool {
+/// `None` when `p` falls on a vertex or edge or outside; else the
+/// constraint edge of the triangle holding it whose diametral circle holds
+/// it, if any (a point there would make a sliver against the boundary).
+fn encroached(
+    cdt: &Cdt,
+    p: Point2<f64>,
+    hint: spade::handles::FixedVertexHandle,
+) -> Option<Option<(usize, usize)>> {
     use spade::PositionInTriangulation::OnFace;
     let OnFace(face) = cdt.locate_with_hint(p, hint) else {
-        return true;
+        return None;
     };
-    cdt.face(face).adjacent_edges().iter().any(|e| {
-        if !cdt.is_constraint_edge(e.as_undirected().fix()) {
-            return false;
-        }
-        let [a, b] = e.positions();
-        let m = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
-        let r2 = 0.25 * ((a.x - b.x).powi(2) + (a.y - b.y).powi(2));
-        (p.x - m.x).powi(2) + (p.y - m.y).powi(2) < r2
-    })
+    Some(
+        cdt.face(face)
+            .adjacent_edges()
+            .iter()
+            .find(|e| {
+                if !cdt.is_constraint_edge(e.as_undirected().fix()) {
+                    return false;
+                }
+                let [a, b] = e.positions();
+                let m = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
+                let r2 = 0.25 * ((a.x - b.x).powi(2) + (a.y - b.y).powi(2));
+                (p.x - m.x).powi(2) + (p.y - m.y).powi(2) < r2
+            })
+            .map(|e| (e.from().fix().index(), e.to().fix().index())),
+    )
 }
 
-/// Puts the boundary points spade added (splitting constraint edges at
-/// their chart midpoints) back on the boundary: on the side they split, or
-/// on W = 0; and threads them into the boundary chains.
-fn snap_splits(
-    cdt: &Cdt,
-    s: &TrimmedSurface,
-    fixed: usize,
-    sides: &[u8],
-    chains: &mut [Vec<usize>],
-    uvs: &mut [[f64; 2]],
-    points3: &mut [Point3],
-) {
+/// True when `p` lies in a triangle, off its constraint edges' diametral
+/// circles and at least `spacing` from its corners (another point of the
+/// same round may have landed nearby).
+fn clear(cdt: &Cdt, p: Point2<f64>, hint: spade::handles::FixedVertexHandle, spacing: f64) -> bool {
+    use spade::PositionInTriangulation::OnFace;
+    if encroached(cdt, p, hint) != Some(None) {
+        return false;
+    }
+    let OnFace(face) = cdt.locate_with_hint(p, hint) else {
+        return false;
+    };
+    cdt.face(face)
+        .positions()
+        .iter()
+        .all(|c| (c.x - p.x).hypot(c.y - p.y) >= spacing)
+}
+
+/// Threads the boundary points split in (each on two constraint edges) into
+/// the boundary chains.
+fn thread_splits(cdt: &Cdt, fixed: usize, chains: &mut [Vec<usize>]) {
     let mut next: HashMap<usize, Vec<usize>> = HashMap::new();
     for e in cdt.undirected_edges() {
         if cdt.is_constraint_edge(e.fix()) {
@@ -490,14 +573,14 @@ fn snap_splits(
             if direct {
                 continue;
             }
-            // Walk from x through added points (each on two constraint edges) to y.
+            // Walk from x through added points to y.
             let starts: Vec<usize> = next.get(&x).map_or(Vec::new(), |n| {
                 n.iter().copied().filter(|&n| n >= fixed).collect()
             });
             for start in starts {
                 let mut path = vec![start];
                 let (mut prev, mut cur) = (x, start);
-                while cur >= fixed && path.len() <= uvs.len() {
+                while cur >= fixed && path.len() <= cdt.num_vertices() {
                     let Some(&n) = next.get(&cur).and_then(|n| n.iter().find(|&&n| n != prev))
                     else {
                         break;
@@ -509,17 +592,6 @@ fn snap_splits(
                     }
                 }
                 if cur == y {
-                    let (ux, uy) = (uvs[x], uvs[y]);
-                    let common = sides[x] & sides[y];
-                    for &p in &path {
-                        let uv = if common != 0 {
-                            snap_to_side(uvs[p], common, s.rect)
-                        } else {
-                            boundary::project(s, uvs[p], ux, uy)
-                        };
-                        uvs[p] = uv;
-                        points3[p] = s.point(uv[0], uv[1]);
-                    }
                     out.extend(path);
                     break;
                 }
@@ -528,21 +600,4 @@ fn snap_splits(
         out.push(*chain.last().unwrap_or(&0));
         *chain = out;
     }
-}
-
-fn snap_to_side(uv: [f64; 2], side: u8, rect: [f64; 4]) -> [f64; 2] {
-    let mut uv = uv;
-    if side & boundary::U_MIN != 0 {
-        uv[0] = rect[0];
-    }
-    if side & boundary::U_MAX != 0 {
-        uv[0] = rect[1];
-    }
-    if side & V_MIN != 0 {
-        uv[1] = rect[2];
-    }
-    if side & V_MAX != 0 {
-        uv[1] = rect[3];
-    }
-    uv
 }

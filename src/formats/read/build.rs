@@ -6,7 +6,9 @@
 use super::Loaded;
 use super::clean;
 use crate::diag::{Code, Diagnostic};
-use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain};
+use crate::mesh::{
+    CellKind, Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain, MeshVolume,
+};
 use std::collections::HashMap;
 
 /// Elements of one named group.
@@ -16,6 +18,21 @@ pub struct Group {
     pub triangles: Vec<[u32; 3]>,
     pub lines: Vec<[u32; 2]>,
     pub points: Vec<u32>,
+    /// Volume cells by kind (index: `CellKind as usize`), corners flat.
+    pub volumes: [Vec<u32>; 4],
+}
+
+impl Group {
+    /// Adds one volume cell; `corners` has `kind.corners()` nodes (the
+    /// readers check the count where they read it).
+    pub fn add_cell(&mut self, kind: CellKind, corners: &[u32]) {
+        if let (Some(list), Some(c)) = (
+            self.volumes.get_mut(kind as usize),
+            corners.get(..kind.corners()),
+        ) {
+            list.extend_from_slice(c);
+        }
+    }
 }
 
 /// A fragment recovered from a file that carries one (geomc's own glTF
@@ -62,12 +79,13 @@ impl Builder {
 
     /// The mesh and its checks. Indices are the readers' to check; this
     /// checks them again so that no reader bug can reach a writer.
-    pub fn finish(self) -> Result<Loaded, Vec<Diagnostic>> {
+    pub fn finish(mut self) -> Result<Loaded, Vec<Diagnostic>> {
         let n = self.nodes.len();
         for g in &self.groups {
             let bad = g.triangles.iter().flatten().any(|&v| v as usize >= n)
                 || g.lines.iter().flatten().any(|&v| v as usize >= n)
-                || g.points.iter().any(|&v| v as usize >= n);
+                || g.points.iter().any(|&v| v as usize >= n)
+                || g.volumes.iter().flatten().any(|&v| v as usize >= n);
             if bad {
                 return Err(vec![Diagnostic::new(
                     Code::MeshIndexOutOfRange,
@@ -93,6 +111,17 @@ impl Builder {
             ..Mesh::default()
         };
         let mut face_of_group = HashMap::new();
+        for g in &mut self.groups {
+            for (kind, nodes) in CellKind::ALL.into_iter().zip(&mut g.volumes) {
+                if !nodes.is_empty() {
+                    mesh.volumes.push(MeshVolume {
+                        name: g.name.clone(),
+                        kind,
+                        nodes: std::mem::take(nodes),
+                    });
+                }
+            }
+        }
         for g in self.groups {
             if !g.triangles.is_empty() {
                 face_of_group.insert(g.name.clone(), mesh.faces.len() as u32);

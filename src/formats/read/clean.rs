@@ -6,7 +6,6 @@
 
 use crate::diag::{Code, Diagnostic};
 use crate::mesh::Mesh;
-use rayon::slice::ParallelSliceMut;
 
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct EdgeCounts {
@@ -112,50 +111,91 @@ fn diagonal(mesh: &Mesh) -> f64 {
     if d.is_finite() { d } else { 0.0 }
 }
 
-/// Edge use counts by sorting packed half-edges: `min << 33 | max << 1 | dir`
-/// (nodes below 2³¹, which any mesh that fits in memory satisfies).
+/// Edge use counts: half-edges bucketed by their lower node (a counting
+/// sort: two passes over the triangles, `(higher << 1) | direction` in
+/// 4 bytes each), then each node's few entries sorted in place. Linear in
+/// the mesh, and the same on any thread count.
 pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCounts {
     let mut out = EdgeCounts::default();
     let area_floor = (scale * scale) * 1e-14;
-    let mut half: Vec<u64> = Vec::with_capacity(triangles.len() * 3);
+    let n = nodes.len();
+    // The half-edges of a triangle as (lower node, higher << 1 | direction);
+    // edges of repeated or unknown nodes are skipped.
+    let halves = |t: &[u32; 3]| {
+        [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]
+            .into_iter()
+            .filter(move |&(a, b)| a != b && (a as usize) < n && (b as usize) < n)
+            .map(|(a, b)| {
+                if a < b {
+                    (a, b << 1)
+                } else {
+                    (b, (a << 1) | 1)
+                }
+            })
+    };
+    let mut start = vec![0u32; n + 1];
     for t in triangles {
         if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || twice_area(nodes, *t) <= area_floor {
             out.degenerate += 1;
         }
-        for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
-            if a == b {
-                continue;
+        for (lo, _) in halves(t) {
+            if let Some(c) = start.get_mut(lo as usize + 1) {
+                *c += 1;
             }
-            let (lo, hi, dir) = if a < b { (a, b, 0) } else { (b, a, 1) };
-            half.push((u64::from(lo) << 33) | (u64::from(hi) << 1) | dir);
         }
     }
-    // Plain integers: the parallel sort gives the same order on any thread count.
-    half.par_sort_unstable();
-    let mut i = 0;
-    while let Some(&first) = half.get(i) {
-        let key = first >> 1;
-        let mut j = i;
-        let (mut forward, mut backward) = (0usize, 0usize);
-        while let Some(&h) = half.get(j).filter(|&&h| h >> 1 == key) {
-            if h & 1 == 0 {
-                forward += 1;
-            } else {
-                backward += 1;
-            }
-            j += 1;
+    for i in 1..start.len() {
+        let before = start.get(i - 1).copied().unwrap_or(0);
+        if let Some(c) = start.get_mut(i) {
+            *c += before;
         }
-        out.edges += 1;
-        match forward + backward {
-            1 => out.open += 1,
-            2 => {
-                if forward != 1 {
-                    out.inconsistent += 1;
+    }
+    let mut fill = start.clone();
+    let mut slots = vec![0u32; start.last().copied().unwrap_or(0) as usize];
+    for t in triangles {
+        for (lo, entry) in halves(t) {
+            if let Some(f) = fill.get_mut(lo as usize)
+                && let Some(slot) = slots.get_mut(*f as usize)
+            {
+                *slot = entry;
+                *f += 1;
+            }
+        }
+    }
+    drop(fill);
+    for w in start.windows(2) {
+        let &[from, to] = w else {
+            continue;
+        };
+        let Some(bucket) = slots.get_mut(from as usize..to as usize) else {
+            continue;
+        };
+        bucket.sort_unstable();
+        let mut i = 0;
+        while let Some(&first) = bucket.get(i) {
+            let key = first >> 1;
+            let mut j = i;
+            let (mut forward, mut backward) = (0usize, 0usize);
+            while let Some(&h) = bucket.get(j).filter(|&&h| h >> 1 == key) {
+                if h & 1 == 0 {
+                    forward += 1;
+                } else {
+                    backward += 1;
                 }
+                j += 1;
             }
-            _ => out.non_manifold += 1,
+            out.edges += 1;
+            match forward + backward {
+                1 => out.open += 1,
+                2 => {
+                    if forward != 1 {
+                        out.inconsistent += 1;
+                    }
+                }
+                _ => out.non_manifold += 1,
+            }
+            i = j;
         }
-        i = j;
     }
     out
 }

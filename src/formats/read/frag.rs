@@ -6,14 +6,14 @@
 //! counts the description says.
 
 use super::build::FastMap;
-use super::{Loaded, ReadFormat, load_mesh_as};
+use super::{Loaded, ReadFormat, ReadLimits, check_named_file, load_mesh_limited};
 use crate::diag::{Code, Diagnostic};
 use crate::formats::frag::{FragDocument, read_frag_xml};
 use crate::mesh::{MeshFragment, MeshSubdomain};
 use crate::span::Span;
 use std::path::Path;
 
-pub fn load(path: &Path, bytes: &[u8]) -> Result<Loaded, Vec<Diagnostic>> {
+pub fn load(path: &Path, bytes: &[u8], limits: &ReadLimits) -> Result<Loaded, Vec<Diagnostic>> {
     let text = String::from_utf8_lossy(bytes);
     let name = path.display().to_string();
     let doc = read_frag_xml(&name, &text).map_err(|e| {
@@ -47,7 +47,8 @@ pub fn load(path: &Path, bytes: &[u8]) -> Result<Loaded, Vec<Diagnostic>> {
             format!("the mesh file `{file}` is itself a .frag.xml"),
         )]);
     }
-    let mut loaded = load_mesh_as(&mesh_path, format)?;
+    check_named_file(&mesh_path, "the mesh file", limits.max_file_size).map_err(|d| vec![d])?;
+    let mut loaded = load_mesh_limited(&mesh_path, format, limits)?;
     if let Err(by_face) = apply(&mut loaded, &doc, &file) {
         // Formats that group by fragment (MSH, STL solids) match fragment-wise.
         if !apply_by_fragment(&mut loaded, &doc) {

@@ -11,7 +11,7 @@
 //! reader needs error positions and no images.
 
 use super::build::{Builder, FragmentInfo, NodeDedup};
-use super::{base64, error_at, error_at_byte};
+use super::{ReadLimits, base64, check_named_file, error_at, error_at_byte};
 use crate::diag::{Code, Diagnostic};
 use serde_json::Value;
 use std::path::Path;
@@ -25,7 +25,7 @@ const IDENTITY: M4 = [
     [0.0, 0.0, 0.0, 1.0],
 ];
 
-pub fn read(bytes: &[u8], folder: &Path) -> Result<Builder, Vec<Diagnostic>> {
+pub fn read(bytes: &[u8], folder: &Path, limits: &ReadLimits) -> Result<Builder, Vec<Diagnostic>> {
     let (json_bytes, json_offset, bin) = if bytes.starts_with(b"glTF") {
         split_glb(bytes)?
     } else {
@@ -55,6 +55,8 @@ pub fn read(bytes: &[u8], folder: &Path) -> Result<Builder, Vec<Diagnostic>> {
         dedup: NodeDedup::default(),
         converted: 0,
         skipped_modes: 0,
+        limits: *limits,
+        elements: std::cell::Cell::new(0),
     };
     r.load_buffers(bin, folder).map_err(|d| vec![d])?;
     r.walk().map_err(|d| vec![d])?;
@@ -158,6 +160,9 @@ struct Reader<'a> {
     dedup: NodeDedup,
     converted: usize,
     skipped_modes: usize,
+    limits: ReadLimits,
+    /// Accessor elements decoded so far (checked against `limits.max_elements`).
+    elements: std::cell::Cell<u64>,
 }
 
 fn bad(path: &str, message: impl Into<String>) -> Diagnostic {
@@ -224,6 +229,7 @@ fn has_scheme(uri: &str) -> bool {
 
 impl<'a> Reader<'a> {
     fn load_buffers(&mut self, bin: Option<&'a [u8]>, folder: &Path) -> Result<(), Diagnostic> {
+        let mut total = 0u64;
         for (i, buf) in list(self.root, "buffers").iter().enumerate() {
             let path = format!("buffers[{i}]");
             let length = uint(buf, "byteLength", &path)?.unwrap_or(0);
@@ -264,6 +270,11 @@ impl<'a> Reader<'a> {
                         ));
                     }
                     let file = folder.join(&name);
+                    check_named_file(
+                        &file,
+                        &format!("{path}: the buffer file"),
+                        self.limits.max_file_size,
+                    )?;
                     std::borrow::Cow::Owned(std::fs::read(&file).map_err(|e| {
                         Diagnostic::new(
                             Code::MeshReadFailed,
@@ -282,6 +293,18 @@ impl<'a> Reader<'a> {
                         data.len()
                     ),
                 ));
+            }
+            total = total.saturating_add(data.len() as u64);
+            if total > self.limits.max_file_size {
+                return Err(Diagnostic::new(
+                    Code::GltfBuffersTooLarge,
+                    None,
+                    format!(
+                        "{path}: the buffers read so far hold {total} bytes, over the limit of {} bytes",
+                        self.limits.max_file_size
+                    ),
+                )
+                .with_help("raise the limit with --max-file-size BYTES"));
             }
             self.buffers.push(data);
         }
@@ -563,6 +586,22 @@ impl<'a> Reader<'a> {
         let Some(elements) = data.get(view_offset + offset..view_end) else {
             return Err(bad(&path, "the accessor starts past its buffer view's end"));
         };
+        // A count the data cannot hold was refused above (E523). An accessor
+        // shared by many primitives is decoded once per use: the sum, not the
+        // file, bounds the memory.
+        let decoded = self.elements.get().saturating_add(count as u64);
+        if decoded > self.limits.max_elements {
+            return Err(Diagnostic::new(
+                Code::GltfTooManyElements,
+                None,
+                format!(
+                    "{path}: decoding its {count} elements would bring the accessor elements read to {decoded}, over the limit of {}",
+                    self.limits.max_elements
+                ),
+            )
+            .with_help("raise the limit with --max-mesh-elements N"));
+        }
+        self.elements.set(decoded);
         Ok((elements, stride, count, ctype, ty))
     }
 

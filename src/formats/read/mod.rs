@@ -17,6 +17,7 @@
 mod base64;
 pub mod build;
 pub mod clean;
+mod f32_nodes;
 mod frag;
 mod gltf;
 mod msh;
@@ -99,6 +100,52 @@ pub struct Loaded {
     pub binary: Option<bool>,
 }
 
+/// Bounds on what a mesh file makes the readers read besides its own bytes
+/// (issue 10): files it names, and glTF accessors read more than once.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ReadLimits {
+    /// Largest file named by the input (a glTF buffer file, the mesh of a
+    /// `.frag.xml`), and most bytes of all a glTF's buffers together
+    /// (`--max-file-size`).
+    pub max_file_size: u64,
+    /// Most accessor elements one glTF makes the reader decode, summed over
+    /// every primitive (an accessor shared by many primitives counts each
+    /// time) (`--max-mesh-elements`).
+    pub max_elements: u64,
+}
+
+/// Largest file read, in bytes (the XML default).
+pub const MAX_FILE_SIZE: u64 = 256 * 1024 * 1024;
+/// Most glTF accessor elements decoded (about 2.4 GB as coordinates).
+pub const MAX_ELEMENTS: u64 = 100_000_000;
+
+impl Default for ReadLimits {
+    fn default() -> ReadLimits {
+        ReadLimits {
+            max_file_size: MAX_FILE_SIZE,
+            max_elements: MAX_ELEMENTS,
+        }
+    }
+}
+
+/// Refuses a file named by the input that is larger than `limit`, from its
+/// size alone (E103). A file that cannot be inspected is left to the read.
+pub(crate) fn check_named_file(path: &Path, what: &str, limit: u64) -> Result<(), Diagnostic> {
+    match std::fs::metadata(path) {
+        Ok(meta) if meta.len() > limit => Err(Diagnostic::new(
+            Code::FileTooLarge,
+            None,
+            format!(
+                "{what} {} is {} bytes, over the input size limit of {limit} bytes",
+                path.display(),
+                meta.len()
+            ),
+        )
+        .with_help("raise the limit with --max-file-size BYTES")),
+        _ => Ok(()),
+    }
+}
+
 /// Reads a mesh file; the format comes from its content where that is
 /// unambiguous (GLB, binary and ASCII STL, MSH, VTU) and else from its ending.
 pub fn load_mesh(path: &Path) -> Result<Loaded, Vec<Diagnostic>> {
@@ -107,6 +154,22 @@ pub fn load_mesh(path: &Path) -> Result<Loaded, Vec<Diagnostic>> {
 
 /// [`load_mesh`] with the format forced (`--from`).
 pub fn load_mesh_as(path: &Path, format: Option<ReadFormat>) -> Result<Loaded, Vec<Diagnostic>> {
+    load_mesh_limited(path, format, &ReadLimits::default())
+}
+
+/// [`load_mesh_as`] within `limits`.
+pub fn load_mesh_limited(
+    path: &Path,
+    format: Option<ReadFormat>,
+    limits: &ReadLimits,
+) -> Result<Loaded, Vec<Diagnostic>> {
+    if matches!(format, None | Some(ReadFormat::Stl))
+        && let Some(read) = stl::read_binary_file(path, format.is_some())
+    {
+        let mut loaded = read?.finish()?;
+        loaded.binary = Some(true);
+        return Ok(loaded);
+    }
     let bytes = std::fs::read(path).map_err(|e| {
         vec![Diagnostic::new(
             Code::MeshReadFailed,
@@ -131,10 +194,10 @@ pub fn load_mesh_as(path: &Path, format: Option<ReadFormat>) -> Result<Loaded, V
         }
     };
     if format == ReadFormat::FragXml {
-        return frag::load(path, &bytes);
+        return frag::load(path, &bytes, limits);
     }
     let folder = path.parent().unwrap_or(Path::new(""));
-    let (builder, binary) = parse(format, &bytes, folder)?;
+    let (builder, binary) = parse(format, &bytes, folder, limits)?;
     // The file's bytes are not needed for the checks: free them first.
     drop(bytes);
     let mut loaded = builder.finish()?;
@@ -149,7 +212,7 @@ pub fn load_bytes(
     bytes: &[u8],
     folder: &Path,
 ) -> Result<Loaded, Vec<Diagnostic>> {
-    let (builder, binary) = parse(format, bytes, folder)?;
+    let (builder, binary) = parse(format, bytes, folder, &ReadLimits::default())?;
     let mut loaded = builder.finish()?;
     loaded.binary = binary;
     Ok(loaded)
@@ -159,16 +222,21 @@ pub fn load_bytes(
 /// the mesh file it names is read from `frag_path`'s folder (the fuzz target's
 /// entry, which needs no file for the description itself).
 pub fn load_frag_bytes(frag_path: &Path, bytes: &[u8]) -> Result<Loaded, Vec<Diagnostic>> {
-    frag::load(frag_path, bytes)
+    frag::load(frag_path, bytes, &ReadLimits::default())
 }
 
 type Parsed = (Builder, Option<bool>);
 
-fn parse(format: ReadFormat, bytes: &[u8], folder: &Path) -> Result<Parsed, Vec<Diagnostic>> {
+fn parse(
+    format: ReadFormat,
+    bytes: &[u8],
+    folder: &Path,
+    limits: &ReadLimits,
+) -> Result<Parsed, Vec<Diagnostic>> {
     Ok(match format {
         ReadFormat::Stl => stl::read(bytes)?,
         ReadFormat::Obj => (obj::read(bytes)?, None),
-        ReadFormat::Gltf | ReadFormat::Glb => (gltf::read(bytes, folder)?, None),
+        ReadFormat::Gltf | ReadFormat::Glb => (gltf::read(bytes, folder, limits)?, None),
         ReadFormat::Msh => msh::read(bytes)?,
         ReadFormat::Vtu => vtu::read(bytes)?,
         ReadFormat::FragXml => {

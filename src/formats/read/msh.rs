@@ -2,15 +2,17 @@
 //! Elements are grouped by physical name: in 4.1 through their entity's
 //! physical tags (`$Entities`), in 2.2 by their first tag; elements in no
 //! physical group are grouped by entity (`surface 3`). Triangles (also the
-//! corners of higher-order ones), lines and points are kept; quadrangles are
-//! split into two triangles and volume cells are not kept (the mesh IR holds
-//! surfaces), each with a warning and counts. Sections geomc does not use
+//! corners of higher-order ones), lines, points and volume cells
+//! (tetrahedra, hexahedra, prisms, pyramids; higher-order ones by their
+//! corners) are kept; quadrangles are split into two triangles, with a
+//! warning and counts. Sections geomc does not use
 //! (`$NodeData`, `$Periodic`, …) are skipped.
 
 use super::build::{Builder, FastMap};
 use super::text::{Scanner, Token, syntax};
 use super::{error_at, error_at_byte};
 use crate::diag::{Code, Diagnostic};
+use crate::mesh::CellKind;
 use std::collections::BTreeMap;
 
 pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
@@ -77,7 +79,7 @@ enum Kind {
     Line,
     Triangle,
     Quad,
-    Volume(&'static str),
+    Volume(CellKind),
 }
 
 /// (number of nodes, kind, name) of a Gmsh element type.
@@ -86,28 +88,36 @@ fn element_type(t: i64) -> Option<(usize, Kind, &'static str)> {
         1 => (2, Kind::Line, "line"),
         2 => (3, Kind::Triangle, "triangle"),
         3 => (4, Kind::Quad, "quadrangle"),
-        4 => (4, Kind::Volume("tetrahedra"), "tetrahedron"),
-        5 => (8, Kind::Volume("hexahedra"), "hexahedron"),
-        6 => (6, Kind::Volume("prisms"), "prism"),
-        7 => (5, Kind::Volume("pyramids"), "pyramid"),
+        4 => (4, Kind::Volume(CellKind::Tetrahedron), "tetrahedron"),
+        5 => (8, Kind::Volume(CellKind::Hexahedron), "hexahedron"),
+        6 => (6, Kind::Volume(CellKind::Wedge), "prism"),
+        7 => (5, Kind::Volume(CellKind::Pyramid), "pyramid"),
         8 => (3, Kind::Line, "3-node line"),
         9 => (6, Kind::Triangle, "6-node triangle"),
         10 => (9, Kind::Quad, "9-node quadrangle"),
-        11 => (10, Kind::Volume("tetrahedra"), "10-node tetrahedron"),
-        12 => (27, Kind::Volume("hexahedra"), "27-node hexahedron"),
-        13 => (18, Kind::Volume("prisms"), "18-node prism"),
-        14 => (14, Kind::Volume("pyramids"), "14-node pyramid"),
+        11 => (
+            10,
+            Kind::Volume(CellKind::Tetrahedron),
+            "10-node tetrahedron",
+        ),
+        12 => (27, Kind::Volume(CellKind::Hexahedron), "27-node hexahedron"),
+        13 => (18, Kind::Volume(CellKind::Wedge), "18-node prism"),
+        14 => (14, Kind::Volume(CellKind::Pyramid), "14-node pyramid"),
         15 => (1, Kind::Point, "point"),
         16 => (8, Kind::Quad, "8-node quadrangle"),
-        17 => (20, Kind::Volume("hexahedra"), "20-node hexahedron"),
-        18 => (15, Kind::Volume("prisms"), "15-node prism"),
-        19 => (13, Kind::Volume("pyramids"), "13-node pyramid"),
+        17 => (20, Kind::Volume(CellKind::Hexahedron), "20-node hexahedron"),
+        18 => (15, Kind::Volume(CellKind::Wedge), "15-node prism"),
+        19 => (13, Kind::Volume(CellKind::Pyramid), "13-node pyramid"),
         20 => (9, Kind::Triangle, "9-node triangle"),
         21 => (10, Kind::Triangle, "10-node triangle"),
         26 => (4, Kind::Line, "4-node line"),
         27 => (5, Kind::Line, "5-node line"),
         28 => (6, Kind::Line, "6-node line"),
-        29 => (20, Kind::Volume("tetrahedra"), "20-node tetrahedron"),
+        29 => (
+            20,
+            Kind::Volume(CellKind::Tetrahedron),
+            "20-node tetrahedron",
+        ),
         _ => return None,
     })
 }
@@ -141,13 +151,8 @@ impl<'a> Reader<'a> {
             }
             let name = t.lossy().get(1..).unwrap_or_default().to_string();
             let end = format!("$End{name}");
-            self.section_closed = self
-                .s
-                .bytes
-                .get(self.s.pos..)
-                .unwrap_or_default()
-                .windows(end.len())
-                .any(|w| w == end.as_bytes());
+            let rest = self.s.bytes.get(self.s.pos..).unwrap_or_default();
+            self.section_closed = memchr::memmem::find(rest, end.as_bytes()).is_some();
             self.section_start();
             match name.as_str() {
                 "PhysicalNames" => self.physical_names()?,
@@ -254,7 +259,7 @@ impl<'a> Reader<'a> {
     fn skip_section(&mut self, name: &str, start: Token) -> Result<(), Diagnostic> {
         let end = format!("$End{name}");
         let rest = self.s.bytes.get(self.s.pos..).unwrap_or_default();
-        match rest.windows(end.len()).position(|w| w == end.as_bytes()) {
+        match memchr::memmem::find(rest, end.as_bytes()) {
             Some(i) => {
                 self.s.pos += i + end.len();
                 Ok(())
@@ -599,13 +604,17 @@ impl<'a> Reader<'a> {
                 g.triangles.push([a, b, c]);
                 g.triangles.push([a, c, d]);
             }
+            (Kind::Volume(k), c) => g.add_cell(k, c),
             _ => {}
         }
-        let high_order = matches!(
-            (kind, corners.len()),
-            (Kind::Line, 3..) | (Kind::Triangle, 4..) | (Kind::Quad, 5..)
-        );
-        if matches!(kind, Kind::Volume(_) | Kind::Quad) || high_order {
+        let high_order = match kind {
+            Kind::Line => corners.len() > 2,
+            Kind::Triangle => corners.len() > 3,
+            Kind::Quad => corners.len() > 4,
+            Kind::Volume(k) => corners.len() > k.corners(),
+            Kind::Point => false,
+        };
+        if kind == Kind::Quad || high_order {
             *self.kinds.entry(name).or_default() += 1;
         }
     }
@@ -747,7 +756,6 @@ impl<'a> Reader<'a> {
     }
 
     fn finish(mut self) -> Builder {
-        let mut volumes: BTreeMap<&str, usize> = BTreeMap::new();
         let mut quads = 0;
         let mut high = Vec::new();
         for (&name, &n) in &self.kinds {
@@ -756,7 +764,6 @@ impl<'a> Reader<'a> {
                 .find(|e| e.2 == name)
                 .map(|e| e.1);
             match kind {
-                Some(Kind::Volume(plural)) => *volumes.entry(plural).or_default() += n,
                 Some(Kind::Quad) => {
                     quads += n;
                     if name != "quadrangle" {
@@ -765,16 +772,6 @@ impl<'a> Reader<'a> {
                 }
                 _ => high.push(format!("{n} {name}s")),
             }
-        }
-        if !volumes.is_empty() {
-            let list: Vec<String> = volumes.iter().map(|(k, n)| format!("{n} {k}")).collect();
-            self.b.warn(
-                Code::InputNotCarried,
-                format!(
-                    "volume cells are not kept (geomc converts surface meshes): {}",
-                    list.join(", ")
-                ),
-            );
         }
         if quads > 0 {
             self.b.warn(

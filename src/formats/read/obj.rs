@@ -29,7 +29,7 @@ fn read_inner(bytes: &[u8]) -> Result<Builder, Diagnostic> {
     let mut group: Option<usize> = None;
     let mut ignored = Ignored::default();
     let mut corners: Vec<u32> = Vec::new();
-    let has_objects = bytes.starts_with(b"o ") || bytes.windows(3).any(|w| w == b"\no ");
+    let has_objects = bytes.starts_with(b"o ") || memchr::memmem::find(bytes, b"\no ").is_some();
     while let Some(t) = s.next_token() {
         if t.text.first() == Some(&b'#') {
             s.skip_line();

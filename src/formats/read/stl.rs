@@ -4,10 +4,14 @@
 //! ASCII `solid NAME` is a group; binary STL is one group, `surface`. Nodes
 //! with identical coordinates are merged (STL repeats them per triangle).
 
+use super::ReadFormat;
 use super::build::{Builder, NodeDedup};
 use super::error_at_byte;
+use super::f32_nodes::F32Nodes;
 use super::text::{Scanner, real, syntax};
 use crate::diag::{Code, Diagnostic};
+use std::io::{Read, Seek, SeekFrom};
+use std::path::Path;
 
 /// Whether the bytes are an STL file by content.
 pub fn looks_like_stl(bytes: &[u8]) -> bool {
@@ -62,54 +66,142 @@ pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
     ])
 }
 
+/// Reads a binary STL from its file in pieces of a megabyte, so the file is
+/// never held whole (its bytes would be half the peak memory). `None` when
+/// the file is not a binary STL by its size or when its head says it is
+/// another format (the caller then reads it the usual way).
+pub(super) fn read_binary_file(
+    path: &Path,
+    forced: bool,
+) -> Option<Result<Builder, Vec<Diagnostic>>> {
+    let mut file = std::fs::File::open(path).ok()?;
+    let size = file.metadata().ok()?.len();
+    let mut head = vec![0u8; size.min(512) as usize];
+    file.read_exact(&mut head).ok()?;
+    let count = u64::from(u32::from_le_bytes(super::bytes_at(&head, 80)?));
+    if 84 + 50 * count != size {
+        return None;
+    }
+    if !forced {
+        let text = String::from_utf8_lossy(&head);
+        let t = text.trim_start();
+        let other = matches!(
+            super::detect(path, &head),
+            Some(ReadFormat::Glb | ReadFormat::Msh | ReadFormat::FragXml | ReadFormat::Vtu)
+        ) || t.starts_with("<?xml")
+            || t.starts_with("<VTKFile");
+        if other {
+            return None;
+        }
+    }
+    let n = count as usize;
+    let mut r = BinaryStl::new(n);
+    let failed = |e: std::io::Error| {
+        vec![Diagnostic::new(
+            Code::MeshReadFailed,
+            None,
+            format!("cannot read {}: {e}", path.display()),
+        )]
+    };
+    let result = (|| {
+        file.seek(SeekFrom::Start(84)).map_err(failed)?;
+        const PIECE: usize = 20_000;
+        let mut buf = vec![0u8; 50 * PIECE.min(n)];
+        let mut done = 0;
+        while done < n {
+            let k = PIECE.min(n - done);
+            let piece = buf.get_mut(..50 * k).unwrap_or_default();
+            file.read_exact(piece).map_err(failed)?;
+            r.records(piece, done)?;
+            done += k;
+        }
+        Ok(())
+    })();
+    Some(result.map(|()| r.finish()))
+}
+
 fn read_binary(bytes: &[u8]) -> Result<Builder, Vec<Diagnostic>> {
     let records = bytes.get(84..).unwrap_or_default();
-    let n = records.len() / 50;
-    let mut b = Builder::new();
-    // About half as many nodes as triangles in a closed surface.
-    let mut dedup = NodeDedup::with_capacity(n / 2 + 16);
-    b.nodes.reserve(n / 2 + 16);
-    let mut triangles = Vec::with_capacity(n);
-    let mut attributes = 0usize;
-    for (i, record) in records.chunks_exact(50).enumerate() {
-        let mut tri = [0u32; 3];
-        for (k, slot) in tri.iter_mut().enumerate() {
-            let mut p = [0.0f64; 3];
-            for (c, value) in p.iter_mut().enumerate() {
-                let at = 12 + 12 * k + 4 * c;
-                // A record is 50 bytes: `at + 4` is at most 48.
-                let v = f32::from_le_bytes(super::bytes_at(record, at).unwrap_or([0; 4]));
-                if !v.is_finite() {
-                    return Err(vec![error_at_byte(
-                        Code::MeshNonFinite,
-                        84 + 50 * i + at,
-                        format!(
-                            "triangle {} has a coordinate `{v}`, not a finite number",
-                            i + 1
-                        ),
-                    )]);
-                }
-                *value = f64::from(v);
+    let mut r = BinaryStl::new(records.len() / 50);
+    r.records(records, 0)?;
+    Ok(r.finish())
+}
+
+/// A binary STL read record by record (from memory, or in pieces from a file).
+pub(super) struct BinaryStl {
+    b: Builder,
+    nodes: F32Nodes,
+    triangles: Vec<[u32; 3]>,
+    attributes: usize,
+}
+
+impl BinaryStl {
+    /// For `n` triangles.
+    pub(super) fn new(n: usize) -> BinaryStl {
+        let mut b = Builder::new();
+        // About half as many nodes as triangles in a closed surface.
+        b.nodes.reserve(n / 2 + 16);
+        BinaryStl {
+            b,
+            nodes: F32Nodes::with_capacity(n / 2 + 16),
+            triangles: Vec::with_capacity(n),
+            attributes: 0,
+        }
+    }
+
+    /// Reads whole 50-byte records; `first` is the index of the first one.
+    pub(super) fn records(&mut self, records: &[u8], first: usize) -> Result<(), Vec<Diagnostic>> {
+        for (k, record) in records.chunks_exact(50).enumerate() {
+            let Some(r) = record.first_chunk::<50>() else {
+                continue;
+            };
+            let f = |at: usize| super::bytes_at::<4>(r, at).map_or(0.0, f32::from_le_bytes);
+            let coords: [f32; 9] = std::array::from_fn(|j| f(12 + 4 * j));
+            if let Some(j) = coords.iter().position(|v| !v.is_finite()) {
+                let i = first + k;
+                return Err(vec![error_at_byte(
+                    Code::MeshNonFinite,
+                    84 + 50 * i + 12 + 4 * j,
+                    format!(
+                        "triangle {} has a coordinate `{}`, not a finite number",
+                        i + 1,
+                        coords.get(j).copied().unwrap_or(f32::NAN)
+                    ),
+                )]);
             }
-            *slot = dedup.node(&mut b.nodes, p);
+            let mut tri = [0u32; 3];
+            for (slot, p) in tri.iter_mut().zip(coords.chunks_exact(3)) {
+                let p = [p.first(), p.get(1), p.get(2)].map(|v| v.copied().unwrap_or(0.0));
+                *slot = self.nodes.node(&mut self.b.nodes, p);
+            }
+            if r.get(48..).is_some_and(|a| a.iter().any(|&x| x != 0)) {
+                self.attributes += 1;
+            }
+            self.triangles.push(tri);
         }
-        if record.get(48..).is_some_and(|a| a.iter().any(|&x| x != 0)) {
-            attributes += 1;
+        Ok(())
+    }
+
+    pub(super) fn finish(self) -> Builder {
+        let BinaryStl {
+            mut b,
+            nodes,
+            triangles,
+            attributes,
+        } = self;
+        drop(nodes);
+        if attributes > 0 {
+            b.warn(
+                Code::InputNotCarried,
+                format!("{attributes} triangles carry attribute bytes (often colours): not kept"),
+            );
         }
-        triangles.push(tri);
+        let g = b.group("surface");
+        if let Some(group) = b.groups.get_mut(g) {
+            group.triangles = triangles;
+        }
+        b
     }
-    drop(dedup);
-    if attributes > 0 {
-        b.warn(
-            Code::InputNotCarried,
-            format!("{attributes} triangles carry attribute bytes (often colours): not kept"),
-        );
-    }
-    let g = b.group("surface");
-    if let Some(group) = b.groups.get_mut(g) {
-        group.triangles = triangles;
-    }
-    Ok(b)
 }
 
 fn read_ascii(bytes: &[u8]) -> Result<Builder, Diagnostic> {

@@ -1,15 +1,18 @@
 //! VTK XML unstructured grids (`.vtu`): data arrays in ASCII, or inline
 //! base64 binary with UInt32 or UInt64 headers, zlib-compressed or not.
 //! Groups come from cell data: geomc's own `fragment_id`, else `face_id`,
-//! `edge_id`, `polyline_id`, `point_set_id` (named by its FieldData), meshio's
-//! `gmsh:physical`, or the first integer cell array; cells without one are
-//! group `vtu`. Vertices, lines, poly-lines, triangles, strips, polygons and
-//! quads are kept (the last three split into triangles); volume cells are
-//! not kept, with a warning and counts.
+//! `edge_id`, `polyline_id`, `point_set_id`, `volume_id` (named by its
+//! FieldData), meshio's `gmsh:physical`, or the first integer cell array;
+//! cells without one are group `vtu`. Vertices, lines, poly-lines,
+//! triangles, strips, polygons and quads are kept (the last three split into
+//! triangles), and so are tetrahedra, hexahedra, wedges and pyramids
+//! (quadratic ones by their corners; wedges turned into Gmsh's corner
+//! order); polyhedra are not kept, with a warning and counts.
 
 use super::build::Builder;
 use super::{base64, error_at};
 use crate::diag::{Code, Diagnostic};
+use crate::mesh::CellKind;
 use crate::span::{SourceFile, Span};
 use crate::syntax::{self, Element, Limits};
 use std::collections::BTreeMap;
@@ -27,13 +30,26 @@ const GROUP_ARRAYS: [&str; 6] = [
 
 /// geomc's own arrays, in the order a cell's group is looked for: (array,
 /// label of unnamed groups, index of the array in the writer's FieldData).
-const GEOMC_ARRAYS: [(&str, &str, i64); 5] = [
+const GEOMC_ARRAYS: [(&str, &str, i64); 6] = [
     ("fragment_id", "fragment", 0),
     ("face_id", "face", 3),
     ("edge_id", "edge", 4),
     ("polyline_id", "poly_line", 5),
     ("point_set_id", "point set", 6),
+    ("volume_id", "volume", 7),
 ];
+
+/// The volume cell kind of a VTK cell type, with its corner count first in
+/// the cell's points (quadratic cells list their corners first).
+fn volume_kind(t: i64) -> Option<CellKind> {
+    Some(match t {
+        10 | 24 => CellKind::Tetrahedron,
+        12 | 25 | 29 => CellKind::Hexahedron,
+        13 | 26 => CellKind::Wedge,
+        14 | 27 => CellKind::Pyramid,
+        _ => return None,
+    })
+}
 
 pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
     let text = std::str::from_utf8(bytes).map_err(|e| {
@@ -212,6 +228,7 @@ impl Reader<'_> {
         b.nodes = coords.chunks_exact(3).filter_map(super::array).collect();
         let mut groups: BTreeMap<(usize, i64), usize> = BTreeMap::new();
         let mut dropped: BTreeMap<&str, usize> = BTreeMap::new();
+        let mut reduced: BTreeMap<&str, usize> = BTreeMap::new();
         let mut split = 0usize;
         let mut start = 0usize;
         // `offsets`, `types` and every cell data array have n_cells entries (checked above).
@@ -253,6 +270,15 @@ impl Reader<'_> {
                             .map(|v| (k, v))
                     })
                     .unwrap_or((usize::MAX, 0))
+            } else if volume_kind(t).is_some() && generic.as_deref() == Some("gmsh:physical") {
+                // Physical volumes are numbered apart from physical surfaces.
+                (
+                    VOLUME_KEY,
+                    cell_data
+                        .get("gmsh:physical")
+                        .and_then(|v| v.get(i).copied())
+                        .unwrap_or(0),
+                )
             } else {
                 match &generic {
                     Some(name) => (
@@ -275,6 +301,7 @@ impl Reader<'_> {
                 }
             };
             let need = match t {
+                _ if volume_kind(t).is_some() => volume_kind(t).map(CellKind::corners),
                 1 => Some(1),
                 3 | 21 => Some(2),
                 5 | 22 => Some(3),
@@ -334,10 +361,19 @@ impl Reader<'_> {
                         );
                     }
                 }
-                10 | 24 => *dropped.entry("tetrahedra").or_default() += 1,
-                12 | 25 | 29 => *dropped.entry("hexahedra").or_default() += 1,
-                13 | 26 => *dropped.entry("wedges").or_default() += 1,
-                14 | 27 => *dropped.entry("pyramids").or_default() += 1,
+                _ if volume_kind(t).is_some() => {
+                    if let Some(kind) = volume_kind(t) {
+                        let order = kind.vtk_order();
+                        let mut corners = [0u32; 8];
+                        for (slot, &from) in corners.iter_mut().zip(order) {
+                            *slot = nodes.get(from).copied().unwrap_or(0);
+                        }
+                        group.add_cell(kind, corners.get(..order.len()).unwrap_or_default());
+                        if nodes.len() > kind.corners() {
+                            *reduced.entry(kind.plural()).or_default() += 1;
+                        }
+                    }
+                }
                 42 => *dropped.entry("polyhedra").or_default() += 1,
                 _ => {
                     return Err(err(
@@ -353,7 +389,17 @@ impl Reader<'_> {
             b.warn(
                 Code::InputNotCarried,
                 format!(
-                    "volume cells are not kept (geomc converts surface meshes): {}",
+                    "polyhedral cells are not kept (MSH and geomc hold tetrahedra, hexahedra, wedges and pyramids): {}",
+                    list.join(", ")
+                ),
+            );
+        }
+        if !reduced.is_empty() {
+            let list: Vec<String> = reduced.iter().map(|(k, n)| format!("{n} {k}")).collect();
+            b.warn(
+                Code::ElementsConverted,
+                format!(
+                    "quadratic volume cells reduced to their corner nodes: {}",
                     list.join(", ")
                 ),
             );
@@ -501,6 +547,9 @@ fn ints(v: Values) -> Vec<i64> {
     }
 }
 
+/// The group key of volume cells grouped by `gmsh:physical`.
+const VOLUME_KEY: usize = usize::MAX - 1;
+
 fn group_name(
     key: (usize, i64),
     geomc: bool,
@@ -519,6 +568,12 @@ fn group_name(
         }
     }
     let array = generic.unwrap_or("group");
+    if key.0 == VOLUME_KEY {
+        if let Some(name) = names.get(&3).and_then(|m| m.get(&key.1)) {
+            return name.clone();
+        }
+        return format!("{array} 3:{}", key.1);
+    }
     if array == "gmsh:physical" {
         // meshio keeps Gmsh physical names as [tag, dim].
         for dim in [2, 1, 0, 3] {

@@ -4,6 +4,9 @@
 //! interpolation of the samples is the function, so the polygonizer's linear
 //! edge crossings are exact for it.
 
+// User-controlled bytes and values: no panicking index (docs/reliability.md).
+#![cfg_attr(not(test), deny(clippy::indexing_slicing))]
+
 use super::{Env, paths, settings};
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::implicit::polygonize::Grid;
@@ -95,9 +98,13 @@ impl Layout {
             max: self.origin,
             cells: [0; 3],
         };
-        for a in 0..3 {
-            grid.max[a] = self.origin[a] + self.spacing[a] * (self.dims[a] - 1) as f64;
-            grid.cells[a] = self.dims[a] - 1;
+        let axes = grid.max.iter_mut().zip(grid.cells.iter_mut());
+        for (((max, cells), origin), (spacing, dims)) in axes
+            .zip(self.origin)
+            .zip(self.spacing.iter().zip(self.dims))
+        {
+            *max = origin + spacing * (dims - 1) as f64;
+            *cells = dims - 1;
         }
         grid
     }
@@ -109,14 +116,17 @@ pub fn decode(bytes: &[u8], layout: &Layout, level: f64) -> Vec<f64> {
     bytes
         .chunks_exact(size)
         .map(|c| {
+            // `chunks_exact(size)` gives exactly `size` bytes: the arrays never fail.
+            let two = <[u8; 2]>::try_from(c).unwrap_or_default();
+            let four = <[u8; 4]>::try_from(c).unwrap_or_default();
             let v = match (layout.ty, layout.big_endian) {
-                (SampleType::U8, _) => c[0] as f64,
-                (SampleType::U16, false) => u16::from_le_bytes([c[0], c[1]]) as f64,
-                (SampleType::U16, true) => u16::from_be_bytes([c[0], c[1]]) as f64,
-                (SampleType::I16, false) => i16::from_le_bytes([c[0], c[1]]) as f64,
-                (SampleType::I16, true) => i16::from_be_bytes([c[0], c[1]]) as f64,
-                (SampleType::F32, false) => f32::from_le_bytes([c[0], c[1], c[2], c[3]]) as f64,
-                (SampleType::F32, true) => f32::from_be_bytes([c[0], c[1], c[2], c[3]]) as f64,
+                (SampleType::U8, _) => c.first().copied().unwrap_or(0) as f64,
+                (SampleType::U16, false) => u16::from_le_bytes(two) as f64,
+                (SampleType::U16, true) => u16::from_be_bytes(two) as f64,
+                (SampleType::I16, false) => i16::from_le_bytes(two) as f64,
+                (SampleType::I16, true) => i16::from_be_bytes(two) as f64,
+                (SampleType::F32, false) => f32::from_le_bytes(four) as f64,
+                (SampleType::F32, true) => f32::from_be_bytes(four) as f64,
             };
             v - level
         })
@@ -220,7 +230,7 @@ pub struct Nrrd {
 /// Parses an NRRD header (the text up to the first empty line). Errors carry
 /// the 1-based line number.
 pub fn parse_nrrd(bytes: &[u8]) -> Result<Nrrd, (usize, String)> {
-    let head = &bytes[..bytes.len().min(MAX_HEADER)];
+    let head = bytes.get(..MAX_HEADER).unwrap_or(bytes);
     let mut ty = None;
     let mut dims = None;
     let mut dimension = None;
@@ -232,14 +242,15 @@ pub fn parse_nrrd(bytes: &[u8]) -> Result<Nrrd, (usize, String)> {
     let mut pos = 0;
     let mut line_no = 0;
     let header_len = loop {
-        let Some(nl) = head[pos..].iter().position(|&b| b == b'\n') else {
+        let rest = head.get(pos..).unwrap_or_default();
+        let Some(nl) = rest.iter().position(|&b| b == b'\n') else {
             return Err((
                 line_no + 1,
                 "the header does not end with an empty line within 64 KiB".into(),
             ));
         };
         line_no += 1;
-        let raw = &head[pos..pos + nl];
+        let raw = rest.get(..nl).unwrap_or_default();
         pos += nl + 1;
         let line = std::str::from_utf8(raw)
             .map_err(|_| (line_no, "the header line is not text".to_string()))?
@@ -348,11 +359,13 @@ fn directions(value: &str) -> Option<[f64; 3]> {
         .collect::<Option<_>>()?;
     let vectors = <[[f64; 3]; 3]>::try_from(vectors).ok()?;
     let mut out = [0.0; 3];
-    for (a, v) in vectors.iter().enumerate() {
-        if (0..3).any(|b| b != a && v[b] != 0.0) || v[a] <= 0.0 {
+    for (a, (v, slot)) in vectors.iter().zip(out.iter_mut()).enumerate() {
+        let along = v.get(a).copied().unwrap_or(0.0);
+        let across = v.iter().enumerate().any(|(b, x)| b != a && *x != 0.0);
+        if across || along <= 0.0 {
             return None;
         }
-        out[a] = v[a];
+        *slot = along;
     }
     Some(out)
 }

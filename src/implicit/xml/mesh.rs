@@ -1,9 +1,11 @@
 //! Implicit subdomains into geomc's mesh IR: each subdomain's closed surface
 //! is one face (`NAME_boundary`) and its fragment against the exterior
 //! (`NAME|exterior`); `--section` adds the contour lines of a plane cut as
-//! line elements (`NAME_section_K`).
+//! line elements (`NAME_section_K`). Touching function subdomains share
+//! their interface faces (`joint`).
 
 use super::ImplicitSubdomain;
+use super::joint;
 use crate::implicit::section;
 use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain};
 use rayon::prelude::*;
@@ -36,17 +38,53 @@ pub struct Appended {
 }
 
 /// Polygonizes every subdomain (in parallel, results in input order) and
-/// appends it to `mesh`.
+/// appends it to `mesh`. Function subdomains that touch one another are
+/// meshed together (`interfaces`): the surface between two of them is one
+/// face `A|B` shared by both, with the fragment `A|B`.
 pub fn append(
     mesh: &mut Mesh,
     subdomains: &[ImplicitSubdomain],
     cells: Option<usize>,
     section: Option<Plane>,
 ) -> Appended {
-    let surfaces: Vec<_> = subdomains.par_iter().map(|s| s.polygonize(cells)).collect();
+    let joint = joint::mesh_touching(subdomains, cells);
+    let surfaces: Vec<_> = subdomains
+        .par_iter()
+        .enumerate()
+        .map(|(i, s)| {
+            if joint.as_ref().is_some_and(|j| j.members.contains(&i)) {
+                Default::default()
+            } else {
+                s.polygonize(cells)
+            }
+        })
+        .collect();
     let mut out = Appended::default();
     mesh.dimension = 3;
-    for (sub, surface) in subdomains.iter().zip(&surfaces) {
+    let first = mesh.subdomains.len() as u32;
+    for sub in subdomains {
+        mesh.subdomains.push(MeshSubdomain {
+            name: sub.name.clone(),
+            material: sub.material.clone(),
+            faces: Vec::new(),
+        });
+    }
+    let joint_counts = joint
+        .as_ref()
+        .map(|j| joint::add(mesh, j, subdomains, first))
+        .unwrap_or_default();
+    for (i, (sub, surface)) in subdomains.iter().zip(&surfaces).enumerate() {
+        let index = first + i as u32;
+        if let Some(j) = joint.as_ref().filter(|j| j.members.contains(&i)) {
+            out.triangles.push(joint_counts[i]);
+            if let Some(plane) = section {
+                let (positions, triangles) = j.boundary_of(i);
+                if !add_section(mesh, &positions, &triangles, &sub.name, plane) {
+                    out.missed_by_section.push(sub.name.clone());
+                }
+            }
+            continue;
+        }
         let base = mesh.nodes.len() as u32;
         mesh.nodes.extend_from_slice(&surface.positions);
         let face = mesh.faces.len() as u32;
@@ -59,12 +97,7 @@ pub fn append(
                 .collect(),
             boundary: Vec::new(),
         });
-        let index = mesh.subdomains.len() as u32;
-        mesh.subdomains.push(MeshSubdomain {
-            name: sub.name.clone(),
-            material: sub.material.clone(),
-            faces: vec![(face, true)],
-        });
+        mesh.subdomains[index as usize].faces.push((face, true));
         mesh.fragments.push(MeshFragment {
             name: format!("{}|exterior", sub.name),
             subdomain: index,

@@ -6,9 +6,11 @@
 //! lowers them here into [`ImplicitSubdomain`]s that compile polygonizes.
 
 pub mod density;
+pub mod joint;
 pub mod mesh;
 mod overlap;
 mod paths;
+pub mod report;
 mod settings;
 mod tree;
 
@@ -31,13 +33,25 @@ const SOLIDS: [&str; 3] = ["rfunction", "level_surface", "density_volume"];
 pub struct Extracted<'s> {
     pub defs: Vec<Element<'s>>,
     pub subdomains: Vec<Element<'s>>,
+    /// Copies of the `<trim>` elements holding an R-function tree, with the
+    /// name of their surface (issue 9); the originals stay in the tree.
+    pub trims: Vec<(String, Element<'s>)>,
 }
 
 impl Extracted<'_> {
     pub fn is_empty(&self) -> bool {
-        self.defs.is_empty() && self.subdomains.is_empty()
+        self.defs.is_empty() && self.subdomains.is_empty() && self.trims.is_empty()
     }
 }
+
+/// The elements of trimmed surfaces (paper 002), which may hold a `<trim>`.
+const TRIMMED: [&str; 5] = [
+    "bezier_surface",
+    "cone_surface",
+    "parametric_surface",
+    "sphere_surface",
+    "torus_surface",
+];
 
 /// Moves the implicit definitions, and every subdomain whose solid tree
 /// names one of them, out of `root`.
@@ -50,6 +64,16 @@ pub fn extract<'s>(root: &mut Element<'s>) -> Extracted<'s> {
         .map(|a| a.value.trim().to_string())
         .collect();
     let mut out = Extracted::default();
+    for surface in root.children.iter().filter(|c| TRIMMED.contains(&c.name)) {
+        let name = surface
+            .attribute("name")
+            .map_or(String::new(), |a| a.value.trim().to_string());
+        for t in surface.children_named("trim") {
+            if !t.children.is_empty() {
+                out.trims.push((name.clone(), t.clone()));
+            }
+        }
+    }
     if !root.children.iter().any(|c| ELEMENTS.contains(&c.name)) {
         return out;
     }
@@ -129,6 +153,17 @@ impl ImplicitSubdomain {
 pub struct Lowered {
     pub subdomains: Vec<ImplicitSubdomain>,
     pub used_parameters: BTreeSet<String>,
+    /// The R-function trees of `<trim>`s, by surface name.
+    pub trims: Vec<LoweredTrim>,
+}
+
+/// A trim's tree F(x, y, z) and its material side.
+#[derive(Debug)]
+pub struct LoweredTrim {
+    pub surface: String,
+    pub ctx: Ctx,
+    pub root: NodeId,
+    pub negative: bool,
 }
 
 /// A named solid while lowering.
@@ -164,6 +199,20 @@ pub fn lower(ex: &Extracted, env: &Env, diags: &mut Diagnostics) -> Lowered {
                 .map(|(grid, values)| Def::Samples(grid, values)),
         };
         defs.insert(name, def.unwrap_or(Def::Failed));
+    }
+    for (surface, e) in &ex.trims {
+        if let Some((ctx, root)) =
+            tree::trim_tree(e, env, &functions, &mut out.used_parameters, diags)
+        {
+            out.trims.push(LoweredTrim {
+                surface: surface.clone(),
+                ctx,
+                root,
+                negative: e
+                    .attribute("material")
+                    .is_some_and(|a| a.value.trim() == "negative"),
+            });
+        }
     }
     for s in &ex.subdomains {
         let Some(name) = s.attribute("name") else {

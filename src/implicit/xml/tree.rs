@@ -118,6 +118,21 @@ pub(super) fn rfunction(
     }))
 }
 
+/// A `<trim>`'s one tree over the global x, y, z (paper 002's F).
+pub(super) fn trim_tree(
+    e: &Element,
+    env: &Env,
+    functions: &Functions,
+    used: &mut BTreeSet<String>,
+    diags: &mut Diagnostics,
+) -> Option<(Ctx, NodeId)> {
+    let mut lw = Lowerer::new(env, Some(functions));
+    let scope = coordinates(&mut lw.ctx, ["x", "y", "z"]);
+    let root = e.children.first().and_then(|c| lw.node(c, &scope, diags));
+    used.extend(std::mem::take(&mut lw.used));
+    Some((lw.ctx, root?))
+}
+
 /// `<level_surface>`: the solid {f > c} in the three named variables, which
 /// are the mesh's x, y and z in order.
 pub(super) fn level_surface(

@@ -1,0 +1,509 @@
+//! Conforming surfaces between several implicit solids (issue 5): when two
+//! subdomains touch (a pin in a hole carved out of a block), the surface
+//! between them must be meshed once and shared, not once per subdomain.
+//!
+//! Every grid sample gets a label: the first solid (in the given order)
+//! with f > 0 there, else the exterior (label 0; solid i is label i + 1).
+//! Each cell is split into eight octants, one per corner, by the quads
+//! (edge point, face point, cell point, face point) around the midpoints
+//! of its edges; a label's region is the union of its corners' octants, so
+//! the surface between labels a and b is the set of quads of the cell
+//! edges whose ends carry a and b. Points are shared through their grid
+//! edge, face or cell, so neighbouring cells use the same nodes: every
+//! patch conforms, and each label's boundary is closed.
+//!
+//! - An edge point is the root, along the edge, of the function of the
+//!   solid at one end (the lower-numbered solid when both ends are solids:
+//!   its f is > 0 at its end and ≤ 0 at the other), by false position.
+//! - Face and cell points are dual contouring's: the least-squares meeting
+//!   point of the edge points' tangent planes (about their mean, small
+//!   eigenvalues dropped), kept inside the face or cell, so creases (a
+//!   box's edges) and junction curves (where three labels meet: the rim of
+//!   a pin leaving a block) are kept; where only two labels meet, the point
+//!   is then moved onto the surface by Newton steps along the gradient.
+//!
+//! Limitation: a cell face whose corners alternate between two labels
+//! (a, b, a, b) makes the two diagonal octants touch along one segment, a
+//! non-manifold edge; at the resolutions models are meshed at this needs a
+//! feature thinner than a cell.
+
+use super::polygonize::Grid;
+use super::tape::Ssa;
+use super::weld;
+use std::collections::HashMap;
+
+/// Triangles between labels `pair.0 < pair.1`, oriented with normals
+/// pointing from `pair.0` into `pair.1`.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Patch {
+    pub pair: (u32, u32),
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// Nodes and the patches between labels, ordered by pair.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Interfaces {
+    pub positions: Vec<[f64; 3]>,
+    pub patches: Vec<Patch>,
+}
+
+impl Interfaces {
+    /// Whether two solids share a surface (a patch between two labels > 0).
+    pub fn touching(&self) -> bool {
+        self.patches.iter().any(|p| p.pair.0 > 0)
+    }
+}
+
+/// One solid: f > 0 inside, within its box.
+#[derive(Debug, Clone)]
+pub struct Solid {
+    pub ssa: Ssa,
+    pub min: [f64; 3],
+    pub max: [f64; 3],
+}
+
+/// Root-finding iterations per edge and Newton steps per face or cell point.
+const ROOT_ITERATIONS: usize = 40;
+const NEWTON_STEPS: usize = 4;
+/// Face and cell points stay this fraction of the cell inside their face
+/// or cell.
+const INSET: f64 = 1e-3;
+
+/// Meshes the labelled partition of the grid by `solids` (f > 0 inside
+/// their boxes). Samples on the grid's box are exterior, so every solid is
+/// closed against the box where it leaves it.
+pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
+    let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
+    let n1 = grid.cells.map(|n| n + 1);
+    let at = |i: usize, j: usize, k: usize| [coords[0][i], coords[1][j], coords[2][k]];
+    let samples: Vec<Vec<f32>> = solids
+        .iter()
+        .map(|s| super::polygonize::sample_grid(&s.ssa, grid))
+        .collect();
+    let idx = |i: usize, j: usize, k: usize| (k * n1[1] + j) * n1[0] + i;
+    let mut labels = vec![0u32; n1[0] * n1[1] * n1[2]];
+    for k in 1..n1[2].saturating_sub(1) {
+        for j in 1..n1[1].saturating_sub(1) {
+            for i in 1..n1[0].saturating_sub(1) {
+                let p = at(i, j, k);
+                let p_idx = idx(i, j, k);
+                labels[p_idx] = solids
+                    .iter()
+                    .zip(&samples)
+                    .position(|(s, v)| {
+                        v[p_idx] > 0.0 && (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a])
+                    })
+                    .map_or(0, |s| s as u32 + 1);
+            }
+        }
+    }
+    let label_at = |c: [usize; 3]| labels[idx(c[0], c[1], c[2])];
+    let mut out = Interfaces::default();
+    // Unit normals of the edge points (zero for face and cell points).
+    let mut normals: Vec<[f64; 3]> = Vec::new();
+    let spacing = (0..3)
+        .map(|a| (grid.max[a] - grid.min[a]) / grid.cells[a].max(1) as f64)
+        .fold(f64::INFINITY, f64::min);
+    let mut edge_nodes: HashMap<u64, u32> = HashMap::new();
+    let mut face_nodes: HashMap<u64, u32> = HashMap::new();
+    let mut patches: HashMap<(u32, u32), Vec<[u32; 3]>> = HashMap::new();
+    // The solid whose function decides the surface between two labels.
+    let deciding_index = |a: u32, b: u32| -> Option<usize> {
+        let s = match (a, b) {
+            (0, s) | (s, 0) => s,
+            (a, b) => a.min(b),
+        };
+        let s = s.checked_sub(1)? as usize;
+        (s < solids.len()).then_some(s)
+    };
+    let deciding = |a: u32, b: u32| deciding_index(a, b).map(|s| &solids[s].ssa);
+    let cells = grid.cells;
+    for k in 0..cells[2] {
+        for j in 0..cells[1] {
+            for i in 0..cells[0] {
+                let corner = |c: usize| [i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)];
+                let l: [u32; 8] = std::array::from_fn(|c| label_at(corner(c)));
+                if l.iter().all(|&x| x == l[0]) {
+                    continue;
+                }
+                // Cell edge (d, o): along axis d, at offset o & 1 along
+                // d + 1 and o >> 1 along d + 2; its corners (lower, upper).
+                let ends = |d: usize, o: usize| {
+                    let mut lo = [0usize; 3];
+                    lo[(d + 1) % 3] = o & 1;
+                    lo[(d + 2) % 3] = o >> 1;
+                    let mut hi = lo;
+                    hi[d] = 1;
+                    (
+                        lo[0] | lo[1] << 1 | lo[2] << 2,
+                        hi[0] | hi[1] << 1 | hi[2] << 2,
+                    )
+                };
+                let mut en = [u32::MAX; 12];
+                for d in 0..3 {
+                    for o in 0..4 {
+                        let (cu, cw) = ends(d, o);
+                        let (a, b) = (l[cu], l[cw]);
+                        if a == b {
+                            continue;
+                        }
+                        let (pu, pw) = (corner(cu), corner(cw));
+                        let key = (idx(pu[0], pu[1], pu[2]) as u64) * 3 + d as u64;
+                        en[d * 4 + o] = *edge_nodes.entry(key).or_insert_with(|| {
+                            let f = deciding(a, b);
+                            let p = edge_root(f, at(pu[0], pu[1], pu[2]), at(pw[0], pw[1], pw[2]));
+                            out.positions.push(p);
+                            normals.push(f.map_or([0.0; 3], |f| unit_gradient(f, p, spacing)));
+                            (out.positions.len() - 1) as u32
+                        });
+                    }
+                }
+                let box_of = |c: &[usize]| -> ([f64; 3], [f64; 3]) {
+                    let ps: Vec<[f64; 3]> = c
+                        .iter()
+                        .map(|&c| {
+                            let q = corner(c);
+                            at(q[0], q[1], q[2])
+                        })
+                        .collect();
+                    let lo = std::array::from_fn(|a| {
+                        ps.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min)
+                    });
+                    let hi: [f64; 3] = std::array::from_fn(|a| {
+                        ps.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max)
+                    });
+                    let lo: [f64; 3] = lo;
+                    // Inset by INSET of the size: a point clamped onto the
+                    // box would be collinear with the edge points there.
+                    let d: [f64; 3] = std::array::from_fn(|a| INSET * (hi[a] - lo[a]));
+                    let lo = std::array::from_fn(|a| lo[a] + d[a]);
+                    let hi = std::array::from_fn(|a| hi[a] - d[a]);
+                    (lo, hi)
+                };
+                // The point of a set of corners: the mean of their crossed
+                // edges' points, projected when two labels meet there.
+                let centre = |edges: &[usize],
+                              corners: &[usize],
+                              positions: &[[f64; 3]],
+                              normals: &[[f64; 3]]| {
+                    let crossed: Vec<usize> = edges
+                        .iter()
+                        .filter(|&&e| en[e] != u32::MAX)
+                        .map(|&e| en[e] as usize)
+                        .collect();
+                    let pts: Vec<[f64; 3]> = crossed.iter().map(|&v| positions[v]).collect();
+                    let mean: [f64; 3] = std::array::from_fn(|a| {
+                        pts.iter().map(|p| p[a]).sum::<f64>() / pts.len().max(1) as f64
+                    });
+                    let mut ls: Vec<u32> = corners.iter().map(|&c| l[c]).collect();
+                    ls.sort_unstable();
+                    ls.dedup();
+                    // The functions whose zero sets meet here: one on a
+                    // surface (project onto it), more on a junction.
+                    let mut fs: Vec<usize> = Vec::new();
+                    for (x, &a) in ls.iter().enumerate() {
+                        for &b in &ls[x + 1..] {
+                            if let Some(f) = deciding_index(a, b) {
+                                if !fs.contains(&f) {
+                                    fs.push(f);
+                                }
+                            }
+                        }
+                    }
+                    let (lo, hi) = box_of(corners);
+                    let planes: Vec<([f64; 3], [f64; 3])> = crossed
+                        .iter()
+                        .map(|&v| (positions[v], normals[v]))
+                        .collect();
+                    let q = qef_point(&planes, mean, lo, hi);
+                    match fs[..] {
+                        [f] => project(&solids[f].ssa, q, lo, hi),
+                        _ => q,
+                    }
+                };
+                // Face (n, s): normal n, offset s; its edges (d, o) with d ≠ n.
+                let face_edges = |n: usize, s: usize| -> Vec<usize> {
+                    (0..3)
+                        .filter(|&d| d != n)
+                        .flat_map(|d| (0..4).map(move |o| (d, o)))
+                        .filter(|&(d, o)| {
+                            let off = if n == (d + 1) % 3 { o & 1 } else { o >> 1 };
+                            off == s
+                        })
+                        .map(|(d, o)| d * 4 + o)
+                        .collect()
+                };
+                let face_corners = |n: usize, s: usize| -> Vec<usize> {
+                    (0..8).filter(|&c| (c >> n) & 1 == s).collect()
+                };
+                let mut fnode = [u32::MAX; 6];
+                for n in 0..3 {
+                    for s in 0..2 {
+                        let fe = face_edges(n, s);
+                        if fe.iter().all(|&e| en[e] == u32::MAX) {
+                            continue;
+                        }
+                        let mut base = [i, j, k];
+                        base[n] += s;
+                        let key = (idx(base[0], base[1], base[2]) as u64) * 3 + n as u64;
+                        fnode[n * 2 + s] = match face_nodes.get(&key) {
+                            Some(&node) => node,
+                            None => {
+                                let p = centre(&fe, &face_corners(n, s), &out.positions, &normals);
+                                out.positions.push(p);
+                                normals.push([0.0; 3]);
+                                let node = (out.positions.len() - 1) as u32;
+                                face_nodes.insert(key, node);
+                                node
+                            }
+                        };
+                    }
+                }
+                let all: Vec<usize> = (0..12).collect();
+                let corners: Vec<usize> = (0..8).collect();
+                let p = centre(&all, &corners, &out.positions, &normals);
+                out.positions.push(p);
+                normals.push([0.0; 3]);
+                let c = (out.positions.len() - 1) as u32;
+                for d in 0..3 {
+                    let (d1, d2) = ((d + 1) % 3, (d + 2) % 3);
+                    for o in 0..4 {
+                        let e = en[d * 4 + o];
+                        if e == u32::MAX {
+                            continue;
+                        }
+                        let (o1, o2) = (o & 1, o >> 1);
+                        let (f1, f2) = (fnode[d1 * 2 + o1], fnode[d2 * 2 + o2]);
+                        let (cu, cw) = ends(d, o);
+                        let (a, b) = (l[cu], l[cw]);
+                        // E, F1, C, F2 turns about −d when o1 + o2 is even.
+                        let towards_plus_d = (o1 + o2) % 2 == 1;
+                        let forward = towards_plus_d == (a < b);
+                        let (tri1, tri2) = if forward {
+                            ([e, f1, c], [e, c, f2])
+                        } else {
+                            ([e, c, f1], [e, f2, c])
+                        };
+                        let list = patches.entry((a.min(b), a.max(b))).or_default();
+                        list.push(tri1);
+                        list.push(tri2);
+                    }
+                }
+            }
+        }
+    }
+    let mut pairs: Vec<_> = patches.into_iter().collect();
+    pairs.sort_by_key(|(pair, _)| *pair);
+    merge_coincident(&mut out.positions, &mut pairs);
+    out.patches = pairs
+        .into_iter()
+        .map(|(pair, triangles)| Patch { pair, triangles })
+        .collect();
+    out
+}
+
+/// The triangles between one pair of labels.
+type PairTriangles = ((u32, u32), Vec<[u32; 3]>);
+
+/// Nodes at one point joined by an edge (an edge point on a sample, a face
+/// or cell point clamped onto it) become one node; the triangles that
+/// collapse are dropped and unused nodes removed (order kept).
+fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [PairTriangles]) {
+    let n = positions.len();
+    let mut parent: Vec<u32> = (0..n as u32).collect();
+    fn find(parent: &mut [u32], mut x: u32) -> u32 {
+        while parent[x as usize] != x {
+            x = parent[x as usize];
+        }
+        x
+    }
+    let mut any = false;
+    for (_, tris) in pairs.iter() {
+        for t in tris {
+            for k in 0..3 {
+                let (a, b) = (t[k], t[(k + 1) % 3]);
+                if positions[a as usize] == positions[b as usize] {
+                    let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
+                    parent[ra.max(rb) as usize] = ra.min(rb);
+                    any = true;
+                }
+            }
+        }
+    }
+    if !any {
+        return;
+    }
+    let root: Vec<u32> = (0..n as u32).map(|v| find(&mut parent, v)).collect();
+    let mut used = vec![false; n];
+    for (_, tris) in pairs.iter_mut() {
+        tris.retain_mut(|t| {
+            *t = t.map(|v| root[v as usize]);
+            t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
+        });
+        for t in tris.iter() {
+            for &v in t {
+                used[v as usize] = true;
+            }
+        }
+    }
+    let mut new_id = vec![u32::MAX; n];
+    let mut kept = Vec::with_capacity(n);
+    for (v, p) in positions.iter().enumerate() {
+        if used[v] {
+            new_id[v] = kept.len() as u32;
+            kept.push(*p);
+        }
+    }
+    *positions = kept;
+    for (_, tris) in pairs.iter_mut() {
+        for t in tris.iter_mut() {
+            *t = t.map(|v| new_id[v as usize]);
+        }
+    }
+}
+
+/// The unit gradient of f at p by central differences (zero where it is
+/// not finite or vanishes).
+fn unit_gradient(f: &Ssa, p: [f64; 3], spacing: f64) -> [f64; 3] {
+    let h = spacing * 1e-4;
+    let g: [f64; 3] = std::array::from_fn(|a| {
+        let (mut up, mut down) = (p, p);
+        up[a] += h;
+        down[a] -= h;
+        (f.eval_point(up) - f.eval_point(down)) / (2.0 * h)
+    });
+    let n = g.iter().map(|x| x * x).sum::<f64>().sqrt();
+    if n.is_finite() && n > 0.0 {
+        g.map(|x| x / n)
+    } else {
+        [0.0; 3]
+    }
+}
+
+/// Dual contouring's point: the least-squares meeting point of the tangent
+/// planes (point, unit normal) of the edge points, solved about their mean
+/// with small eigenvalues dropped (a flat surface keeps the mean along
+/// it, a crease or junction curve pulls the point onto the curve), kept in
+/// the box [lo, hi].
+fn qef_point(
+    planes: &[([f64; 3], [f64; 3])],
+    mean: [f64; 3],
+    lo: [f64; 3],
+    hi: [f64; 3],
+) -> [f64; 3] {
+    use nalgebra::{Matrix3, SymmetricEigen, Vector3};
+    let mut ata = Matrix3::<f64>::zeros();
+    let mut atb = Vector3::<f64>::zeros();
+    for (p, n) in planes {
+        let n = Vector3::from(*n);
+        let d = n.dot(&(Vector3::from(*p) - Vector3::from(mean)));
+        ata += n * n.transpose();
+        atb += n * d;
+    }
+    let eig = SymmetricEigen::new(ata);
+    let top = eig.eigenvalues.iter().fold(0.0f64, |m, &v| m.max(v.abs()));
+    if !(top.is_finite() && top > 0.0) {
+        return mean;
+    }
+    let mut x = Vector3::<f64>::zeros();
+    for k in 0..3 {
+        let v = eig.eigenvalues[k];
+        if v.abs() > 0.1 * top {
+            let e = eig.eigenvectors.column(k);
+            x += e * (e.dot(&atb) / v);
+        }
+    }
+    let q: [f64; 3] = std::array::from_fn(|a| (mean[a] + x[a]).clamp(lo[a], hi[a]));
+    if q.iter().all(|c| c.is_finite()) {
+        q
+    } else {
+        mean
+    }
+}
+
+/// Newton steps from `p` towards f = 0 along the gradient, kept in the box
+/// [lo, hi] (a face's box is flat along its normal, so the point stays on
+/// the face); `p` itself when f is not finite there.
+fn project(f: &Ssa, p: [f64; 3], lo: [f64; 3], hi: [f64; 3]) -> [f64; 3] {
+    let size = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+    let h = size * 1e-6;
+    let mut q = p;
+    for _ in 0..NEWTON_STEPS {
+        let v = f.eval_point(q);
+        let g: [f64; 3] = std::array::from_fn(|a| {
+            if hi[a] == lo[a] {
+                return 0.0;
+            }
+            let (mut up, mut down) = (q, q);
+            up[a] += h;
+            down[a] -= h;
+            (f.eval_point(up) - f.eval_point(down)) / (2.0 * h)
+        });
+        let g2: f64 = g.iter().map(|x| x * x).sum();
+        if !(v.is_finite() && g2.is_finite()) || g2 == 0.0 {
+            return if v.is_finite() { q } else { p };
+        }
+        let next: [f64; 3] = std::array::from_fn(|a| (q[a] - v * g[a] / g2).clamp(lo[a], hi[a]));
+        if next == q {
+            break;
+        }
+        q = next;
+    }
+    if q.iter().all(|c| c.is_finite()) {
+        q
+    } else {
+        p
+    }
+}
+
+/// The root of `f` on the segment p0–p1 (f changes sign between them), by
+/// Illinois false position; the midpoint without a function.
+fn edge_root(f: Option<&Ssa>, p0: [f64; 3], p1: [f64; 3]) -> [f64; 3] {
+    let lerp = |t: f64| std::array::from_fn(|a| p0[a] + t * (p1[a] - p0[a]));
+    let Some(f) = f else {
+        return lerp(0.5);
+    };
+    let (mut tl, mut tr) = (0.0, 1.0);
+    let (mut fl, mut fr) = (f.eval_point(p0), f.eval_point(p1));
+    if !(fl.is_finite() && fr.is_finite()) || (fl > 0.0) == (fr > 0.0) {
+        return lerp(0.5);
+    }
+    let mut side = 0;
+    let mut t = 0.5;
+    for _ in 0..ROOT_ITERATIONS {
+        let d = fr - fl;
+        let guess = (tl * fr - tr * fl) / d;
+        t = if d != 0.0 && guess.is_finite() {
+            guess.clamp(tl, tr)
+        } else {
+            0.5 * (tl + tr)
+        };
+        let ft = f.eval_point(lerp(t));
+        if ft == 0.0 || tr - tl < 1e-15 {
+            break;
+        }
+        if (ft > 0.0) == (fl > 0.0) {
+            tl = t;
+            fl = ft;
+            if side == -1 {
+                fr *= 0.5;
+            }
+            side = -1;
+        } else {
+            tr = t;
+            fr = ft;
+            if side == 1 {
+                fl *= 0.5;
+            }
+            side = 1;
+        }
+    }
+    // On a sample within the snap tolerance, exactly on it.
+    if t <= weld::SNAP {
+        return p0;
+    }
+    if t >= 1.0 - weld::SNAP {
+        return p1;
+    }
+    lerp(t)
+}
