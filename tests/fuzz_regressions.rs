@@ -127,7 +127,7 @@ fn decode_triangulate(data: &[u8]) -> Triangulate {
         })
         .fold(0.0, f64::max);
     let options = geomc::meshing::MeshOptions {
-        min_angle_degrees: [0.0, 15.0, 20.0, 25.0][usize::from(flags & 3)],
+        min_angle_degrees: [1.0, 15.0, 20.0, 25.0][usize::from(flags & 3)],
         max_area: Some(
             (extent * extent / f64::from(8 + u16::from(flags >> 2 & 15) * 32)).max(1e-6),
         ),
@@ -453,4 +453,39 @@ fn density_volume_case_reads_every_layout() {
             .iter()
             .any(|d| d.code.as_str() == "E620")
     );
+}
+
+/// A 0.016° sliver (-0.00024, 0), (4.4375, 0.0012), (0, 0) meshed with no
+/// angle limit at all (`min_angle_degrees` 0, flags & 3 = 0) never finished:
+/// one unit ran over 20 minutes in the fuzz build and over a minute in
+/// release (found by `triangulate`, 2026-11-26). The library now refuses 0
+/// as the CLI does, and the target's lowest angle is 1°, at which the same
+/// sliver meshes at once.
+#[test]
+fn a_sliver_with_no_angle_limit_is_refused_and_meshes_at_one_degree() {
+    let found = inputs("triangulate_no_angle");
+    assert_eq!(found.len(), 1, "triangulate_no_angle regression inputs");
+    for (path, bytes) in &found {
+        let mut input = decode_triangulate(bytes);
+        assert_eq!(
+            input.polygon,
+            [[-0.000244140625, 0.0], [4.4375, 0.001220703125], [0.0, 0.0]]
+        );
+        assert_eq!(input.options.min_angle_degrees, 1.0);
+        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
+        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let lowered = checked.lowered.expect("the front end accepts it");
+        let mesh = geomc::meshing::mesh_model(&lowered.model, &input.options)
+            .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
+        geomc::meshing::sanity_check(&mesh).expect("a sane mesh");
+        let triangles: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
+        assert!((1..=100).contains(&triangles), "{triangles} triangles");
+        input.options.min_angle_degrees = 0.0;
+        match geomc::meshing::mesh_model(&lowered.model, &input.options) {
+            Err(geomc::meshing::MeshError::Options(message)) => {
+                assert!(message.contains("(0, 33] (got 0)"), "{message}")
+            }
+            other => panic!("expected the options refused, got {other:?}"),
+        }
+    }
 }

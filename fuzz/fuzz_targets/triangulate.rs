@@ -93,7 +93,7 @@ fuzz_target!(|data: &[u8]| {
     // An area limit keeps every mesh small (at most a few thousand triangles
     // from the limit; small angles may add more).
     let options = MeshOptions {
-        min_angle_degrees: [0.0, 15.0, 20.0, 25.0][usize::from(flags & 3)],
+        min_angle_degrees: [1.0, 15.0, 20.0, 25.0][usize::from(flags & 3)],
         max_area: Some((extent * extent / f64::from(8 + u16::from(flags >> 2 & 15) * 32)).max(1e-6)),
         order: 1 + (flags >> 2 & 1),
         ..MeshOptions::default()
