@@ -4,12 +4,15 @@
 //! volume.
 
 mod implicit_common;
+mod writers_common;
 
 use geomc::implicit::polygonize::Surface;
 use geomc::implicit::{ImplicitModel, lang};
 use geomc::span::SourceFile;
-use implicit_common::volume;
+use implicit_common::{geomc_ok, volume};
 use std::collections::HashMap;
+use std::path::Path;
+use writers_common::run_json;
 
 const SEVEN_BALLS: &str = include_str!("../fixtures/rfs/seven_balls.rfs");
 
@@ -173,30 +176,8 @@ fn gmsh_tetrahedralizes_the_seven_balls() {
     std::fs::write(&rfs, SEVEN_BALLS).expect("write the listing");
     for cells in ["20", "48"] {
         let msh = dir.path().join(format!("balls{cells}.msh"));
-        let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
-            .args(["compile", "-q", "--cells", cells, "-o"])
-            .arg(&msh)
-            .arg(&rfs)
-            .output()
-            .expect("run geomc");
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
-        );
-        let tools = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/tools");
-        let out = std::process::Command::new("python3")
-            .arg(tools.join("check_mesh.py"))
-            .arg(&msh)
-            .arg("--tetra")
-            .output()
-            .expect("run check_mesh.py");
-        assert!(
-            out.status.success(),
-            "{}",
-            String::from_utf8_lossy(&out.stderr)
-        );
-        let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+        geomc_ok(&["compile", "-q", "--cells", cells, "-o"], &[&msh, &rfs]);
+        let report = run_json("python3", "check_mesh.py", &[&msh, Path::new("--tetra")]);
         assert_eq!(report["tetra"]["ok"], true, "{cells}: {report}");
         let tets = report["tetra"]["tetrahedra"]["balls"].as_u64().unwrap_or(0);
         assert!(tets > 1000, "{cells}: {tets} tetrahedra: {report}");

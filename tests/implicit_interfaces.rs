@@ -5,12 +5,17 @@
 //! tags reach the MSH file that gmsh and meshio read (gmsh tetrahedralizes
 //! both volumes).
 
+mod implicit_common;
+mod writers_common;
+
 use geomc::driver::{Checked, Options, check_file};
 use geomc::implicit::xml::mesh::append;
 use geomc::mesh::Mesh;
+use implicit_common::geomc_ok;
 use std::collections::HashMap;
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
+use writers_common::run_json;
 
 const PIN_IN_BLOCK: &str = r#"<?xml version="1.0"?>
 <geometry version="1">
@@ -160,30 +165,8 @@ fn the_fragment_tags_reach_the_msh_file_and_gmsh_tetrahedralizes_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let xml = write(dir.path(), "pin.xml", PIN_IN_BLOCK);
     let msh = dir.path().join("pin.msh");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
-        .args(["compile", "--cells", "24", "-o"])
-        .arg(&msh)
-        .arg(&xml)
-        .output()
-        .expect("run geomc");
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
-    let tools = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/tools");
-    let out = std::process::Command::new("python3")
-        .arg(tools.join("check_mesh.py"))
-        .arg(&msh)
-        .arg("--tetra")
-        .output()
-        .expect("run check_mesh.py");
-    assert!(
-        out.status.success(),
-        "check_mesh.py (gmsh and meshio; ./scripts/test.sh installs them): {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    geomc_ok(&["compile", "--cells", "24", "-o"], &[&msh, &xml]);
+    let report = run_json("python3", "check_mesh.py", &[&msh, Path::new("--tetra")]);
     let groups = report["gmsh"]["groups"]
         .as_array()
         .cloned()

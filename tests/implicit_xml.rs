@@ -9,7 +9,7 @@ mod implicit_common;
 use geomc::driver::{Checked, Options, check_file};
 use geomc::implicit::polygonize::Surface;
 use geomc::implicit::xml::{ImplicitSolid, ImplicitSubdomain};
-use implicit_common::{area, volume};
+use implicit_common::{area, geomc_ok, volume};
 use std::f64::consts::PI;
 use std::path::{Path, PathBuf};
 
@@ -511,17 +511,7 @@ fn compile_writes_the_implicit_mesh_and_section_contours_as_lines() {
         .as_bytes(),
     );
     let obj = dir.path().join("m.obj");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
-        .args(["compile", "--section", "z=0.1", "-o"])
-        .arg(&obj)
-        .arg(&xml)
-        .output()
-        .expect("run geomc");
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    geomc_ok(&["compile", "--section", "z=0.1", "-o"], &[&obj, &xml]);
     let text = std::fs::read_to_string(&obj).expect("read obj");
     let faces = text.lines().filter(|l| l.starts_with("f ")).count();
     let lines: Vec<&str> = text.lines().filter(|l| l.starts_with("l ")).collect();
@@ -638,17 +628,7 @@ fn rfs_inputs_take_section_too() {
     let dir = tempfile::tempdir().expect("temp dir");
     let rfs = write(dir.path(), "balls.rfs", SEVEN_BALLS.as_bytes());
     let obj = dir.path().join("balls.obj");
-    let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
-        .args(["compile", "--section", "z=0", "-o"])
-        .arg(&obj)
-        .arg(&rfs)
-        .output()
-        .expect("run geomc");
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
-    );
+    geomc_ok(&["compile", "--section", "z=0", "-o"], &[&obj, &rfs]);
     let text = std::fs::read_to_string(&obj).expect("read obj");
     // The plane z = 0 cuts the central ball and the four side balls in one
     // outline: a single closed contour.

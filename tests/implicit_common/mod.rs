@@ -32,3 +32,18 @@ pub fn area(s: &Surface) -> f64 {
         })
         .sum()
 }
+
+/// Runs the geomc binary on `args` followed by `paths` and asserts it
+/// succeeded (its stderr in the failure message).
+pub fn geomc_ok(args: &[&str], paths: &[&std::path::Path]) {
+    let run = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
+        .args(args)
+        .args(paths)
+        .output()
+        .expect("run geomc");
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+}
