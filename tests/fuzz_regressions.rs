@@ -141,6 +141,12 @@ fn decode_triangulate(data: &[u8]) -> Triangulate {
     }
 }
 
+/// The decoded input through the front end, as the target feeds it.
+fn check_triangulate(input: &Triangulate) -> geomc::driver::Checked {
+    let source = SourceFile::new("fuzz.xml", triangulate_xml(input));
+    geomc::driver::check_source(source, &geomc::driver::Options::default())
+}
+
 fn triangulate_xml(input: &Triangulate) -> String {
     use std::fmt::Write;
     let mut xml = String::from(r#"<geometry version="1" dimension="2"><polygon name="p">"#);
@@ -194,8 +200,7 @@ fn on_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> bool {
 /// area is below tolerance². Returns the triangle count and the
 /// smallest checked angle.
 fn mesh_thin(label: &str, input: &Triangulate) -> Option<(usize, f64)> {
-    let source = SourceFile::new("fuzz.xml", triangulate_xml(input));
-    let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+    let checked = check_triangulate(input);
     if !checked.is_valid() {
         return None;
     }
@@ -331,8 +336,7 @@ fn a_poly_line_touching_the_boundary_is_refused_not_meshed_non_conforming() {
         let input = decode_triangulate(bytes);
         assert_eq!(input.polygon, [[0.0, 0.0], [4.0, 0.0], [0.0, 3.0]]);
         assert_eq!(input.segments, [[[0.0, 0.00390625], [3.6875, 0.0]]]);
-        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
-        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let checked = check_triangulate(&input);
         let lowered = checked.lowered.expect("the front end accepts it");
         match geomc::meshing::mesh_model(&lowered.model, &input.options) {
             Err(geomc::meshing::MeshError::Face { face, reason }) => {
@@ -362,8 +366,7 @@ fn large_area_bits_decode_without_overflow_and_mesh() {
         let extent = 4.0;
         assert_eq!(input.options.max_area, Some(extent * extent / 424.0));
         assert_eq!(input.options.min_angle_degrees, 25.0);
-        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
-        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let checked = check_triangulate(&input);
         let valid = checked.is_valid();
         if let Some(lowered) = checked.lowered.filter(|_| valid)
             && let Ok(mesh) = geomc::meshing::mesh_model(&lowered.model, &input.options)
@@ -472,8 +475,7 @@ fn a_sliver_with_no_angle_limit_is_refused_and_meshes_at_one_degree() {
             [[-0.000244140625, 0.0], [4.4375, 0.001220703125], [0.0, 0.0]]
         );
         assert_eq!(input.options.min_angle_degrees, 1.0);
-        let source = SourceFile::new("fuzz.xml", triangulate_xml(&input));
-        let checked = geomc::driver::check_source(source, &geomc::driver::Options::default());
+        let checked = check_triangulate(&input);
         let lowered = checked.lowered.expect("the front end accepts it");
         let mesh = geomc::meshing::mesh_model(&lowered.model, &input.options)
             .unwrap_or_else(|e| panic!("{}: {e}", path.display()));
