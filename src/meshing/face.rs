@@ -24,6 +24,7 @@
 use super::MeshError;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
+use super::polyline_split;
 use super::size::Sizing;
 use crate::geom::{Point3, Surface, Vec3};
 use crate::ir::{Face, Model};
@@ -33,7 +34,7 @@ use spade::{
 use std::collections::{BTreeMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};
 
-type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+pub(super) type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Rounds of "refine in the plane, then insert points where the surface is
 /// missed" before giving up on a face's tolerance.
@@ -163,9 +164,13 @@ pub(crate) fn mesh_face(
     }
     // Poly_lines inside the face: constraint chains the mesh must follow.
     let mut polyline_handles: Vec<(usize, Vec<usize>)> = Vec::new();
+    // A poly_line tip may be a boundary node (`constraints::assign` put it
+    // on a boundary edge); no other poly_line point may coincide with one.
+    let boundary_nodes = keys.len();
     for (index, points) in constraints {
         let mut handles = Vec::with_capacity(points.len());
-        for p in points {
+        for (k, p) in points.iter().enumerate() {
+            let tip = k == 0 || k + 1 == points.len();
             let uv = chart
                 .to_param(p)
                 .ok_or_else(|| failed("a poly_line point has no parameters".into()))?;
@@ -175,7 +180,9 @@ pub(crate) fn mesh_face(
             if handle.index() == keys.len() {
                 keys.push(FacePoint::Interior(*p));
                 positions.push(*p);
-            } else if handles.last() != Some(&handle.index()) {
+            } else if handles.last() != Some(&handle.index())
+                && !(tip && handle.index() < boundary_nodes)
+            {
                 return Err(failed(format!(
                     "a point of poly_line #{} coincides with another node",
                     index + 1
@@ -252,6 +259,23 @@ pub(crate) fn mesh_face(
     let mut unchecked = fixed;
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
+        if settings.keep_boundary && !polyline_segments.is_empty() {
+            // Spade keeps the poly_lines whole with the loops: split them
+            // here where they are in the way, and refine again.
+            for _ in 0..MAX_PASSES {
+                let split = polyline_split::split_pieces(
+                    &mut cdt,
+                    &polyline_segments,
+                    settings.min_angle,
+                    settings.max_area,
+                )
+                .map_err(failed)?;
+                if split == 0 {
+                    break;
+                }
+                cdt.refine(parameters.clone());
+            }
+        }
         if small_angle && !result.refinement_complete && !settings.keep_boundary {
             // Segments at a tiny angle split each other without end, and
             // each round would start over from the splits sent back: mesh
@@ -592,7 +616,7 @@ fn guide_area(uv_loops: &[Vec<[f64; 2]>], surface: &Surface) -> f64 {
 
 /// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and
 /// `b`, when it lies on it.
-fn on_segment(cdt: &Cdt, a: usize, b: usize, p: Point2<f64>) -> Option<f64> {
+pub(super) fn on_segment(cdt: &Cdt, a: usize, b: usize, p: Point2<f64>) -> Option<f64> {
     let pa = cdt
         .vertex(spade::handles::FixedVertexHandle::from_index(a))
         .position();

@@ -31,6 +31,7 @@ mod edges;
 pub mod exact;
 mod face;
 mod guard;
+mod polyline_split;
 mod quadratic;
 mod report;
 mod size;
@@ -201,7 +202,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             )
         })
         .collect::<Result<Vec<_>, MeshError>>()?;
-    let constraints = constraints::assign(model, &edge_nodes, &lines)?;
+    let constraints = constraints::assign(model, &mut edge_nodes, &lines)?;
     let settings = Settings {
         tolerance,
         sizing: &sizing,
