@@ -111,6 +111,9 @@ fn vertical_crack_is_split_and_opened_at_every_area_limit() {
         );
         assert!(uses.values().all(|&n| n <= 2));
         let angle = min_angle_degrees(&mesh);
-        assert!(angle >= 28.0 - 1e-9, "max-area {max_area}: min angle {angle}");
+        assert!(
+            angle >= 28.0 - 1e-9,
+            "max-area {max_area}: min angle {angle}"
+        );
     }
 }

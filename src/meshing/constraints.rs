@@ -175,7 +175,8 @@ fn crosses(loops: &[Vec<LoopSegment>], line: &[Point3], tips: &[usize], toleranc
     line.windows(2).enumerate().any(|(k, w)| {
         loops.iter().flatten().any(|seg| {
             let at_tip = [k, k + 1].iter().any(|i| {
-                tips.contains(i) && polygon::segment_distance(&line[*i], &seg.a, &seg.b) <= tolerance
+                tips.contains(i)
+                    && polygon::segment_distance(&line[*i], &seg.a, &seg.b) <= tolerance
             });
             !at_tip && segments_cross(&w[0], &w[1], &seg.a, &seg.b)
         })
@@ -212,7 +213,17 @@ fn tip_on_edge(
             a = c;
         }
     }
-    let s = 0.5 * (a + b);
+    // The projection on the chord, exact for straight edges, unless the
+    // search found a nearer point.
+    let chord = seg.b - seg.a;
+    let t = ((tip - seg.a).dot(&chord) / chord.norm_squared()).clamp(0.0, 1.0);
+    let projected = seg.sa + t * (seg.sb - seg.sa);
+    let searched = 0.5 * (a + b);
+    let s = if distance(projected) <= distance(searched) {
+        projected
+    } else {
+        searched
+    };
     nodes.insert(&edge.curve, s);
     // The node there (new, or an existing one within 1e-12 in parameter).
     nodes

@@ -207,11 +207,13 @@ fn open_mouth(mesh: &mut Mesh, face: usize, m: &Mouth, crack: &str) -> u32 {
     }
     // The boundary edge with the segment mouth–right neighbour.
     let found = mesh.edges.iter().enumerate().find_map(|(e, edge)| {
-        edge.nodes.windows(2).position(|w| {
-            (w[0] == m.node && w[1] == m.right_neighbour)
-                || (w[1] == m.node && w[0] == m.right_neighbour)
-        })
-        .map(|j| (e, j))
+        edge.nodes
+            .windows(2)
+            .position(|w| {
+                (w[0] == m.node && w[1] == m.right_neighbour)
+                    || (w[1] == m.node && w[0] == m.right_neighbour)
+            })
+            .map(|j| (e, j))
     });
     let Some((e, j)) = found else {
         return copy;

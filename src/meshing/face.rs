@@ -51,10 +51,12 @@ const MAX_FACE_VERTICES: usize = 2_000_000;
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum FacePoint {
     Vertex(u32),
-    /// Interior node `index` of an edge's discretisation.
+    /// Interior node of an edge's discretisation, at curve parameter `s`
+    /// (a parameter, not an index, so the key stays valid when the edge
+    /// gets more nodes).
     Edge {
         edge: usize,
-        index: usize,
+        s: f64,
     },
     Interior(Point3),
 }
@@ -66,6 +68,10 @@ pub(crate) struct FaceMesh {
     /// Constrained poly_lines: (poly_line index, its points in order, as
     /// indices into `points`, refinement points included).
     pub polylines: Vec<(usize, Vec<usize>)>,
+    /// Nodes refinement added on straight boundary edges and kept (edge,
+    /// curve parameter): the caller adds them to the edges and re-meshes
+    /// only the other faces using those edges.
+    pub added: Vec<(usize, f64)>,
 }
 
 pub(crate) enum Outcome {
@@ -257,6 +263,7 @@ pub(crate) fn mesh_face(
     };
     // Vertices from this index on have not been checked for boundary splits.
     let mut unchecked = fixed;
+    let mut added = Vec::new();
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if settings.keep_boundary && !polyline_segments.is_empty() {
@@ -286,16 +293,34 @@ pub(crate) fn mesh_face(
             };
             return mesh_face(model, face, edges, &keep, constraints);
         }
+        let mut kept = Vec::new();
         if !settings.keep_boundary {
             // Only the vertices added since the last check.
             let splits =
                 boundary_splits(&cdt, unchecked, &segments, &polyline_segments).map_err(failed)?;
-            if !splits.is_empty() {
-                return Ok(Outcome::Split(splits));
+            // On a straight edge of a plane the split is already on the
+            // curve: keep it (the caller adds the node to the edge) instead
+            // of meshing the face again from scratch.
+            let straight = |&(edge, _, _): &(usize, usize, f64)| {
+                matches!(face.surface, Surface::Plane { .. })
+                    && matches!(
+                        model.edges.get(edge).map(|e| &e.curve),
+                        Some(crate::geom::Curve::Segment { .. })
+                    )
+            };
+            if !splits.iter().all(straight) {
+                return Ok(Outcome::Split(
+                    splits.into_iter().map(|(e, _, s)| (e, s)).collect(),
+                ));
             }
+            kept = splits;
         }
         unchecked = cdt.num_vertices();
         lift_new_vertices(&cdt, &chart, &mut keys, &mut positions).map_err(failed)?;
+        for (edge, v, s) in kept {
+            keys[v] = FacePoint::Edge { edge, s };
+            added.push((edge, s));
+        }
         let mut excluded = vec![false; cdt.num_all_faces()];
         if polyline_segments.is_empty() {
             for f in &result.excluded_faces {
@@ -361,6 +386,7 @@ pub(crate) fn mesh_face(
         points: keys,
         triangles: inner,
         polylines,
+        added,
     }))
 }
 
@@ -396,7 +422,10 @@ fn walk_loops(
                 } else if j + 1 == n {
                     FacePoint::Vertex(edge.end.0)
                 } else {
-                    FacePoint::Edge { edge: i, index: j }
+                    FacePoint::Edge {
+                        edge: i,
+                        s: nodes.params[j],
+                    }
                 }
             };
             let order: Vec<usize> = if oe.forward {
@@ -491,13 +520,13 @@ fn winding_odd(loops: &[Vec<[f64; 2]>], p: [f64; 2]) -> bool {
 }
 
 /// Vertices from index `first` on that the refinement put on boundary
-/// segments, as curve parameters.
+/// segments: (edge, vertex, curve parameter).
 fn boundary_splits(
     cdt: &Cdt,
     first: usize,
     segments: &Segments,
     polyline_segments: &[(usize, usize)],
-) -> Result<Vec<(usize, f64)>, String> {
+) -> Result<Vec<(usize, usize, f64)>, String> {
     let mut splits = Vec::new();
     for v in first..cdt.num_vertices() {
         let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(v));
@@ -522,7 +551,11 @@ fn boundary_splits(
             let len2 = dx * dx + dy * dy;
             let t = ((p.x - pa.x) * dx + (p.y - pa.y) * dy) / len2;
             let off = ((p.x - pa.x) * dy - (p.y - pa.y) * dx).abs() / len2.sqrt();
-            (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some((edge, sa + t * (sb - sa)))
+            (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some((
+                edge,
+                v,
+                sa + t * (sb - sa),
+            ))
         });
         splits.push(found.ok_or("refinement put a node on its boundary away from every edge")?);
     }
