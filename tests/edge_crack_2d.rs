@@ -211,3 +211,80 @@ fn touching_the_boundary_away_from_a_tip_is_still_refused() {
         other => panic!("expected a refusal, got {other:?}"),
     }
 }
+
+/// A solver sees the open mouth: Laplace's equation on the 2 × 1 plate with
+/// u = 1 on x = 0 and u = 0 on x = 2 and an insulated edge crack from
+/// (1, 0) up to (1, 0.5), solved by scikit-fem on geomc's MSH
+/// (tests/tools/fem_crack.py, installed by ./scripts/test.sh). Without the
+/// crack u = 1 − x/2, so 1/2 on both sides of x = 1; the crack holds the
+/// flow back, so the hot side is above 1/2 and the cold side below, and the
+/// jump is the same on a finer mesh.
+#[test]
+fn scikit_fem_sees_the_edge_crack_open_to_the_boundary() {
+    let xml = format!(
+        r#"<geometry version="1" dimension="2">
+      <polygon name="plate"><vertex x="0" y="0"/><vertex x="2" y="0"/><vertex x="2" y="1"/><vertex x="0" y="1"/></polygon>
+      {}
+      <subdomain name="sheet"><solid ref="plate"/></subdomain>
+      <boundary name="hot" edges="plate.e4"/>
+      <boundary name="cold" edges="plate.e2"/>
+    </geometry>"#,
+        line("cr", true, &[(1.0, 0.0), (1.0, 0.5)])
+    );
+    let dir = tempfile::tempdir().expect("tempdir");
+    let input = dir.path().join("edge_crack.xml");
+    std::fs::write(&input, xml).expect("write input");
+    let solve = |max_area: &str| {
+        let msh = dir.path().join(format!("edge_crack_{max_area}.msh"));
+        let status = std::process::Command::new(env!("CARGO_BIN_EXE_geomc"))
+            .args(["compile", "-q"])
+            .arg(&input)
+            .args(["--max-area", max_area, "-o"])
+            .arg(&msh)
+            .status()
+            .expect("run geomc");
+        assert!(status.success());
+        let script = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/tools/fem_crack.py");
+        let out = std::process::Command::new("python3")
+            .arg(script)
+            .arg(&msh)
+            .args(["cr.left", "cr.right", "hot=1", "cold=0"])
+            .output()
+            .expect("run python3");
+        assert!(
+            out.status.success(),
+            "fem_crack.py failed (./scripts/test.sh installs scikit-fem and meshio): {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let stdout = String::from_utf8_lossy(&out.stdout).to_string();
+        let v: serde_json::Value =
+            serde_json::from_str(stdout.lines().last().unwrap_or("")).expect("json");
+        let num = |k: &str| v[k].as_f64().unwrap_or_else(|| panic!("no {k} in {v}"));
+        (
+            num("mid_left"),
+            num("mid_right"),
+            v["pairs"].as_u64().unwrap_or(0),
+            num("u_min"),
+            num("u_max"),
+        )
+    };
+    let (left, right, pairs, lo, hi) = solve("0.002");
+    // Walking up from the mouth, the left side is x < 1 (hot).
+    assert!(
+        left > 0.55 && right < 0.45,
+        "crack middle: {left} | {right}"
+    );
+    assert!(
+        (left + right - 1.0).abs() < 0.02,
+        "symmetric about x = 1: {left} + {right}"
+    );
+    // The mouth is duplicated with the inner nodes.
+    assert!(pairs >= 6, "{pairs} duplicated node pairs");
+    assert!(lo >= -1e-12 && hi <= 1.0 + 1e-12, "u in [{lo}, {hi}]");
+    let (fine_left, fine_right, ..) = solve("0.0005");
+    let (jump, fine_jump) = (left - right, fine_left - fine_right);
+    assert!(
+        (jump - fine_jump).abs() < 0.02,
+        "jump {jump} then {fine_jump}"
+    );
+}
