@@ -63,10 +63,10 @@ fn vertical_crack_is_split_and_opened_at_every_area_limit() {
         // Refinement splits a 0.6-long line: its segments are at most about
         // the side of an equilateral triangle of the area limit.
         let side = (4.0 * max_area / 3f64.sqrt()).sqrt();
+        let segments = chain.len() - 1;
         assert!(
-            chain.len() - 1 >= (0.6 / side).floor() as usize,
-            "max-area {max_area}: only {} crack nodes",
-            chain.len()
+            segments >= (0.6 / side).floor() as usize,
+            "max-area {max_area}: only {segments} crack segments"
         );
         for &n in chain {
             let p = mesh.nodes[n as usize];
