@@ -95,9 +95,11 @@ impl<K: DenseId, V: Copy + PartialEq> IdMap<K, V> {
 
     /// The entries in id order.
     pub fn iter(&self) -> impl Iterator<Item = (K, &V)> + '_ {
-        self.slots.iter().enumerate().filter_map(|(i, &slot)| {
-            (slot != EMPTY).then(|| (K::from_index(i), &self.values[slot as usize]))
-        })
+        self.slots
+            .iter()
+            .enumerate()
+            .filter(|&(_, &slot)| slot != EMPTY)
+            .map(|(i, &slot)| (K::from_index(i), &self.values[slot as usize]))
     }
 
     /// The table with every id renamed by `map`; ids it drops are removed.
