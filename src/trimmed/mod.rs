@@ -7,6 +7,7 @@
 pub(crate) mod boundary;
 mod chart;
 mod measure;
+mod pole;
 pub mod program;
 mod split;
 mod triangulate;
@@ -149,3 +150,5 @@ fn de_casteljau(points: &[Point3], t: f64) -> Point3 {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_seams;
