@@ -250,3 +250,25 @@ fn torus_hole_across_the_tube_seam_is_one_chain() {
         m.triangles.len()
     );
 }
+
+#[test]
+fn closed_surfaces_fixture_through_the_mesher() {
+    let text = include_str!("../../fixtures/valid/trimmed_closed_surfaces.xml");
+    let source = crate::span::SourceFile::new("closed.xml", text);
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    assert!(checked.is_valid(), "{:?}", checked.diagnostics);
+    let model = &checked.lowered.as_ref().expect("lowered").model;
+    assert_eq!(model.trimmed.len(), 3);
+    let mesh = crate::meshing::mesh_model(model, &crate::meshing::MeshOptions::default())
+        .expect("meshable");
+    crate::meshing::sanity_check(&mesh).expect("sane");
+    let edges: Vec<&str> = mesh.edges.iter().map(|e| e.name.as_str()).collect();
+    for (face, chains) in [("ball", 0), ("ring", 1), ("saddle", 2)] {
+        let f = mesh.faces.iter().find(|f| f.name == face).expect("face");
+        assert_eq!(f.boundary.len(), chains, "{face}");
+        assert!(!f.triangles.is_empty());
+        for k in 1..=chains {
+            assert!(edges.contains(&format!("{face}.boundary[{k}]").as_str()));
+        }
+    }
+}
