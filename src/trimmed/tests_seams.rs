@@ -272,3 +272,42 @@ fn closed_surfaces_fixture_through_the_mesher() {
         }
     }
 }
+
+#[test]
+fn cone_apex_is_one_vertex() {
+    // r from 0 to 1 over a length of 2: the side u = 0 is the apex. Lateral
+    // area π r s with the slant s = √5; the fan spans 360°·sin(26.57°) ≈ 161°
+    // in 4 steps of about 40°.
+    let s = TrimmedSurface {
+        name: "tip".into(),
+        carrier: Carrier::Cone {
+            r1: 0.0,
+            r2: 1.0,
+            length: 2.0,
+        },
+        frame: Frame::identity(),
+        rect: [0.0, 2.0, 0.0, TAU],
+        trim: None,
+    };
+    let m = mesh_trimmed(&s, settings(0.1)).expect("meshable");
+    check_manifold(&m);
+    assert_eq!(m.boundary.len(), 1, "only the rim");
+    let apex = m.nodes.iter().filter(|p| p.coords.norm() < 1e-12).count();
+    assert_eq!(apex, 1);
+    let fan = m
+        .triangles
+        .iter()
+        .filter(|t| t.iter().any(|&i| m.nodes[i as usize].coords.norm() < 1e-12))
+        .count();
+    assert_eq!(fan, 4);
+    assert_eq!(euler(&m), 1);
+    let q = m.quality(&s);
+    let exact = PI * 5f64.sqrt();
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    assert!(q.max_centroid_distance <= 0.002, "{q:?}");
+}
