@@ -243,6 +243,9 @@ pub fn close(mesh: &mut TrimmedMesh, s: &TrimmedSurface, cap: &Cap) {
     let ring_edge = |a: u32, b: u32| on_ring.contains(&a) && on_ring.contains(&b);
     let mut runs = Vec::new();
     for chain in std::mem::take(&mut mesh.boundary) {
+        if chain.len() < 2 {
+            continue;
+        }
         let closed_chain = chain.len() > 2 && chain.first() == chain.last();
         let n = chain.len() - 1;
         let Some(start) = (0..n).find(|&k| !ring_edge(chain[k], chain[k + 1])) else {
