@@ -164,6 +164,12 @@ fn a_pin_in_a_carved_block_shares_one_interface_surface() {
 fn the_fragment_tags_reach_the_msh_file_and_gmsh_tetrahedralizes_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     let xml = write(dir.path(), "pin.xml", PIN_IN_BLOCK);
+    // At 20³ the pin's rim and the block's top lie on samples: gmsh used to
+    // refuse "overlapping facets" there (see the test below).
+    let msh20 = dir.path().join("pin20.msh");
+    geomc_ok(&["compile", "--cells", "20", "-o"], &[&msh20, &xml]);
+    let report = run_json("python3", "check_mesh.py", &[&msh20, Path::new("--tetra")]);
+    assert_eq!(report["tetra"]["ok"], true, "20³: {report}");
     let msh = dir.path().join("pin.msh");
     geomc_ok(&["compile", "--cells", "24", "-o"], &[&msh, &xml]);
     let report = run_json("python3", "check_mesh.py", &[&msh, Path::new("--tetra")]);
@@ -191,4 +197,35 @@ fn the_fragment_tags_reach_the_msh_file_and_gmsh_tetrahedralizes_it() {
     }
     assert_eq!(report["meshio"]["points"], report["gmsh"]["nodes"]);
     assert_eq!(report["tetra"]["ok"], true, "{report}");
+}
+
+/// At 20³ the rim where the pin leaves the block lies on samples: edge
+/// points sit on them and the face and cell points clamped next to them
+/// were 1e-4 away (the inset), joined by edges of that length into 0.15°
+/// slivers that overlapped. Such nodes are now one node: no edge is shorter
+/// than 1% of the spacing (0.1), both boundaries stay closed with their
+/// volumes.
+#[test]
+fn the_rim_on_samples_leaves_no_sliver_edges() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let c = checked(dir.path());
+    let mut mesh = Mesh::default();
+    append(&mut mesh, &c.implicit, Some(20), None);
+    let shortest = mesh
+        .faces
+        .iter()
+        .flat_map(|f| f.triangles.iter())
+        .flat_map(|t| (0..3).map(move |k| (t[k], t[(k + 1) % 3])))
+        .map(|(a, b)| {
+            let (p, q) = (mesh.nodes[a as usize], mesh.nodes[b as usize]);
+            ((p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)).sqrt()
+        })
+        .fold(f64::INFINITY, f64::min);
+    assert!(shortest >= 1e-3, "shortest edge {shortest}");
+    for (s, exact) in [(0, PI * 0.09 * 1.8), (1, 1.44 - PI * 0.09)] {
+        let b = boundary(&mesh, s);
+        assert_closed(&b);
+        let v = volume(&mesh, &b);
+        assert!(rel(v, exact) < 2e-2, "subdomain {s}: volume {v} vs {exact}");
+    }
 }

@@ -225,6 +225,12 @@ fn snap_creases(surface: &mut Surface, field: &Field, fixed: &[bool]) -> Vec<boo
             neighbours[t[k] as usize].push(t[(k + 2) % 3]);
         }
     }
+    let before = surface.positions.clone();
+    let normals: Vec<P> = surface
+        .triangles
+        .iter()
+        .map(|t| tri_normal(surface, *t))
+        .collect();
     let mut snapped = vec![false; nv];
     for m in order {
         let (d, a, _) = candidates[m];
@@ -236,6 +242,10 @@ fn snap_creases(surface: &mut Surface, field: &Field, fixed: &[bool]) -> Vec<boo
         }
         snapped[a] = true;
         surface.positions[a] = q[m];
+    }
+    undo_folds(surface, &before, &normals);
+    for (v, s) in snapped.iter_mut().enumerate() {
+        *s = *s && surface.positions[v] != before[v];
     }
     snapped
 }
@@ -391,16 +401,57 @@ fn smooth(surface: &mut Surface, field: &Field, fixed: &[bool], cell: f64) {
             surface.positions[v] = pts[m];
         }
     }
-    // A move that turns a triangle over is undone (repeated until none is).
-    for _ in 0..8 {
+    undo_folds(surface, &before, &normals);
+}
+
+/// Undoes the moves (positions differing from `before`) of the vertices of
+/// every triangle that turned over against its normal in `normals` (taken
+/// before the moves) or now folds onto a neighbour across an edge (their
+/// normals more than 120° apart where they were not), repeated until none
+/// does. Snapping onto a crease could turn a triangle over (the seven balls
+/// at 32³, where gmsh then found a segment crossing a facet).
+pub(crate) fn undo_folds(surface: &mut Surface, before: &[P], normals: &[P]) {
+    let unit_normals = |s: &Surface| -> Vec<P> {
+        s.triangles
+            .iter()
+            .map(|t| unit(tri_normal(s, *t)))
+            .collect()
+    };
+    let mut across: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (ti, t) in surface.triangles.iter().enumerate() {
+        for k in 0..3 {
+            across
+                .entry(edge_key(t[k], t[(k + 1) % 3]))
+                .or_default()
+                .push(ti);
+        }
+    }
+    let mut pairs: Vec<(usize, usize)> = across
+        .values()
+        .filter(|ts| ts.len() == 2)
+        .map(|ts| (ts[0], ts[1]))
+        .collect();
+    pairs.sort_unstable();
+    let old: Vec<P> = normals.iter().map(|&n| unit(n)).collect();
+    const FOLD_COS: f64 = -0.5;
+    for _ in 0..16 {
+        let now = unit_normals(surface);
+        let mut bad: Vec<usize> = (0..surface.triangles.len())
+            .filter(|&t| dot(now[t], old[t]) <= 0.0)
+            .collect();
+        for &(a, b) in &pairs {
+            if dot(now[a], now[b]) < FOLD_COS && dot(old[a], old[b]) >= FOLD_COS {
+                bad.push(a);
+                bad.push(b);
+            }
+        }
         let mut undone = false;
-        for (t, n) in surface.triangles.iter().zip(&normals) {
-            if dot(tri_normal(surface, *t), *n) <= 0.0 {
-                for &v in t {
-                    if surface.positions[v as usize] != before[v as usize] {
-                        surface.positions[v as usize] = before[v as usize];
-                        undone = true;
-                    }
+        for t in bad {
+            for &v in &surface.triangles[t] {
+                let v = v as usize;
+                if surface.positions[v] != before[v] {
+                    surface.positions[v] = before[v];
+                    undone = true;
                 }
             }
         }

@@ -4,11 +4,13 @@
 //! face `A_B_interface` listed by both subdomains (outward for A, the
 //! earlier one) and the fragment `A|B`; the rest of each boundary is the
 //! face `NAME_boundary` with the fragment `NAME|exterior`, as for a lone
-//! subdomain.
+//! subdomain, and where a member reaches the joint grid's box, the surface
+//! closing it next to the box is `NAME_box_cap` with `NAME|box`.
 
 use super::{ImplicitSolid, ImplicitSubdomain};
 use crate::implicit::interfaces::{self, Interfaces};
 use crate::implicit::polygonize::Grid;
+use crate::implicit::push_boundary;
 use crate::mesh::{Mesh, MeshFace, MeshFragment};
 
 /// The touching subdomains and their labelled surfaces (label m + 1 is
@@ -111,6 +113,26 @@ pub fn mesh_touching(subdomains: &[ImplicitSubdomain], cells: Option<usize>) -> 
     })
 }
 
+/// Adds a box cap face `NAME_box_cap` with its fragment `NAME|box`.
+fn push_cap(mesh: &mut Mesh, subdomain: u32, name: &str, triangles: Vec<[u32; 3]>) {
+    let face = mesh.faces.len() as u32;
+    mesh.faces.push(MeshFace {
+        name: format!("{name}_box_cap"),
+        triangles,
+        boundary: Vec::new(),
+    });
+    if let Some(s) = mesh.subdomains.get_mut(subdomain as usize) {
+        s.faces.push((face, true));
+    }
+    mesh.fragments.push(MeshFragment {
+        name: format!("{name}|box"),
+        subdomain,
+        other: None,
+        faces: vec![face],
+        edges: Vec::new(),
+    });
+}
+
 /// Adds the joint surfaces to `mesh` (whose subdomains `first..` are
 /// `subdomains`); returns the triangles on each subdomain's boundary.
 pub fn add(
@@ -132,21 +154,12 @@ pub fn add(
         if a == 0 {
             // Normals point into b: reversed, they point out of it.
             let name = &subdomains[sb].name;
-            mesh.faces.push(MeshFace {
-                name: format!("{name}_boundary"),
-                triangles: shifted.map(|t| [t[0], t[2], t[1]]).collect(),
-                boundary: Vec::new(),
-            });
-            mesh.subdomains[first as usize + sb]
-                .faces
-                .push((face, true));
-            mesh.fragments.push(MeshFragment {
-                name: format!("{name}|exterior"),
-                subdomain: first + sb as u32,
-                other: None,
-                faces: vec![face],
-                edges: Vec::new(),
-            });
+            let reversed = shifted.map(|t| [t[0], t[2], t[1]]).collect();
+            if patch.cap {
+                push_cap(mesh, first + sb as u32, name, reversed);
+            } else {
+                push_boundary(mesh, first + sb as u32, name, reversed, Vec::new());
+            }
             counts[sb] += patch.triangles.len();
             continue;
         }
