@@ -93,12 +93,25 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
             for i in 1..n1[0].saturating_sub(1) {
                 let p = at(i, j, k);
                 let p_idx = idx(i, j, k);
-                labels[p_idx] = solids
+                let within = |s: &Solid| (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a]);
+                let first = |test: &dyn Fn(f32) -> bool| {
+                    solids
+                        .iter()
+                        .zip(&samples)
+                        .position(|(s, v)| test(v[p_idx]) && within(s))
+                };
+                // A sample on the zero sets of two solids lies on their
+                // interface, not in a gap between them: it takes the first
+                // (else the two surfaces would pass on either side of it,
+                // a sheet of exterior between them, as along the lines
+                // where a pin of r = 0.3 touches the samples at 20³).
+                let on_zero = solids
                     .iter()
                     .zip(&samples)
-                    .position(|(s, v)| {
-                        v[p_idx] > 0.0 && (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a])
-                    })
+                    .filter(|(s, v)| v[p_idx] == 0.0 && within(s))
+                    .count();
+                labels[p_idx] = first(&|v| v > 0.0)
+                    .or_else(|| (on_zero >= 2).then(|| first(&|v| v == 0.0)).flatten())
                     .map_or(0, |s| s as u32 + 1);
             }
         }
@@ -122,15 +135,7 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
     let mut edge_nodes: HashMap<u64, u32> = HashMap::new();
     let mut face_nodes: HashMap<u64, u32> = HashMap::new();
     let mut patches: HashMap<PatchKey, Vec<[u32; 3]>> = HashMap::new();
-    // The solid whose function decides the surface between two labels.
-    let deciding_index = |a: u32, b: u32| -> Option<usize> {
-        let s = match (a, b) {
-            (0, s) | (s, 0) => s,
-            (a, b) => a.min(b),
-        };
-        let s = s.checked_sub(1)? as usize;
-        (s < solids.len()).then_some(s)
-    };
+    let deciding_index = |a: u32, b: u32| deciding_solid(a, b, solids.len());
     let deciding = |a: u32, b: u32| deciding_index(a, b).map(|s| &solids[s].ssa);
     let cells = grid.cells;
     for k in 0..cells[2] {
@@ -355,6 +360,17 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
         })
         .collect();
     out
+}
+
+/// The solid whose function decides the surface between labels `a` and `b`
+/// (the lower-numbered solid when both are solids) among `n` solids.
+pub fn deciding_solid(a: u32, b: u32, n: usize) -> Option<usize> {
+    let s = match (a, b) {
+        (0, s) | (s, 0) => s,
+        (a, b) => a.min(b),
+    };
+    let s = s.checked_sub(1)? as usize;
+    (s < n).then_some(s)
 }
 
 /// A pair of labels and whether the triangles between them are a box cap.

@@ -9,6 +9,7 @@ pub mod expr_ops;
 pub mod interfaces;
 pub mod interval;
 pub mod ir;
+pub mod joint_optimize;
 pub mod lang;
 pub mod library;
 pub mod optimize;

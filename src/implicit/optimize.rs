@@ -15,7 +15,7 @@
 
 use super::polygonize::{Grid, Surface};
 use super::tape::{Ssa, Tape};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Normals of neighbouring vertices further apart than this angle mark a
 /// crease edge (cos 35°).
@@ -65,15 +65,15 @@ fn tri_normal(s: &Surface, t: [u32; 3]) -> P {
 }
 
 /// f and its gradient (central differences) at many points, batched.
-struct Field<'a> {
-    tape: &'a Tape,
+pub(crate) struct Field<'a> {
+    pub(crate) tape: &'a Tape,
     /// Difference step and largest projection step.
-    h: f64,
-    reach: f64,
+    pub(crate) h: f64,
+    pub(crate) reach: f64,
 }
 
 impl Field<'_> {
-    fn eval(&self, pts: &[P]) -> (Vec<f64>, Vec<P>) {
+    pub(crate) fn eval(&self, pts: &[P]) -> (Vec<f64>, Vec<P>) {
         let n = pts.len();
         let mut ws = self.tape.workspace();
         let mut xs = Vec::with_capacity(7 * n);
@@ -104,7 +104,7 @@ impl Field<'_> {
     }
 
     /// Newton steps along the gradient onto f = 0.
-    fn project(&self, pts: &mut [P], steps: usize) {
+    pub(crate) fn project(&self, pts: &mut [P], steps: usize) {
         for _ in 0..steps {
             let (f, g) = self.eval(pts);
             for (m, p) in pts.iter_mut().enumerate() {
@@ -147,7 +147,7 @@ pub fn optimize(surface: &mut Surface, ssa: &Ssa, grid: &Grid, iterations: u32) 
     let crease = snap_creases(surface, &field, &fixed_box);
     let fixed: Vec<bool> = (0..nv).map(|v| fixed_box[v] || crease[v]).collect();
     for _ in 0..iterations {
-        flip_edges(surface);
+        flip_edges(surface, &HashSet::new());
         smooth(surface, &field, &fixed, cell);
     }
 }
@@ -261,12 +261,14 @@ fn mean_edge(surface: &Surface) -> f64 {
     sum / surface.triangles.len().max(1) as f64
 }
 
-fn edge_key(a: u32, b: u32) -> (u32, u32) {
+pub(crate) fn edge_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
-/// One pass of angle-improving flips between nearly coplanar triangles.
-fn flip_edges(surface: &mut Surface) {
+/// One pass of angle-improving flips between nearly coplanar triangles; a
+/// flip never makes an edge in `taken` (edges of other patches that share
+/// these nodes, in the joint mesher).
+pub(crate) fn flip_edges(surface: &mut Surface, taken: &HashSet<(u32, u32)>) {
     let mut edges: HashMap<(u32, u32), [u32; 2]> =
         HashMap::with_capacity(surface.triangles.len() * 2);
     for (ti, t) in surface.triangles.iter().enumerate() {
@@ -302,7 +304,7 @@ fn flip_edges(surface: &mut Surface) {
         let (Some(Some(c)), Some(Some(d))) = (third(ta), third(tb)) else {
             continue;
         };
-        if c == d || edges.contains_key(&edge_key(c, d)) {
+        if c == d || edges.contains_key(&edge_key(c, d)) || taken.contains(&edge_key(c, d)) {
             continue;
         }
         let (na, nb) = (unit(tri_normal(surface, ta)), unit(tri_normal(surface, tb)));

@@ -9,6 +9,7 @@
 
 use super::{ImplicitSolid, ImplicitSubdomain};
 use crate::implicit::interfaces::{self, Interfaces};
+use crate::implicit::joint_optimize::optimize_joint;
 use crate::implicit::polygonize::Grid;
 use crate::implicit::push_boundary;
 use crate::mesh::{Mesh, MeshFace, MeshFragment};
@@ -102,10 +103,20 @@ pub fn mesh_touching(subdomains: &[ImplicitSubdomain], cells: Option<usize>) -> 
             max: m.geom.max,
         })
         .collect();
-    let interfaces = interfaces::polygonize_labels(&solids, &grid);
+    let mut interfaces = interfaces::polygonize_labels(&solids, &grid);
     if !interfaces.touching() {
         return None;
     }
+    // The members' optimisation rounds (the most any of them asks for).
+    let iterations = models.iter().map(|(_, m)| m.geom.optiterations).max();
+    let spacing = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+    optimize_joint(
+        &mut interfaces,
+        &solids,
+        |a, b| interfaces::deciding_solid(a, b, solids.len()),
+        spacing,
+        iterations.unwrap_or(0),
+    );
     Some(Joint {
         members: models.iter().map(|(i, _)| *i).collect(),
         grid,
