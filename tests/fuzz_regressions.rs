@@ -200,6 +200,12 @@ fn on_segment(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> bool {
 /// area is below tolerance². Returns the triangle count and the
 /// smallest checked angle.
 fn mesh_thin(label: &str, input: &Triangulate) -> Option<(usize, f64)> {
+    mesh_thin_above(label, input, input.options.min_angle_degrees)
+}
+
+/// [`mesh_thin`] with the non-exempt triangles held to `floor` degrees
+/// instead of the minimum angle.
+fn mesh_thin_above(label: &str, input: &Triangulate, floor: f64) -> Option<(usize, f64)> {
     let checked = check_triangulate(input);
     if !checked.is_valid() {
         return None;
@@ -277,7 +283,7 @@ fn mesh_thin(label: &str, input: &Triangulate) -> Option<(usize, f64)> {
         "{}: triangles cover {area}, the polygon {polygon_area}",
         label
     );
-    assert!(worst >= limit - 1e-9, "{}: {worst}° < {limit}°", label);
+    assert!(worst >= floor - 1e-9, "{}: {worst}° < {floor}°", label);
     Some((triangles, worst))
 }
 
@@ -422,6 +428,36 @@ fn polylines_near_a_tilted_side_mesh_small() {
             path.display()
         );
         assert!(worst >= 25.0, "{}: {worst}°", path.display());
+    }
+}
+
+/// A quadrilateral folded into a 0.0009° corner whose sliver (0.00012 wide
+/// at its mouth, far below the model tolerance of 0.016) runs 8 units down,
+/// with a free poly_line of zero length: hung for over 20 minutes in the
+/// fuzz build (session 7, before the 2D branch kept straight-edge splits).
+/// It now meshes small and covers the polygon; at the sliver's mouth the
+/// fallback of a face with a tiny corner (meshed against its boundary as it
+/// stands once its budget runs out) leaves triangles down to about 11°,
+/// under the 25° asked for: asserted as it is, not hidden.
+#[test]
+fn a_folded_quadrilateral_meshes_small() {
+    let found = inputs("triangulate_folded");
+    assert_eq!(found.len(), 1, "triangulate_folded regression inputs");
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        assert_eq!(input.options.min_angle_degrees, 25.0);
+        let (triangles, worst) = mesh_thin_above(&path.display().to_string(), &input, 10.0)
+            .unwrap_or_else(|| panic!("{}: refused by the front end", path.display()));
+        assert!(
+            triangles <= 2_000,
+            "{}: {triangles} triangles",
+            path.display()
+        );
+        assert!(
+            worst < 25.0,
+            "{}: the shortfall is gone ({worst}°): tighten this test",
+            path.display()
+        );
     }
 }
 
