@@ -131,26 +131,47 @@ impl Document {
             warnings: Vec::new(),
         };
         let mut empty = Vec::new();
-        // Every (face, orientation) a surface or subdomain group uses is
-        // expanded once, in parallel; a group is its faces' parts in order.
-        let surface_groups = groups::surface_groups(mesh);
-        let subdomain_groups = groups::subdomain_surfaces(mesh);
-        let mut parts = Parts::of(mesh, surface_groups.iter().chain(&subdomain_groups));
+        // Groups go in windows of about a third of the mesh's triangles:
+        // each (face, orientation) a window uses is expanded once, in
+        // parallel, and a group is its faces' parts in order; memory holds
+        // one window's parts, not the whole expanded mesh.
+        let triangles_of = |g: &groups::SurfaceGroup| -> usize {
+            g.faces
+                .iter()
+                .map(|&(f, _)| mesh.faces[f as usize].triangles.len())
+                .sum()
+        };
+        let total: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
+        let budget = (total / 3).max(1 << 16);
         for (name, list) in [
-            ("surfaces", surface_groups),
-            ("subdomains", subdomain_groups),
+            ("surfaces", groups::surface_groups(mesh)),
+            ("subdomains", groups::subdomain_surfaces(mesh)),
         ] {
             let mut children = Vec::new();
-            for g in list {
-                let used: Vec<&Part> = g.faces.iter().filter_map(|key| parts.get(key)).collect();
-                if used.iter().all(|p| p.triangles.is_empty()) {
-                    empty.push(g.name.to_string());
-                    parts.release(&g.faces);
-                    continue;
+            let mut start = 0;
+            while start < list.len() {
+                let mut end = start;
+                let mut window = 0;
+                while end < list.len()
+                    && (end == start || window + triangles_of(&list[end]) <= budget)
+                {
+                    window += triangles_of(&list[end]);
+                    end += 1;
                 }
-                let primitive = d.triangles(&used);
-                parts.release(&g.faces);
-                children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+                let mut parts = Parts::of(mesh, &list[start..end]);
+                for g in &list[start..end] {
+                    let used: Vec<&Part> =
+                        g.faces.iter().filter_map(|key| parts.get(key)).collect();
+                    if used.iter().all(|p| p.triangles.is_empty()) {
+                        empty.push(g.name.to_string());
+                        parts.release(&g.faces);
+                        continue;
+                    }
+                    let primitive = d.triangles(&used);
+                    parts.release(&g.faces);
+                    children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+                }
+                start = end;
             }
             d.parent(name, children);
         }
@@ -364,7 +385,7 @@ struct Parts {
 }
 
 impl Parts {
-    fn of<'a>(mesh: &Mesh, groups: impl Iterator<Item = &'a groups::SurfaceGroup<'a>>) -> Parts {
+    fn of(mesh: &Mesh, groups: &[groups::SurfaceGroup]) -> Parts {
         let mut uses: BTreeMap<(u32, bool), usize> = BTreeMap::new();
         for g in groups {
             for key in &g.faces {
