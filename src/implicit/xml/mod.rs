@@ -45,7 +45,8 @@ impl Extracted<'_> {
 }
 
 /// The elements of trimmed surfaces (paper 002), which may hold a `<trim>`.
-const TRIMMED: [&str; 5] = [
+const TRIMMED: [&str; 6] = [
+    "patch9",
     "bezier_surface",
     "cone_surface",
     "parametric_surface",
