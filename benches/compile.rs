@@ -15,6 +15,10 @@
 //! memory only). Under `cargo test --all-targets` it is
 //! a smoke run: a coarse sphere, every binary writer, no peers.
 
+// The allocator of the `geomc` command, so meshing is timed as users run it.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use geomc::driver::{Options, check_source};
 use geomc::formats::{Encoding, WRITERS, WriteOptions, write_mesh_file};
 use geomc::ir::Model;

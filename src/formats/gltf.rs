@@ -11,7 +11,9 @@
 use super::groups::{self, Source};
 use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 use serde_json::{Value, json};
+use std::collections::BTreeMap;
 use std::io::Write;
 
 pub(crate) struct Gltf {
@@ -129,31 +131,50 @@ impl Document {
             warnings: Vec::new(),
         };
         let mut empty = Vec::new();
-        let mut expander = groups::Expander::new(mesh);
-
-        let mut children = Vec::new();
-        for g in groups::surface_groups(mesh) {
-            let ex = expander.expand(&g.faces);
-            if ex.triangles.is_empty() {
-                empty.push(g.name.to_string());
-                continue;
+        // Groups go in windows of about a third of the mesh's triangles:
+        // each (face, orientation) a window uses is expanded once, in
+        // parallel, and a group is its faces' parts in order; memory holds
+        // one window's parts, not the whole expanded mesh.
+        let triangles_of = |g: &groups::SurfaceGroup| -> usize {
+            g.faces
+                .iter()
+                .map(|&(f, _)| mesh.faces[f as usize].triangles.len())
+                .sum()
+        };
+        let total: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
+        let budget = (total / 3).max(1 << 16);
+        for (name, list) in [
+            ("surfaces", groups::surface_groups(mesh)),
+            ("subdomains", groups::subdomain_surfaces(mesh)),
+        ] {
+            let mut children = Vec::new();
+            let mut start = 0;
+            while start < list.len() {
+                let mut end = start;
+                let mut window = 0;
+                while end < list.len()
+                    && (end == start || window + triangles_of(&list[end]) <= budget)
+                {
+                    window += triangles_of(&list[end]);
+                    end += 1;
+                }
+                let mut parts = Parts::of(mesh, &list[start..end]);
+                for g in &list[start..end] {
+                    let used: Vec<&Part> =
+                        g.faces.iter().filter_map(|key| parts.get(key)).collect();
+                    if used.iter().all(|p| p.triangles.is_empty()) {
+                        empty.push(g.name.to_string());
+                        parts.release(&g.faces);
+                        continue;
+                    }
+                    let primitive = d.triangles(&used);
+                    parts.release(&g.faces);
+                    children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+                }
+                start = end;
             }
-            let primitive = d.triangles(&ex);
-            children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+            d.parent(name, children);
         }
-        d.parent("surfaces", children);
-
-        let mut children = Vec::new();
-        for g in groups::subdomain_surfaces(mesh) {
-            let ex = expander.expand(&g.faces);
-            if ex.triangles.is_empty() {
-                empty.push(g.name.to_string());
-                continue;
-            }
-            let primitive = d.triangles(&ex);
-            children.push(d.node(g.name, primitive, extras(mesh, g.source)));
-        }
-        d.parent("subdomains", children);
 
         let mut children = Vec::new();
         for g in groups::line_groups(mesh) {
@@ -255,15 +276,35 @@ impl Document {
         self.accessors.len() - 1
     }
 
-    fn triangles(&mut self, ex: &groups::Expanded) -> Value {
+    /// One TRIANGLES primitive over some faces' parts, in order.
+    fn triangles(&mut self, parts: &[&Part]) -> Value {
+        let vertices: usize = parts.iter().map(|p| p.positions.len()).sum();
+        let triangles: usize = parts.iter().map(|p| p.triangles.len()).sum();
         // Positions, normals and indices in one reservation (three would
         // reallocate and copy the buffer twice).
-        self.buffer
-            .reserve(24 * ex.positions.len() + 12 * ex.triangles.len());
-        let position = self.vec3_accessor(ex.positions.iter().map(|p| p.map(|c| c as f32)), true);
-        let normal = self.vec3_accessor(ex.normals.iter().map(|n| n.map(|c| c as f32)), false);
-        let flat = ex.triangles.as_flattened();
-        let indices = self.index_accessor(flat.iter().copied());
+        self.buffer.reserve(24 * vertices + 12 * triangles);
+        let position = self.vec3_accessor(
+            ExactLen(
+                vertices,
+                parts.iter().flat_map(|p| p.positions.iter().copied()),
+            ),
+            true,
+        );
+        let normal = self.vec3_accessor(
+            ExactLen(
+                vertices,
+                parts.iter().flat_map(|p| p.normals.iter().copied()),
+            ),
+            false,
+        );
+        // Each part numbers its vertices from 0: shifted by the vertices before it.
+        let mut base = 0u32;
+        let shifted = parts.iter().flat_map(|p| {
+            let offset = base;
+            base += p.positions.len() as u32;
+            p.triangles.as_flattened().iter().map(move |i| i + offset)
+        });
+        let indices = self.index_accessor(ExactLen(3 * triangles, shifted));
         json!({
             "attributes": {"POSITION": position, "NORMAL": normal},
             "indices": indices,
@@ -328,6 +369,86 @@ impl Document {
         serde_json::to_vec_pretty(&root).unwrap_or_default()
     }
 }
+
+/// One face's triangles with vertices of their own (see
+/// [`groups::Expander`]), in glTF's `f32`, vertices numbered from 0.
+struct Part {
+    positions: Vec<[f32; 3]>,
+    normals: Vec<[f32; 3]>,
+    triangles: Vec<[u32; 3]>,
+}
+
+/// The parts groups use, each computed once and handed out until its last
+/// user took it (then dropped, so they do not all stay alive).
+struct Parts {
+    parts: BTreeMap<(u32, bool), (Part, usize)>,
+}
+
+impl Parts {
+    fn of(mesh: &Mesh, groups: &[groups::SurfaceGroup]) -> Parts {
+        let mut uses: BTreeMap<(u32, bool), usize> = BTreeMap::new();
+        for g in groups {
+            for key in &g.faces {
+                *uses.entry(*key).or_default() += 1;
+            }
+        }
+        let keys: Vec<((u32, bool), usize)> = uses.into_iter().collect();
+        // Faces in parallel, each thread with its own node table; the result
+        // is the same for any thread count (a part depends on its face only).
+        let parts = keys
+            .par_iter()
+            .map_init(
+                || groups::Expander::new(mesh),
+                |expander, &(key, n)| {
+                    let ex = expander.expand(&[key]);
+                    let f32s = |v: &Vec<[f64; 3]>| v.iter().map(|p| p.map(|c| c as f32)).collect();
+                    let part = Part {
+                        positions: f32s(&ex.positions),
+                        normals: f32s(&ex.normals),
+                        triangles: ex.triangles,
+                    };
+                    (key, (part, n))
+                },
+            )
+            .collect();
+        Parts { parts }
+    }
+
+    fn get(&self, key: &(u32, bool)) -> Option<&Part> {
+        self.parts.get(key).map(|(part, _)| part)
+    }
+
+    /// A group is done with these parts: drop those no later group uses.
+    fn release(&mut self, keys: &[(u32, bool)]) {
+        for key in keys {
+            if let Some((_, uses)) = self.parts.get_mut(key) {
+                *uses -= 1;
+                if *uses == 0 {
+                    self.parts.remove(key);
+                }
+            }
+        }
+    }
+}
+
+/// An iterator with its length told (chains of parts are not `ExactSizeIterator`).
+struct ExactLen<I>(usize, I);
+
+impl<I: Iterator> Iterator for ExactLen<I> {
+    type Item = I::Item;
+
+    fn next(&mut self) -> Option<I::Item> {
+        let item = self.1.next()?;
+        self.0 = self.0.saturating_sub(1);
+        Some(item)
+    }
+
+    fn size_hint(&self) -> (usize, Option<usize>) {
+        (self.0, Some(self.0))
+    }
+}
+
+impl<I: Iterator> ExactSizeIterator for ExactLen<I> {}
 
 /// Distinct nodes in first-use order, and each input node's index among them.
 fn compact(nodes: impl Iterator<Item = u32>) -> (Vec<u32>, Vec<u32>) {

@@ -6,6 +6,7 @@
 use super::groups::{self, SurfaceGroup};
 use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, push_num32, warning};
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 use std::io::Write;
 
 pub(crate) struct Stl;
@@ -138,26 +139,51 @@ fn write_binary(
     header[..text.len()].copy_from_slice(text);
     out.write_all(&header)?;
     out.write_all(&n.to_le_bytes())?;
-    // Records gathered into large pieces: one dynamic write per 50 bytes
-    // would cost more than building them.
-    const CHUNK: usize = 50 << 12;
-    let mut bytes = Vec::with_capacity(CHUNK);
-    for g in groups {
-        for (normal, points) in facets(mesh, g) {
-            // One 50-byte record assembled on the stack, then one copy.
-            let mut record = [0u8; 50];
-            for (k, c) in normal.iter().chain(points.iter().flatten()).enumerate() {
-                record[4 * k..4 * k + 4].copy_from_slice(&c.to_le_bytes());
-            }
-            bytes.extend_from_slice(&record);
-            if bytes.len() >= CHUNK {
-                out.write_all(&bytes)?;
-                bytes.clear();
-            }
+    // Records are built in pieces of a face's triangles, a window of pieces
+    // at a time in parallel, and written in order: the bytes do not depend
+    // on the thread count, and memory holds one window, not the file.
+    const PIECE: usize = 1 << 13;
+    const WINDOW: usize = 32;
+    let pieces: Vec<(u32, bool, usize)> = groups
+        .iter()
+        .flat_map(|g| &g.faces)
+        .flat_map(|&(f, flip)| {
+            let len = mesh.faces[f as usize].triangles.len();
+            (0..len).step_by(PIECE).map(move |start| (f, flip, start))
+        })
+        .collect();
+    for window in pieces.chunks(WINDOW) {
+        let bytes: Vec<Vec<u8>> = window
+            .par_iter()
+            .map(|&(f, flip, start)| {
+                let triangles = &mesh.faces[f as usize].triangles;
+                let end = (start + PIECE).min(triangles.len());
+                let mut bytes = Vec::with_capacity(50 * (end - start));
+                for &[a, b, c] in &triangles[start..end] {
+                    let tri = if flip { [a, c, b] } else { [a, b, c] };
+                    bytes.extend_from_slice(&record(mesh, tri));
+                }
+                bytes
+            })
+            .collect();
+        for piece in bytes {
+            out.write_all(&piece)?;
         }
     }
-    out.write_all(&bytes)?;
     Ok(())
+}
+
+/// One 50-byte binary record: unit normal, corners (f32), no attributes.
+fn record(mesh: &Mesh, tri: [u32; 3]) -> [u8; 50] {
+    let n = groups::unit(groups::triangle_normal(mesh, tri)).unwrap_or([0.0; 3]);
+    let mut record = [0u8; 50];
+    let values = n
+        .into_iter()
+        .chain(tri.into_iter().flat_map(|v| mesh.nodes[v as usize]));
+    for (k, c) in values.enumerate() {
+        record[4 * k..4 * k + 4].copy_from_slice(&(c as f32).to_le_bytes());
+    }
+    record
 }
 
 /// STL names are one word: whitespace becomes `_`.

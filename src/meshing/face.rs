@@ -31,8 +31,7 @@ use crate::ir::{Face, Model};
 use spade::{
     AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation,
 };
-use std::collections::{BTreeMap, HashSet};
-use std::hash::{BuildHasherDefault, Hasher};
+use std::collections::BTreeMap;
 
 pub(super) type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
@@ -64,7 +63,8 @@ pub(crate) enum FacePoint {
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FaceMesh {
     pub points: Vec<FacePoint>,
-    pub triangles: Vec<[usize; 3]>,
+    /// Indices into `points` (a face has at most `MAX_FACE_VERTICES` nodes).
+    pub triangles: Vec<[u32; 3]>,
     /// Constrained poly_lines: (poly_line index, its points in order, as
     /// indices into `points`, refinement points included).
     pub polylines: Vec<(usize, Vec<usize>)>,
@@ -119,9 +119,15 @@ pub(crate) fn mesh_face(
     let chart = Chart::new(&face.surface, &boundary, area_vector(face, &loops)).map_err(failed)?;
     let uv_loops = unwrap_loops(&chart, &loops).map_err(failed)?;
 
-    let mut cdt = Cdt::new();
-    let mut keys: Vec<FacePoint> = Vec::new();
-    let mut positions: Vec<Point3> = Vec::new();
+    // Sized up front for the nodes the area limit will ask for: growing
+    // spade's tables by doubling copied them and touched twice the memory.
+    let expected = expected_vertices(
+        &uv_loops,
+        settings.max_area.min(guide_area(&uv_loops, &face.surface)),
+    );
+    let mut cdt = Cdt::with_capacity(expected, 3 * expected, 2 * expected);
+    let mut keys: Vec<FacePoint> = Vec::with_capacity(expected);
+    let mut positions: Vec<Point3> = Vec::with_capacity(expected);
     let mut segments = Segments::new();
     for (lp, uv) in loops.iter().zip(&uv_loops) {
         let mut handles = Vec::with_capacity(lp.len());
@@ -237,10 +243,14 @@ pub(crate) fn mesh_face(
     } else {
         guide_area(&uv_loops, &face.surface)
     };
+    // Spade finds the outside by peeling the whole triangulation into hash
+    // sets on every call (a tenth of the meshing time); a single loop that is
+    // the convex hull (a hemisphere's circle, a convex polygon) has no outside.
+    let peel = polyline_segments.is_empty() && !loop_is_hull(&cdt, &uv_loops);
     let mut parameters = RefinementParameters::<f64>::new()
         // Spade's peeling takes an open poly_line for a loop: with poly_lines
         // the outside is found here instead (`outside_faces`).
-        .exclude_outer_faces(polyline_segments.is_empty())
+        .exclude_outer_faces(peel)
         .with_angle_limit(AngleLimit::from_deg(settings.min_angle))
         .with_max_additional_vertices(vertex_budget(
             &uv_loops,
@@ -263,9 +273,11 @@ pub(crate) fn mesh_face(
         parameters = parameters.with_min_required_area(settings.tolerance * settings.tolerance);
     }
     let mut inner = Vec::new();
-    // Triangles (by their corner nodes, which never move) already found
-    // fine: later passes only check the triangles insertions created.
-    let mut fine: FineSet = FineSet::default();
+    // Triangles already found fine, by face slot: the key of the triangle
+    // (its corner nodes, which never move) that was fine there. Later passes
+    // only check the triangles insertions created or moved.
+    let mut fine: Vec<u64> = Vec::new();
+    let mut excluded: Vec<bool> = Vec::new();
     let deviation = Deviation::of(&face.surface);
     let coarse = Coarse {
         deviation: &deviation,
@@ -333,8 +345,10 @@ pub(crate) fn mesh_face(
             keys[v] = FacePoint::Edge { edge, s };
             added.push((edge, s));
         }
-        let mut excluded = vec![false; cdt.num_all_faces()];
         if polyline_segments.is_empty() {
+            // Reused across passes: a fresh zeroed table per pass cost page faults.
+            excluded.clear();
+            excluded.resize(cdt.num_all_faces(), false);
             for f in &result.excluded_faces {
                 if let Some(slot) = excluded.get_mut(f.index()) {
                     *slot = true;
@@ -343,16 +357,19 @@ pub(crate) fn mesh_face(
         } else {
             excluded = outside_faces(&cdt, &polyline_segments);
         }
+        fine.resize(cdt.num_all_faces(), NOT_FINE);
         inner.clear();
         let mut bad = Vec::new();
         for f in cdt.inner_faces() {
-            if excluded.get(f.fix().index()).copied().unwrap_or(true) {
+            let slot = f.fix().index();
+            if excluded.get(slot).copied().unwrap_or(true) {
                 continue;
             }
             let [a, b, c] = f.vertices().map(|v| v.fix().index());
-            inner.push([a, b, c]);
+            // Node indices fit in 32 bits (`MAX_FACE_VERTICES`).
+            inner.push([a as u32, b as u32, c as u32]);
             let key = triangle_key(a, b, c);
-            if key.is_some_and(|k| fine.contains(&k)) {
+            if key.is_some_and(|k| fine[slot] == k) {
                 continue;
             }
             if coarse.is(f, &positions) {
@@ -361,7 +378,7 @@ pub(crate) fn mesh_face(
                 // A corner of the triangle is a good start for locating it.
                 bad.push((centroid, f.vertices()[0].fix()));
             } else if let Some(key) = key {
-                fine.insert(key);
+                fine[slot] = key;
             }
         }
         if bad.is_empty() {
@@ -394,9 +411,15 @@ pub(crate) fn mesh_face(
         .iter()
         .map(|(index, handles)| (*index, polyline_chain(&cdt, fixed, handles)))
         .collect();
+    // Kept until every face is meshed: without the room to spare the pass
+    // buffers had.
+    drop((positions, cdt));
+    let mut triangles = inner;
+    triangles.shrink_to_fit();
+    keys.shrink_to_fit();
     Ok(Outcome::Meshed(FaceMesh {
         points: keys,
-        triangles: inner,
+        triangles,
         polylines,
         added,
     }))
@@ -612,6 +635,12 @@ fn boundary_splits(
     Ok(splits)
 }
 
+/// True when the face has one loop and every convex-hull edge of the
+/// triangulation is one of its segments: then nothing lies outside the loop.
+fn loop_is_hull(cdt: &Cdt, uv_loops: &[Vec<[f64; 2]>]) -> bool {
+    uv_loops.len() == 1 && cdt.convex_hull().all(|e| e.is_constraint_edge())
+}
+
 /// True when two constraint segments (loop or poly_line) meet at a vertex at
 /// an angle below `min_angle` degrees.
 fn has_small_input_angle(cdt: &Cdt, min_angle: f64) -> bool {
@@ -662,6 +691,20 @@ fn vertex_budget(
     } else {
         for_area.clamp(200_000.0, cap) as usize
     }
+}
+
+/// About the nodes a face will have: its boundary nodes and one per
+/// `max_area` of its chart area (refinement leaves triangles of about half
+/// the limit, two per node), capped by the face's node limit.
+fn expected_vertices(uv_loops: &[Vec<[f64; 2]>], max_area: f64) -> usize {
+    let boundary: usize = uv_loops.iter().map(Vec::len).sum();
+    let area = uv_loops.iter().map(|lp| shoelace(lp)).sum::<f64>().abs() / 2.0;
+    let interior = if max_area.is_finite() && max_area > 0.0 {
+        (area / max_area).min(MAX_FACE_VERTICES as f64) as usize
+    } else {
+        0
+    };
+    (boundary + interior).min(MAX_FACE_VERTICES)
 }
 
 /// A first area limit for the angle refinement of a curved face, in chart
@@ -913,9 +956,9 @@ fn quadratic_peak(m_ab: f64, m_bc: f64, m_ca: f64) -> f64 {
     4.0 * (m_ab * la * lb + m_bc * lb * lc + m_ca * lc * la)
 }
 
-/// Triangles known to be fine, by [`triangle_key`]; the keys are the
-/// mesher's own, so a fast multiplicative hash replaces SipHash.
-type FineSet = HashSet<u64, BuildHasherDefault<KeyHasher>>;
+/// A face slot with no triangle known to be fine ([`triangle_key`] never
+/// gives it: its nodes would have to be equal).
+const NOT_FINE: u64 = u64::MAX;
 
 /// The sorted corner nodes of a triangle packed into 64 bits, 21 bits each
 /// (`None`, so not cached, for the rare node index beyond that).
@@ -923,25 +966,6 @@ fn triangle_key(a: usize, b: usize, c: usize) -> Option<u64> {
     let mut key = [a as u64, b as u64, c as u64];
     key.sort_unstable();
     (key[2] < 1 << 21).then(|| key[0] | (key[1] << 21) | (key[2] << 42))
-}
-
-#[derive(Default)]
-struct KeyHasher(u64);
-
-impl Hasher for KeyHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-
-    fn write_u64(&mut self, n: u64) {
-        self.0 = (self.0.rotate_left(5) ^ n).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-    }
 }
 
 /// A face's surface, prepared once for the many distance queries of

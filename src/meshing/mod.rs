@@ -428,6 +428,7 @@ fn assemble(
             for t in &mesh.triangles {
                 let mut tri = [0u32; 3];
                 for (slot, &i) in tri.iter_mut().zip(t) {
+                    let i = i as usize;
                     let id = match (&mesh.points[i], ids[i]) {
                         (_, Some(id)) => id,
                         (FacePoint::Vertex(v), None) => *v,
