@@ -12,6 +12,7 @@ use super::groups::{self, Source};
 use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
 use crate::mesh::Mesh;
 use serde_json::{Value, json};
+use std::borrow::Cow;
 use std::io::Write;
 
 pub(crate) struct Gltf {
@@ -53,13 +54,13 @@ impl MeshWriter for Gltf {
         }
         if self.glb {
             let json = doc.json(None);
-            write_glb(&json, &doc.buffer, out)?;
+            write_glb(&json, &doc, out)?;
         } else {
             let uri = match bin_name(options) {
                 Some(name) => percent_encode(&name),
                 None => format!(
                     "data:application/octet-stream;base64,{}",
-                    base64::encode(&doc.buffer)
+                    base64::encode(&doc.buffer_bytes())
                 ),
             };
             out.write_all(&doc.json(Some(uri)))?;
@@ -75,7 +76,7 @@ impl MeshWriter for Gltf {
         Ok(match bin_name(options) {
             Some(name) => vec![SideFile {
                 name,
-                bytes: Document::of(mesh, self.name()).buffer,
+                bytes: Document::of(mesh, self.name()).buffer_bytes(),
             }],
             None => Vec::new(),
         })
@@ -106,25 +107,81 @@ fn percent_encode(s: &str) -> String {
     out
 }
 
-/// The JSON parts and the binary buffer, built together.
-struct Document {
+/// One part of the binary buffer, kept where it is (the mesh's nodes and
+/// triangles, an expansion's vectors) and converted while it is written: no
+/// copy of the whole buffer is built before the output.
+enum Piece<'a> {
+    /// Vectors written as three little-endian `f32`.
+    Vec3(Cow<'a, [[f64; 3]]>),
+    /// Triangle corners written as little-endian `u32`.
+    Triangles(Cow<'a, [[u32; 3]]>),
+    /// Indices written as little-endian `u32`.
+    Indices(Vec<u32>),
+}
+
+impl Piece<'_> {
+    fn byte_len(&self) -> usize {
+        match self {
+            Piece::Vec3(v) => 12 * v.len(),
+            Piece::Triangles(t) => 12 * t.len(),
+            Piece::Indices(i) => 4 * i.len(),
+        }
+    }
+
+    /// Converts and writes the piece in blocks of `BLOCK` values.
+    fn write(&self, block: &mut Vec<u8>, out: &mut dyn Write) -> std::io::Result<()> {
+        match self {
+            Piece::Vec3(v) => {
+                write_blocks(v.as_flattened(), block, out, |c| (c as f32).to_le_bytes())
+            }
+            Piece::Triangles(t) => write_blocks(t.as_flattened(), block, out, u32::to_le_bytes),
+            Piece::Indices(i) => write_blocks(i, block, out, u32::to_le_bytes),
+        }
+    }
+}
+
+/// Values per block converted before a write (256 kB of output).
+const BLOCK: usize = 1 << 16;
+
+fn write_blocks<T: Copy>(
+    values: &[T],
+    block: &mut Vec<u8>,
+    out: &mut dyn Write,
+    bytes: impl Fn(T) -> [u8; 4],
+) -> std::io::Result<()> {
+    for chunk in values.chunks(BLOCK) {
+        block.clear();
+        block.resize(4 * chunk.len(), 0);
+        for (slot, &v) in block.chunks_exact_mut(4).zip(chunk) {
+            slot.copy_from_slice(&bytes(v));
+        }
+        out.write_all(block)?;
+    }
+    Ok(())
+}
+
+/// The JSON parts and the binary buffer's pieces, built together.
+struct Document<'a> {
     nodes: Vec<Value>,
     meshes: Vec<Value>,
     accessors: Vec<Value>,
     views: Vec<Value>,
-    buffer: Vec<u8>,
+    pieces: Vec<Piece<'a>>,
+    /// The buffer's length so far: the sum of the pieces' lengths.
+    buffer_len: usize,
     scene: Vec<usize>,
     warnings: Vec<Warning>,
 }
 
-impl Document {
-    fn of(mesh: &Mesh, format: &'static str) -> Document {
+impl<'a> Document<'a> {
+    fn of(mesh: &'a Mesh, format: &'static str) -> Document<'a> {
         let mut d = Document {
             nodes: Vec::new(),
             meshes: Vec::new(),
             accessors: Vec::new(),
             views: Vec::new(),
-            buffer: Vec::new(),
+            pieces: Vec::new(),
+            buffer_len: 0,
             scene: Vec::new(),
             warnings: Vec::new(),
         };
@@ -138,7 +195,7 @@ impl Document {
                 empty.push(g.name.to_string());
                 continue;
             }
-            let primitive = d.triangles(&ex);
+            let primitive = d.triangles(ex);
             children.push(d.node(g.name, primitive, extras(mesh, g.source)));
         }
         d.parent("surfaces", children);
@@ -150,7 +207,7 @@ impl Document {
                 empty.push(g.name.to_string());
                 continue;
             }
-            let primitive = d.triangles(&ex);
+            let primitive = d.triangles(ex);
             children.push(d.node(g.name, primitive, extras(mesh, g.source)));
         }
         d.parent("subdomains", children);
@@ -191,39 +248,35 @@ impl Document {
         d
     }
 
-    /// Records `self.buffer[offset..]` as a new buffer view; returns its index.
-    fn view(&mut self, offset: usize, target: u32) -> usize {
+    /// Appends a piece to the buffer as a new buffer view; returns its index.
+    fn view(&mut self, piece: Piece<'a>, target: u32) -> usize {
+        let length = piece.byte_len();
         self.views.push(json!({
             "buffer": 0,
-            "byteOffset": offset,
-            "byteLength": self.buffer.len() - offset,
+            "byteOffset": self.buffer_len,
+            "byteLength": length,
             "target": target,
         }));
+        self.buffer_len += length;
+        self.pieces.push(piece);
         self.views.len() - 1
     }
 
-    /// Writes the values straight into the buffer (no copy in between).
-    fn vec3_accessor(
-        &mut self,
-        values: impl ExactSizeIterator<Item = [f32; 3]>,
-        with_bounds: bool,
-    ) -> usize {
+    fn vec3_accessor(&mut self, values: Cow<'a, [[f64; 3]]>, with_bounds: bool) -> usize {
         let count = values.len();
-        let offset = self.buffer.len();
-        self.buffer.reserve(count * 12);
         // The validator compares the bounds with the stored f32 values exactly.
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
-        for v in values {
-            let mut record = [0u8; 12];
-            for k in 0..3 {
-                record[4 * k..4 * k + 4].copy_from_slice(&v[k].to_le_bytes());
-                lo[k] = lo[k].min(v[k]);
-                hi[k] = hi[k].max(v[k]);
+        if with_bounds {
+            for v in values.iter() {
+                for k in 0..3 {
+                    let c = v[k] as f32;
+                    lo[k] = lo[k].min(c);
+                    hi[k] = hi[k].max(c);
+                }
             }
-            self.buffer.extend_from_slice(&record);
         }
-        let view = self.view(offset, ARRAY_BUFFER);
+        let view = self.view(Piece::Vec3(values), ARRAY_BUFFER);
         let mut accessor = json!({
             "bufferView": view,
             "componentType": FLOAT,
@@ -238,14 +291,9 @@ impl Document {
         self.accessors.len() - 1
     }
 
-    fn index_accessor(&mut self, indices: impl ExactSizeIterator<Item = u32>) -> usize {
-        let count = indices.len();
-        let offset = self.buffer.len();
-        self.buffer.reserve(count * 4);
-        for i in indices {
-            self.buffer.extend_from_slice(&i.to_le_bytes());
-        }
-        let view = self.view(offset, ELEMENT_ARRAY_BUFFER);
+    fn index_accessor(&mut self, piece: Piece<'a>) -> usize {
+        let count = piece.byte_len() / 4;
+        let view = self.view(piece, ELEMENT_ARRAY_BUFFER);
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": UNSIGNED_INT,
@@ -255,15 +303,10 @@ impl Document {
         self.accessors.len() - 1
     }
 
-    fn triangles(&mut self, ex: &groups::Expanded) -> Value {
-        // Positions, normals and indices in one reservation (three would
-        // reallocate and copy the buffer twice).
-        self.buffer
-            .reserve(24 * ex.positions.len() + 12 * ex.triangles.len());
-        let position = self.vec3_accessor(ex.positions.iter().map(|p| p.map(|c| c as f32)), true);
-        let normal = self.vec3_accessor(ex.normals.iter().map(|n| n.map(|c| c as f32)), false);
-        let flat = ex.triangles.as_flattened();
-        let indices = self.index_accessor(flat.iter().copied());
+    fn triangles(&mut self, ex: groups::Expanded<'a>) -> Value {
+        let position = self.vec3_accessor(ex.positions, true);
+        let normal = self.vec3_accessor(Cow::Owned(ex.normals), false);
+        let indices = self.index_accessor(Piece::Triangles(ex.triangles));
         json!({
             "attributes": {"POSITION": position, "NORMAL": normal},
             "indices": indices,
@@ -273,15 +316,11 @@ impl Document {
 
     /// A LINES (mode 1) or POINTS (mode 0) primitive over some mesh nodes.
     fn indexed(&mut self, mesh: &Mesh, nodes: &[u32], indices: Option<&[u32]>, mode: u32) -> Value {
-        let position = self.vec3_accessor(
-            nodes
-                .iter()
-                .map(|&n| mesh.nodes[n as usize].map(|c| c as f32)),
-            true,
-        );
+        let points = nodes.iter().map(|&n| mesh.nodes[n as usize]).collect();
+        let position = self.vec3_accessor(Cow::Owned(points), true);
         let mut primitive = json!({"attributes": {"POSITION": position}, "mode": mode});
         if let Some(indices) = indices {
-            primitive["indices"] = json!(self.index_accessor(indices.iter().copied()));
+            primitive["indices"] = json!(self.index_accessor(Piece::Indices(indices.to_vec())));
         }
         primitive
     }
@@ -318,7 +357,7 @@ impl Document {
             root["meshes"] = json!(self.meshes);
             root["accessors"] = json!(self.accessors);
             root["bufferViews"] = json!(self.views);
-            let mut buffer = json!({"byteLength": self.buffer.len()});
+            let mut buffer = json!({"byteLength": self.buffer_len});
             if let Some(uri) = uri {
                 buffer["uri"] = json!(uri);
             }
@@ -326,6 +365,23 @@ impl Document {
         }
         // serde_json's maps are sorted: the same document gives the same bytes.
         serde_json::to_vec_pretty(&root).unwrap_or_default()
+    }
+
+    /// Writes the binary buffer's pieces in order.
+    fn write_buffer(&self, out: &mut dyn Write) -> std::io::Result<()> {
+        let mut block = Vec::with_capacity(4 * BLOCK);
+        for piece in &self.pieces {
+            piece.write(&mut block, out)?;
+        }
+        Ok(())
+    }
+
+    /// The binary buffer as bytes (a `.gltf`'s side file or data URI).
+    fn buffer_bytes(&self) -> Vec<u8> {
+        let mut bytes = Vec::with_capacity(self.buffer_len);
+        // Writing to a vector cannot fail.
+        let _ = self.write_buffer(&mut bytes);
+        bytes
     }
 }
 
@@ -371,12 +427,13 @@ fn extras(mesh: &Mesh, source: Source) -> Value {
 
 /// GLB container: a 12-byte header, the JSON chunk padded with spaces and the
 /// BIN chunk padded with zeros, both to 4 bytes.
-fn write_glb(json: &[u8], bin: &[u8], out: &mut dyn Write) -> Result<(), WriteError> {
+fn write_glb(json: &[u8], doc: &Document, out: &mut dyn Write) -> Result<(), WriteError> {
     let pad = |n: usize| (4 - n % 4) % 4;
     let json_len = json.len() + pad(json.len());
-    let bin_len = bin.len() + pad(bin.len());
+    let bin = doc.buffer_len;
+    let bin_len = bin + pad(bin);
     let mut total = 12 + 8 + json_len;
-    if !bin.is_empty() {
+    if bin > 0 {
         total += 8 + bin_len;
     }
     let total = u32::try_from(total).map_err(|_| {
@@ -389,11 +446,11 @@ fn write_glb(json: &[u8], bin: &[u8], out: &mut dyn Write) -> Result<(), WriteEr
     out.write_all(b"JSON")?;
     out.write_all(json)?;
     out.write_all(&b"   "[..pad(json.len())])?;
-    if !bin.is_empty() {
+    if bin > 0 {
         out.write_all(&(bin_len as u32).to_le_bytes())?;
         out.write_all(b"BIN\0")?;
-        out.write_all(bin)?;
-        out.write_all(&[0u8; 3][..pad(bin.len())])?;
+        doc.write_buffer(out)?;
+        out.write_all(&[0u8; 3][..pad(bin)])?;
     }
     Ok(())
 }
