@@ -533,7 +533,7 @@ impl<'a> Reader<'a> {
         };
         for (i, (record, &(tag, tag_at))) in block.chunks_exact(24).zip(tags).enumerate() {
             let mut p = [0.0; 3];
-            for (k, c) in record.chunks_exact(8).enumerate() {
+            for (k, (slot, c)) in p.iter_mut().zip(record.chunks_exact(8)).enumerate() {
                 let v = f64::from_le_bytes(super::array(c).unwrap_or([0; 8]));
                 if !v.is_finite() {
                     return Err(error_at_byte(
@@ -542,7 +542,7 @@ impl<'a> Reader<'a> {
                         format!("a node coordinate is {v}, not a finite number"),
                     ));
                 }
-                p[k] = v;
+                *slot = v;
             }
             self.add_node(tag, tag_at, p, dense_limit)?;
         }
@@ -573,7 +573,12 @@ impl<'a> Reader<'a> {
         for (i, record) in block.chunks_exact(per).enumerate() {
             corners.clear();
             // The element's own tag (the first 8 bytes) is not kept.
-            for (j, t) in record[8..].chunks_exact(8).enumerate() {
+            for (j, t) in record
+                .get(8..)
+                .unwrap_or_default()
+                .chunks_exact(8)
+                .enumerate()
+            {
                 let tag = u64::from_le_bytes(super::array(t).unwrap_or([0; 8]));
                 corners.push(self.node(tag, start + per * i + 8 * (j + 1))?);
             }
