@@ -294,3 +294,107 @@ fn convert_options_carry_volume_cells() {
     run(&["convert", "layers.msh", "welded.msh", "--weld", "1e-9"]);
     assert_eq!(volumes(&load(&at("welded.msh"))), before);
 }
+
+/// A unit cube as five tetrahedra (the middle one touches no side), two in
+/// volume `left` and three in `right`, with no surface elements at all.
+const TETS_ONLY_MSH: &str = "$MeshFormat
+4.1 0 8
+$EndMeshFormat
+$PhysicalNames
+2
+3 1 \"left\"
+3 2 \"right\"
+$EndPhysicalNames
+$Entities
+0 0 0 2
+1 0 0 0 1 1 1 1 1 0
+2 0 0 0 1 1 1 1 2 0
+$EndEntities
+$Nodes
+1 8 1 8
+3 1 0 8
+1
+2
+3
+4
+5
+6
+7
+8
+0 0 0
+1 0 0
+1 1 0
+0 1 0
+0 0 1
+1 0 1
+1 1 1
+0 1 1
+$EndNodes
+$Elements
+2 5 1 5
+3 1 4 2
+1 1 2 4 5
+2 2 3 4 7
+3 2 4 3
+3 2 7 5 6
+4 4 5 7 8
+5 2 4 7 5
+$EndElements
+";
+
+#[test]
+fn volume_only_meshes_give_their_boundary_to_surface_formats() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let at = |name: &str| dir.path().join(name);
+    std::fs::write(at("tets_only.msh"), TETS_ONLY_MSH).expect("write msh");
+    // ASCII STL: binary STL has no solids to carry the groups.
+    for out in ["cube.stl", "cube.obj", "cube.glb"] {
+        let o = Command::new(env!("CARGO_BIN_EXE_geomc"))
+            .args(["convert", "tets_only.msh", out])
+            .args(out.ends_with(".stl").then_some("--ascii"))
+            .current_dir(dir.path())
+            .output()
+            .expect("run geomc");
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(0), "{out}: {err}");
+        assert!(
+            err.contains("the mesh has volume cells only: writing their boundary surface (12 triangles in 2 groups)"),
+            "{out}: {err}"
+        );
+        assert!(
+            err.contains("5 tetrahedra in 2 volume groups not written"),
+            "{out}: {err}"
+        );
+        let back = load(&at(out));
+        let faces = &back.mesh.faces;
+        let triangles: usize = faces.iter().map(|f| f.triangles.len()).sum();
+        assert_eq!(triangles, 12, "{out}");
+        // The six sides, each two triangles; closed and outward: the
+        // divergence theorem gives the cube's volume.
+        let p = |n: u32| back.mesh.nodes[n as usize];
+        let enclosed: f64 = faces
+            .iter()
+            .flat_map(|f| &f.triangles)
+            .map(|&[a, b, c]| {
+                let (a, b, c) = (p(a), p(b), p(c));
+                (a[0] * (b[1] * c[2] - b[2] * c[1]) - a[1] * (b[0] * c[2] - b[2] * c[0])
+                    + a[2] * (b[0] * c[1] - b[1] * c[0]))
+                    / 6.0
+            })
+            .sum();
+        assert!((enclosed - 1.0).abs() < 1e-6, "{out}: encloses {enclosed}");
+        if out != "cube.glb" {
+            // STL solids and OBJ groups keep the volume groups' names.
+            let names: Vec<&str> = faces.iter().map(|f| f.name.as_str()).collect();
+            assert_eq!(names, ["left", "right"], "{out}");
+            assert_eq!(faces[0].triangles.len(), 6, "{out}");
+        }
+        if out == "cube.stl" {
+            assert!(
+                back.report.whole.watertight(),
+                "{out}: {:?}",
+                back.report.whole
+            );
+        }
+    }
+}

@@ -232,6 +232,20 @@ pub fn run(args: &Args) -> i32 {
             );
         }
     }
+    let mesh = &mut loaded.mesh;
+    if !writer.keeps_volume_cells()
+        && !mesh.volumes.is_empty()
+        && mesh.faces.iter().all(|f| f.triangles.is_empty())
+    {
+        // Volume cells only, for a surface format: their boundary is the surface.
+        let b = geomc::convert::boundary::extract(mesh);
+        eprintln!(
+            "geomc: the mesh has volume cells only: writing their boundary surface ({} triangles in {} group{})",
+            b.triangles,
+            b.groups,
+            if b.groups == 1 { "" } else { "s" }
+        );
+    }
     let encoding = if args.ascii {
         Some(Encoding::Ascii)
     } else if args.binary {

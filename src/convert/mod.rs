@@ -3,6 +3,7 @@
 //! triangles consistently. Each works on the mesh IR in place and reports
 //! what it did; [`inspect`] summarises a mesh file for `geomc inspect`.
 
+pub mod boundary;
 pub mod inspect;
 mod orient;
 mod weld;

@@ -11,9 +11,8 @@
 use super::groups::{self, Source};
 use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
 use crate::mesh::Mesh;
-use rayon::prelude::*;
 use serde_json::{Value, json};
-use std::collections::BTreeMap;
+use std::borrow::Cow;
 use std::io::Write;
 
 pub(crate) struct Gltf {
@@ -55,13 +54,13 @@ impl MeshWriter for Gltf {
         }
         if self.glb {
             let json = doc.json(None);
-            write_glb(&json, &doc.buffer, out)?;
+            write_glb(&json, &doc, out)?;
         } else {
             let uri = match bin_name(options) {
                 Some(name) => percent_encode(&name),
                 None => format!(
                     "data:application/octet-stream;base64,{}",
-                    base64::encode(&doc.buffer)
+                    base64::encode(&doc.buffer_bytes())
                 ),
             };
             out.write_all(&doc.json(Some(uri)))?;
@@ -77,7 +76,7 @@ impl MeshWriter for Gltf {
         Ok(match bin_name(options) {
             Some(name) => vec![SideFile {
                 name,
-                bytes: Document::of(mesh, self.name()).buffer,
+                bytes: Document::of(mesh, self.name()).buffer_bytes(),
             }],
             None => Vec::new(),
         })
@@ -108,73 +107,110 @@ fn percent_encode(s: &str) -> String {
     out
 }
 
-/// The JSON parts and the binary buffer, built together.
-struct Document {
+/// One part of the binary buffer, kept where it is (the mesh's nodes and
+/// triangles, an expansion's vectors) and converted while it is written: no
+/// copy of the whole buffer is built before the output.
+enum Piece<'a> {
+    /// Vectors written as three little-endian `f32`.
+    Vec3(Cow<'a, [[f64; 3]]>),
+    /// Triangle corners written as little-endian `u32`.
+    Triangles(Cow<'a, [[u32; 3]]>),
+    /// Indices written as little-endian `u32`.
+    Indices(Vec<u32>),
+}
+
+impl Piece<'_> {
+    fn byte_len(&self) -> usize {
+        match self {
+            Piece::Vec3(v) => 12 * v.len(),
+            Piece::Triangles(t) => 12 * t.len(),
+            Piece::Indices(i) => 4 * i.len(),
+        }
+    }
+
+    /// Converts and writes the piece in blocks of `BLOCK` values.
+    fn write(&self, block: &mut Vec<u8>, out: &mut dyn Write) -> std::io::Result<()> {
+        match self {
+            Piece::Vec3(v) => {
+                write_blocks(v.as_flattened(), block, out, |c| (c as f32).to_le_bytes())
+            }
+            Piece::Triangles(t) => write_blocks(t.as_flattened(), block, out, u32::to_le_bytes),
+            Piece::Indices(i) => write_blocks(i, block, out, u32::to_le_bytes),
+        }
+    }
+}
+
+/// Values per block converted before a write (256 kB of output).
+const BLOCK: usize = 1 << 16;
+
+fn write_blocks<T: Copy>(
+    values: &[T],
+    block: &mut Vec<u8>,
+    out: &mut dyn Write,
+    bytes: impl Fn(T) -> [u8; 4],
+) -> std::io::Result<()> {
+    for chunk in values.chunks(BLOCK) {
+        block.clear();
+        block.resize(4 * chunk.len(), 0);
+        for (slot, &v) in block.chunks_exact_mut(4).zip(chunk) {
+            slot.copy_from_slice(&bytes(v));
+        }
+        out.write_all(block)?;
+    }
+    Ok(())
+}
+
+/// The JSON parts and the binary buffer's pieces, built together.
+struct Document<'a> {
     nodes: Vec<Value>,
     meshes: Vec<Value>,
     accessors: Vec<Value>,
     views: Vec<Value>,
-    buffer: Vec<u8>,
+    pieces: Vec<Piece<'a>>,
+    /// The buffer's length so far: the sum of the pieces' lengths.
+    buffer_len: usize,
     scene: Vec<usize>,
     warnings: Vec<Warning>,
 }
 
-impl Document {
-    fn of(mesh: &Mesh, format: &'static str) -> Document {
+impl<'a> Document<'a> {
+    fn of(mesh: &'a Mesh, format: &'static str) -> Document<'a> {
         let mut d = Document {
             nodes: Vec::new(),
             meshes: Vec::new(),
             accessors: Vec::new(),
             views: Vec::new(),
-            buffer: Vec::new(),
+            pieces: Vec::new(),
+            buffer_len: 0,
             scene: Vec::new(),
             warnings: Vec::new(),
         };
         let mut empty = Vec::new();
-        // Groups go in windows of about a third of the mesh's triangles:
-        // each (face, orientation) a window uses is expanded once, in
-        // parallel, and a group is its faces' parts in order; memory holds
-        // one window's parts, not the whole expanded mesh.
-        let triangles_of = |g: &groups::SurfaceGroup| -> usize {
-            g.faces
-                .iter()
-                .map(|&(f, _)| mesh.faces[f as usize].triangles.len())
-                .sum()
-        };
-        let total: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
-        let budget = (total / 3).max(1 << 16);
-        for (name, list) in [
-            ("surfaces", groups::surface_groups(mesh)),
-            ("subdomains", groups::subdomain_surfaces(mesh)),
-        ] {
-            let mut children = Vec::new();
-            let mut start = 0;
-            while start < list.len() {
-                let mut end = start;
-                let mut window = 0;
-                while end < list.len()
-                    && (end == start || window + triangles_of(&list[end]) <= budget)
-                {
-                    window += triangles_of(&list[end]);
-                    end += 1;
-                }
-                let mut parts = Parts::of(mesh, &list[start..end]);
-                for g in &list[start..end] {
-                    let used: Vec<&Part> =
-                        g.faces.iter().filter_map(|key| parts.get(key)).collect();
-                    if used.iter().all(|p| p.triangles.is_empty()) {
-                        empty.push(g.name.to_string());
-                        parts.release(&g.faces);
-                        continue;
-                    }
-                    let primitive = d.triangles(&used);
-                    parts.release(&g.faces);
-                    children.push(d.node(g.name, primitive, extras(mesh, g.source)));
-                }
-                start = end;
+        let mut expander = groups::Expander::new(mesh);
+
+        let mut children = Vec::new();
+        for g in groups::surface_groups(mesh) {
+            let ex = expander.expand(&g.faces);
+            if ex.triangles.is_empty() {
+                empty.push(g.name.to_string());
+                continue;
             }
-            d.parent(name, children);
+            let primitive = d.triangles(ex);
+            children.push(d.node(g.name, primitive, extras(mesh, g.source)));
         }
+        d.parent("surfaces", children);
+
+        let mut children = Vec::new();
+        for g in groups::subdomain_surfaces(mesh) {
+            let ex = expander.expand(&g.faces);
+            if ex.triangles.is_empty() {
+                empty.push(g.name.to_string());
+                continue;
+            }
+            let primitive = d.triangles(ex);
+            children.push(d.node(g.name, primitive, extras(mesh, g.source)));
+        }
+        d.parent("subdomains", children);
 
         let mut children = Vec::new();
         for g in groups::line_groups(mesh) {
@@ -212,39 +248,35 @@ impl Document {
         d
     }
 
-    /// Records `self.buffer[offset..]` as a new buffer view; returns its index.
-    fn view(&mut self, offset: usize, target: u32) -> usize {
+    /// Appends a piece to the buffer as a new buffer view; returns its index.
+    fn view(&mut self, piece: Piece<'a>, target: u32) -> usize {
+        let length = piece.byte_len();
         self.views.push(json!({
             "buffer": 0,
-            "byteOffset": offset,
-            "byteLength": self.buffer.len() - offset,
+            "byteOffset": self.buffer_len,
+            "byteLength": length,
             "target": target,
         }));
+        self.buffer_len += length;
+        self.pieces.push(piece);
         self.views.len() - 1
     }
 
-    /// Writes the values straight into the buffer (no copy in between).
-    fn vec3_accessor(
-        &mut self,
-        values: impl ExactSizeIterator<Item = [f32; 3]>,
-        with_bounds: bool,
-    ) -> usize {
+    fn vec3_accessor(&mut self, values: Cow<'a, [[f64; 3]]>, with_bounds: bool) -> usize {
         let count = values.len();
-        let offset = self.buffer.len();
-        self.buffer.reserve(count * 12);
         // The validator compares the bounds with the stored f32 values exactly.
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
-        for v in values {
-            let mut record = [0u8; 12];
-            for k in 0..3 {
-                record[4 * k..4 * k + 4].copy_from_slice(&v[k].to_le_bytes());
-                lo[k] = lo[k].min(v[k]);
-                hi[k] = hi[k].max(v[k]);
+        if with_bounds {
+            for v in values.iter() {
+                for k in 0..3 {
+                    let c = v[k] as f32;
+                    lo[k] = lo[k].min(c);
+                    hi[k] = hi[k].max(c);
+                }
             }
-            self.buffer.extend_from_slice(&record);
         }
-        let view = self.view(offset, ARRAY_BUFFER);
+        let view = self.view(Piece::Vec3(values), ARRAY_BUFFER);
         let mut accessor = json!({
             "bufferView": view,
             "componentType": FLOAT,
@@ -259,14 +291,9 @@ impl Document {
         self.accessors.len() - 1
     }
 
-    fn index_accessor(&mut self, indices: impl ExactSizeIterator<Item = u32>) -> usize {
-        let count = indices.len();
-        let offset = self.buffer.len();
-        self.buffer.reserve(count * 4);
-        for i in indices {
-            self.buffer.extend_from_slice(&i.to_le_bytes());
-        }
-        let view = self.view(offset, ELEMENT_ARRAY_BUFFER);
+    fn index_accessor(&mut self, piece: Piece<'a>) -> usize {
+        let count = piece.byte_len() / 4;
+        let view = self.view(piece, ELEMENT_ARRAY_BUFFER);
         self.accessors.push(json!({
             "bufferView": view,
             "componentType": UNSIGNED_INT,
@@ -276,35 +303,10 @@ impl Document {
         self.accessors.len() - 1
     }
 
-    /// One TRIANGLES primitive over some faces' parts, in order.
-    fn triangles(&mut self, parts: &[&Part]) -> Value {
-        let vertices: usize = parts.iter().map(|p| p.positions.len()).sum();
-        let triangles: usize = parts.iter().map(|p| p.triangles.len()).sum();
-        // Positions, normals and indices in one reservation (three would
-        // reallocate and copy the buffer twice).
-        self.buffer.reserve(24 * vertices + 12 * triangles);
-        let position = self.vec3_accessor(
-            ExactLen(
-                vertices,
-                parts.iter().flat_map(|p| p.positions.iter().copied()),
-            ),
-            true,
-        );
-        let normal = self.vec3_accessor(
-            ExactLen(
-                vertices,
-                parts.iter().flat_map(|p| p.normals.iter().copied()),
-            ),
-            false,
-        );
-        // Each part numbers its vertices from 0: shifted by the vertices before it.
-        let mut base = 0u32;
-        let shifted = parts.iter().flat_map(|p| {
-            let offset = base;
-            base += p.positions.len() as u32;
-            p.triangles.as_flattened().iter().map(move |i| i + offset)
-        });
-        let indices = self.index_accessor(ExactLen(3 * triangles, shifted));
+    fn triangles(&mut self, ex: groups::Expanded<'a>) -> Value {
+        let position = self.vec3_accessor(ex.positions, true);
+        let normal = self.vec3_accessor(Cow::Owned(ex.normals), false);
+        let indices = self.index_accessor(Piece::Triangles(ex.triangles));
         json!({
             "attributes": {"POSITION": position, "NORMAL": normal},
             "indices": indices,
@@ -314,15 +316,11 @@ impl Document {
 
     /// A LINES (mode 1) or POINTS (mode 0) primitive over some mesh nodes.
     fn indexed(&mut self, mesh: &Mesh, nodes: &[u32], indices: Option<&[u32]>, mode: u32) -> Value {
-        let position = self.vec3_accessor(
-            nodes
-                .iter()
-                .map(|&n| mesh.nodes[n as usize].map(|c| c as f32)),
-            true,
-        );
+        let points = nodes.iter().map(|&n| mesh.nodes[n as usize]).collect();
+        let position = self.vec3_accessor(Cow::Owned(points), true);
         let mut primitive = json!({"attributes": {"POSITION": position}, "mode": mode});
         if let Some(indices) = indices {
-            primitive["indices"] = json!(self.index_accessor(indices.iter().copied()));
+            primitive["indices"] = json!(self.index_accessor(Piece::Indices(indices.to_vec())));
         }
         primitive
     }
@@ -359,7 +357,7 @@ impl Document {
             root["meshes"] = json!(self.meshes);
             root["accessors"] = json!(self.accessors);
             root["bufferViews"] = json!(self.views);
-            let mut buffer = json!({"byteLength": self.buffer.len()});
+            let mut buffer = json!({"byteLength": self.buffer_len});
             if let Some(uri) = uri {
                 buffer["uri"] = json!(uri);
             }
@@ -368,87 +366,24 @@ impl Document {
         // serde_json's maps are sorted: the same document gives the same bytes.
         serde_json::to_vec_pretty(&root).unwrap_or_default()
     }
-}
 
-/// One face's triangles with vertices of their own (see
-/// [`groups::Expander`]), in glTF's `f32`, vertices numbered from 0.
-struct Part {
-    positions: Vec<[f32; 3]>,
-    normals: Vec<[f32; 3]>,
-    triangles: Vec<[u32; 3]>,
-}
-
-/// The parts groups use, each computed once and handed out until its last
-/// user took it (then dropped, so they do not all stay alive).
-struct Parts {
-    parts: BTreeMap<(u32, bool), (Part, usize)>,
-}
-
-impl Parts {
-    fn of(mesh: &Mesh, groups: &[groups::SurfaceGroup]) -> Parts {
-        let mut uses: BTreeMap<(u32, bool), usize> = BTreeMap::new();
-        for g in groups {
-            for key in &g.faces {
-                *uses.entry(*key).or_default() += 1;
-            }
+    /// Writes the binary buffer's pieces in order.
+    fn write_buffer(&self, out: &mut dyn Write) -> std::io::Result<()> {
+        let mut block = Vec::with_capacity(4 * BLOCK);
+        for piece in &self.pieces {
+            piece.write(&mut block, out)?;
         }
-        let keys: Vec<((u32, bool), usize)> = uses.into_iter().collect();
-        // Faces in parallel, each thread with its own node table; the result
-        // is the same for any thread count (a part depends on its face only).
-        let parts = keys
-            .par_iter()
-            .map_init(
-                || groups::Expander::new(mesh),
-                |expander, &(key, n)| {
-                    let ex = expander.expand(&[key]);
-                    let f32s = |v: &Vec<[f64; 3]>| v.iter().map(|p| p.map(|c| c as f32)).collect();
-                    let part = Part {
-                        positions: f32s(&ex.positions),
-                        normals: f32s(&ex.normals),
-                        triangles: ex.triangles,
-                    };
-                    (key, (part, n))
-                },
-            )
-            .collect();
-        Parts { parts }
+        Ok(())
     }
 
-    fn get(&self, key: &(u32, bool)) -> Option<&Part> {
-        self.parts.get(key).map(|(part, _)| part)
-    }
-
-    /// A group is done with these parts: drop those no later group uses.
-    fn release(&mut self, keys: &[(u32, bool)]) {
-        for key in keys {
-            if let Some((_, uses)) = self.parts.get_mut(key) {
-                *uses -= 1;
-                if *uses == 0 {
-                    self.parts.remove(key);
-                }
-            }
-        }
+    /// The binary buffer as bytes (a `.gltf`'s side file or data URI).
+    fn buffer_bytes(&self) -> Vec<u8> {
+        let mut bytes = Vec::with_capacity(self.buffer_len);
+        // Writing to a vector cannot fail.
+        let _ = self.write_buffer(&mut bytes);
+        bytes
     }
 }
-
-/// An iterator with its length told (chains of parts are not `ExactSizeIterator`).
-struct ExactLen<I>(usize, I);
-
-impl<I: Iterator> Iterator for ExactLen<I> {
-    type Item = I::Item;
-
-    fn next(&mut self) -> Option<I::Item> {
-        let item = self.1.next()?;
-        self.0 = self.0.saturating_sub(1);
-        Some(item)
-    }
-
-    fn size_hint(&self) -> (usize, Option<usize>) {
-        (self.0, Some(self.0))
-    }
-}
-
-impl<I: Iterator> ExactSizeIterator for ExactLen<I> {}
 
 /// Distinct nodes in first-use order, and each input node's index among them.
 fn compact(nodes: impl Iterator<Item = u32>) -> (Vec<u32>, Vec<u32>) {
@@ -492,12 +427,13 @@ fn extras(mesh: &Mesh, source: Source) -> Value {
 
 /// GLB container: a 12-byte header, the JSON chunk padded with spaces and the
 /// BIN chunk padded with zeros, both to 4 bytes.
-fn write_glb(json: &[u8], bin: &[u8], out: &mut dyn Write) -> Result<(), WriteError> {
+fn write_glb(json: &[u8], doc: &Document, out: &mut dyn Write) -> Result<(), WriteError> {
     let pad = |n: usize| (4 - n % 4) % 4;
     let json_len = json.len() + pad(json.len());
-    let bin_len = bin.len() + pad(bin.len());
+    let bin = doc.buffer_len;
+    let bin_len = bin + pad(bin);
     let mut total = 12 + 8 + json_len;
-    if !bin.is_empty() {
+    if bin > 0 {
         total += 8 + bin_len;
     }
     let total = u32::try_from(total).map_err(|_| {
@@ -510,11 +446,11 @@ fn write_glb(json: &[u8], bin: &[u8], out: &mut dyn Write) -> Result<(), WriteEr
     out.write_all(b"JSON")?;
     out.write_all(json)?;
     out.write_all(&b"   "[..pad(json.len())])?;
-    if !bin.is_empty() {
+    if bin > 0 {
         out.write_all(&(bin_len as u32).to_le_bytes())?;
         out.write_all(b"BIN\0")?;
-        out.write_all(bin)?;
-        out.write_all(&[0u8; 3][..pad(bin.len())])?;
+        doc.write_buffer(out)?;
+        out.write_all(&[0u8; 3][..pad(bin)])?;
     }
     Ok(())
 }

@@ -5,6 +5,7 @@
 
 use super::WriteError;
 use crate::mesh::Mesh;
+use std::borrow::Cow;
 
 /// Rejects a mesh whose indices leave their tables or whose coordinates are
 /// not finite. After it, writers may index the mesh's tables directly.
@@ -246,12 +247,22 @@ pub(crate) fn oriented(mesh: &Mesh, face: u32, flip: bool) -> impl Iterator<Item
 /// faces becomes two vertices, so normals are smooth within a face and flat
 /// across the edges between faces (the creases).
 #[derive(Debug, Default)]
-pub(crate) struct Expanded {
-    pub positions: Vec<[f64; 3]>,
+pub(crate) struct Expanded<'a> {
+    pub positions: Cow<'a, [[f64; 3]]>,
     pub normals: Vec<[f64; 3]>,
-    /// The mesh node each vertex copies.
-    pub nodes: Vec<u32>,
-    pub triangles: Vec<[u32; 3]>,
+    /// The mesh node each vertex copies; `None` when vertex `i` is node `i`.
+    nodes: Option<Vec<u32>>,
+    pub triangles: Cow<'a, [[u32; 3]]>,
+}
+
+impl Expanded<'_> {
+    /// The mesh node a vertex copies.
+    pub(crate) fn node(&self, vertex: usize) -> u32 {
+        match &self.nodes {
+            Some(nodes) => nodes[vertex],
+            None => vertex as u32,
+        }
+    }
 }
 
 /// Expands groups of one mesh: each node's vertex in the current face sits in
@@ -259,6 +270,7 @@ pub(crate) struct Expanded {
 /// map is built per face and the table is reused across calls.
 pub(crate) struct Expander<'a> {
     mesh: &'a Mesh,
+    /// Made on first use: the common single-face case needs none.
     slot: Vec<(u32, u32)>,
     stamp: u32,
 }
@@ -267,17 +279,71 @@ impl<'a> Expander<'a> {
     pub(crate) fn new(mesh: &'a Mesh) -> Expander<'a> {
         Expander {
             mesh,
-            slot: vec![(u32::MAX, 0); mesh.nodes.len()],
+            slot: Vec::new(),
             stamp: 0,
         }
     }
 
-    pub(crate) fn expand(&mut self, faces: &[(u32, bool)]) -> Expanded {
+    pub(crate) fn expand(&mut self, faces: &[(u32, bool)]) -> Expanded<'a> {
+        if let [(face, false)] = faces {
+            // One face as it is whose nodes first appear in their own order
+            // (an STL solid, a mesh written face by face): its vertices are
+            // the mesh's first nodes, so nothing is copied.
+            let mesh = self.mesh;
+            let triangles = &mesh.faces[*face as usize].triangles;
+            if let Some(used) = identity_prefix(triangles) {
+                return Expanded {
+                    positions: Cow::Borrowed(&mesh.nodes[..used]),
+                    normals: node_normals(mesh, triangles, used),
+                    nodes: None,
+                    triangles: Cow::Borrowed(triangles),
+                };
+            }
+        }
+        if self.slot.len() != self.mesh.nodes.len() {
+            self.slot = vec![(u32::MAX, 0); self.mesh.nodes.len()];
+            self.stamp = 0;
+        }
         expand_into(self, faces)
     }
 }
 
-fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
+/// `Some(k)` when the triangles use nodes `0..k` and each first appears after
+/// all smaller ones (the order the expansion would number them in).
+fn identity_prefix(triangles: &[[u32; 3]]) -> Option<usize> {
+    let mut next = 0u32;
+    for &n in triangles.as_flattened() {
+        if n == next {
+            next += 1;
+        } else if n > next {
+            return None;
+        }
+    }
+    Some(next as usize)
+}
+
+/// The unit normals of nodes `0..used` over one face's triangles: the
+/// area-weighted sums, in triangle order, that [`expand_into`] forms (the
+/// same numbers, so the output does not depend on which path made it).
+fn node_normals(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> Vec<[f64; 3]> {
+    let mut normals = vec![[0.0; 3]; used];
+    let mut total = [0.0; 3];
+    for &tri in triangles {
+        let n = triangle_normal(mesh, tri);
+        total = add(total, n);
+        for v in tri {
+            let s = &mut normals[v as usize];
+            *s = add(*s, n);
+        }
+    }
+    let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
+    for s in &mut normals {
+        *s = unit(*s).unwrap_or(fallback);
+    }
+    normals
+}
+
+fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a> {
     let mesh = ex.mesh;
     let triangles: usize = faces
         .iter()
@@ -286,12 +352,10 @@ fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
     // Each node once per face: at most all nodes, at most three per triangle
     // (reserved at once: growing by doubling copied and touched twice the memory).
     let vertices = mesh.nodes.len().min(3 * triangles);
-    let mut out = Expanded {
-        triangles: Vec::with_capacity(triangles),
-        positions: Vec::with_capacity(vertices),
-        nodes: Vec::with_capacity(vertices),
-        normals: Vec::with_capacity(vertices),
-    };
+    let mut out_triangles = Vec::with_capacity(triangles);
+    let mut positions = Vec::with_capacity(vertices);
+    let mut nodes = Vec::with_capacity(vertices);
+    let mut normals: Vec<[f64; 3]> = Vec::with_capacity(vertices);
     for &(face, flip) in faces {
         if ex.stamp == u32::MAX - 1 {
             ex.slot.fill((u32::MAX, 0));
@@ -299,7 +363,7 @@ fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
         }
         ex.stamp += 1;
         let stamp = ex.stamp;
-        let first = out.positions.len();
+        let first = positions.len();
         let mut total = [0.0; 3];
         for tri in oriented(mesh, face, flip) {
             let n = triangle_normal(mesh, tri);
@@ -308,26 +372,31 @@ fn expand_into(ex: &mut Expander, faces: &[(u32, bool)]) -> Expanded {
             for (k, &node) in tri.iter().enumerate() {
                 let entry = &mut ex.slot[node as usize];
                 if entry.0 != stamp {
-                    out.positions.push(mesh.nodes[node as usize]);
-                    out.nodes.push(node);
+                    positions.push(mesh.nodes[node as usize]);
+                    nodes.push(node);
                     // The area-weighted sum of the normals around the node,
                     // made a unit vector once the face is done.
-                    out.normals.push([0.0; 3]);
-                    *entry = (stamp, (out.positions.len() - 1) as u32);
+                    normals.push([0.0; 3]);
+                    *entry = (stamp, (positions.len() - 1) as u32);
                 }
                 let index = entry.1 as usize;
                 // Area weighting: the unnormalised cross product is twice the area.
-                out.normals[index] = add(out.normals[index], n);
+                normals[index] = add(normals[index], n);
                 t[k] = entry.1;
             }
-            out.triangles.push(t);
+            out_triangles.push(t);
         }
         let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
-        for s in &mut out.normals[first..] {
+        for s in &mut normals[first..] {
             *s = unit(*s).unwrap_or(fallback);
         }
     }
-    out
+    Expanded {
+        positions: Cow::Owned(positions),
+        normals,
+        nodes: Some(nodes),
+        triangles: Cow::Owned(out_triangles),
+    }
 }
 
 /// Twice the area times the unit normal, by the right-hand rule.

@@ -71,11 +71,11 @@ impl MeshWriter for Obj {
                     vector(&mut text, "vn ", *n);
                     spill(&mut text, out)?;
                 }
-                for t in &ex.triangles {
+                for t in ex.triangles.iter() {
                     text.push('f');
                     for &local in t {
                         let local = local as usize;
-                        let _ = write!(text, " {}//{}", ex.nodes[local] + 1, next_normal + local);
+                        let _ = write!(text, " {}//{}", ex.node(local) + 1, next_normal + local);
                     }
                     text.push('\n');
                     spill(&mut text, out)?;

@@ -486,6 +486,10 @@ impl<'a> Reader<'a> {
             } else {
                 0
             };
+            if self.binary && extra == 0 && self.binary_coordinates(&tags, dense_limit)? {
+                read += n;
+                continue;
+            }
             for &(tag, at) in &tags {
                 let p = [
                     self.real("a node coordinate")?,
@@ -508,6 +512,80 @@ impl<'a> Reader<'a> {
             ));
         }
         Ok(())
+    }
+
+    /// A binary block of node coordinates read at once, when the file holds
+    /// all of it (else `false`: the value-by-value path finds the end and says
+    /// where). Errors as that path gives them.
+    fn binary_coordinates(
+        &mut self,
+        tags: &[(u64, usize)],
+        dense_limit: u64,
+    ) -> Result<bool, Diagnostic> {
+        let bytes = self.s.bytes;
+        let start = self.s.pos;
+        let Some(block) = tags
+            .len()
+            .checked_mul(24)
+            .and_then(|len| bytes.get(start..)?.get(..len))
+        else {
+            return Ok(false);
+        };
+        for (i, (record, &(tag, tag_at))) in block.chunks_exact(24).zip(tags).enumerate() {
+            let mut p = [0.0; 3];
+            for (k, (slot, c)) in p.iter_mut().zip(record.chunks_exact(8)).enumerate() {
+                let v = f64::from_le_bytes(super::array(c).unwrap_or([0; 8]));
+                if !v.is_finite() {
+                    return Err(error_at_byte(
+                        Code::MeshNonFinite,
+                        start + 24 * i + 8 * k,
+                        format!("a node coordinate is {v}, not a finite number"),
+                    ));
+                }
+                *slot = v;
+            }
+            self.add_node(tag, tag_at, p, dense_limit)?;
+        }
+        self.s.pos = start + block.len();
+        Ok(true)
+    }
+
+    /// A binary block of `n` elements of `k` nodes read at once, when the
+    /// file holds all of it (else `false`, as [`Self::binary_coordinates`]).
+    fn binary_elements(
+        &mut self,
+        n: usize,
+        k: usize,
+        kind: Kind,
+        name: &'static str,
+        group: usize,
+    ) -> Result<bool, Diagnostic> {
+        let bytes = self.s.bytes;
+        let start = self.s.pos;
+        let per = 8 * (k + 1);
+        let Some(block) = n
+            .checked_mul(per)
+            .and_then(|len| bytes.get(start..)?.get(..len))
+        else {
+            return Ok(false);
+        };
+        let mut corners: Vec<u32> = Vec::with_capacity(k);
+        for (i, record) in block.chunks_exact(per).enumerate() {
+            corners.clear();
+            // The element's own tag (the first 8 bytes) is not kept.
+            for (j, t) in record
+                .get(8..)
+                .unwrap_or_default()
+                .chunks_exact(8)
+                .enumerate()
+            {
+                let tag = u64::from_le_bytes(super::array(t).unwrap_or([0; 8]));
+                corners.push(self.node(tag, start + per * i + 8 * (j + 1))?);
+            }
+            self.add_element(kind, name, &corners, group);
+        }
+        self.s.pos = start + block.len();
+        Ok(true)
     }
 
     fn nodes22(&mut self) -> Result<(), Diagnostic> {
@@ -654,6 +732,10 @@ impl<'a> Reader<'a> {
                     g.triangles
                         .reserve(n * if kind == Kind::Quad { 2 } else { 1 });
                 }
+            }
+            if self.binary && self.binary_elements(n, k, kind, name, group)? {
+                read += n;
+                continue;
             }
             for _ in 0..n {
                 self.size("an element tag")?;
