@@ -34,6 +34,16 @@ pub fn depth_of(value: u64) -> f32 {
     f32::from_bits((value >> 32) as u32)
 }
 
+/// The triangle's corners as given, and which side faces the eye (none when
+/// it is seen edge-on): what binning needs, without the depths.
+#[inline]
+fn facing(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], u32)> {
+    let v = t.map(|n| proj.xy[n as usize]);
+    let [a, b, c] = v;
+    let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    (area != 0).then_some((v, u32::from(area > 0)))
+}
+
 /// The triangle's corners ordered with positive area, and which side faces the eye.
 #[inline]
 fn setup(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], [f32; 3], u32)> {
@@ -103,7 +113,7 @@ pub fn bin(
             let mut bands: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
             let end = ((c + 1) * CHUNK).min(scene.tris.len());
             for tri in c * CHUNK..end {
-                let Some((v, _, back)) = setup(proj, scene.tris[tri]) else {
+                let Some((v, back)) = facing(proj, scene.tris[tri]) else {
                     continue;
                 };
                 if !visible_side(scene, tri, back) {
