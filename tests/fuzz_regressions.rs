@@ -376,6 +376,32 @@ fn large_area_bits_decode_without_overflow_and_mesh() {
     }
 }
 
+/// A poly_line near a side whose nodes are collinear only up to rounding
+/// (found by `triangulate`, 2026-11-26, as slow units of 1–5 s ending in
+/// E502): spade refined the slivers between that side and the hull without
+/// end. Both inputs now mesh, small and at the minimum angle.
+#[test]
+fn polylines_near_a_tilted_side_mesh_small() {
+    let found = inputs("triangulate_near_boundary");
+    assert_eq!(
+        found.len(),
+        2,
+        "triangulate_near_boundary regression inputs"
+    );
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        assert_eq!(input.segments.len(), 1, "{}", path.display());
+        let (triangles, worst) = mesh_thin(&path.display().to_string(), &input)
+            .unwrap_or_else(|| panic!("{}: refused by the front end", path.display()));
+        assert!(
+            triangles <= 2_000,
+            "{}: {triangles} triangles",
+            path.display()
+        );
+        assert!(worst >= 25.0, "{}: {worst}°", path.display());
+    }
+}
+
 #[path = "../fuzz/shared/density_case.rs"]
 mod density_case;
 

@@ -88,3 +88,70 @@ fn line_clearly_outside_stays_free_and_line_inside_is_followed() {
         assert!((p[1] - 0.1).abs() < 1e-12 && (q[1] - 0.1).abs() < 1e-12);
     }
 }
+
+/// The smallest angle of a triangle, in degrees.
+fn smallest_angle(p: [f64; 3], q: [f64; 3], r: [f64; 3]) -> f64 {
+    let angle = |a: [f64; 3], b: [f64; 3], c: [f64; 3]| {
+        let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+        (u[0] * v[1] - u[1] * v[0])
+            .abs()
+            .atan2(u[0] * v[0] + u[1] * v[1])
+            .to_degrees()
+    };
+    angle(p, q, r).min(angle(q, r, p)).min(angle(r, p, q))
+}
+
+/// A crack inside a tilted square (sides 3·√0.1 ≈ 0.949, area 0.9). The
+/// sides' nodes are collinear only up to rounding, and with a poly_line
+/// spade refined the slivers between them and its hull without end: this
+/// ran for minutes. It now meshes at each area limit, covering the square at
+/// the default minimum angle (25°), with the crack followed over its whole
+/// length (√0.1 ≈ 0.316).
+#[test]
+fn crack_in_a_tilted_square_meshes_at_every_area_limit() {
+    let xml = r#"<geometry version="1" dimension="2">
+      <polygon name="p"><vertex x="0" y="0"/><vertex x="0.9" y="0.3"/><vertex x="0.6" y="1.2"/><vertex x="-0.3" y="0.9"/></polygon>
+      <poly_line name="cut"><line><begin_point x="0.2" y="0.4"/><end_point x="0.5" y="0.5"/></line></poly_line>
+      <subdomain name="inside"><solid ref="p"/></subdomain>
+    </geometry>"#;
+    let checked = check_source(SourceFile::new("t.xml", xml), &Options::default());
+    assert!(checked.is_valid(), "{:#?}", checked.diagnostics.items);
+    let model = checked.lowered.expect("a model").model;
+    let mut previous = 0;
+    for max_area in [0.05, 0.01, 0.002] {
+        let options = MeshOptions {
+            max_area: Some(max_area),
+            ..MeshOptions::default()
+        };
+        let mesh = mesh_model(&model, &options).expect("meshes");
+        let mut area = 0.0;
+        let mut count = 0;
+        for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
+            let [p, q, r] = t.map(|n| mesh.nodes[n as usize]);
+            let twice = (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]);
+            assert!(twice.abs() / 2.0 <= max_area * (1.0 + 1e-9), "{max_area}");
+            assert!(smallest_angle(p, q, r) >= 25.0 - 1e-9, "{max_area}");
+            area += twice.abs() / 2.0;
+            count += 1;
+        }
+        assert!((area - 0.9).abs() < 1e-12, "{max_area}: area {area}");
+        assert!(
+            count >= (0.9 / max_area) as usize,
+            "{max_area}: {count} triangles"
+        );
+        assert!(count > previous, "{max_area}: {count} ≤ {previous}");
+        previous = count;
+        let crack = &mesh.polylines[0].nodes;
+        let length: f64 = crack
+            .windows(2)
+            .map(|w| {
+                let [p, q] = [w[0], w[1]].map(|n| mesh.nodes[n as usize]);
+                (q[0] - p[0]).hypot(q[1] - p[1])
+            })
+            .sum();
+        assert!(
+            (length - 0.1f64.sqrt()).abs() < 1e-12,
+            "{max_area}: {length}"
+        );
+    }
+}

@@ -204,6 +204,18 @@ pub(crate) fn mesh_face(
         .iter()
         .flat_map(|(_, h)| h.windows(2).map(|w| (w[0], w[1])))
         .collect();
+    // With poly_lines spade cannot tell the outside (its peeling takes an
+    // open poly_line for a loop) and refines every face of the hull. Where a
+    // straight boundary's nodes are collinear only up to rounding, the
+    // slivers between it and the hull encroach each other without end (a
+    // tilted square with a crack ran for minutes). Four points far around a
+    // plane face move the hull away; the faces out there are refined for
+    // their angles only (the area limit is checked on the face's own
+    // triangles, `Coarse`) and dropped with the rest of the outside.
+    let framed = !polyline_segments.is_empty() && matches!(face.surface, Surface::Plane { .. });
+    if framed {
+        insert_frame(&mut cdt, &chart, &uv_loops, &mut keys, &mut positions).map_err(failed)?;
+    }
     let fixed = cdt.num_vertices();
 
     let small_angle = has_small_input_angle(&cdt, settings.min_angle);
@@ -226,7 +238,7 @@ pub(crate) fn mesh_face(
     if settings.keep_boundary {
         parameters = parameters.keep_constraint_edges();
     }
-    if settings.max_area.min(guide).is_finite() {
+    if settings.max_area.min(guide).is_finite() && !framed {
         parameters = parameters.with_max_allowed_area(settings.max_area.min(guide));
     }
     // Next to an input angle below the limit no triangle can meet it, and
@@ -447,6 +459,44 @@ fn unwrap_loops(chart: &Chart, loops: &[Vec<LoopPoint>]) -> Result<Vec<Vec<[f64;
         out.push(uv);
     }
     Ok(out)
+}
+
+/// Four corners of a square twice the loops' extent beyond their bounding
+/// box: the hull of the triangulation, far from every boundary segment.
+fn insert_frame(
+    cdt: &mut Cdt,
+    chart: &Chart,
+    uv_loops: &[Vec<[f64; 2]>],
+    keys: &mut Vec<FacePoint>,
+    positions: &mut Vec<Point3>,
+) -> Result<(), String> {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in uv_loops.iter().flatten() {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let margin = 2.0 * (hi[0] - lo[0]).max(hi[1] - lo[1]);
+    for corner in [
+        [lo[0] - margin, lo[1] - margin],
+        [hi[0] + margin, lo[1] - margin],
+        [hi[0] + margin, hi[1] + margin],
+        [lo[0] - margin, hi[1] + margin],
+    ] {
+        let handle = cdt
+            .insert(point2(corner))
+            .map_err(|e| format!("the outside frame cannot be triangulated: {e:?}"))?;
+        let p = chart
+            .lift(corner)
+            .ok_or("the outside frame does not lift onto the face's plane")?;
+        if handle.index() != keys.len() {
+            return Err("the outside frame meets the face".into());
+        }
+        keys.push(FacePoint::Interior(p));
+        positions.push(p);
+    }
+    Ok(())
 }
 
 /// Even–odd point-in-polygon test over all loops.
