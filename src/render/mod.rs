@@ -379,7 +379,12 @@ pub fn render_png(
     options: &RenderOptions,
 ) -> Result<(Vec<u8>, Vec<RenderWarning>), RenderError> {
     let rendered = render_image(mesh, options)?;
-    Ok((png_out::encode(&rendered.image), rendered.warnings))
+    let te = std::time::Instant::now();
+    let png = png_out::encode(&rendered.image);
+    if std::env::var_os("GEOMC_RENDER_TIMES").is_some() {
+        eprintln!("TIME encode {:.1} ms", te.elapsed().as_secs_f64() * 1e3);
+    }
+    Ok((png, rendered.warnings))
 }
 
 /// Decodes a PNG written by [`render_png`] (for tests and tools).

@@ -31,7 +31,8 @@ pub struct Scene<'a> {
     /// Per face: the group shown on its front (normal) side and on its back.
     pub face_sides: Vec<[u32; 2]>,
     /// Per triangle corner: an index into `light`.
-    pub corner_slots: Vec<[u32; 3]>,
+    /// (The triangles themselves when smooth shading one face: a node's own slot.)
+    pub corner_slots: Cow<'a, [[u32; 3]]>,
     /// Light intensity in [0, 1] seen on the front and on the back side.
     pub light: Vec<[f32; 2]>,
     pub groups: Vec<Group>,
@@ -267,14 +268,19 @@ fn shade(scene: &mut Scene, shading: Shading, camera: &Camera) {
             scene.light = (scene.tris.par_iter())
                 .map(|&t| intensity(tri_normal(points, t), light))
                 .collect();
-            scene.corner_slots = (0..scene.tris.len() as u32)
-                .into_par_iter()
-                .map(|i| [i, i, i])
-                .collect();
+            scene.corner_slots = Cow::Owned(
+                (0..scene.tris.len() as u32)
+                    .into_par_iter()
+                    .map(|i| [i, i, i])
+                    .collect(),
+            );
         }
         Shading::Smooth => {
             let (slots, sums) = smooth::sums(&scene.points, &scene.tris, &scene.tri_face);
-            scene.corner_slots = slots;
+            scene.corner_slots = match slots {
+                Some(slots) => Cow::Owned(slots),
+                None => scene.tris.clone(),
+            };
             scene.light = sums.par_iter().map(|&n| intensity(n, light)).collect();
         }
     }
@@ -289,15 +295,16 @@ fn cut(scene: &mut Scene<'_>, section: Section) {
     let old_faces = std::mem::take(&mut scene.tri_face);
     let old_slots = std::mem::take(&mut scene.corner_slots);
     let mut tris = Vec::with_capacity(old_tris.len());
+    let mut slots = Vec::with_capacity(old_tris.len());
     // Points made on a crossed edge, shared by the triangles on both sides of it.
     let mut made: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    for ((&t, f), s) in old_tris.iter().zip(old_faces).zip(old_slots) {
+    for ((&t, f), &s) in old_tris.iter().zip(old_faces).zip(old_slots.iter()) {
         let d = t.map(|n| scene.points[n as usize][axis] - value);
         let kept = d.iter().filter(|&&v| v <= 0.0).count();
         if kept == 3 {
             tris.push(t);
             scene.tri_face.push(f);
-            scene.corner_slots.push(s);
+            slots.push(s);
             continue;
         }
         if kept == 0 {
@@ -336,11 +343,10 @@ fn cut(scene: &mut Scene<'_>, section: Section) {
         }
         for k in 1..poly.len().saturating_sub(1) {
             tris.push([poly[0].0, poly[k].0, poly[k + 1].0]);
-            scene
-                .corner_slots
-                .push([poly[0].1, poly[k].1, poly[k + 1].1]);
+            slots.push([poly[0].1, poly[k].1, poly[k + 1].1]);
             scene.tri_face.push(f);
         }
     }
     scene.tris = Cow::Owned(tris);
+    scene.corner_slots = Cow::Owned(slots);
 }

@@ -34,53 +34,21 @@ fn add(sum: &mut [f64; 3], n: [f64; 3]) {
 /// Per triangle corner a slot, and per slot the summed normal. A node's slot
 /// is its own index in the first face (lowest index) that uses it; the
 /// (face, node) pairs of later faces get slots after the nodes, in sorted order.
+/// The slots are `None` when they are the triangles' own nodes (one face).
 /// `tri_face` must be non-decreasing (triangles grouped by face in face order).
 pub fn sums(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     tri_face: &[u32],
-) -> (Vec<[u32; 3]>, Vec<[f64; 3]>) {
+) -> (Option<Vec<[u32; 3]>>, Vec<[f64; 3]>) {
     let n = points.len();
-    let one_face = tri_face.first() == tri_face.last();
-    let owner: Vec<u32> = if one_face {
-        vec![tri_face.first().copied().unwrap_or(0); n]
+    let (own_slots, extra) = if tri_face.first() == tri_face.last() {
+        (None, Vec::new())
     } else {
-        let owner: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(u32::MAX)).collect();
-        tris.par_iter().zip(tri_face).for_each(|(t, &f)| {
-            for &node in t {
-                owner[node as usize].fetch_min(f, Ordering::Relaxed);
-            }
-        });
-        owner.into_iter().map(AtomicU32::into_inner).collect()
+        let (slots, extra) = later_face_slots(n, tris, tri_face);
+        (Some(slots), extra)
     };
-    let owner = &owner;
-    let mut extra: Vec<(u32, u32)> = if one_face {
-        Vec::new()
-    } else {
-        tris.par_iter()
-            .zip(tri_face)
-            .flat_map_iter(|(t, &f)| {
-                t.iter()
-                    .filter(move |&&node| owner[node as usize] != f)
-                    .map(move |&node| (f, node))
-            })
-            .collect()
-    };
-    extra.par_sort_unstable();
-    extra.dedup();
-    let slot = |node: u32, f: u32| -> u32 {
-        if owner[node as usize] == f {
-            node
-        } else {
-            // Always found: every pair of a later face was collected.
-            (n + extra.binary_search(&(f, node)).unwrap_or_else(|i| i)) as u32
-        }
-    };
-    let corner_slots: Vec<[u32; 3]> = tris
-        .par_iter()
-        .zip(tri_face)
-        .map(|(t, &f)| t.map(|node| slot(node, f)))
-        .collect();
+    let corner_slots: &[[u32; 3]] = own_slots.as_deref().unwrap_or(tris);
     let mut sums = vec![[0.0; 3]; n + extra.len()];
     // Each chunk's node range over the corners of its first faces.
     let spans: Vec<(usize, usize)> = corner_slots
@@ -96,13 +64,13 @@ pub fn sums(
         .iter()
         .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
     if !local {
-        for (t, s) in tris.iter().zip(&corner_slots) {
+        for (t, s) in tris.iter().zip(corner_slots) {
             let normal = tri_normal(points, *t);
             for &k in s {
                 add(&mut sums[k as usize], normal);
             }
         }
-        return (corner_slots, sums);
+        return (own_slots, sums);
     }
     // Partial sums per chunk: an array over its node span, and the corners
     // of later faces in order.
@@ -145,7 +113,49 @@ pub fn sums(
             add(&mut later[k as usize - n], normal);
         }
     }
-    (corner_slots, sums)
+    (own_slots, sums)
+}
+
+/// The slots of a mesh of several faces, and the (face, node) pairs of the
+/// nodes used by a face after their first, sorted.
+fn later_face_slots(
+    n: usize,
+    tris: &[[u32; 3]],
+    tri_face: &[u32],
+) -> (Vec<[u32; 3]>, Vec<(u32, u32)>) {
+    let owner: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(u32::MAX)).collect();
+    tris.par_iter().zip(tri_face).for_each(|(t, &f)| {
+        for &node in t {
+            owner[node as usize].fetch_min(f, Ordering::Relaxed);
+        }
+    });
+    let owner: Vec<u32> = owner.into_iter().map(AtomicU32::into_inner).collect();
+    let owner = &owner;
+    let mut extra: Vec<(u32, u32)> = tris
+        .par_iter()
+        .zip(tri_face)
+        .flat_map_iter(|(t, &f)| {
+            t.iter()
+                .filter(move |&&node| owner[node as usize] != f)
+                .map(move |&node| (f, node))
+        })
+        .collect();
+    extra.par_sort_unstable();
+    extra.dedup();
+    let slot = |node: u32, f: u32| -> u32 {
+        if owner[node as usize] == f {
+            node
+        } else {
+            // Always found: every pair of a later face was collected.
+            (n + extra.binary_search(&(f, node)).unwrap_or_else(|i| i)) as u32
+        }
+    };
+    let slots = tris
+        .par_iter()
+        .zip(tri_face)
+        .map(|(t, &f)| t.map(|node| slot(node, f)))
+        .collect();
+    (slots, extra)
 }
 
 #[cfg(test)]
