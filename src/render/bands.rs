@@ -25,11 +25,7 @@ pub fn render(
 ) -> Image {
     let (sw, sh) = (width * ss, height * ss);
     let band_rows = BAND_PIXELS * ss;
-    let tb = std::time::Instant::now();
     let bins = raster::bin(scene, proj, sw, sh, band_rows);
-    if std::env::var_os("GEOMC_RENDER_TIMES").is_some() {
-        eprintln!("TIME bin {:.1} ms", tb.elapsed().as_secs_f64() * 1e3);
-    }
     let mut rgba = vec![0u8; width * height * 4];
     rgba.par_chunks_mut(width * 4 * BAND_PIXELS)
         .enumerate()

@@ -252,20 +252,11 @@ fn section_warning(scene: &scene::Scene, options: &RenderOptions) -> Option<Rend
 /// Renders the shaded raster picture.
 pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, RenderError> {
     check(mesh, options)?;
-    let tm = std::time::Instant::now();
-    let stage = |name: &str| {
-        if std::env::var_os("GEOMC_RENDER_TIMES").is_some() {
-            eprintln!("TIME {name} {:.1} ms", tm.elapsed().as_secs_f64() * 1e3);
-        }
-    };
     let camera = camera_for(mesh, options);
-    stage("camera");
     let scene = scene::build(mesh, options, &camera);
-    stage("scene");
     let mut warnings: Vec<RenderWarning> = section_warning(&scene, options).into_iter().collect();
     let ss = options.antialias as usize;
     let proj = project(&scene, &camera, ss);
-    stage("project");
     let (sw, sh) = (options.width as usize * ss, options.height as usize * ss);
     let mut image = if options.edges == Edges::None {
         let (w, h) = (options.width as usize, options.height as usize);
@@ -296,7 +287,6 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
         raster::mark_edges(&zbuf, &segments, 0.75 * ss as f32, 0.01, is_cap, &mut mask);
         resolve::resolve(&scene, &proj, &zbuf, &mask, ss, options.background)
     };
-    stage("raster+resolve");
     let mut entries = Vec::new();
     if options.legend {
         let (e, not_shown) = legend::layout(&scene.groups, options.width, options.height);
@@ -379,12 +369,7 @@ pub fn render_png(
     options: &RenderOptions,
 ) -> Result<(Vec<u8>, Vec<RenderWarning>), RenderError> {
     let rendered = render_image(mesh, options)?;
-    let te = std::time::Instant::now();
-    let png = png_out::encode(&rendered.image);
-    if std::env::var_os("GEOMC_RENDER_TIMES").is_some() {
-        eprintln!("TIME encode {:.1} ms", te.elapsed().as_secs_f64() * 1e3);
-    }
-    Ok((png, rendered.warnings))
+    Ok((png_out::encode(&rendered.image), rendered.warnings))
 }
 
 /// Decodes a PNG written by [`render_png`] (for tests and tools).

@@ -276,12 +276,15 @@ fn shade(scene: &mut Scene, shading: Shading, camera: &Camera) {
             );
         }
         Shading::Smooth => {
-            let (slots, sums) = smooth::sums(&scene.points, &scene.tris, &scene.tri_face);
+            let (slots, light) =
+                smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, |n| {
+                    intensity(n, light)
+                });
             scene.corner_slots = match slots {
                 Some(slots) => Cow::Owned(slots),
                 None => scene.tris.clone(),
             };
-            scene.light = sums.par_iter().map(|&n| intensity(n, light)).collect();
+            scene.light = light;
         }
     }
 }

@@ -31,16 +31,18 @@ fn add(sum: &mut [f64; 3], n: [f64; 3]) {
     sum[2] += n[2];
 }
 
-/// Per triangle corner a slot, and per slot the summed normal. A node's slot
+/// Per triangle corner a slot, and per slot `finish` of the summed normal
+/// (the light, for pictures: the sums themselves are never stored). A node's slot
 /// is its own index in the first face (lowest index) that uses it; the
 /// (face, node) pairs of later faces get slots after the nodes, in sorted order.
 /// The slots are `None` when they are the triangles' own nodes (one face).
 /// `tri_face` must be non-decreasing (triangles grouped by face in face order).
-pub fn sums(
+pub fn per_slot<T: Copy + Default + Send + Sync>(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     tri_face: &[u32],
-) -> (Option<Vec<[u32; 3]>>, Vec<[f64; 3]>) {
+    finish: impl Fn([f64; 3]) -> T + Sync,
+) -> (Option<Vec<[u32; 3]>>, Vec<T>) {
     let n = points.len();
     let (own_slots, extra) = if tri_face.first() == tri_face.last() {
         (None, Vec::new())
@@ -49,7 +51,6 @@ pub fn sums(
         (Some(slots), extra)
     };
     let corner_slots: &[[u32; 3]] = own_slots.as_deref().unwrap_or(tris);
-    let mut sums = vec![[0.0; 3]; n + extra.len()];
     // Each chunk's node range over the corners of its first faces.
     let spans: Vec<(usize, usize)> = corner_slots
         .par_chunks(CHUNK)
@@ -64,13 +65,14 @@ pub fn sums(
         .iter()
         .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
     if !local {
+        let mut sums = vec![[0.0; 3]; n + extra.len()];
         for (t, s) in tris.iter().zip(corner_slots) {
             let normal = tri_normal(points, *t);
             for &k in s {
                 add(&mut sums[k as usize], normal);
             }
         }
-        return (own_slots, sums);
+        return (own_slots, sums.par_iter().map(|&v| finish(v)).collect());
     }
     // Partial sums per chunk: an array over its node span, and the corners
     // of later faces in order.
@@ -95,25 +97,35 @@ pub fn sums(
             (lo, part, later)
         })
         .collect();
-    let (owned, later) = sums.split_at_mut(n);
-    owned
-        .par_chunks_mut(BLOCK)
-        .enumerate()
-        .for_each(|(b, block)| {
+    let mut out = vec![T::default(); n + extra.len()];
+    let (owned, later) = out.split_at_mut(n);
+    owned.par_chunks_mut(BLOCK).enumerate().for_each_init(
+        Vec::new,
+        |sums: &mut Vec<[f64; 3]>, (b, block)| {
             let (b0, b1) = (b * BLOCK, b * BLOCK + block.len());
+            sums.clear();
+            sums.resize(block.len(), [0.0; 3]);
             for (lo, part, _) in &partials {
                 let (from, to) = (b0.max(*lo), b1.min(lo + part.len()));
                 for node in from..to {
-                    add(&mut block[node - b0], part[node - lo]);
+                    add(&mut sums[node - b0], part[node - lo]);
                 }
             }
-        });
+            for (o, &v) in block.iter_mut().zip(sums.iter()) {
+                *o = finish(v);
+            }
+        },
+    );
+    let mut later_sums = vec![[0.0; 3]; later.len()];
     for (_, _, extra_corners) in &partials {
         for &(k, normal) in extra_corners {
-            add(&mut later[k as usize - n], normal);
+            add(&mut later_sums[k as usize - n], normal);
         }
     }
-    (own_slots, sums)
+    for (o, &v) in later.iter_mut().zip(&later_sums) {
+        *o = finish(v);
+    }
+    (own_slots, out)
 }
 
 /// The slots of a mesh of several faces, and the (face, node) pairs of the
@@ -202,7 +214,7 @@ mod tests {
     }
 
     fn check(points: &[[f64; 3]], tris: &[[u32; 3]], tri_face: &[u32], (nx, ny): (usize, usize)) {
-        let (slots, sums) = sums(points, tris, tri_face);
+        let (slots, sums) = per_slot(points, tris, tri_face, |v| v);
         let one_face = tri_face.iter().all(|&f| f == 0);
         assert_eq!(slots.is_none(), one_face);
         let slots = slots.unwrap_or_else(|| tris.to_vec());
