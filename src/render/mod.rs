@@ -317,6 +317,9 @@ fn sample_point(proj: &raster::Projected, node: u32) -> [f32; 3] {
     [p[0], p[1], proj.z[node as usize]]
 }
 
+/// Nodes' sample-space positions before snapping, and their depths.
+type Unsnapped = (Vec<[f32; 2]>, Vec<f32>);
+
 /// Node positions in sample space, depths normalised to [0, 1].
 fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projected {
     use rayon::prelude::*;
@@ -336,7 +339,7 @@ fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projecte
     let s = ss as f64;
     // Far outside the picture only the clamped bounding box matters.
     let limit = 1e6;
-    let (xy, (xy_f, z)): (Vec<[i64; 2]>, (Vec<[f32; 2]>, Vec<f32>)) = scene
+    let (xy, (xy_f, z)): (Vec<[i64; 2]>, Unsnapped) = scene
         .points
         .par_iter()
         .map(|&q| {
