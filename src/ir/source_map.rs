@@ -30,31 +30,44 @@ dense_id!(VertexId, EdgeId, FaceId, SubdomainId, SolidId);
 /// A map from dense ids to values, stored as a vector indexed by id: ids are
 /// allocated in order, so this costs a slot per entity and no hashing (a
 /// hash map per entity kind dominated lowering time and memory on large files).
+///
+/// A slot holds the index of its value in a list of distinct values: every
+/// entity of one primitive solid has the same origin, so runs of equal values
+/// are stored once (4 bytes an entity instead of an `Option<V>`).
 #[derive(Debug, Clone)]
 pub struct IdMap<K, V> {
-    slots: Vec<Option<V>>,
+    slots: Vec<u32>,
+    values: Vec<V>,
     len: usize,
     _key: std::marker::PhantomData<K>,
 }
+
+/// An id without a value.
+const EMPTY: u32 = u32::MAX;
 
 impl<K, V> Default for IdMap<K, V> {
     fn default() -> Self {
         IdMap {
             slots: Vec::new(),
+            values: Vec::new(),
             len: 0,
             _key: std::marker::PhantomData,
         }
     }
 }
 
-impl<K: DenseId, V: Copy> IdMap<K, V> {
+impl<K: DenseId, V: Copy + PartialEq> IdMap<K, V> {
     /// Sets the value of `id`, returning the previous one.
     pub fn insert(&mut self, id: K, value: V) -> Option<V> {
         let i = id.index();
         if self.slots.len() <= i {
-            self.slots.resize(i + 1, None);
+            self.slots.resize(i + 1, EMPTY);
         }
-        let old = self.slots[i].replace(value);
+        let old = self.get(&id).copied();
+        if self.values.last() != Some(&value) {
+            self.values.push(value);
+        }
+        self.slots[i] = (self.values.len() - 1) as u32;
         if old.is_none() {
             self.len += 1;
         }
@@ -62,7 +75,10 @@ impl<K: DenseId, V: Copy> IdMap<K, V> {
     }
 
     pub fn get(&self, id: &K) -> Option<&V> {
-        self.slots.get(id.index()).and_then(Option::as_ref)
+        match self.slots.get(id.index()) {
+            Some(&slot) if slot != EMPTY => self.values.get(slot as usize),
+            _ => None,
+        }
     }
 
     pub fn contains_key(&self, id: &K) -> bool {
@@ -82,7 +98,8 @@ impl<K: DenseId, V: Copy> IdMap<K, V> {
         self.slots
             .iter()
             .enumerate()
-            .filter_map(|(i, v)| v.as_ref().map(|v| (K::from_index(i), v)))
+            .filter(|&(_, &slot)| slot != EMPTY)
+            .map(|(i, &slot)| (K::from_index(i), &self.values[slot as usize]))
     }
 
     /// The table with every id renamed by `map`; ids it drops are removed.

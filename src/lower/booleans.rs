@@ -325,37 +325,38 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
     let key = |v: f64| (v / cell).floor() as i64;
     // A sorted list of (cell, box) instead of a map of cells: boxes sharing a
     // cell are adjacent after sorting, and nothing is allocated per cell.
-    // The cell range (lowest, highest) of each placeable box and how many cells it covers.
-    type CellRange = ([i64; 3], [i64; 3], i128);
-    let ranges: Vec<Option<CellRange>> = boxes
-        .iter()
-        .map(|b| {
-            let finite = [b.min, b.max]
-                .iter()
-                .all(|p| p.iter().all(|c| c.is_finite()));
-            if b.is_empty() || !finite {
-                // Nothing, or nothing placeable: it cannot overlap anything.
-                return None;
-            }
-            let lo = [key(b.min.x - tol), key(b.min.y - tol), key(b.min.z - tol)];
-            let hi = [key(b.max.x + tol), key(b.max.y + tol), key(b.max.z + tol)];
-            let count = (0..3)
-                .map(|k| (i128::from(hi[k]) - i128::from(lo[k]) + 1).max(0))
-                .fold(1i128, |acc, n| acc.saturating_mul(n));
-            Some((lo, hi, count))
-        })
-        .collect();
+    // The cell range (lowest, highest) of a placeable box and how many cells
+    // it covers; computed twice (count, then fill) rather than stored, since on
+    // large models a stored range per box was megabytes at the peak.
+    let range = |b: &crate::geom::Aabb| -> Option<([i64; 3], [i64; 3], i128)> {
+        let finite = [b.min, b.max]
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()));
+        if b.is_empty() || !finite {
+            // Nothing, or nothing placeable: it cannot overlap anything.
+            return None;
+        }
+        let lo = [key(b.min.x - tol), key(b.min.y - tol), key(b.min.z - tol)];
+        let hi = [key(b.max.x + tol), key(b.max.y + tol), key(b.max.z + tol)];
+        let count = (0..3)
+            .map(|k| (i128::from(hi[k]) - i128::from(lo[k]) + 1).max(0))
+            .fold(1i128, |acc, n| acc.saturating_mul(n));
+        Some((lo, hi, count))
+    };
     // Sized exactly: on large models the list has millions of entries.
-    let total: usize = ranges
+    let total: usize = boxes
         .iter()
-        .flatten()
+        .filter_map(range)
         .filter(|r| r.2 <= 64)
         .map(|r| r.2 as usize)
         .sum();
-    let mut cells: Vec<([i64; 3], u32)> = Vec::with_capacity(total);
+    // A cell is kept as a 64-bit hash of its coordinates (16 bytes an entry
+    // instead of 32): cells that collide only add candidates, which the box
+    // test below discards, and the pairs are sorted at the end.
+    let mut cells: Vec<(u64, u32)> = Vec::with_capacity(total);
     let mut big = Vec::new();
-    for (i, range) in ranges.iter().enumerate() {
-        let Some((lo, hi, count)) = *range else {
+    for (i, b) in boxes.iter().enumerate() {
+        let Some((lo, hi, count)) = range(b) else {
             continue;
         };
         if count > 64 {
@@ -365,7 +366,7 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
         for x in lo[0]..=hi[0] {
             for y in lo[1]..=hi[1] {
                 for z in lo[2]..=hi[2] {
-                    cells.push(([x, y, z], i as u32));
+                    cells.push((cell_hash([x, y, z]), i as u32));
                 }
             }
         }
@@ -376,7 +377,8 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
         for (k, &(_, i)) in run.iter().enumerate() {
             for &(_, j) in &run[k + 1..] {
                 let (i, j) = (i as usize, j as usize);
-                if boxes[i].overlaps(&boxes[j], tol) {
+                // Two cells of one box may share a hash.
+                if i != j && boxes[i].overlaps(&boxes[j], tol) {
                     pairs.push((i.min(j), i.max(j)));
                 }
             }
@@ -392,6 +394,12 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
     pairs.sort_unstable();
     pairs.dedup();
     pairs
+}
+
+/// A well-mixed 64-bit hash of a grid cell (fixed, so runs are reproducible).
+fn cell_hash(cell: [i64; 3]) -> u64 {
+    use std::hash::BuildHasher;
+    foldhash::quality::FixedState::with_seed(0x5eed).hash_one(cell)
 }
 
 fn check_pair(

@@ -149,13 +149,16 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
             ),
         }
     }
+    // Only the face samples outlive the welder: its tables (tens of megabytes
+    // on large files) must not still be alive while subdomains are built.
+    let face_samples = std::mem::take(&mut welder.face_samples);
+    drop(welder);
     explicit::lower_topology(resolved, &mut model, &mut source_map, &mut entities, diags);
     let named_lists =
         !doc.boundaries.is_empty() || doc.subdomains.iter().any(|s| s.faces.is_some());
     if named_lists {
         entities.add_solid_entities(&model);
     }
-    let face_samples = welder.face_samples;
     booleans::lower_subdomains(
         doc,
         resolved,
