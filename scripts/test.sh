@@ -41,7 +41,7 @@ if ! python3 -c "import trimesh" >/dev/null 2>&1; then
 fi
 
 # tests/tools/fem_poisson.py (tests/fem_2d.rs, tests/region_2d.rs), fem_crack.py
-# (tests/crack_2d.rs) and benches/mesh2d.rs' peer
+# (tests/crack_2d.rs, tests/edge_crack_2d.rs) and benches/mesh2d.rs' peer
 # (benches/mesh2d_triangle.py): scikit-fem solves on geomc's meshes, Triangle
 # is the 2D meshing peer.
 if ! python3 -c "import skfem, triangle" >/dev/null 2>&1; then

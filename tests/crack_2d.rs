@@ -151,9 +151,8 @@ fn crack_opens_into_two_sides_with_shared_tips() {
 /// problem is antisymmetric about the centre (1, 0.5): u(2 − x, 1 − y) =
 /// 1 − u(x, y), so uncracked u(1, 0.5) = 1/2; the crack holds the flow back,
 /// so at its middle the two sides carry different values summing to 1.
-/// (The crack is slanted because a vertical one through boundary nodes
-/// and finer area limits (0.0006 and below here) trip a known failure of
-/// the 2D refinement with poly_lines: see docs/format.md, "Poly_lines".)
+/// (A vertical crack at finer area limits is checked on the mesh in
+/// tests/crack_fine_area.rs.)
 #[test]
 fn scikit_fem_sees_different_values_on_the_two_crack_sides() {
     let xml = r#"<geometry version="1" dimension="2">

@@ -327,9 +327,13 @@ fn a_thin_spike_leaves_the_rest_of_the_face_at_the_minimum_angle() {
 /// above the corner on one side and its end on the other (found by
 /// `triangulate`, 2026-11-26): the triangulation split the boundary where
 /// the boundary's line elements did not, so a boundary segment had one
-/// triangle. A poly_line touching its region's boundary is now refused.
+/// triangle. It was then refused; since poly_line tips may lie on the
+/// boundary (the boundary edges are split there first), it meshes
+/// conforming: the edges used by one triangle are exactly the boundary's
+/// line elements, the area is the triangle's 6, and both tips are nodes of
+/// the boundary.
 #[test]
-fn a_poly_line_touching_the_boundary_is_refused_not_meshed_non_conforming() {
+fn a_poly_line_touching_the_boundary_at_its_tips_meshes_conforming() {
     let found = inputs("triangulate_touching");
     assert_eq!(found.len(), 1, "triangulate_touching regression inputs");
     for (path, bytes) in &found {
@@ -338,15 +342,34 @@ fn a_poly_line_touching_the_boundary_is_refused_not_meshed_non_conforming() {
         assert_eq!(input.segments, [[[0.0, 0.00390625], [3.6875, 0.0]]]);
         let checked = check_triangulate(&input);
         let lowered = checked.lowered.expect("the front end accepts it");
-        match geomc::meshing::mesh_model(&lowered.model, &input.options) {
-            Err(geomc::meshing::MeshError::Face { face, reason }) => {
-                assert_eq!(face, "inside", "{}", path.display());
-                assert!(
-                    reason.contains("poly_line `cut` touches or crosses its boundary"),
-                    "{reason}"
-                );
+        let mesh = geomc::meshing::mesh_model(&lowered.model, &input.options)
+            .unwrap_or_else(|e| panic!("{}: {e:?}", path.display()));
+        let key = |a: u32, b: u32| (a.min(b), a.max(b));
+        let mut uses: std::collections::HashMap<(u32, u32), usize> = Default::default();
+        let mut area = 0.0;
+        for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
+            for k in 0..3 {
+                *uses.entry(key(t[k], t[(k + 1) % 3])).or_default() += 1;
             }
-            other => panic!("{}: expected a refusal, got {other:?}", path.display()),
+            let [p, q, r] = t.map(|n| mesh.nodes[n as usize]);
+            area += 0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]));
+        }
+        assert!((area - 6.0).abs() < 1e-9, "{}: area {area}", path.display());
+        let open: std::collections::BTreeSet<(u32, u32)> = uses
+            .iter()
+            .filter(|&(_, &n)| n == 1)
+            .map(|(&k, _)| k)
+            .collect();
+        let boundary: std::collections::BTreeSet<(u32, u32)> = mesh
+            .edges
+            .iter()
+            .flat_map(|e| e.nodes.windows(2).map(|w| key(w[0], w[1])))
+            .collect();
+        assert_eq!(open, boundary, "{}", path.display());
+        assert!(uses.values().all(|&n| n <= 2));
+        let chain = &mesh.polylines[0].nodes;
+        for tip in [chain[0], chain[chain.len() - 1]] {
+            assert!(mesh.edges.iter().any(|e| e.nodes.contains(&tip)));
         }
     }
 }

@@ -126,7 +126,7 @@ pub fn load_with_section(
         messages.push_str(&render_human(&source, &d));
         return (messages, Err(EXIT_INVALID));
     }
-    let mut mesh = surface_to_mesh(&surface, model.name());
+    let mut mesh = surface_to_mesh(&surface, model.name(), model.geom.min, model.geom.max);
     if let Some(plane) = section {
         if !add_section(
             &mut mesh,

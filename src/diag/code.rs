@@ -353,7 +353,7 @@ codes! {
 
     // ---- trimmed parametric surfaces (issue 9, branch trim) ----
     TrimmedCarrierInvalid = "E740", Error, "invalid parametric surface",
-        "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a sphere_surface a positive radius and -90 < from_latitude < to_latitude < 90; a torus_surface 0 < minor_radius < major_radius and tube angles less than a full turn apart; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
+        "A bezier_surface needs rows of equal length (at least 2 x 2 control points); a cone_surface needs a positive length, non-negative radii not both zero and from_angle < to_angle; a sphere_surface a positive radius and -90 <= from_latitude < to_latitude <= 90; a torus_surface 0 < minor_radius < major_radius and tube angles at most a full turn apart; a parametric_surface needs u_min < u_max and v_min < v_max. Fix the values the message names.";
     TrimmedUnknownVariable = "E741", Error, "unknown variable in a surface or trim expression",
         "The coordinates of a parametric_surface are expressions in u and v, and a trim's equation is an expression in the global x, y and z; other names must be parameters or basis coordinates. Rename the variable or define the parameter.";
     TrimmedTrimForm = "E742", Error, "a trim needs exactly one of equation= and an R-function tree",

@@ -257,15 +257,21 @@ impl Builder<'_> {
                     discriminant: self.value_child(e, "discriminant"),
                 }
             }
-            "patch9" => ObjectKind::Patch9 {
+            "patch9" if e.children_named("trim").next().is_none() => ObjectKind::Patch9 {
                 rows: e
                     .children_named("row")
                     .map(|r| self.points_named(r, "node"))
                     .collect(),
             },
-            "bezier_surface" | "cone_surface" | "parametric_surface" | "sphere_surface"
-            | "torus_surface" => {
+            "patch9" | "bezier_surface" | "cone_surface" | "parametric_surface"
+            | "sphere_surface" | "torus_surface" => {
                 let carrier = match e.name {
+                    "patch9" => CarrierSpec::Patch9 {
+                        rows: e
+                            .children_named("row")
+                            .map(|r| self.points_named(r, "node"))
+                            .collect(),
+                    },
                     "bezier_surface" => CarrierSpec::Bezier {
                         rows: e
                             .children_named("row")

@@ -398,12 +398,13 @@ pub static PATCH_ROW: Rule = Rule {
     any_attrs: false,
     content: Content::Sequence(&[exactly(&PATCH_NODE, 3)]),
 };
-/// The 9-point parabolic patch: rows A, B, C of three points each.
+/// The 9-point parabolic patch: rows A, B, C of three points each; with a
+/// `<trim>` it is a trimmed parametric surface (paper 002).
 pub static PATCH9: Rule = Rule {
     name: "patch9",
     attrs: NAMED,
     any_attrs: false,
-    content: Content::Sequence(&[exactly(&PATCH_ROW, 3)]),
+    content: Content::Sequence(&[exactly(&PATCH_ROW, 3), maybe(&TRIM)]),
 };
 
 // ---- trimmed parametric surfaces (paper 002) ----
@@ -472,8 +473,8 @@ pub static PARAMETRIC_SURFACE: Rule = Rule {
 };
 
 /// A sphere patch about the local origin: latitude u from the local xz
-/// plane towards +y, longitude v about the local y axis (degrees). The
-/// poles are left out (a latitude of ±90° is E740).
+/// plane towards +y, longitude v about the local y axis (degrees). A
+/// latitude of ±90° is a pole (meshed as one vertex).
 pub static SPHERE_SURFACE: Rule = Rule {
     name: "sphere_surface",
     attrs: &[

@@ -344,6 +344,7 @@ impl ObjectKind {
                 CarrierSpec::Sphere { .. } => "sphere_surface",
                 CarrierSpec::Torus { .. } => "torus_surface",
                 CarrierSpec::Expressions { .. } => "parametric_surface",
+                CarrierSpec::Patch9 { .. } => "patch9",
             },
         }
     }
@@ -429,6 +430,9 @@ pub enum CarrierSpec {
         xyz: [Option<Number>; 3],
         rect: [Option<Number>; 4],
     },
+    /// Paper 003's 9-point patch with a `<trim>`: rows A, B, C (v = 0, ½, 1)
+    /// of three points (u = 0, ½, 1).
+    Patch9 { rows: Vec<Vec<PointSpec>> },
 }
 
 /// `<trim equation="F" material="positive|negative"/>`.

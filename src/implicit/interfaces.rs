@@ -38,6 +38,9 @@ use std::collections::HashMap;
 pub struct Patch {
     pub pair: (u32, u32),
     pub triangles: Vec<[u32; 3]>,
+    /// Where solid `pair.1` reaches the grid's box (`pair.0` is then 0): the
+    /// cap that closes it there, not its surface.
+    pub cap: bool,
 }
 
 /// Nodes and the patches between labels, ordered by pair.
@@ -68,6 +71,9 @@ const NEWTON_STEPS: usize = 4;
 /// Face and cell points stay this fraction of the cell inside their face
 /// or cell.
 const INSET: f64 = 1e-3;
+/// Nodes joined by an edge shorter than this fraction of the spacing are
+/// merged (several times the inset's diagonal).
+const MERGE: f64 = 1e-2;
 
 /// Meshes the labelled partition of the grid by `solids` (f > 0 inside
 /// their boxes). Samples on the grid's box are exterior, so every solid is
@@ -87,35 +93,49 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
             for i in 1..n1[0].saturating_sub(1) {
                 let p = at(i, j, k);
                 let p_idx = idx(i, j, k);
-                labels[p_idx] = solids
+                let within = |s: &Solid| (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a]);
+                let first = |test: &dyn Fn(f32) -> bool| {
+                    solids
+                        .iter()
+                        .zip(&samples)
+                        .position(|(s, v)| test(v[p_idx]) && within(s))
+                };
+                // A sample on the zero sets of two solids lies on their
+                // interface, not in a gap between them: it takes the first
+                // (else the two surfaces would pass on either side of it,
+                // a sheet of exterior between them, as along the lines
+                // where a pin of r = 0.3 touches the samples at 20³).
+                let on_zero = solids
                     .iter()
                     .zip(&samples)
-                    .position(|(s, v)| {
-                        v[p_idx] > 0.0 && (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a])
-                    })
+                    .filter(|(s, v)| v[p_idx] == 0.0 && within(s))
+                    .count();
+                labels[p_idx] = first(&|v| v > 0.0)
+                    .or_else(|| (on_zero >= 2).then(|| first(&|v| v == 0.0)).flatten())
                     .map_or(0, |s| s as u32 + 1);
             }
         }
     }
     let label_at = |c: [usize; 3]| labels[idx(c[0], c[1], c[2])];
+    // An exterior sample where solid `l` (label) is positive lies on the
+    // grid's box or outside that solid's box: the surface between them is
+    // the cap closing the solid there, not its boundary.
+    let cut_at = |c: [usize; 3], l: u32| {
+        let p_idx = idx(c[0], c[1], c[2]);
+        l > 0 && samples.get(l as usize - 1).is_some_and(|v| v[p_idx] > 0.0)
+    };
     let mut out = Interfaces::default();
     // Unit normals of the edge points (zero for face and cell points).
     let mut normals: Vec<[f64; 3]> = Vec::new();
+    // Which nodes are edge points (on the surface of their edge's function).
+    let mut edge_point: Vec<bool> = Vec::new();
     let spacing = (0..3)
         .map(|a| (grid.max[a] - grid.min[a]) / grid.cells[a].max(1) as f64)
         .fold(f64::INFINITY, f64::min);
     let mut edge_nodes: HashMap<u64, u32> = HashMap::new();
     let mut face_nodes: HashMap<u64, u32> = HashMap::new();
-    let mut patches: HashMap<(u32, u32), Vec<[u32; 3]>> = HashMap::new();
-    // The solid whose function decides the surface between two labels.
-    let deciding_index = |a: u32, b: u32| -> Option<usize> {
-        let s = match (a, b) {
-            (0, s) | (s, 0) => s,
-            (a, b) => a.min(b),
-        };
-        let s = s.checked_sub(1)? as usize;
-        (s < solids.len()).then_some(s)
-    };
+    let mut patches: HashMap<PatchKey, Vec<[u32; 3]>> = HashMap::new();
+    let deciding_index = |a: u32, b: u32| deciding_solid(a, b, solids.len());
     let deciding = |a: u32, b: u32| deciding_index(a, b).map(|s| &solids[s].ssa);
     let cells = grid.cells;
     for k in 0..cells[2] {
@@ -151,9 +171,41 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
                         let key = (idx(pu[0], pu[1], pu[2]) as u64) * 3 + d as u64;
                         en[d * 4 + o] = *edge_nodes.entry(key).or_insert_with(|| {
                             let f = deciding(a, b);
-                            let p = edge_root(f, at(pu[0], pu[1], pu[2]), at(pw[0], pw[1], pw[2]));
+                            let (xu, xw) = (at(pu[0], pu[1], pu[2]), at(pw[0], pw[1], pw[2]));
+                            // A cap's point is where the edge leaves the
+                            // solid's box (the exterior sample when that is
+                            // the grid's box), its normal the box's.
+                            let cut = if a == 0 && cut_at(pu, b) {
+                                Some((b, xw, xu, -1.0))
+                            } else if b == 0 && cut_at(pw, a) {
+                                Some((a, xu, xw, 1.0))
+                            } else {
+                                None
+                            };
+                            let (p, n) = match cut {
+                                Some((s, inside, outside, sign)) => {
+                                    let s = &solids[s as usize - 1];
+                                    let bound = if outside[d] > s.max[d] {
+                                        s.max[d]
+                                    } else if outside[d] < s.min[d] {
+                                        s.min[d]
+                                    } else {
+                                        outside[d]
+                                    };
+                                    let mut p = inside;
+                                    p[d] = bound.clamp(xu[d], xw[d]);
+                                    let mut n = [0.0; 3];
+                                    n[d] = sign;
+                                    (p, n)
+                                }
+                                None => {
+                                    let p = edge_root(f, xu, xw);
+                                    (p, f.map_or([0.0; 3], |f| unit_gradient(f, p, spacing)))
+                                }
+                            };
                             out.positions.push(p);
-                            normals.push(f.map_or([0.0; 3], |f| unit_gradient(f, p, spacing)));
+                            normals.push(n);
+                            edge_point.push(true);
                             (out.positions.len() - 1) as u32
                         });
                     }
@@ -252,6 +304,7 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
                                 let p = centre(&fe, &face_corners(n, s), &out.positions, &normals);
                                 out.positions.push(p);
                                 normals.push([0.0; 3]);
+                                edge_point.push(false);
                                 let node = (out.positions.len() - 1) as u32;
                                 face_nodes.insert(key, node);
                                 node
@@ -264,6 +317,7 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
                 let p = centre(&all, &corners, &out.positions, &normals);
                 out.positions.push(p);
                 normals.push([0.0; 3]);
+                edge_point.push(false);
                 let c = (out.positions.len() - 1) as u32;
                 for d in 0..3 {
                     let (d1, d2) = ((d + 1) % 3, (d + 2) % 3);
@@ -284,7 +338,9 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
                         } else {
                             ([e, c, f1], [e, f2, c])
                         };
-                        let list = patches.entry((a.min(b), a.max(b))).or_default();
+                        let cap =
+                            (a == 0 && cut_at(corner(cu), b)) || (b == 0 && cut_at(corner(cw), a));
+                        let list = patches.entry(((a.min(b), a.max(b)), cap)).or_default();
                         list.push(tri1);
                         list.push(tri2);
                     }
@@ -293,22 +349,49 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
         }
     }
     let mut pairs: Vec<_> = patches.into_iter().collect();
-    pairs.sort_by_key(|(pair, _)| *pair);
-    merge_coincident(&mut out.positions, &mut pairs);
+    pairs.sort_by_key(|(key, _)| *key);
+    merge_coincident(&mut out.positions, &edge_point, &mut pairs, MERGE * spacing);
     out.patches = pairs
         .into_iter()
-        .map(|(pair, triangles)| Patch { pair, triangles })
+        .map(|((pair, cap), triangles)| Patch {
+            pair,
+            triangles,
+            cap,
+        })
         .collect();
     out
 }
 
-/// The triangles between one pair of labels.
-type PairTriangles = ((u32, u32), Vec<[u32; 3]>);
+/// The solid whose function decides the surface between labels `a` and `b`
+/// (the lower-numbered solid when both are solids) among `n` solids.
+pub fn deciding_solid(a: u32, b: u32, n: usize) -> Option<usize> {
+    let s = match (a, b) {
+        (0, s) | (s, 0) => s,
+        (a, b) => a.min(b),
+    };
+    let s = s.checked_sub(1)? as usize;
+    (s < n).then_some(s)
+}
 
-/// Nodes at one point joined by an edge (an edge point on a sample, a face
-/// or cell point clamped onto it) become one node; the triangles that
-/// collapse are dropped and unused nodes removed (order kept).
-fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [PairTriangles]) {
+/// A pair of labels and whether the triangles between them are a box cap.
+type PatchKey = ((u32, u32), bool);
+/// The triangles between one pair of labels.
+type PairTriangles = (PatchKey, Vec<[u32; 3]>);
+
+/// Nodes joined by an edge shorter than `tol` become one node: an edge point
+/// on a sample and the face or cell points clamped next to it (the inset
+/// keeps them 1e-3 of a cell apart, which left 0.15° slivers that folded
+/// over each other where the pin's rim lies on samples, 20³). The group
+/// takes an edge point's position when it has one (that point is on the
+/// surface). Triangles that collapse are dropped, so are pairs of one patch
+/// that became the same triangle both ways round (a fin), and unused nodes
+/// are removed (order kept).
+fn merge_coincident(
+    positions: &mut Vec<[f64; 3]>,
+    edge_point: &[bool],
+    pairs: &mut [PairTriangles],
+    tol: f64,
+) {
     let n = positions.len();
     let mut parent: Vec<u32> = (0..n as u32).collect();
     fn find(parent: &mut [u32], mut x: u32) -> u32 {
@@ -322,7 +405,9 @@ fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [PairTriangles]) 
         for t in tris {
             for k in 0..3 {
                 let (a, b) = (t[k], t[(k + 1) % 3]);
-                if positions[a as usize] == positions[b as usize] {
+                let (pa, pb) = (positions[a as usize], positions[b as usize]);
+                let d2: f64 = (0..3).map(|k| (pa[k] - pb[k]) * (pa[k] - pb[k])).sum();
+                if d2 <= tol * tol {
                     let (ra, rb) = (find(&mut parent, a), find(&mut parent, b));
                     parent[ra.max(rb) as usize] = ra.min(rb);
                     any = true;
@@ -334,12 +419,22 @@ fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [PairTriangles]) 
         return;
     }
     let root: Vec<u32> = (0..n as u32).map(|v| find(&mut parent, v)).collect();
+    // The lowest-numbered edge point of each group gives its position.
+    let mut placed = vec![false; n];
+    for v in 0..n {
+        let r = root[v] as usize;
+        if edge_point.get(v).copied().unwrap_or(false) && !placed[r] {
+            positions[r] = positions[v];
+            placed[r] = true;
+        }
+    }
     let mut used = vec![false; n];
     for (_, tris) in pairs.iter_mut() {
         tris.retain_mut(|t| {
             *t = t.map(|v| root[v as usize]);
             t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
         });
+        drop_fins(tris);
         for t in tris.iter() {
             for &v in t {
                 used[v as usize] = true;
@@ -359,6 +454,42 @@ fn merge_coincident(positions: &mut Vec<[f64; 3]>, pairs: &mut [PairTriangles]) 
         for t in tris.iter_mut() {
             *t = t.map(|v| new_id[v as usize]);
         }
+    }
+}
+
+/// Drops the triangle pairs that are one triangle both ways round.
+fn drop_fins(tris: &mut Vec<[u32; 3]>) {
+    let key = |t: &[u32; 3]| {
+        let mut k = *t;
+        k.sort_unstable();
+        k
+    };
+    // Cyclic order of a sorted key: +1 when t runs like the key.
+    let turn = |t: &[u32; 3]| {
+        let k = t
+            .iter()
+            .position(|&v| v == t.iter().copied().min().unwrap_or(0));
+        let k = k.unwrap_or(0);
+        t[(k + 1) % 3] < t[(k + 2) % 3]
+    };
+    let mut seen: HashMap<[u32; 3], Vec<usize>> = HashMap::new();
+    for (i, t) in tris.iter().enumerate() {
+        seen.entry(key(t)).or_default().push(i);
+    }
+    let mut drop = vec![false; tris.len()];
+    for ids in seen.values() {
+        let (up, down): (Vec<usize>, Vec<usize>) = ids.iter().partition(|&&i| turn(&tris[i]));
+        for (&a, &b) in up.iter().zip(&down) {
+            drop[a] = true;
+            drop[b] = true;
+        }
+    }
+    if drop.iter().any(|&d| d) {
+        let mut i = 0;
+        tris.retain(|_| {
+            i += 1;
+            !drop[i - 1]
+        });
     }
 }
 

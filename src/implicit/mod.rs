@@ -4,10 +4,12 @@
 //! ([`tape`]), interval pruning ([`interval`]) and paper 004's watertight
 //! polygonization ([`polygonize`]) into geomc's mesh IR.
 
+pub mod caps;
 pub mod expr_ops;
 pub mod interfaces;
 pub mod interval;
 pub mod ir;
+pub mod joint_optimize;
 pub mod lang;
 pub mod library;
 pub mod optimize;
@@ -97,29 +99,58 @@ impl ImplicitModel {
     }
 }
 
-/// The surface as geomc's mesh IR: one face, one subdomain (the solid) whose
-/// boundary it is, and its fragment against the exterior.
-pub fn surface_to_mesh(surface: &Surface, name: &str) -> Mesh {
-    Mesh {
+/// The surface as geomc's mesh IR: one subdomain (the solid) whose boundary
+/// is the face `NAME_boundary` (fragment `NAME|exterior`) and, where the
+/// solid leaves its box [min, max], the cap `NAME_box_cap` (fragment
+/// `NAME|box`).
+pub fn surface_to_mesh(surface: &Surface, name: &str, min: [f64; 3], max: [f64; 3]) -> Mesh {
+    let mut mesh = Mesh {
         dimension: 3,
         nodes: surface.positions.clone(),
-        faces: vec![MeshFace {
-            name: format!("{name}_boundary"),
-            triangles: surface.triangles.clone(),
-            boundary: Vec::new(),
-        }],
         subdomains: vec![MeshSubdomain {
             name: name.to_string(),
             material: None,
-            faces: vec![(0, true)],
-        }],
-        fragments: vec![MeshFragment {
-            name: format!("{name}|exterior"),
-            subdomain: 0,
-            other: None,
-            faces: vec![0],
-            edges: Vec::new(),
+            faces: Vec::new(),
         }],
         ..Mesh::default()
+    };
+    let (rest, caps) = caps::split_caps(&surface.positions, &surface.triangles, min, max);
+    push_boundary(&mut mesh, 0, name, rest, caps);
+    mesh
+}
+
+/// Adds a subdomain's outer boundary (`NAME_boundary`, `NAME|exterior`) and
+/// its box cap when it has one (`NAME_box_cap`, `NAME|box`), both outward,
+/// node ids already in `mesh`'s numbering.
+pub fn push_boundary(
+    mesh: &mut Mesh,
+    subdomain: u32,
+    name: &str,
+    rest: Vec<[u32; 3]>,
+    caps: Vec<[u32; 3]>,
+) {
+    for (triangles, face, fragment) in [
+        (rest, format!("{name}_boundary"), format!("{name}|exterior")),
+        (caps, format!("{name}_box_cap"), format!("{name}|box")),
+    ] {
+        if triangles.is_empty() && face.ends_with("_box_cap") {
+            continue;
+        }
+        let index = mesh.faces.len() as u32;
+        mesh.faces.push(MeshFace {
+            name: face,
+            triangles,
+            boundary: Vec::new(),
+        });
+        if let Some(s) = mesh.subdomains.get_mut(subdomain as usize) {
+            s.faces.push((index, true));
+        }
+        mesh.fragments.push(MeshFragment {
+            name: fragment,
+            subdomain,
+            other: None,
+            faces: vec![index],
+            edges: Vec::new(),
+        });
     }
 }

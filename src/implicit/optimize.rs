@@ -15,7 +15,7 @@
 
 use super::polygonize::{Grid, Surface};
 use super::tape::{Ssa, Tape};
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 /// Normals of neighbouring vertices further apart than this angle mark a
 /// crease edge (cos 35°).
@@ -65,15 +65,15 @@ fn tri_normal(s: &Surface, t: [u32; 3]) -> P {
 }
 
 /// f and its gradient (central differences) at many points, batched.
-struct Field<'a> {
-    tape: &'a Tape,
+pub(crate) struct Field<'a> {
+    pub(crate) tape: &'a Tape,
     /// Difference step and largest projection step.
-    h: f64,
-    reach: f64,
+    pub(crate) h: f64,
+    pub(crate) reach: f64,
 }
 
 impl Field<'_> {
-    fn eval(&self, pts: &[P]) -> (Vec<f64>, Vec<P>) {
+    pub(crate) fn eval(&self, pts: &[P]) -> (Vec<f64>, Vec<P>) {
         let n = pts.len();
         let mut ws = self.tape.workspace();
         let mut xs = Vec::with_capacity(7 * n);
@@ -104,7 +104,7 @@ impl Field<'_> {
     }
 
     /// Newton steps along the gradient onto f = 0.
-    fn project(&self, pts: &mut [P], steps: usize) {
+    pub(crate) fn project(&self, pts: &mut [P], steps: usize) {
         for _ in 0..steps {
             let (f, g) = self.eval(pts);
             for (m, p) in pts.iter_mut().enumerate() {
@@ -147,7 +147,7 @@ pub fn optimize(surface: &mut Surface, ssa: &Ssa, grid: &Grid, iterations: u32) 
     let crease = snap_creases(surface, &field, &fixed_box);
     let fixed: Vec<bool> = (0..nv).map(|v| fixed_box[v] || crease[v]).collect();
     for _ in 0..iterations {
-        flip_edges(surface);
+        flip_edges(surface, &HashSet::new());
         smooth(surface, &field, &fixed, cell);
     }
 }
@@ -225,6 +225,12 @@ fn snap_creases(surface: &mut Surface, field: &Field, fixed: &[bool]) -> Vec<boo
             neighbours[t[k] as usize].push(t[(k + 2) % 3]);
         }
     }
+    let before = surface.positions.clone();
+    let normals: Vec<P> = surface
+        .triangles
+        .iter()
+        .map(|t| tri_normal(surface, *t))
+        .collect();
     let mut snapped = vec![false; nv];
     for m in order {
         let (d, a, _) = candidates[m];
@@ -236,6 +242,10 @@ fn snap_creases(surface: &mut Surface, field: &Field, fixed: &[bool]) -> Vec<boo
         }
         snapped[a] = true;
         surface.positions[a] = q[m];
+    }
+    undo_folds(surface, &before, &normals);
+    for (v, s) in snapped.iter_mut().enumerate() {
+        *s = *s && surface.positions[v] != before[v];
     }
     snapped
 }
@@ -251,12 +261,14 @@ fn mean_edge(surface: &Surface) -> f64 {
     sum / surface.triangles.len().max(1) as f64
 }
 
-fn edge_key(a: u32, b: u32) -> (u32, u32) {
+pub(crate) fn edge_key(a: u32, b: u32) -> (u32, u32) {
     (a.min(b), a.max(b))
 }
 
-/// One pass of angle-improving flips between nearly coplanar triangles.
-fn flip_edges(surface: &mut Surface) {
+/// One pass of angle-improving flips between nearly coplanar triangles; a
+/// flip never makes an edge in `taken` (edges of other patches that share
+/// these nodes, in the joint mesher).
+pub(crate) fn flip_edges(surface: &mut Surface, taken: &HashSet<(u32, u32)>) {
     let mut edges: HashMap<(u32, u32), [u32; 2]> =
         HashMap::with_capacity(surface.triangles.len() * 2);
     for (ti, t) in surface.triangles.iter().enumerate() {
@@ -292,7 +304,7 @@ fn flip_edges(surface: &mut Surface) {
         let (Some(Some(c)), Some(Some(d))) = (third(ta), third(tb)) else {
             continue;
         };
-        if c == d || edges.contains_key(&edge_key(c, d)) {
+        if c == d || edges.contains_key(&edge_key(c, d)) || taken.contains(&edge_key(c, d)) {
             continue;
         }
         let (na, nb) = (unit(tri_normal(surface, ta)), unit(tri_normal(surface, tb)));
@@ -391,16 +403,57 @@ fn smooth(surface: &mut Surface, field: &Field, fixed: &[bool], cell: f64) {
             surface.positions[v] = pts[m];
         }
     }
-    // A move that turns a triangle over is undone (repeated until none is).
-    for _ in 0..8 {
+    undo_folds(surface, &before, &normals);
+}
+
+/// Undoes the moves (positions differing from `before`) of the vertices of
+/// every triangle that turned over against its normal in `normals` (taken
+/// before the moves) or now folds onto a neighbour across an edge (their
+/// normals more than 120° apart where they were not), repeated until none
+/// does. Snapping onto a crease could turn a triangle over (the seven balls
+/// at 32³, where gmsh then found a segment crossing a facet).
+pub(crate) fn undo_folds(surface: &mut Surface, before: &[P], normals: &[P]) {
+    let unit_normals = |s: &Surface| -> Vec<P> {
+        s.triangles
+            .iter()
+            .map(|t| unit(tri_normal(s, *t)))
+            .collect()
+    };
+    let mut across: HashMap<(u32, u32), Vec<usize>> = HashMap::new();
+    for (ti, t) in surface.triangles.iter().enumerate() {
+        for k in 0..3 {
+            across
+                .entry(edge_key(t[k], t[(k + 1) % 3]))
+                .or_default()
+                .push(ti);
+        }
+    }
+    let mut pairs: Vec<(usize, usize)> = across
+        .values()
+        .filter(|ts| ts.len() == 2)
+        .map(|ts| (ts[0], ts[1]))
+        .collect();
+    pairs.sort_unstable();
+    let old: Vec<P> = normals.iter().map(|&n| unit(n)).collect();
+    const FOLD_COS: f64 = -0.5;
+    for _ in 0..16 {
+        let now = unit_normals(surface);
+        let mut bad: Vec<usize> = (0..surface.triangles.len())
+            .filter(|&t| dot(now[t], old[t]) <= 0.0)
+            .collect();
+        for &(a, b) in &pairs {
+            if dot(now[a], now[b]) < FOLD_COS && dot(old[a], old[b]) >= FOLD_COS {
+                bad.push(a);
+                bad.push(b);
+            }
+        }
         let mut undone = false;
-        for (t, n) in surface.triangles.iter().zip(&normals) {
-            if dot(tri_normal(surface, *t), *n) <= 0.0 {
-                for &v in t {
-                    if surface.positions[v as usize] != before[v as usize] {
-                        surface.positions[v as usize] = before[v as usize];
-                        undone = true;
-                    }
+        for t in bad {
+            for &v in &surface.triangles[t] {
+                let v = v as usize;
+                if surface.positions[v] != before[v] {
+                    surface.positions[v] = before[v];
+                    undone = true;
                 }
             }
         }

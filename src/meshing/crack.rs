@@ -10,6 +10,16 @@
 //! next chain node, is on the left when it comes before the previous chain
 //! node's direction. Triangles of one fan never straddle a chain edge (the
 //! mesh follows the line), so this needs no adjacency.
+//!
+//! A tip on the outer boundary (an edge crack) is duplicated too, so the
+//! crack mouth opens: at the tip the fan of triangles runs from one
+//! boundary neighbour to the other, and the side is read from the angle
+//! against the boundary neighbour met first turning counter-clockwise from
+//! the chain. The boundary edge through the mouth is cut there: it keeps
+//! its part up to the mouth (node order and curve parameters unchanged)
+//! and a new mesh edge `EDGE.beyond.NAME` takes the rest, listed in every
+//! face and fragment the edge was. A tip on an interface between two
+//! faces stays shared (opening it would break the interface).
 
 use crate::ir::Model;
 use crate::mesh::{Mesh, MeshEdge, MeshFragment};
@@ -31,7 +41,15 @@ pub(crate) fn open(model: &Model, mesh: &mut Mesh) {
             // A free line (outside every region): nothing to open.
             continue;
         };
-        let right = open_chain(mesh, face, &chain);
+        let mouths: Vec<Option<Mouth>> = [0, chain.len() - 1]
+            .map(|k| mouth(mesh, face, &chain, k))
+            .into();
+        let mut right = open_chain(mesh, face, &chain);
+        for (m, k) in mouths.into_iter().zip([0, chain.len() - 1]) {
+            if let Some(m) = m {
+                right[k] = open_mouth(mesh, face, &m, &line.name);
+            }
+        }
         let subdomain = mesh
             .subdomains
             .iter()
@@ -101,4 +119,135 @@ fn open_chain(mesh: &mut Mesh, face: usize, chain: &[u32]) -> Vec<u32> {
         }
     }
     right
+}
+
+/// A crack tip on the outer boundary: its node, the triangles (in the
+/// crack's face) that move to the copy, and its boundary neighbour on the
+/// right side.
+struct Mouth {
+    node: u32,
+    right_triangles: Vec<usize>,
+    right_neighbour: u32,
+}
+
+/// The mouth at chain position `k` (0 or last), when that tip lies on the
+/// outer boundary (its fan's two boundary edges are used by one triangle
+/// in the whole mesh).
+fn mouth(mesh: &Mesh, face: usize, chain: &[u32], k: usize) -> Option<Mouth> {
+    let node = chain[k];
+    let first = k == 0;
+    let along = if first { chain[1] } else { chain[k - 1] };
+    let mut uses: std::collections::HashMap<u32, usize> = std::collections::HashMap::new();
+    let mut fan = Vec::new();
+    for (f, mf) in mesh.faces.iter().enumerate() {
+        for (i, t) in mf.triangles.iter().enumerate() {
+            if !t.contains(&node) {
+                continue;
+            }
+            if f == face {
+                fan.push(i);
+            }
+            for &n in t.iter().filter(|&&n| n != node) {
+                *uses.entry(n).or_default() += 1;
+            }
+        }
+    }
+    let neighbours: Vec<u32> = uses
+        .iter()
+        .filter(|&(_, &c)| c == 1)
+        .map(|(&n, _)| n)
+        .collect();
+    if neighbours.len() != 2 || neighbours.contains(&along) {
+        return None;
+    }
+    let at = mesh.nodes[node as usize];
+    let angle_of = |p: [f64; 3]| (p[1] - at[1]).atan2(p[0] - at[0]);
+    let base = angle_of(mesh.nodes[along as usize]);
+    let from_along = |p: [f64; 3]| (angle_of(p) - base).rem_euclid(TAU);
+    let (near, far) = {
+        let [a, b] = [neighbours[0], neighbours[1]];
+        if from_along(mesh.nodes[a as usize]) <= from_along(mesh.nodes[b as usize]) {
+            (a, b)
+        } else {
+            (b, a)
+        }
+    };
+    let limit = from_along(mesh.nodes[near as usize]);
+    // From the first tip the fan before `near` is the left side; into the
+    // last tip it is the right side.
+    let triangles = &mesh.faces[face].triangles;
+    let right_triangles = fan
+        .into_iter()
+        .filter(|&i| {
+            let t = triangles[i];
+            let centroid: [f64; 3] = std::array::from_fn(|c| {
+                t.iter().map(|&n| mesh.nodes[n as usize][c]).sum::<f64>() / 3.0
+            });
+            (from_along(centroid) < limit) != first
+        })
+        .collect();
+    Some(Mouth {
+        node,
+        right_triangles,
+        right_neighbour: if first { far } else { near },
+    })
+}
+
+/// Duplicates a mouth node for the right side's triangles and cuts the
+/// boundary edge through it; returns the copy.
+fn open_mouth(mesh: &mut Mesh, face: usize, m: &Mouth, crack: &str) -> u32 {
+    let copy = mesh.nodes.len() as u32;
+    mesh.nodes.push(mesh.nodes[m.node as usize]);
+    for &i in &m.right_triangles {
+        for n in mesh.faces[face].triangles[i].iter_mut() {
+            if *n == m.node {
+                *n = copy;
+            }
+        }
+    }
+    // The boundary edge with the segment mouth–right neighbour.
+    let found = mesh.edges.iter().enumerate().find_map(|(e, edge)| {
+        edge.nodes
+            .windows(2)
+            .position(|w| {
+                (w[0] == m.node && w[1] == m.right_neighbour)
+                    || (w[1] == m.node && w[0] == m.right_neighbour)
+            })
+            .map(|j| (e, j))
+    });
+    let Some((e, j)) = found else {
+        return copy;
+    };
+    let nodes = mesh.edges[e].nodes.clone();
+    let at = if nodes[j] == m.node { j } else { j + 1 };
+    let right_before = at > 0 && nodes[at - 1] == m.right_neighbour;
+    if at == 0 || at + 1 == nodes.len() {
+        // The mouth is an end of this edge: the edge just moves to the copy.
+        mesh.edges[e].nodes[at] = copy;
+        return copy;
+    }
+    let (mut head, mut tail) = (nodes[..=at].to_vec(), nodes[at..].to_vec());
+    if right_before {
+        head[at] = copy;
+    } else {
+        tail[0] = copy;
+    }
+    let new = mesh.edges.len() as u32;
+    let name = format!("{}.beyond.{crack}", mesh.edges[e].name);
+    mesh.edges[e].nodes = head;
+    mesh.edges.push(MeshEdge { name, nodes: tail });
+    for f in &mut mesh.faces {
+        if let Some(pos) = f.boundary.iter().position(|&(b, _)| b as usize == e) {
+            // The new part comes after the kept one along the edge.
+            let forward = f.boundary[pos].1;
+            f.boundary
+                .insert(if forward { pos + 1 } else { pos }, (new, forward));
+        }
+    }
+    for fragment in &mut mesh.fragments {
+        if fragment.edges.contains(&(e as u32)) {
+            fragment.edges.push(new);
+        }
+    }
+    copy
 }

@@ -171,6 +171,18 @@ impl EdgeNodes {
     }
 }
 
+impl EdgeNodes {
+    /// The index of the node whose parameter is nearest to `s`.
+    pub(crate) fn index_of(&self, s: f64) -> usize {
+        let at = self.params.partition_point(|&t| t < s);
+        match (at.checked_sub(1), self.params.get(at)) {
+            (Some(before), Some(&after)) if s - self.params[before] < after - s => before,
+            (Some(before), None) => before,
+            _ => at,
+        }
+    }
+}
+
 pub(crate) fn distance_to_segment(p: &Point3, a: &Point3, b: &Point3) -> f64 {
     let d = b - a;
     let len2 = d.norm_squared();

@@ -24,6 +24,7 @@
 use super::MeshError;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
+use super::polyline_split;
 use super::size::Sizing;
 use crate::geom::{Point3, Surface, Vec3};
 use crate::ir::{Face, Model};
@@ -33,7 +34,7 @@ use spade::{
 use std::collections::{BTreeMap, HashSet};
 use std::hash::{BuildHasherDefault, Hasher};
 
-type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
+pub(super) type Cdt = ConstrainedDelaunayTriangulation<Point2<f64>>;
 
 /// Rounds of "refine in the plane, then insert points where the surface is
 /// missed" before giving up on a face's tolerance.
@@ -50,10 +51,12 @@ const MAX_FACE_VERTICES: usize = 2_000_000;
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum FacePoint {
     Vertex(u32),
-    /// Interior node `index` of an edge's discretisation.
+    /// Interior node of an edge's discretisation, at curve parameter `s`
+    /// (a parameter, not an index, so the key stays valid when the edge
+    /// gets more nodes).
     Edge {
         edge: usize,
-        index: usize,
+        s: f64,
     },
     Interior(Point3),
 }
@@ -65,6 +68,10 @@ pub(crate) struct FaceMesh {
     /// Constrained poly_lines: (poly_line index, its points in order, as
     /// indices into `points`, refinement points included).
     pub polylines: Vec<(usize, Vec<usize>)>,
+    /// Nodes refinement added on straight boundary edges and kept (edge,
+    /// curve parameter): the caller adds them to the edges and re-meshes
+    /// only the other faces using those edges.
+    pub added: Vec<(usize, f64)>,
 }
 
 pub(crate) enum Outcome {
@@ -163,9 +170,13 @@ pub(crate) fn mesh_face(
     }
     // Poly_lines inside the face: constraint chains the mesh must follow.
     let mut polyline_handles: Vec<(usize, Vec<usize>)> = Vec::new();
+    // A poly_line tip may be a boundary node (`constraints::assign` put it
+    // on a boundary edge); no other poly_line point may coincide with one.
+    let boundary_nodes = keys.len();
     for (index, points) in constraints {
         let mut handles = Vec::with_capacity(points.len());
-        for p in points {
+        for (k, p) in points.iter().enumerate() {
+            let tip = k == 0 || k + 1 == points.len();
             let uv = chart
                 .to_param(p)
                 .ok_or_else(|| failed("a poly_line point has no parameters".into()))?;
@@ -175,7 +186,9 @@ pub(crate) fn mesh_face(
             if handle.index() == keys.len() {
                 keys.push(FacePoint::Interior(*p));
                 positions.push(*p);
-            } else if handles.last() != Some(&handle.index()) {
+            } else if handles.last() != Some(&handle.index())
+                && !(tip && handle.index() < boundary_nodes)
+            {
                 return Err(failed(format!(
                     "a point of poly_line #{} coincides with another node",
                     index + 1
@@ -262,8 +275,26 @@ pub(crate) fn mesh_face(
     };
     // Vertices from this index on have not been checked for boundary splits.
     let mut unchecked = fixed;
+    let mut added = Vec::new();
     for _ in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
+        if settings.keep_boundary && !polyline_segments.is_empty() {
+            // Spade keeps the poly_lines whole with the loops: split them
+            // here where they are in the way, and refine again.
+            for _ in 0..MAX_PASSES {
+                let split = polyline_split::split_pieces(
+                    &mut cdt,
+                    &polyline_segments,
+                    settings.min_angle,
+                    settings.max_area,
+                )
+                .map_err(failed)?;
+                if split == 0 {
+                    break;
+                }
+                cdt.refine(parameters.clone());
+            }
+        }
         if small_angle && !result.refinement_complete && !settings.keep_boundary {
             // Segments at a tiny angle split each other without end, and
             // each round would start over from the splits sent back: mesh
@@ -274,16 +305,34 @@ pub(crate) fn mesh_face(
             };
             return mesh_face(model, face, edges, &keep, constraints);
         }
+        let mut kept = Vec::new();
         if !settings.keep_boundary {
             // Only the vertices added since the last check.
             let splits =
                 boundary_splits(&cdt, unchecked, &segments, &polyline_segments).map_err(failed)?;
-            if !splits.is_empty() {
-                return Ok(Outcome::Split(splits));
+            // On a straight edge of a plane the split is already on the
+            // curve: keep it (the caller adds the node to the edge) instead
+            // of meshing the face again from scratch.
+            let straight = |&(edge, _, _): &(usize, usize, f64)| {
+                matches!(face.surface, Surface::Plane { .. })
+                    && matches!(
+                        model.edges.get(edge).map(|e| &e.curve),
+                        Some(crate::geom::Curve::Segment { .. })
+                    )
+            };
+            if !splits.iter().all(straight) {
+                return Ok(Outcome::Split(
+                    splits.into_iter().map(|(e, _, s)| (e, s)).collect(),
+                ));
             }
+            kept = splits;
         }
         unchecked = cdt.num_vertices();
         lift_new_vertices(&cdt, &chart, &mut keys, &mut positions).map_err(failed)?;
+        for (edge, v, s) in kept {
+            keys[v] = FacePoint::Edge { edge, s };
+            added.push((edge, s));
+        }
         let mut excluded = vec![false; cdt.num_all_faces()];
         if polyline_segments.is_empty() {
             for f in &result.excluded_faces {
@@ -349,6 +398,7 @@ pub(crate) fn mesh_face(
         points: keys,
         triangles: inner,
         polylines,
+        added,
     }))
 }
 
@@ -384,7 +434,10 @@ fn walk_loops(
                 } else if j + 1 == n {
                     FacePoint::Vertex(edge.end.0)
                 } else {
-                    FacePoint::Edge { edge: i, index: j }
+                    FacePoint::Edge {
+                        edge: i,
+                        s: nodes.params[j],
+                    }
                 }
             };
             let order: Vec<usize> = if oe.forward {
@@ -517,13 +570,13 @@ fn winding_odd(loops: &[Vec<[f64; 2]>], p: [f64; 2]) -> bool {
 }
 
 /// Vertices from index `first` on that the refinement put on boundary
-/// segments, as curve parameters.
+/// segments: (edge, vertex, curve parameter).
 fn boundary_splits(
     cdt: &Cdt,
     first: usize,
     segments: &Segments,
     polyline_segments: &[(usize, usize)],
-) -> Result<Vec<(usize, f64)>, String> {
+) -> Result<Vec<(usize, usize, f64)>, String> {
     let mut splits = Vec::new();
     for v in first..cdt.num_vertices() {
         let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(v));
@@ -548,7 +601,11 @@ fn boundary_splits(
             let len2 = dx * dx + dy * dy;
             let t = ((p.x - pa.x) * dx + (p.y - pa.y) * dy) / len2;
             let off = ((p.x - pa.x) * dy - (p.y - pa.y) * dx).abs() / len2.sqrt();
-            (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some((edge, sa + t * (sb - sa)))
+            (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some((
+                edge,
+                v,
+                sa + t * (sb - sa),
+            ))
         });
         splits.push(found.ok_or("refinement put a node on its boundary away from every edge")?);
     }
@@ -642,7 +699,7 @@ fn guide_area(uv_loops: &[Vec<[f64; 2]>], surface: &Surface) -> f64 {
 
 /// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and
 /// `b`, when it lies on it.
-fn on_segment(cdt: &Cdt, a: usize, b: usize, p: Point2<f64>) -> Option<f64> {
+pub(super) fn on_segment(cdt: &Cdt, a: usize, b: usize, p: Point2<f64>) -> Option<f64> {
     let pa = cdt
         .vertex(spade::handles::FixedVertexHandle::from_index(a))
         .position();

@@ -31,6 +31,7 @@ mod edges;
 pub mod exact;
 mod face;
 mod guard;
+mod polyline_split;
 mod quadratic;
 mod report;
 mod size;
@@ -201,7 +202,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             )
         })
         .collect::<Result<Vec<_>, MeshError>>()?;
-    let constraints = constraints::assign(model, &edge_nodes, &lines)?;
+    let constraints = constraints::assign(model, &mut edge_nodes, &lines)?;
     let settings = Settings {
         tolerance,
         sizing: &sizing,
@@ -301,12 +302,23 @@ fn mesh_faces(
                 (f, outcome)
             })
             .collect();
+        // Faces whose mesh already has an edge's new nodes (kept splits on
+        // straight edges): they need no new round for that edge.
+        let mut has_them: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
+        let mut split_by: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
         for (f, outcome) in outcomes {
             match outcome? {
-                Outcome::Meshed(mesh) => meshes[f] = Some(mesh),
+                Outcome::Meshed(mesh) => {
+                    for &(edge, s) in &mesh.added {
+                        splits.entry(edge).or_default().push(s);
+                        has_them.entry(edge).or_default().insert(f);
+                    }
+                    meshes[f] = Some(mesh);
+                }
                 Outcome::Split(points) => {
                     for (edge, s) in points {
                         splits.entry(edge).or_default().push(s);
+                        split_by.entry(edge).or_default().insert(f);
                     }
                 }
             }
@@ -322,7 +334,20 @@ fn mesh_faces(
                 changed |= nodes.insert(&model_edge.curve, s);
             }
             if changed {
-                todo.extend(faces_of_edge.get(&edge).into_iter().flatten().copied());
+                // One face split the edge and kept its mesh: only the
+                // others need the new nodes.
+                let keeper = match (has_them.get(&edge), split_by.get(&edge)) {
+                    (Some(faces), None) if faces.len() == 1 => faces.first().copied(),
+                    _ => None,
+                };
+                todo.extend(
+                    faces_of_edge
+                        .get(&edge)
+                        .into_iter()
+                        .flatten()
+                        .copied()
+                        .filter(|&g| Some(g) != keeper),
+                );
             }
         }
         if todo.is_empty() {
@@ -406,9 +431,10 @@ fn assemble(
                     let id = match (&mesh.points[i], ids[i]) {
                         (_, Some(id)) => id,
                         (FacePoint::Vertex(v), None) => *v,
-                        (FacePoint::Edge { edge, index }, None) => edge_ids
+                        (FacePoint::Edge { edge, s }, None) => edge_ids
                             .get(*edge)
-                            .and_then(|e| e.get(*index))
+                            .zip(edge_nodes.get(*edge))
+                            .and_then(|(ids, disc)| ids.get(disc.index_of(*s)))
                             .copied()
                             .unwrap_or(0),
                         (FacePoint::Interior(p), None) => push(&mut nodes, p),

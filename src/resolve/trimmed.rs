@@ -7,6 +7,7 @@ use super::objects::Resolver;
 use crate::diag::{Code, Diagnostic};
 use crate::doc::{CarrierSpec, Number, Object, TrimSpec, TrimmedSpec};
 use crate::expr::{Expr, ExprKind};
+use crate::geom::point_calculus::Patch9;
 use crate::geom::{Frame, Point3};
 use crate::implicit::ir::Ctx;
 use crate::implicit::tape::Ssa;
@@ -99,14 +100,14 @@ pub(super) fn surface(
             let l1 = r.number(latitudes[1].as_ref()?)?;
             let a0 = optional(r, &angles[0], 0.0)?;
             let a1 = optional(r, &angles[1], 360.0)?;
-            let ok = radius > 0.0 && -90.0 < l0 && l0 < l1 && l1 < 90.0 && a0 < a1;
+            let ok = radius > 0.0 && -90.0 <= l0 && l0 < l1 && l1 <= 90.0 && a0 < a1;
             if !ok {
                 invalid(
                     r,
                     format!(
                         "sphere_surface '{name}': radius {radius}, latitudes {l0}° to {l1}°, angles {a0}° to {a1}°"
                     ),
-                    "use a positive radius, -90 < from_latitude < to_latitude < 90 (the poles are left out) and from_angle < to_angle",
+                    "use a positive radius, -90 <= from_latitude < to_latitude <= 90 and from_angle < to_angle",
                 );
                 return None;
             }
@@ -132,14 +133,14 @@ pub(super) fn surface(
             let t1 = r.number(tube[1].as_ref()?)?;
             let a0 = optional(r, &angles[0], 0.0)?;
             let a1 = optional(r, &angles[1], 360.0)?;
-            let ok = minor > 0.0 && major > minor && t0 < t1 && t1 - t0 < 360.0 && a0 < a1;
+            let ok = minor > 0.0 && major > minor && t0 < t1 && t1 - t0 <= 360.0 && a0 < a1;
             if !ok {
                 invalid(
                     r,
                     format!(
                         "torus_surface '{name}': radii {major} and {minor}, tube angles {t0}° to {t1}°, angles {a0}° to {a1}°"
                     ),
-                    "use 0 < minor_radius < major_radius, from_tube_angle < to_tube_angle less than a full turn apart, and from_angle < to_angle",
+                    "use 0 < minor_radius < major_radius, from_tube_angle < to_tube_angle at most a full turn apart, and from_angle < to_angle",
                 );
                 return None;
             }
@@ -152,6 +153,30 @@ pub(super) fn surface(
                     a0.to_radians(),
                     a1.to_radians(),
                 ],
+            )
+        }
+        CarrierSpec::Patch9 { rows } => {
+            let mut grid = [[Point3::origin(); 3]; 3];
+            if rows.len() != 3 || rows.iter().any(|row| row.len() != 3) {
+                // Reported by the structural check.
+                return None;
+            }
+            let mut ok = true;
+            for (i, row) in rows.iter().enumerate() {
+                for (j, p) in row.iter().enumerate() {
+                    match r.point(p, frame, false) {
+                        Some(p) => grid[i][j] = p,
+                        None => ok = false,
+                    }
+                }
+            }
+            if !ok {
+                return None;
+            }
+            (
+                Carrier::Patch9(Box::new(Patch9 { rows: grid })),
+                Frame::identity(),
+                [0.0, 1.0, 0.0, 1.0],
             )
         }
         CarrierSpec::Expressions { xyz, rect } => {

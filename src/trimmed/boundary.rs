@@ -24,6 +24,8 @@ pub struct Boundary {
     pub sides: Vec<u8>,
     /// Loops of point indices (closed: the last joins the first).
     pub loops: Vec<Vec<usize>>,
+    /// Sides whose points are fixed (a pole cap's ring): never split.
+    pub fixed: u8,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash)]
@@ -355,6 +357,7 @@ pub fn trace(s: &TrimmedSurface, cells: [usize; 2]) -> Result<Boundary, String> 
         points: b.points,
         sides: b.sides,
         loops,
+        fixed: 0,
     })
 }
 
@@ -489,6 +492,44 @@ impl Boundary {
         }
     }
 
+    /// Makes the side `bit` (u = `u`, all material) a ring of `segments`
+    /// equal steps in v, fixed: a pole cap's fan joins these nodes.
+    pub fn fix_ring(&mut self, bit: u8, u: f64, v: [f64; 2], segments: usize) {
+        self.fixed |= bit;
+        let step = (v[1] - v[0]) / segments as f64;
+        let loops = std::mem::take(&mut self.loops);
+        for lp in loops {
+            // The side's own grid points go; its ends (corners) stay.
+            let kept: Vec<usize> = lp
+                .iter()
+                .copied()
+                .filter(|&p| self.sides[p] != bit)
+                .collect();
+            let mut out = Vec::with_capacity(kept.len() + segments);
+            for k in 0..kept.len() {
+                let (a, b) = (kept[k], kept[(k + 1) % kept.len()]);
+                out.push(a);
+                if self.sides[a] & self.sides[b] & bit == 0 {
+                    continue;
+                }
+                let (va, vb) = (self.points[a][1], self.points[b][1]);
+                let mut inner: Vec<f64> = (1..segments)
+                    .map(|j| v[0] + step * j as f64)
+                    .filter(|&x| x > va.min(vb) && x < va.max(vb))
+                    .collect();
+                if vb < va {
+                    inner.reverse();
+                }
+                for x in inner {
+                    self.points.push([u, x]);
+                    self.sides.push(bit);
+                    out.push(self.points.len() - 1);
+                }
+            }
+            self.loops.push(out);
+        }
+    }
+
     /// Splits edges until the surface point over each edge's middle (on the
     /// side, or on W = 0) is within `tolerance` of the chord and no edge is
     /// longer than `max_len` (3D).
@@ -521,6 +562,9 @@ impl Boundary {
         }
         let (pa, pb) = (self.points[a], self.points[b]);
         let common = self.sides[a] & self.sides[b];
+        if common & self.fixed != 0 {
+            return;
+        }
         let mid = [(pa[0] + pb[0]) / 2.0, (pa[1] + pb[1]) / 2.0];
         let m = if common != 0 {
             mid

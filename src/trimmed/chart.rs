@@ -1,7 +1,10 @@
-//! The plane the triangulation works in: each parameter mapped by the arc
-//! length of the surface along it (through the middle of the rectangle), so
-//! chart lengths follow 3D lengths for tensor-product-like surfaces and the
-//! Delaunay triangulation in the chart is close to the one on the surface.
+//! The plane the triangulation works in: v mapped by the arc length along the
+//! middle line u = u_m, and u by the conformal coordinate ∫ |R_u| g(u_m) / g(u) du
+//! with g = |R_v| along v = v_m. For a surface of revolution (sphere, torus,
+//! cone) the chart is then exactly conformal (Mercator-like), so angles in the
+//! chart are the angles on the surface and the Delaunay triangulation in the
+//! chart is close to the one on the surface even where the rings shrink
+//! towards a pole; for tensor-product-like surfaces it is close to arc length.
 
 use super::TrimmedSurface;
 
@@ -11,6 +14,8 @@ const SAMPLES: usize = 256;
 pub struct ArcChart {
     u: Axis,
     v: Axis,
+    /// The 3D arc lengths along the middle lines.
+    lengths: (f64, f64),
 }
 
 /// Parameter values and the cumulative arc length at each (strictly increasing).
@@ -75,9 +80,23 @@ impl ArcChart {
     pub fn new(s: &TrimmedSurface) -> Result<ArcChart, String> {
         let [u0, u1, v0, v1] = s.rect;
         let (um, vm) = (0.5 * (u0 + u1), 0.5 * (v0 + v1));
+        let arc_u = Axis::new(u0, u1, |u| s.tangents(u, vm).0.norm())?;
+        let v = Axis::new(v0, v1, |v| s.tangents(um, v).1.norm())?;
+        let g_mid = s.tangents(um, vm).1.norm();
+        // Where the rings shrink (g → 0) the factor grows; capped so the map
+        // stays finite next to a degenerate side.
+        let u = if g_mid.is_finite() && g_mid > 0.0 {
+            Axis::new(u0, u1, |u| {
+                let (du, dv) = s.tangents(u, vm);
+                du.norm() * (g_mid / dv.norm().max(1e-3 * g_mid)).min(1e3)
+            })?
+        } else {
+            arc_u.clone()
+        };
         Ok(ArcChart {
-            u: Axis::new(u0, u1, |u| s.tangents(u, vm).0.norm())?,
-            v: Axis::new(v0, v1, |v| s.tangents(um, v).1.norm())?,
+            lengths: (arc_u.length(), v.length()),
+            u,
+            v,
         })
     }
 
@@ -89,8 +108,8 @@ impl ArcChart {
         [self.u.back(xy[0]), self.v.back(xy[1])]
     }
 
-    /// The chart's extent: the arc lengths along u and along v.
+    /// The surface's extent: the 3D arc lengths along the middle lines in u and in v.
     pub fn lengths(&self) -> (f64, f64) {
-        (self.u.length(), self.v.length())
+        self.lengths
     }
 }

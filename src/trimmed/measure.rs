@@ -44,7 +44,15 @@ impl TrimmedMesh {
                 (uv[0][0] + uv[1][0] + uv[2][0]) / 3.0,
                 (uv[0][1] + uv[1][1] + uv[2][1]) / 3.0,
             ];
-            q.max_centroid_distance = q.max_centroid_distance.max(centroid_distance(s, c, start));
+            // Across a welded seam or at a pole the corners' parameters are
+            // not near one another and their mean may be no start: each
+            // corner is tried too (every result is a surface point, so the
+            // smallest is the best bound).
+            let d = uv
+                .iter()
+                .map(|&corner| centroid_distance(s, c, corner))
+                .fold(centroid_distance(s, c, start), f64::min);
+            q.max_centroid_distance = q.max_centroid_distance.max(d);
         }
         q
     }

@@ -7,6 +7,7 @@
 pub(crate) mod boundary;
 mod chart;
 mod measure;
+mod pole;
 pub mod program;
 mod split;
 mod triangulate;
@@ -14,6 +15,7 @@ mod triangulate;
 pub use measure::{TrimmedQuality, centroid_distance};
 pub use triangulate::{TrimSettings, TrimmedMesh, mesh_trimmed};
 
+use crate::geom::point_calculus::Patch9;
 use crate::geom::{Frame, Point3, Vec3};
 use crate::implicit::ir::{Ctx, NodeId};
 use crate::implicit::tape::Ssa;
@@ -34,6 +36,8 @@ pub enum Carrier {
     Torus { major: f64, minor: f64 },
     /// x(u, v), y(u, v), z(u, v) as programs in the variables u (0) and v (1).
     Expressions { xyz: Box<[Ssa; 3]> },
+    /// Paper 003's 9-point parabolic patch (point calculus), u, v ∈ [0, 1].
+    Patch9(Box<Patch9>),
 }
 
 /// The trim: F over global x, y, z; material where F ≥ 0, or F ≤ 0 when `negative`.
@@ -81,6 +85,7 @@ impl TrimmedSurface {
                 let ring = major + minor * u.cos();
                 Point3::new(ring * v.cos(), minor * u.sin(), ring * v.sin())
             }
+            Carrier::Patch9(patch) => patch.point(u, v),
             Carrier::Expressions { xyz } => {
                 let p = [u, v, 0.0];
                 Point3::new(
@@ -149,3 +154,7 @@ fn de_casteljau(points: &[Point3], t: f64) -> Point3 {
 
 #[cfg(test)]
 mod tests;
+#[cfg(test)]
+mod tests_patch9;
+#[cfg(test)]
+mod tests_seams;

@@ -22,46 +22,58 @@ pub(super) struct Nodes {
     pub xyz: Vec<Point3>,
     /// Side bits (U_MIN … V_MAX) per vertex; 0 for trim and interior points.
     pub sides: Vec<u8>,
-    /// Seam twins of a periodic surface: a V_MIN vertex ↔ its V_MAX vertex.
-    pub twin: HashMap<usize, usize>,
+    /// Seam twins of a periodic surface: `twin[0]` a U_MIN vertex ↔ its
+    /// U_MAX vertex (same v), `twin[1]` a V_MIN vertex ↔ its V_MAX vertex.
+    pub twin: [HashMap<usize, usize>; 2],
+    /// Sides whose edges are never split (a pole cap's ring).
+    pub fixed: u8,
 }
+
+/// The side bits of the two sides of each parameter's seam.
+pub(super) const SEAM: [u8; 2] = [U_MIN | U_MAX, V_MIN | V_MAX];
 
 impl Nodes {
     /// Side bits and seam twins of the boundary points (`handles[p]` is the
-    /// vertex of boundary point p).
+    /// vertex of boundary point p); `periodic[a]` when parameter a (u, v) closes.
     pub fn mark_boundary(
         &mut self,
         b: &Boundary,
         handles: &[usize],
-        periodic: bool,
+        periodic: [bool; 2],
         rect: [f64; 4],
     ) {
         self.sides = vec![0; self.uv.len()];
+        self.fixed = b.fixed;
         for (p, &h) in handles.iter().enumerate() {
             if let (Some(slot), Some(&bits)) = (self.sides.get_mut(h), b.sides.get(p)) {
                 *slot |= bits;
             }
         }
-        if !periodic {
-            return;
-        }
-        let eps = 1e-9 * (rect[1] - rect[0]);
-        let mut low: Vec<(f64, usize)> = (0..self.uv.len())
-            .filter(|&h| self.sides[h] & V_MIN != 0)
-            .map(|h| (self.uv[h][0], h))
-            .collect();
-        low.sort_by(|x, y| x.0.total_cmp(&y.0));
-        for h in 0..self.uv.len() {
-            if self.sides[h] & V_MAX == 0 {
+        for axis in 0..2 {
+            if !periodic[axis] {
                 continue;
             }
-            let u = self.uv[h][0];
-            let at = low.partition_point(|x| x.0 < u - eps);
-            if let Some(&(lu, lh)) = low.get(at)
-                && (lu - u).abs() <= eps
-            {
-                self.twin.insert(h, lh);
-                self.twin.insert(lh, h);
+            // Twins share the other parameter.
+            let along = 1 - axis;
+            let (low_bit, high_bit) = (SEAM[axis] & (U_MIN | V_MIN), SEAM[axis] & (U_MAX | V_MAX));
+            let eps = 1e-9 * (rect[2 * along + 1] - rect[2 * along]);
+            let mut low: Vec<(f64, usize)> = (0..self.uv.len())
+                .filter(|&h| self.sides[h] & low_bit != 0)
+                .map(|h| (self.uv[h][along], h))
+                .collect();
+            low.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for h in 0..self.uv.len() {
+                if self.sides[h] & high_bit == 0 {
+                    continue;
+                }
+                let t = self.uv[h][along];
+                let at = low.partition_point(|x| x.0 < t - eps);
+                if let Some(&(lt, lh)) = low.get(at)
+                    && (lt - t).abs() <= eps
+                {
+                    self.twin[axis].insert(h, lh);
+                    self.twin[axis].insert(lh, h);
+                }
             }
         }
     }
@@ -114,31 +126,33 @@ pub(super) fn split_constraint(
             middle
         }
     };
-    let seam = common & (V_MIN | V_MAX);
-    let twins = if seam != 0 {
-        match (nodes.twin.get(&x), nodes.twin.get(&y)) {
-            (Some(&tx), Some(&ty)) => Some((tx, ty)),
-            _ => None,
+    // An edge along a seam side is split with its twin on the other side.
+    let seam = (0..2).find_map(|axis| {
+        let bits = common & SEAM[axis];
+        if bits == 0 {
+            return None;
         }
-    } else {
-        None
-    };
+        let (tx, ty) = (nodes.twin[axis].get(&x)?, nodes.twin[axis].get(&y)?);
+        Some((axis, bits, *tx, *ty))
+    });
     let Some(n) = split_at(cdt, arc, s, nodes, x, y, uv, common) else {
         return false;
     };
-    if let Some((tx, ty)) = twins {
-        let v = if seam & V_MIN != 0 {
-            s.rect[3]
+    if let Some((axis, bits, tx, ty)) = seam {
+        let mut other = uv;
+        let low = bits & (U_MIN | V_MIN) != 0;
+        other[axis] = if low {
+            s.rect[2 * axis + 1]
         } else {
-            s.rect[2]
+            s.rect[2 * axis]
         };
-        let bits = (common & (U_MIN | U_MAX)) | (seam ^ (V_MIN | V_MAX));
-        let Some(m) = split_at(cdt, arc, s, nodes, tx, ty, [uv[0], v], bits) else {
+        let sides = (common & !SEAM[axis]) | (bits ^ SEAM[axis]);
+        let Some(m) = split_at(cdt, arc, s, nodes, tx, ty, other, sides) else {
             undo(cdt, nodes, x, y);
             return false;
         };
-        nodes.twin.insert(n, m);
-        nodes.twin.insert(m, n);
+        nodes.twin[axis].insert(n, m);
+        nodes.twin[axis].insert(m, n);
     }
     true
 }

@@ -43,7 +43,7 @@ const SETTINGS: TrimSettings = TrimSettings {
 /// Every interior segment is shared by two triangles with opposite
 /// directions, every boundary segment by one; the boundary segments are
 /// exactly those of the boundary chains.
-fn check_manifold(m: &TrimmedMesh) -> usize {
+pub(super) fn check_manifold(m: &TrimmedMesh) -> usize {
     let mut directed: BTreeMap<(u32, u32), usize> = BTreeMap::new();
     for t in &m.triangles {
         for k in 0..3 {
@@ -381,9 +381,9 @@ fn periodic_trimmed_cylinder_at_fine_sizes() {
         };
         let m = mesh_trimmed(&s, settings).expect("meshable");
         check_manifold(&m);
-        // Two rims, a hole, and the hole across the seam as two open
-        // chains (the seam is welded, its segments are not boundary).
-        assert_eq!(m.boundary.len(), 5, "size {size}");
+        // Two rims, a hole, and the hole across the seam as one closed
+        // chain (the seam is welded, its segments are not boundary).
+        assert_eq!(m.boundary.len(), 4, "size {size}");
         let q = m.quality(&s);
         assert!(q.min_angle >= 25.0, "size {size}: {q:?}");
         assert!(min_area(&m) > 1e-4 * size * size, "size {size}");
@@ -528,8 +528,9 @@ fn sphere_zone_with_two_caps_cut_out() {
     let m = mesh_trimmed(&s, fine(0.08)).expect("meshable");
     check_manifold(&m);
     // Two rims (the latitude circles), a hole, and the hole across the seam
-    // as two open chains.
-    assert_eq!(m.boundary.len(), 5);
+    // as one closed chain.
+    assert_eq!(m.boundary.len(), 4);
+    assert!(m.boundary.iter().all(|c| c.first() == c.last()));
     let q = m.quality(&s);
     let tau = std::f64::consts::TAU;
     let exact = tau - 2.0 * tau * (1.0 - 0.91f64.sqrt());
@@ -578,7 +579,8 @@ fn torus_outer_half_area() {
     s.trim = Some(x_cylinder_hole(0.3));
     let m = mesh_trimmed(&s, fine(0.1)).expect("meshable");
     check_manifold(&m);
-    assert_eq!(m.boundary.len(), 5);
+    assert_eq!(m.boundary.len(), 4);
+    assert!(m.boundary.iter().all(|c| c.first() == c.last()));
     let on_holes = m
         .boundary
         .iter()

@@ -7,9 +7,10 @@
 //! the triangle's 3D circumcentre E3 (minimising |R(u, v) − E3|).
 
 use super::TrimmedSurface;
-use super::boundary::{self, V_MAX, V_MIN};
+use super::boundary::{self, U_MAX, V_MAX};
 use super::chart::ArcChart;
-use super::split::{Cdt, Nodes, split_constraint};
+use super::pole;
+use super::split::{Cdt, Nodes, SEAM, split_constraint};
 use crate::geom::{Point3, Vec3};
 use spade::{AngleLimit, Point2, RefinementParameters, Triangulation};
 use std::collections::{HashMap, HashSet};
@@ -52,19 +53,56 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     }
     let arc = ArcChart::new(s)?;
     let (lu, lv) = arc.lengths();
+    let h = element_size(lu, lv, &settings);
+    let caps = pole::plan(s, &settings, h)?;
+    if caps.is_empty() {
+        return mesh_band(s, settings, &[]);
+    }
+    let mut band = s.clone();
+    for c in &caps {
+        band.rect[c.side_index()] = c.u_ring;
+    }
+    let mut mesh = mesh_band(&band, settings, &caps)?;
+    for c in caps.iter().filter(|c| c.material) {
+        pole::close(&mut mesh, s, c);
+    }
+    Ok(mesh)
+}
+
+/// The element size: the smaller of `--max-edge` and the length whose chord
+/// on a bend of radius ~extent/2 deviates by the tolerance (h²/(4·extent)).
+pub(super) fn element_size(lu: f64, lv: f64, settings: &TrimSettings) -> f64 {
     let extent = lu.hypot(lv);
-    let tol = settings.tolerance;
-    // A chord of length h on a bend of radius ~extent/2 deviates h²/(4·extent).
-    let h = (4.0 * extent * tol)
+    (4.0 * extent * settings.tolerance)
         .sqrt()
         .min(extent / 48.0)
-        .min(settings.max_edge);
+        .min(settings.max_edge)
+}
+
+/// Meshes the rectangle of `s`; the sides of `caps` with material become
+/// fixed rings of their caps' segments.
+fn mesh_band(
+    s: &TrimmedSurface,
+    settings: TrimSettings,
+    caps: &[pole::Cap],
+) -> Result<TrimmedMesh, String> {
+    let arc = ArcChart::new(s)?;
+    let (lu, lv) = arc.lengths();
+    let extent = lu.hypot(lv);
+    let tol = settings.tolerance;
+    let h = element_size(lu, lv, &settings);
     let nu = ((lu / h).ceil() as usize).clamp(4, 2048);
     let nv = ((lv / h).ceil() as usize).clamp(4, 2048);
     let mut b = boundary::trace(s, [nu, nv])?;
     let cell = (lu / nu as f64).hypot(lv / nv as f64);
     b.merge_short(s, 0.4 * cell);
-    let periodic = is_periodic_v(s, extent);
+    let periodic = [is_periodic(s, 0, extent), is_periodic(s, 1, extent)];
+    let seams = (0..2)
+        .filter(|&a| periodic[a])
+        .fold(0, |bits, a| bits | SEAM[a]);
+    for c in caps.iter().filter(|c| c.material) {
+        b.fix_ring(c.bit, c.u_ring, [s.rect[2], s.rect[3]], c.segments);
+    }
     // Boundary edges start at the element size; refinement splits them
     // (a seam edge with its twin) where they are encroached.
     let side = h.max(0.5 * cell);
@@ -82,7 +120,8 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
         uv: Vec::new(),
         xyz: Vec::new(),
         sides: Vec::new(),
-        twin: HashMap::new(),
+        twin: [HashMap::new(), HashMap::new()],
+        fixed: 0,
     };
     for lp in &b.loops {
         for &p in lp {
@@ -173,8 +212,10 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
                 .map(|e| (e.from().fix().index(), e.to().fix().index()))
                 .collect();
             // Two constraint edges meet at an input angle: the angle test
-            // cannot be met there.
-            let angles = constraints.len() < 2;
+            // cannot be met there. A seam is no boundary on the surface: its
+            // edges make no input angle.
+            let on_seam = |&&(a, b): &&(usize, usize)| nodes.sides[a] & nodes.sides[b] & seams != 0;
+            let angles = constraints.iter().filter(|e| !on_seam(e)).count() < 2;
             match needs_split(s, &p, &q, &settings, floor, angles) {
                 Some(split) => {
                     if let Some(a) = choose(&cdt, &arc, &nodes, split, &constraints, t[0], floor) {
@@ -227,19 +268,27 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
         .collect();
     thread_splits(&cdt, fixed, &mut boundary_chains);
     let mut remap: Vec<usize> = (0..nodes.uv.len()).collect();
-    if periodic {
-        weld_seam(&nodes, &mut remap, &mut boundary_chains);
+    if periodic.contains(&true) {
+        weld_seams(&nodes, periodic, &mut remap, &mut boundary_chains);
     }
     let (uvs, points3) = (nodes.uv, nodes.xyz);
     Ok(assemble(&uvs, &points3, &inner, &remap, &boundary_chains))
 }
 
-/// True when the sides v = v_min and v = v_max are the same curve in 3D.
-fn is_periodic_v(s: &TrimmedSurface, extent: f64) -> bool {
-    let [u0, u1, v0, v1] = s.rect;
+/// True when the two sides across parameter `axis` (0: u = u_min and
+/// u = u_max; 1: v = v_min and v = v_max) are the same curve in 3D.
+pub(super) fn is_periodic(s: &TrimmedSurface, axis: usize, extent: f64) -> bool {
+    let r = s.rect;
+    let (lo, hi) = (r[2 * axis], r[2 * axis + 1]);
+    let (a, b) = (r[2 - 2 * axis], r[3 - 2 * axis]);
     (0..=8).all(|i| {
-        let u = u0 + (u1 - u0) * i as f64 / 8.0;
-        (s.point(u, v0) - s.point(u, v1)).norm() <= 1e-9 * extent
+        let t = a + (b - a) * i as f64 / 8.0;
+        let (p, q) = if axis == 0 {
+            (s.point(lo, t), s.point(hi, t))
+        } else {
+            (s.point(t, lo), s.point(t, hi))
+        };
+        (p - q).norm() <= 1e-9 * extent
     })
 }
 
@@ -348,7 +397,10 @@ fn choose(
             .iter()
             .map(|c| (c[0] - mid[0]).hypot(c[1] - mid[1]))
             .fold(0.0, f64::max);
-    let splittable = |(x, y): (usize, usize)| (nodes.xyz[x] - nodes.xyz[y]).norm() > 2.0 * floor;
+    let splittable = |(x, y): (usize, usize)| {
+        nodes.sides[x] & nodes.sides[y] & nodes.fixed == 0
+            && (nodes.xyz[x] - nodes.xyz[y]).norm() > 2.0 * floor
+    };
     let longest_constraint = || {
         constraints
             .iter()
@@ -430,23 +482,45 @@ pub(crate) fn nearest_parameter(s: &TrimmedSurface, target: Point3, start: [f64;
     uv
 }
 
-/// Merges each node of the side v = v_max into its twin on v = v_min, and
-/// drops both sides from the boundary chains.
-fn weld_seam(nodes: &Nodes, remap: &mut [usize], chains: &mut Vec<Vec<usize>>) {
-    for (&a, &b) in &nodes.twin {
-        if nodes.sides[a] & V_MAX != 0 {
-            remap[a] = b;
+/// Merges each node of a seam's high side (u = u_max, v = v_max) into its
+/// twin on the low side, drops the seam sides from the boundary chains, and
+/// joins the pieces a seam cut (a hole across it) into one chain again.
+fn weld_seams(
+    nodes: &Nodes,
+    periodic: [bool; 2],
+    remap: &mut [usize],
+    chains: &mut Vec<Vec<usize>>,
+) {
+    let mut seams = 0;
+    for axis in 0..2 {
+        if !periodic[axis] {
+            continue;
+        }
+        seams |= SEAM[axis];
+        let high = SEAM[axis] & (U_MAX | V_MAX);
+        for (&a, &b) in &nodes.twin[axis] {
+            if nodes.sides[a] & high != 0 {
+                remap[a] = b;
+            }
         }
     }
-    let along_seam = |x: usize, y: usize| nodes.sides[x] & nodes.sides[y] & (V_MIN | V_MAX) != 0;
-    let mut out = Vec::new();
+    // A corner of a surface closed both ways goes through two twins.
+    for h in 0..remap.len() {
+        let mut t = remap[h];
+        for _ in 0..3 {
+            t = remap[t];
+        }
+        remap[h] = t;
+    }
+    let along_seam = |x: usize, y: usize| nodes.sides[x] & nodes.sides[y] & seams != 0;
+    let mut runs = Vec::new();
     for chain in chains.drain(..) {
         // Cut the closed chain at segments along the seam; rotate so a cut
         // comes first, then collect the runs between cuts.
         let n = chain.len() - 1;
         let cut = (0..n).find(|&k| along_seam(chain[k], chain[k + 1]));
         let Some(cut) = cut else {
-            out.push(chain);
+            runs.push(chain);
             continue;
         };
         let ring: Vec<usize> = (0..=n).map(|k| chain[(cut + 1 + k) % n]).collect();
@@ -454,7 +528,7 @@ fn weld_seam(nodes: &Nodes, remap: &mut [usize], chains: &mut Vec<Vec<usize>>) {
         for w in ring.windows(2) {
             if along_seam(w[0], w[1]) {
                 if run.len() >= 2 {
-                    out.push(std::mem::take(&mut run));
+                    runs.push(std::mem::take(&mut run));
                 }
                 run = vec![w[1]];
             } else {
@@ -462,15 +536,40 @@ fn weld_seam(nodes: &Nodes, remap: &mut [usize], chains: &mut Vec<Vec<usize>>) {
             }
         }
         if run.len() >= 2 {
-            out.push(run);
+            runs.push(run);
         }
     }
-    for chain in &mut out {
-        for h in chain.iter_mut() {
+    for run in &mut runs {
+        for h in run.iter_mut() {
             *h = remap[*h];
         }
+        run.dedup();
     }
-    *chains = out;
+    runs.retain(|r| r.len() >= 2);
+    *chains = join_runs(runs);
+}
+
+/// Joins open runs end to start (or end to end, one reversed) until each is
+/// closed or has no continuation; in input order, so deterministic.
+pub(super) fn join_runs(mut runs: Vec<Vec<usize>>) -> Vec<Vec<usize>> {
+    let mut out = Vec::new();
+    while !runs.is_empty() {
+        let mut cur = runs.remove(0);
+        while cur.first() != cur.last() {
+            let end = cur[cur.len() - 1];
+            let next = runs
+                .iter()
+                .position(|r| r[0] == end || r[r.len() - 1] == end);
+            let Some(k) = next else { break };
+            let mut r = runs.remove(k);
+            if r[0] != end {
+                r.reverse();
+            }
+            cur.extend_from_slice(&r[1..]);
+        }
+        out.push(cur);
+    }
+    out
 }
 
 fn assemble(

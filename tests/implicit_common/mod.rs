@@ -47,3 +47,36 @@ pub fn geomc_ok(args: &[&str], paths: &[&std::path::Path]) {
         String::from_utf8_lossy(&run.stderr)
     );
 }
+
+/// Edges whose two triangles' normals are more than 120° apart (a triangle
+/// folded back onto its neighbour, which gmsh's tetrahedralizer refuses as
+/// a segment crossing a facet).
+pub fn folded_edges(s: &Surface) -> usize {
+    let normal = |t: &[u32; 3]| {
+        let [a, b, c] = t.map(|i| s.positions[i as usize]);
+        let u = [b[0] - a[0], b[1] - a[1], b[2] - a[2]];
+        let v = [c[0] - a[0], c[1] - a[1], c[2] - a[2]];
+        let n = [
+            u[1] * v[2] - u[2] * v[1],
+            u[2] * v[0] - u[0] * v[2],
+            u[0] * v[1] - u[1] * v[0],
+        ];
+        let l = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt().max(1e-300);
+        n.map(|x| x / l)
+    };
+    let mut by_edge: std::collections::HashMap<(u32, u32), Vec<usize>> = Default::default();
+    for (i, t) in s.triangles.iter().enumerate() {
+        for k in 0..3 {
+            let (a, b) = (t[k], t[(k + 1) % 3]);
+            by_edge.entry((a.min(b), a.max(b))).or_default().push(i);
+        }
+    }
+    by_edge
+        .values()
+        .filter(|ts| ts.len() == 2)
+        .filter(|ts| {
+            let (m, n) = (normal(&s.triangles[ts[0]]), normal(&s.triangles[ts[1]]));
+            m[0] * n[0] + m[1] * n[1] + m[2] * n[2] < -0.5
+        })
+        .count()
+}

@@ -4,11 +4,14 @@
 //! face `A_B_interface` listed by both subdomains (outward for A, the
 //! earlier one) and the fragment `A|B`; the rest of each boundary is the
 //! face `NAME_boundary` with the fragment `NAME|exterior`, as for a lone
-//! subdomain.
+//! subdomain, and where a member reaches the joint grid's box, the surface
+//! closing it next to the box is `NAME_box_cap` with `NAME|box`.
 
 use super::{ImplicitSolid, ImplicitSubdomain};
 use crate::implicit::interfaces::{self, Interfaces};
+use crate::implicit::joint_optimize::optimize_joint;
 use crate::implicit::polygonize::Grid;
+use crate::implicit::push_boundary;
 use crate::mesh::{Mesh, MeshFace, MeshFragment};
 
 /// The touching subdomains and their labelled surfaces (label m + 1 is
@@ -100,15 +103,45 @@ pub fn mesh_touching(subdomains: &[ImplicitSubdomain], cells: Option<usize>) -> 
             max: m.geom.max,
         })
         .collect();
-    let interfaces = interfaces::polygonize_labels(&solids, &grid);
+    let mut interfaces = interfaces::polygonize_labels(&solids, &grid);
     if !interfaces.touching() {
         return None;
     }
+    // The members' optimisation rounds (the most any of them asks for).
+    let iterations = models.iter().map(|(_, m)| m.geom.optiterations).max();
+    let spacing = spacing.iter().copied().fold(f64::INFINITY, f64::min);
+    optimize_joint(
+        &mut interfaces,
+        &solids,
+        |a, b| interfaces::deciding_solid(a, b, solids.len()),
+        spacing,
+        iterations.unwrap_or(0),
+    );
     Some(Joint {
         members: models.iter().map(|(i, _)| *i).collect(),
         grid,
         interfaces,
     })
+}
+
+/// Adds a box cap face `NAME_box_cap` with its fragment `NAME|box`.
+fn push_cap(mesh: &mut Mesh, subdomain: u32, name: &str, triangles: Vec<[u32; 3]>) {
+    let face = mesh.faces.len() as u32;
+    mesh.faces.push(MeshFace {
+        name: format!("{name}_box_cap"),
+        triangles,
+        boundary: Vec::new(),
+    });
+    if let Some(s) = mesh.subdomains.get_mut(subdomain as usize) {
+        s.faces.push((face, true));
+    }
+    mesh.fragments.push(MeshFragment {
+        name: format!("{name}|box"),
+        subdomain,
+        other: None,
+        faces: vec![face],
+        edges: Vec::new(),
+    });
 }
 
 /// Adds the joint surfaces to `mesh` (whose subdomains `first..` are
@@ -132,21 +165,12 @@ pub fn add(
         if a == 0 {
             // Normals point into b: reversed, they point out of it.
             let name = &subdomains[sb].name;
-            mesh.faces.push(MeshFace {
-                name: format!("{name}_boundary"),
-                triangles: shifted.map(|t| [t[0], t[2], t[1]]).collect(),
-                boundary: Vec::new(),
-            });
-            mesh.subdomains[first as usize + sb]
-                .faces
-                .push((face, true));
-            mesh.fragments.push(MeshFragment {
-                name: format!("{name}|exterior"),
-                subdomain: first + sb as u32,
-                other: None,
-                faces: vec![face],
-                edges: Vec::new(),
-            });
+            let reversed = shifted.map(|t| [t[0], t[2], t[1]]).collect();
+            if patch.cap {
+                push_cap(mesh, first + sb as u32, name, reversed);
+            } else {
+                push_boundary(mesh, first + sb as u32, name, reversed, Vec::new());
+            }
             counts[sb] += patch.triangles.len();
             continue;
         }

@@ -1,13 +1,15 @@
 //! Implicit subdomains into geomc's mesh IR: each subdomain's closed surface
 //! is one face (`NAME_boundary`) and its fragment against the exterior
-//! (`NAME|exterior`); `--section` adds the contour lines of a plane cut as
+//! (`NAME|exterior`), plus the cap where it leaves its box (`NAME_box_cap`,
+//! `NAME|box`); `--section` adds the contour lines of a plane cut as
 //! line elements (`NAME_section_K`). Touching function subdomains share
 //! their interface faces (`joint`).
 
 use super::ImplicitSubdomain;
 use super::joint;
-use crate::implicit::section;
-use crate::mesh::{Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain};
+use crate::implicit::caps::split_caps;
+use crate::implicit::{push_boundary, section};
+use crate::mesh::{Mesh, MeshPolyline, MeshSubdomain};
 use rayon::prelude::*;
 
 /// A plane x, y or z = value.
@@ -87,24 +89,10 @@ pub fn append(
         }
         let base = mesh.nodes.len() as u32;
         mesh.nodes.extend_from_slice(&surface.positions);
-        let face = mesh.faces.len() as u32;
-        mesh.faces.push(MeshFace {
-            name: format!("{}_boundary", sub.name),
-            triangles: surface
-                .triangles
-                .iter()
-                .map(|t| t.map(|i| i + base))
-                .collect(),
-            boundary: Vec::new(),
-        });
-        mesh.subdomains[index as usize].faces.push((face, true));
-        mesh.fragments.push(MeshFragment {
-            name: format!("{}|exterior", sub.name),
-            subdomain: index,
-            other: None,
-            faces: vec![face],
-            edges: Vec::new(),
-        });
+        let (min, max) = sub.bounds();
+        let (rest, caps) = split_caps(&surface.positions, &surface.triangles, min, max);
+        let shift = |t: Vec<[u32; 3]>| t.into_iter().map(|t| t.map(|i| i + base)).collect();
+        push_boundary(mesh, index, &sub.name, shift(rest), shift(caps));
         out.triangles.push(surface.triangles.len());
         if let Some(plane) = section {
             if !add_section(

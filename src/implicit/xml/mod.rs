@@ -45,7 +45,8 @@ impl Extracted<'_> {
 }
 
 /// The elements of trimmed surfaces (paper 002), which may hold a `<trim>`.
-const TRIMMED: [&str; 5] = [
+const TRIMMED: [&str; 6] = [
+    "patch9",
     "bezier_surface",
     "cone_surface",
     "parametric_surface",
@@ -136,6 +137,14 @@ pub struct ImplicitSubdomain {
 }
 
 impl ImplicitSubdomain {
+    /// The box the solid is polygonized in (where it is capped).
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        match &self.solid {
+            ImplicitSolid::Function(model) => (model.geom.min, model.geom.max),
+            ImplicitSolid::Samples { grid, .. } => (grid.min, grid.max),
+        }
+    }
+
     /// The boundary surface: on the solid's own grid, or `cells` per axis for functions.
     pub fn polygonize(&self, cells: Option<usize>) -> Surface {
         match &self.solid {
