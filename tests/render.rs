@@ -605,3 +605,40 @@ fn svg_section_fills_the_cut_face_of_each_subdomain() {
     let plain = render_svg(&mesh, &bare(400, 400, View::TOP)).expect("draws");
     assert!(section_paths(&plain.text).is_empty());
 }
+
+#[test]
+fn render_checks_implicit_grids_against_max_grid_cells() {
+    let dir = tempfile::tempdir().expect("temporary folder");
+    let xml = dir.path().join("ball.xml");
+    std::fs::write(
+        &xml,
+        r#"<?xml version="1.0"?>
+<geometry version="1">
+<rfunction name="part" nx="20" ny="20" nz="20"> <ball r="0.5" x0="0" y0="0" z0="0"/> </rfunction>
+<subdomain name="ball"> <solid ref="part"/> </subdomain>
+</geometry>
+"#,
+    )
+    .expect("write");
+    let png = dir.path().join("ball.png");
+    let (x, p) = (xml.to_str().unwrap(), png.to_str().unwrap());
+    // 20³ = 8000 cells: one under the grid is refused, at the grid drawn.
+    let out = geomc(&["render", x, "-o", p, "--max-grid-cells", "7999"]);
+    assert_eq!(out.status.code(), Some(1));
+    let stderr = String::from_utf8_lossy(&out.stderr);
+    assert!(
+        stderr.contains("error[E800]") && stderr.contains(":4:2:"),
+        "{stderr}"
+    );
+    assert!(!png.exists(), "no partial output");
+    let out = geomc(&["render", x, "-o", p, "--max-grid-cells", "8000"]);
+    assert_eq!(
+        out.status.code(),
+        Some(0),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let image =
+        geomc::render::decode_png(&std::fs::read(&png).expect("PNG written")).expect("decodes");
+    assert_eq!((image.width, image.height), (800, 600));
+}

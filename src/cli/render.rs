@@ -330,8 +330,9 @@ fn load_input(
             exit: EXIT_INVALID,
         })
     })?;
-    // Implicit subdomains are not in the model: polygonized as compile does.
-    let limit = super::limits::MAX_GRID_CELLS;
+    // Implicit subdomains are not in the model: polygonized as compile does,
+    // within the user's --max-grid-cells.
+    let limit = limits.budget.max_grid_cells;
     if let Err(messages) =
         super::implicit::add_to_mesh(&mut mesh, &checked, None, None, true, limit)
     {

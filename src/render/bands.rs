@@ -25,7 +25,7 @@ pub fn render(
 ) -> Image {
     let (sw, sh) = (width * ss, height * ss);
     let band_rows = BAND_PIXELS * ss;
-    let bins = raster::bin(scene, proj, sh, band_rows);
+    let bins = raster::bin(scene, proj, sw, sh, band_rows);
     let mut rgba = vec![0u8; width * height * 4];
     rgba.par_chunks_mut(width * 4 * BAND_PIXELS)
         .enumerate()

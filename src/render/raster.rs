@@ -34,6 +34,16 @@ pub fn depth_of(value: u64) -> f32 {
     f32::from_bits((value >> 32) as u32)
 }
 
+/// The triangle's corners as given, and which side faces the eye (none when
+/// it is seen edge-on): what binning needs, without the depths.
+#[inline]
+fn facing(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], u32)> {
+    let v = t.map(|n| proj.xy[n as usize]);
+    let [a, b, c] = v;
+    let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    (area != 0).then_some((v, u32::from(area > 0)))
+}
+
 /// The triangle's corners ordered with positive area, and which side faces the eye.
 #[inline]
 fn setup(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], [f32; 3], u32)> {
@@ -65,20 +75,37 @@ fn visible_side(scene: &Scene, tri: usize, back: u32) -> bool {
     scene.face_sides[scene.tri_face[tri] as usize][back as usize] != HIDDEN
 }
 
-/// Sample rows a triangle may cover, clamped to the image.
+/// First and last sample centre (index) within snapped coordinates `lo..=hi`,
+/// clamped to `0..size`.
 #[inline]
-fn row_range(v: &[[i64; 2]; 3], height: usize) -> Option<(usize, usize)> {
-    let lo = v[0][1].min(v[1][1]).min(v[2][1]);
-    let hi = v[0][1].max(v[1][1]).max(v[2][1]);
+fn sample_span(lo: i64, hi: i64, size: usize) -> Option<(usize, usize)> {
     // Sample centres sit at (i + 1/2) samples.
     let first = (lo - SUB / 2 + SUB - 1).div_euclid(SUB).max(0);
-    let last = (hi - SUB / 2).div_euclid(SUB).min(height as i64 - 1);
+    let last = (hi - SUB / 2).div_euclid(SUB).min(size as i64 - 1);
     (first <= last).then_some((first as usize, last as usize))
+}
+
+/// Sample rows a triangle may cover, clamped to the image; none when its
+/// bounding box holds no sample centre of the image.
+#[inline]
+fn row_range(v: &[[i64; 2]; 3], width: usize, height: usize) -> Option<(usize, usize)> {
+    let min_x = v[0][0].min(v[1][0]).min(v[2][0]);
+    let max_x = v[0][0].max(v[1][0]).max(v[2][0]);
+    sample_span(min_x, max_x, width)?;
+    let lo = v[0][1].min(v[1][1]).min(v[2][1]);
+    let hi = v[0][1].max(v[1][1]).max(v[2][1]);
+    sample_span(lo, hi, height)
 }
 
 /// For each chunk of triangles, the ids each band of `band_rows` sample rows
 /// must draw (front-facing visible sides only, rows clamped to the image).
-pub fn bin(scene: &Scene, proj: &Projected, height: usize, band_rows: usize) -> Vec<Vec<Vec<u32>>> {
+pub fn bin(
+    scene: &Scene,
+    proj: &Projected,
+    width: usize,
+    height: usize,
+    band_rows: usize,
+) -> Vec<Vec<Vec<u32>>> {
     let n_bands = height.div_ceil(band_rows);
     (0..scene.tris.len().div_ceil(CHUNK))
         .into_par_iter()
@@ -86,13 +113,13 @@ pub fn bin(scene: &Scene, proj: &Projected, height: usize, band_rows: usize) -> 
             let mut bands: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
             let end = ((c + 1) * CHUNK).min(scene.tris.len());
             for tri in c * CHUNK..end {
-                let Some((v, _, back)) = setup(proj, scene.tris[tri]) else {
+                let Some((v, back)) = facing(proj, scene.tris[tri]) else {
                     continue;
                 };
                 if !visible_side(scene, tri, back) {
                     continue;
                 }
-                if let Some((first, last)) = row_range(&v, height) {
+                if let Some((first, last)) = row_range(&v, width, height) {
                     for band in bands
                         .iter_mut()
                         .take(last / band_rows + 1)
@@ -128,7 +155,7 @@ pub fn draw_band(
 }
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
-    let bins = bin(scene, proj, height, BAND);
+    let bins = bin(scene, proj, width, height, BAND);
     let mut data = vec![EMPTY; width * height];
     data.par_chunks_mut(width * BAND)
         .enumerate()
@@ -186,32 +213,40 @@ fn draw(
         step_y[k] = dx * SUB;
     }
     // Depth as a plane over sample coordinates, referenced at the triangle's
-    // own first sample so bands agree exactly: one division per triangle.
-    let area = ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
-        - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0])) as f64;
-    let (x1, y1_, x2, y2) = (
-        (v[1][0] - v[0][0]) as f64,
-        (v[1][1] - v[0][1]) as f64,
-        (v[2][0] - v[0][0]) as f64,
-        (v[2][1] - v[0][1]) as f64,
-    );
-    let (z1, z2) = ((z[1] - z[0]) as f64, (z[2] - z[0]) as f64);
-    let inv = 1.0 / area;
-    // dz per snapped unit, then per sample.
-    let gx = (z1 * y2 - z2 * y1_) * inv;
-    let gy = (z2 * x1 - z1 * x2) * inv;
-    let (rx, ry) = (sx0 * SUB + SUB / 2, sy0 * SUB + SUB / 2);
-    let z_ref = z[0] as f64 + gx * (rx - v[0][0]) as f64 + gy * (ry - v[0][1]) as f64;
-    let dzdx = (gx * SUB as f64) as f32;
-    let dzdy = (gy * SUB as f64) as f32;
-    let z_ref = z_ref as f32;
+    // own first sample so bands agree exactly: one division per triangle,
+    // made only once a sample is found inside (most tiny triangles of a
+    // large mesh cover none).
+    let plane = || {
+        let area = ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
+            - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0])) as f64;
+        let (x1, y1_, x2, y2) = (
+            (v[1][0] - v[0][0]) as f64,
+            (v[1][1] - v[0][1]) as f64,
+            (v[2][0] - v[0][0]) as f64,
+            (v[2][1] - v[0][1]) as f64,
+        );
+        let (z1, z2) = ((z[1] - z[0]) as f64, (z[2] - z[0]) as f64);
+        let inv = 1.0 / area;
+        // dz per snapped unit, then per sample.
+        let gx = (z1 * y2 - z2 * y1_) * inv;
+        let gy = (z2 * x1 - z1 * x2) * inv;
+        let (rx, ry) = (sx0 * SUB + SUB / 2, sy0 * SUB + SUB / 2);
+        let z_ref = z[0] as f64 + gx * (rx - v[0][0]) as f64 + gy * (ry - v[0][1]) as f64;
+        (
+            z_ref as f32,
+            (gx * SUB as f64) as f32,
+            (gy * SUB as f64) as f32,
+        )
+    };
+    let mut depth_plane: Option<(f32, f32, f32)> = None;
     let id = id as u64;
     for sy in y_first..=sy1 {
         let row = &mut rows[(sy as usize - y0) * width..][..width];
         let mut e = e_row;
-        let zy = z_ref + dzdy * (sy - sy0) as f32;
         for sx in x_first..=sx1 {
             if (e[0] | e[1] | e[2]) >= 0 {
+                let (z_ref, dzdx, dzdy) = *depth_plane.get_or_insert_with(plane);
+                let zy = z_ref + dzdy * (sy - sy0) as f32;
                 let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
                 let value = ((depth.to_bits() as u64) << 32) | id;
                 let slot = &mut row[sx as usize];

@@ -85,7 +85,9 @@ fn shade(
     };
     group
         .color
-        .map(|c| (c as f32 * light).round().clamp(0.0, 255.0) as u8)
+        // Rounded by adding a half: the value is not negative, `as`
+        // saturates at 255, and `f32::round` is a library call.
+        .map(|c| (c as f32 * light + 0.5) as u8)
 }
 
 /// A pixel whose samples all show one colour group's surface (no edge mark,
@@ -128,6 +130,14 @@ fn uniform(
         }
     }
     Some(shade(scene, proj, first_id, sx, sy, px, py))
+}
+
+/// Whether every sample of the pixel shows the background (no edge mark).
+#[inline]
+fn background_only(samples: &Samples, ss: usize, px: usize, py: usize) -> bool {
+    (py * ss..(py + 1) * ss).all(|sy| {
+        (px * ss..(px + 1) * ss).all(|sx| samples.value(sx, sy) == EMPTY && !samples.edge(sx, sy))
+    })
 }
 
 /// Samples of sample rows `y0..` (stored from `data[0]`), `width` per row,
@@ -196,6 +206,16 @@ pub fn resolve_rows(
         for px in 0..width {
             if let Some(color) = uniform(scene, proj, samples, ss, px, py) {
                 row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
+                continue;
+            }
+            if background_only(samples, ss, px, py) {
+                // The average of equal samples, as the sums below give it.
+                let bg = if background[3] == 0 {
+                    [0; 4]
+                } else {
+                    background
+                };
+                row[px * 4..px * 4 + 4].copy_from_slice(&bg);
                 continue;
             }
             let mut sum = [0u32; 4];

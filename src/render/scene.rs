@@ -3,10 +3,12 @@
 //! colour groups the legend names, per-corner light intensities, and the
 //! optional section cut.
 
-use super::camera::{Camera, cross, dot};
+use super::camera::{Camera, dot};
+use super::smooth::{self, tri_normal};
 use super::{ColorBy, RenderOptions, Section, Shading};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
+use std::borrow::Cow;
 
 /// A side that is never seen (inside a closed subdomain, no section).
 pub const HIDDEN: u32 = u32::MAX;
@@ -19,16 +21,18 @@ pub struct Group {
     pub cap: bool,
 }
 
+/// Borrows the mesh's nodes and triangles when it can: a large mesh is not copied.
 #[derive(Debug, Clone, Default)]
-pub struct Scene {
+pub struct Scene<'a> {
     /// Model coordinates: the mesh's nodes, then nodes made by the section.
-    pub points: Vec<[f64; 3]>,
-    pub tris: Vec<[u32; 3]>,
+    pub points: Cow<'a, [[f64; 3]]>,
+    pub tris: Cow<'a, [[u32; 3]]>,
     pub tri_face: Vec<u32>,
     /// Per face: the group shown on its front (normal) side and on its back.
     pub face_sides: Vec<[u32; 2]>,
     /// Per triangle corner: an index into `light`.
-    pub corner_slots: Vec<[u32; 3]>,
+    /// (The triangles themselves when smooth shading one face: a node's own slot.)
+    pub corner_slots: Cow<'a, [[u32; 3]]>,
     /// Light intensity in [0, 1] seen on the front and on the back side.
     pub light: Vec<[f32; 2]>,
     pub groups: Vec<Group>,
@@ -73,7 +77,7 @@ fn effective_color_by(mesh: &Mesh, wanted: ColorBy) -> ColorBy {
     }
 }
 
-pub fn build(mesh: &Mesh, options: &RenderOptions, camera: &Camera) -> Scene {
+pub fn build<'a>(mesh: &'a Mesh, options: &RenderOptions, camera: &Camera) -> Scene<'a> {
     let n_faces = mesh.faces.len();
     let color_by = effective_color_by(mesh, options.color_by);
     // The subdomain on each side: `outward` means the normal leaves it, so it
@@ -194,24 +198,16 @@ pub fn build(mesh: &Mesh, options: &RenderOptions, camera: &Camera) -> Scene {
         })
         .collect();
 
+    let (tris, tri_face) = triangles(mesh);
     let mut scene = Scene {
-        points: mesh.nodes.clone(),
+        points: Cow::Borrowed(&mesh.nodes),
+        tris,
+        tri_face,
         face_sides,
         groups,
         ..Scene::default()
     };
-    let n_tris: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
-    scene.tris.reserve(n_tris);
-    scene.tri_face.reserve(n_tris);
-    for (f, face) in mesh.faces.iter().enumerate() {
-        for t in &face.triangles {
-            if t.iter().all(|&n| (n as usize) < mesh.nodes.len()) {
-                scene.tris.push(*t);
-                scene.tri_face.push(f as u32);
-            }
-        }
-    }
-    shade(&mut scene, mesh, options.shading, camera);
+    shade(&mut scene, options.shading, camera);
     if let Some(section) = options.section {
         cut(&mut scene, section);
     }
@@ -238,87 +234,80 @@ fn intensity(normal: [f64; 3], light: [f64; 3]) -> [f32; 2] {
     ]
 }
 
-fn tri_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
-    let (a, b, c) = (p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
-    cross(
-        [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
-        [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
-    )
+/// The mesh's triangles grouped by face in face order, with their face; those
+/// naming a node the mesh lacks are left out. Borrowed when one face holds them all.
+fn triangles(mesh: &Mesh) -> (Cow<'_, [[u32; 3]]>, Vec<u32>) {
+    let n = mesh.nodes.len();
+    let valid = |t: &[u32; 3]| t.iter().all(|&i| (i as usize) < n);
+    let all_valid = mesh.faces.iter().all(|f| f.triangles.par_iter().all(valid));
+    let mut filled = (mesh.faces.iter().enumerate()).filter(|(_, f)| !f.triangles.is_empty());
+    if let (true, Some((f, face)), None) = (all_valid, filled.next(), filled.next()) {
+        let tri_face = vec![f as u32; face.triangles.len()];
+        return (Cow::Borrowed(&face.triangles), tri_face);
+    }
+    let total: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
+    let mut tris = Vec::with_capacity(total);
+    let mut tri_face = Vec::with_capacity(total);
+    for (f, face) in mesh.faces.iter().enumerate() {
+        for t in face.triangles.iter().filter(|t| valid(t)) {
+            tris.push(*t);
+            tri_face.push(f as u32);
+        }
+    }
+    (Cow::Owned(tris), tri_face)
 }
 
 /// Light per corner: flat gives each triangle one slot; smooth averages the
 /// area-weighted normals of a node within one face (creases between faces
 /// stay sharp).
-fn shade(scene: &mut Scene, mesh: &Mesh, shading: Shading, camera: &Camera) {
+fn shade(scene: &mut Scene, shading: Shading, camera: &Camera) {
     let light = light_direction(camera);
     match shading {
         Shading::Flat => {
-            scene.light = scene
-                .tris
-                .iter()
-                .map(|&t| intensity(tri_normal(&scene.points, t), light))
+            let points = &scene.points;
+            scene.light = (scene.tris.par_iter())
+                .map(|&t| intensity(tri_normal(points, t), light))
                 .collect();
-            scene.corner_slots = (0..scene.tris.len() as u32).map(|i| [i, i, i]).collect();
+            scene.corner_slots = Cow::Owned(
+                (0..scene.tris.len() as u32)
+                    .into_par_iter()
+                    .map(|i| [i, i, i])
+                    .collect(),
+            );
         }
         Shading::Smooth => {
-            // Normals computed where they are summed: a stored array of them
-            // costs more in memory traffic than the cross products.
-            let mut slot_of = vec![u32::MAX; mesh.nodes.len()];
-            let mut sums: Vec<[f64; 3]> = Vec::new();
-            scene.corner_slots = Vec::with_capacity(scene.tris.len());
-            let mut start = 0;
-            while start < scene.tris.len() {
-                let face = scene.tri_face[start];
-                let mut end = start;
-                while end < scene.tris.len() && scene.tri_face[end] == face {
-                    end += 1;
-                }
-                for &t in &scene.tris[start..end] {
-                    let n = tri_normal(&scene.points, t);
-                    let mut slots = [0u32; 3];
-                    for (k, &node) in t.iter().enumerate() {
-                        let s = &mut slot_of[node as usize];
-                        if *s == u32::MAX {
-                            *s = sums.len() as u32;
-                            sums.push([0.0; 3]);
-                        }
-                        let sum = &mut sums[*s as usize];
-                        sum[0] += n[0];
-                        sum[1] += n[1];
-                        sum[2] += n[2];
-                        slots[k] = *s;
-                    }
-                    scene.corner_slots.push(slots);
-                }
-                for &t in &scene.tris[start..end] {
-                    for node in t {
-                        slot_of[node as usize] = u32::MAX;
-                    }
-                }
-                start = end;
-            }
-            scene.light = sums.par_iter().map(|&n| intensity(n, light)).collect();
+            let (slots, light) =
+                smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, |n| {
+                    intensity(n, light)
+                });
+            scene.corner_slots = match slots {
+                Some(slots) => Cow::Owned(slots),
+                None => scene.tris.clone(),
+            };
+            scene.light = light;
         }
     }
 }
 
 /// Removes the part of every triangle on the far side of the section plane
 /// (coordinate > value), splitting the triangles it crosses.
-fn cut(scene: &mut Scene, section: Section) {
+fn cut(scene: &mut Scene<'_>, section: Section) {
     let axis = section.axis as usize;
     let value = section.value;
     let old_tris = std::mem::take(&mut scene.tris);
     let old_faces = std::mem::take(&mut scene.tri_face);
     let old_slots = std::mem::take(&mut scene.corner_slots);
+    let mut tris = Vec::with_capacity(old_tris.len());
+    let mut slots = Vec::with_capacity(old_tris.len());
     // Points made on a crossed edge, shared by the triangles on both sides of it.
     let mut made: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    for ((t, f), s) in old_tris.into_iter().zip(old_faces).zip(old_slots) {
+    for ((&t, f), &s) in old_tris.iter().zip(old_faces).zip(old_slots.iter()) {
         let d = t.map(|n| scene.points[n as usize][axis] - value);
         let kept = d.iter().filter(|&&v| v <= 0.0).count();
         if kept == 3 {
-            scene.tris.push(t);
+            tris.push(t);
             scene.tri_face.push(f);
-            scene.corner_slots.push(s);
+            slots.push(s);
             continue;
         }
         if kept == 0 {
@@ -343,6 +332,7 @@ fn cut(scene: &mut Scene, section: Section) {
                         p[c] = pa[c] + u * (pb[c] - pa[c]);
                     }
                     p[axis] = value;
+                    let points = points.to_mut();
                     points.push(p);
                     (points.len() - 1) as u32
                 });
@@ -355,11 +345,11 @@ fn cut(scene: &mut Scene, section: Section) {
             }
         }
         for k in 1..poly.len().saturating_sub(1) {
-            scene.tris.push([poly[0].0, poly[k].0, poly[k + 1].0]);
-            scene
-                .corner_slots
-                .push([poly[0].1, poly[k].1, poly[k + 1].1]);
+            tris.push([poly[0].0, poly[k].0, poly[k + 1].0]);
+            slots.push([poly[0].1, poly[k].1, poly[k + 1].1]);
             scene.tri_face.push(f);
         }
     }
+    scene.tris = Cow::Owned(tris);
+    scene.corner_slots = Cow::Owned(slots);
 }

@@ -1,0 +1,265 @@
+//! Smooth-shading normals: for each node of each face, the sum of the
+//! area-weighted normals of the face's triangles around it (creases between
+//! faces stay sharp). Computed in parallel in a fixed order, so any thread
+//! count gives the same sums: triangles are cut into chunks of a fixed size,
+//! each chunk sums into a small array over the nodes it touches, and the
+//! chunks' partial sums are added in chunk order.
+
+use super::camera::cross;
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicU32, Ordering};
+
+/// Triangles per chunk of partial sums.
+const CHUNK: usize = 1 << 14;
+/// Nodes per block of the final reduction.
+const BLOCK: usize = 1 << 12;
+/// Widest node range a chunk sums over in an array of its own; a mesh whose
+/// chunks reach further (nodes numbered without locality) is summed serially.
+const LOCAL_SPAN: usize = 2 * CHUNK;
+
+pub fn tri_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
+    let (a, b, c) = (p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
+    cross(
+        [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+        [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+    )
+}
+
+fn add(sum: &mut [f64; 3], n: [f64; 3]) {
+    sum[0] += n[0];
+    sum[1] += n[1];
+    sum[2] += n[2];
+}
+
+/// Per triangle corner a slot, and per slot `finish` of the summed normal
+/// (the light, for pictures: the sums themselves are never stored). A node's slot
+/// is its own index in the first face (lowest index) that uses it; the
+/// (face, node) pairs of later faces get slots after the nodes, in sorted order.
+/// The slots are `None` when they are the triangles' own nodes (one face).
+/// `tri_face` must be non-decreasing (triangles grouped by face in face order).
+pub fn per_slot<T: Copy + Default + Send + Sync>(
+    points: &[[f64; 3]],
+    tris: &[[u32; 3]],
+    tri_face: &[u32],
+    finish: impl Fn([f64; 3]) -> T + Sync,
+) -> (Option<Vec<[u32; 3]>>, Vec<T>) {
+    let n = points.len();
+    let (own_slots, extra) = if tri_face.first() == tri_face.last() {
+        (None, Vec::new())
+    } else {
+        let (slots, extra) = later_face_slots(n, tris, tri_face);
+        (Some(slots), extra)
+    };
+    let corner_slots: &[[u32; 3]] = own_slots.as_deref().unwrap_or(tris);
+    // Each chunk's node range over the corners of its first faces.
+    let spans: Vec<(usize, usize)> = corner_slots
+        .par_chunks(CHUNK)
+        .map(|chunk| {
+            let owned = chunk.iter().flatten().filter(|&&s| (s as usize) < n);
+            owned.fold((usize::MAX, 0), |(lo, hi), &s| {
+                (lo.min(s as usize), hi.max(s as usize + 1))
+            })
+        })
+        .collect();
+    let local = spans
+        .iter()
+        .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
+    if !local {
+        let mut sums = vec![[0.0; 3]; n + extra.len()];
+        for (t, s) in tris.iter().zip(corner_slots) {
+            let normal = tri_normal(points, *t);
+            for &k in s {
+                add(&mut sums[k as usize], normal);
+            }
+        }
+        return (own_slots, sums.par_iter().map(|&v| finish(v)).collect());
+    }
+    // Partial sums per chunk: an array over its node span, and the corners
+    // of later faces in order.
+    type Partial = (usize, Vec<[f64; 3]>, Vec<(u32, [f64; 3])>);
+    let partials: Vec<Partial> = tris
+        .par_chunks(CHUNK)
+        .zip(corner_slots.par_chunks(CHUNK))
+        .zip(&spans)
+        .map(|((ts, ss), &(lo, hi))| {
+            let mut part = vec![[0.0; 3]; hi.saturating_sub(lo)];
+            let mut later = Vec::new();
+            for (t, s) in ts.iter().zip(ss) {
+                let normal = tri_normal(points, *t);
+                for &k in s {
+                    if (k as usize) < n {
+                        add(&mut part[k as usize - lo], normal);
+                    } else {
+                        later.push((k, normal));
+                    }
+                }
+            }
+            (lo, part, later)
+        })
+        .collect();
+    let mut out = vec![T::default(); n + extra.len()];
+    let (owned, later) = out.split_at_mut(n);
+    owned.par_chunks_mut(BLOCK).enumerate().for_each_init(
+        Vec::new,
+        |sums: &mut Vec<[f64; 3]>, (b, block)| {
+            let (b0, b1) = (b * BLOCK, b * BLOCK + block.len());
+            sums.clear();
+            sums.resize(block.len(), [0.0; 3]);
+            for (lo, part, _) in &partials {
+                let (from, to) = (b0.max(*lo), b1.min(lo + part.len()));
+                for node in from..to {
+                    add(&mut sums[node - b0], part[node - lo]);
+                }
+            }
+            for (o, &v) in block.iter_mut().zip(sums.iter()) {
+                *o = finish(v);
+            }
+        },
+    );
+    let mut later_sums = vec![[0.0; 3]; later.len()];
+    for (_, _, extra_corners) in &partials {
+        for &(k, normal) in extra_corners {
+            add(&mut later_sums[k as usize - n], normal);
+        }
+    }
+    for (o, &v) in later.iter_mut().zip(&later_sums) {
+        *o = finish(v);
+    }
+    (own_slots, out)
+}
+
+/// The slots of a mesh of several faces, and the (face, node) pairs of the
+/// nodes used by a face after their first, sorted.
+fn later_face_slots(
+    n: usize,
+    tris: &[[u32; 3]],
+    tri_face: &[u32],
+) -> (Vec<[u32; 3]>, Vec<(u32, u32)>) {
+    let owner: Vec<AtomicU32> = (0..n).map(|_| AtomicU32::new(u32::MAX)).collect();
+    tris.par_iter().zip(tri_face).for_each(|(t, &f)| {
+        for &node in t {
+            owner[node as usize].fetch_min(f, Ordering::Relaxed);
+        }
+    });
+    let owner: Vec<u32> = owner.into_iter().map(AtomicU32::into_inner).collect();
+    let owner = &owner;
+    let mut extra: Vec<(u32, u32)> = tris
+        .par_iter()
+        .zip(tri_face)
+        .flat_map_iter(|(t, &f)| {
+            t.iter()
+                .filter(move |&&node| owner[node as usize] != f)
+                .map(move |&node| (f, node))
+        })
+        .collect();
+    extra.par_sort_unstable();
+    extra.dedup();
+    let slot = |node: u32, f: u32| -> u32 {
+        if owner[node as usize] == f {
+            node
+        } else {
+            // Always found: every pair of a later face was collected.
+            (n + extra.binary_search(&(f, node)).unwrap_or_else(|i| i)) as u32
+        }
+    };
+    let slots = tris
+        .par_iter()
+        .zip(tri_face)
+        .map(|(t, &f)| t.map(|node| slot(node, f)))
+        .collect();
+    (slots, extra)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A bumpy height field of `nx × ny` quads (two triangles each), nodes
+    /// numbered row by row, split into two faces at column `nx / 2`.
+    fn field(nx: u32, ny: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>, Vec<u32>) {
+        let mut points = Vec::new();
+        for j in 0..=ny {
+            for i in 0..=nx {
+                let (x, y) = (i as f64 * 0.1, j as f64 * 0.1);
+                points.push([x, y, (3.0 * x).sin() * (2.0 * y).cos()]);
+            }
+        }
+        let id = |i: u32, j: u32| j * (nx + 1) + i;
+        let mut faces: [Vec<[u32; 3]>; 2] = [Vec::new(), Vec::new()];
+        for j in 0..ny {
+            for i in 0..nx {
+                let f = &mut faces[usize::from(i >= nx / 2)];
+                f.push([id(i, j), id(i + 1, j), id(i + 1, j + 1)]);
+                f.push([id(i, j), id(i + 1, j + 1), id(i, j + 1)]);
+            }
+        }
+        let tri_face: Vec<u32> = (0..2)
+            .flat_map(|f| std::iter::repeat_n(f as u32, faces[f].len()))
+            .collect();
+        let tris = faces.concat();
+        (points, tris, tri_face)
+    }
+
+    /// The plain serial sums: per (face, node), in triangle order.
+    fn serial(p: &[[f64; 3]], tris: &[[u32; 3]], tri_face: &[u32]) -> Vec<[[f64; 3]; 3]> {
+        let mut sum = std::collections::HashMap::<(u32, u32), [f64; 3]>::new();
+        for (t, &f) in tris.iter().zip(tri_face) {
+            for &node in t {
+                add(sum.entry((f, node)).or_default(), tri_normal(p, *t));
+            }
+        }
+        (tris.iter().zip(tri_face))
+            .map(|(t, &f)| t.map(|node| sum[&(f, node)]))
+            .collect()
+    }
+
+    fn check(points: &[[f64; 3]], tris: &[[u32; 3]], tri_face: &[u32], (nx, ny): (usize, usize)) {
+        let (slots, sums) = per_slot(points, tris, tri_face, |v| v);
+        let one_face = tri_face.iter().all(|&f| f == 0);
+        assert_eq!(slots.is_none(), one_face);
+        let slots = slots.unwrap_or_else(|| tris.to_vec());
+        let want = serial(points, tris, tri_face);
+        assert_eq!(slots.len(), tris.len());
+        for (s, w) in slots.iter().zip(&want) {
+            for k in 0..3 {
+                let got = sums[s[k] as usize];
+                for c in 0..3 {
+                    assert!((got[c] - w[k][c]).abs() < 1e-12, "{got:?} vs {:?}", w[k]);
+                }
+            }
+        }
+        // A node on the crease between the faces has one slot per face.
+        let distinct: std::collections::HashSet<(u32, u32)> = (tris.iter().zip(&slots))
+            .flat_map(|(t, s)| (0..3).map(move |k| (t[k], s[k])))
+            .collect();
+        let nodes: std::collections::HashSet<u32> = tris.iter().flatten().copied().collect();
+        let crease = if one_face { 0 } else { ny + 1 };
+        assert_eq!(distinct.len(), nodes.len() + crease);
+        assert_eq!(nodes.len(), (nx + 1) * (ny + 1));
+    }
+
+    #[test]
+    fn chunked_sums_match_serial_sums_per_face() {
+        // 60,000 triangles: several chunks, nodes numbered with locality.
+        let (points, tris, tri_face) = field(300, 100);
+        assert!(tris.len() > 3 * CHUNK);
+        check(&points, &tris, &tri_face, (300, 100));
+        // As one face: the triangles are their own slots, no crease.
+        check(&points, &tris, &vec![0; tris.len()], (300, 100));
+    }
+
+    #[test]
+    fn nodes_numbered_without_locality_are_summed_serially_alike() {
+        let (points, tris, tri_face) = field(400, 100);
+        assert!(points.len() > LOCAL_SPAN);
+        // Renumber the nodes by a stride coprime to their count.
+        let n = points.len() as u64;
+        let to = |i: u32| ((i as u64 * 7919) % n) as u32;
+        let mut shuffled = vec![[0.0; 3]; points.len()];
+        for (i, p) in points.iter().enumerate() {
+            shuffled[to(i as u32) as usize] = *p;
+        }
+        let tris: Vec<[u32; 3]> = tris.iter().map(|t| t.map(to)).collect();
+        check(&shuffled, &tris, &tri_face, (400, 100));
+    }
+}
