@@ -461,6 +461,31 @@ fn a_folded_quadrilateral_meshes_small() {
     }
 }
 
+/// A poly_line along the bottom of a sliver 0.0078 high and 4 long, 0.00024
+/// from its side and ending on its far corner (an edge crack, session 7):
+/// the last round's poly_line splitting found its pieces encroached and
+/// skinny however short they got and split them without end (captured from
+/// the fuzzer after 7 minutes). Pieces shorter than twice the tolerance are
+/// now left whole; the input meshes at once. The sliver between the crack and
+/// the side is far below the tolerance (0.004), so no angle is promised
+/// there: the test asserts a bounded, sane mesh covering the polygon.
+#[test]
+fn a_crack_ending_on_a_tiny_corner_meshes_small() {
+    let found = inputs("triangulate_crack_tip");
+    assert_eq!(found.len(), 1, "triangulate_crack_tip regression inputs");
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        assert_eq!(input.segments.len(), 1, "{}", path.display());
+        let (triangles, _) = mesh_thin_above(&path.display().to_string(), &input, 0.0)
+            .unwrap_or_else(|| panic!("{}: refused by the front end", path.display()));
+        assert!(
+            triangles <= 2_000,
+            "{}: {triangles} triangles",
+            path.display()
+        );
+    }
+}
+
 #[path = "../fuzz/shared/density_case.rs"]
 mod density_case;
 

@@ -299,6 +299,7 @@ pub(crate) fn mesh_face(
                     &polyline_segments,
                     settings.min_angle,
                     settings.max_area,
+                    settings.tolerance,
                 )
                 .map_err(failed)?;
                 if split == 0 {

@@ -16,12 +16,17 @@ use spade::handles::FixedVertexHandle;
 use spade::{Point2, Triangulation};
 
 /// Splits the encroached or badly surrounded poly_line pieces; returns how
-/// many were split (0: the poly_lines are done).
+/// many were split (0: the poly_lines are done). A piece shorter than twice
+/// `min_length` (the tolerance: below the model's resolution) is left
+/// whole: where a poly_line meets a side at a tiny angle, its pieces are
+/// encroached and skinny however short they get (a crack ending on a corner
+/// at 0.003° split without end).
 pub(super) fn split_pieces(
     cdt: &mut Cdt,
     polyline_segments: &[(usize, usize)],
     min_angle_degrees: f64,
     max_area: f64,
+    min_length: f64,
 ) -> Result<usize, String> {
     let cos_limit = min_angle_degrees.to_radians().cos();
     let mut pieces: Vec<(FixedVertexHandle, FixedVertexHandle, Point2<f64>)> = Vec::new();
@@ -31,6 +36,9 @@ pub(super) fn split_pieces(
         }
         let [a, b] = edge.vertices();
         let (pa, pb) = (a.position(), b.position());
+        if (pb.x - pa.x).hypot(pb.y - pa.y) < 2.0 * min_length {
+            continue;
+        }
         let mid = Point2::new(0.5 * (pa.x + pb.x), 0.5 * (pa.y + pb.y));
         let (ia, ib) = (a.fix().index(), b.fix().index());
         let on_polyline = polyline_segments.iter().any(|&(p, q)| {
