@@ -486,6 +486,34 @@ fn a_crack_ending_on_a_tiny_corner_meshes_small() {
     }
 }
 
+/// A poly_line from a polygon corner along that corner's side for 0.0129
+/// and on inside (found by `triangulate`, session 7, the day edge cracks
+/// arrived): the probes (points and midpoints) missed the shared stretch,
+/// and the mesh was not conforming ("segment … is used by 1 triangles").
+/// A side running along the poly_line from its tip is contact away from
+/// the tip, refused with E502 naming the poly_line.
+#[test]
+fn a_poly_line_running_along_a_side_from_its_tip_is_refused() {
+    let found = inputs("triangulate_tip_overlap");
+    assert_eq!(found.len(), 1, "triangulate_tip_overlap regression inputs");
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        assert_eq!(input.segments, [[[1.062255859375, 0.0], [0.0, 0.0]]]);
+        let checked = check_triangulate(&input);
+        let lowered = checked.lowered.expect("the front end accepts it");
+        match geomc::meshing::mesh_model(&lowered.model, &input.options) {
+            Err(geomc::meshing::MeshError::Face { face, reason }) => {
+                assert_eq!(face, "inside", "{}", path.display());
+                assert!(
+                    reason.contains("poly_line `cut` touches or crosses"),
+                    "{reason}"
+                );
+            }
+            other => panic!("{}: expected the refusal, got {other:?}", path.display()),
+        }
+    }
+}
+
 #[path = "../fuzz/shared/density_case.rs"]
 mod density_case;
 

@@ -91,7 +91,8 @@ pub(crate) fn assign(
                 .iter()
                 .enumerate()
                 .any(|(k, p)| !tip_ends.contains(&k) && touching(p).is_some())
-                || crosses(loops, points, &tip_ends, tolerance);
+                || crosses(loops, points, &tip_ends, tolerance)
+                || runs_along_at_tip(loops, points, &tip_ends, tolerance);
             if other_contact {
                 return Err(refuse(format!(
                     "poly_line `{}` touches or crosses its boundary (within the tolerance {:e}) away from its end points; a poly_line constraint must lie inside one subdomain, touching its boundary only at its first or last point",
@@ -179,6 +180,32 @@ fn crosses(loops: &[Vec<LoopSegment>], line: &[Point3], tips: &[usize], toleranc
                     && polygon::segment_distance(&line[*i], &seg.a, &seg.b) <= tolerance
             });
             !at_tip && segments_cross(&w[0], &w[1], &seg.a, &seg.b)
+        })
+    })
+}
+
+/// Whether a loop segment that meets a tip runs along the poly_line's piece
+/// from that tip: its far end lies on the piece (within `tolerance`). The
+/// probes (points and midpoints) miss such an overlap when it is shorter
+/// than half the piece, and the triangulation would then take the shared
+/// stretch as two constraints on one line (fuzz `triangulate`, session 7).
+fn runs_along_at_tip(
+    loops: &[Vec<LoopSegment>],
+    line: &[Point3],
+    tips: &[usize],
+    tolerance: f64,
+) -> bool {
+    tips.iter().any(|&k| {
+        let next = if k == 0 { 1 } else { k - 1 };
+        let (Some(tip), Some(other)) = (line.get(k), line.get(next)) else {
+            return false;
+        };
+        loops.iter().flatten().any(|seg| {
+            polygon::segment_distance(tip, &seg.a, &seg.b) <= tolerance
+                && [seg.a, seg.b].iter().any(|q| {
+                    (q - tip).norm() > tolerance
+                        && polygon::segment_distance(q, tip, other) <= tolerance
+                })
         })
     })
 }
