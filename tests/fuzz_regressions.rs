@@ -514,6 +514,34 @@ fn a_poly_line_running_along_a_side_from_its_tip_is_refused() {
     }
 }
 
+/// A triangle 7.5 long and 0.00024 wide at its base (angles of 0.002°),
+/// far thinner than the tolerance (0.0075): meshing left triangles whose
+/// corners are collinear, which `sanity_check` refuses (fuzz `triangulate`,
+/// session 7; the mesher before that day's merges gave 81 of them). It is
+/// now refused with E502 naming the collapse and the tolerance.
+#[test]
+fn a_face_thinner_than_the_tolerance_is_refused_not_collapsed() {
+    let found = inputs("triangulate_collapsed");
+    assert_eq!(found.len(), 1, "triangulate_collapsed regression inputs");
+    for (path, bytes) in &found {
+        let input = decode_triangulate(bytes);
+        let checked = check_triangulate(&input);
+        let lowered = checked.lowered.expect("the front end accepts it");
+        match geomc::meshing::mesh_model(&lowered.model, &input.options) {
+            Err(geomc::meshing::MeshError::Face { face, reason }) => {
+                assert_eq!(face, "inside", "{}", path.display());
+                assert!(reason.contains("too thin to mesh"), "{reason}");
+            }
+            Ok(mesh) => panic!(
+                "{}: meshed, sanity check says {:?}",
+                path.display(),
+                geomc::meshing::sanity_check(&mesh)
+            ),
+            Err(other) => panic!("{}: {other:?}", path.display()),
+        }
+    }
+}
+
 #[path = "../fuzz/shared/density_case.rs"]
 mod density_case;
 

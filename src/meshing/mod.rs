@@ -215,6 +215,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         || "the assembly of the mesh".to_string(),
         || {
             let mut mesh = assemble(model, &edge_nodes, face_meshes, &lines);
+            refuse_collapsed(&mesh, tolerance)?;
             trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
             crack::open(model, &mut mesh);
             if options.order == 2 {
@@ -223,6 +224,32 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             Ok(mesh)
         },
     )
+}
+
+/// A face far thinner than the tolerance (a 0.002° sliver) can leave
+/// triangles whose corners are collinear in the assembled nodes (boundary
+/// nodes are recomputed on their curves): refused, by `sanity_check`'s
+/// measure, rather than written for a solver to divide by their zero area.
+fn refuse_collapsed(mesh: &Mesh, tolerance: f64) -> Result<(), MeshError> {
+    for face in &mesh.faces {
+        for t in &face.triangles {
+            let [a, b, c] = t.map(|i| {
+                nalgebra::Vector3::from(mesh.nodes.get(i as usize).copied().unwrap_or_default())
+            });
+            let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+            let twice = (b - a).cross(&(c - a)).norm();
+            if twice <= 1e-14 * longest * longest {
+                return Err(MeshError::Face {
+                    face: face.name.clone(),
+                    reason: format!(
+                        "it is too thin to mesh: a triangle across it collapses to no area (width {:e}, under the tolerance {tolerance:e}); widen it or remove it",
+                        twice / longest.max(f64::MIN_POSITIVE)
+                    ),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Each face's area limit: the smallest of `max_area` and the `area=` of
