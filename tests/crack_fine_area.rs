@@ -10,7 +10,8 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
-use std::collections::HashMap;
+mod mesh2d_common;
+use mesh2d_common::{edge_uses, length, min_angle_degrees};
 
 fn cracked_plate(max_area: f64) -> Mesh {
     let xml = r#"<geometry version="1" dimension="2">
@@ -29,30 +30,6 @@ fn cracked_plate(max_area: f64) -> Mesh {
         ..MeshOptions::default()
     };
     mesh_model(&model, &options).expect("meshes")
-}
-
-fn length(mesh: &Mesh, nodes: &[u32]) -> f64 {
-    nodes
-        .windows(2)
-        .map(|w| {
-            let [p, q] = [w[0], w[1]].map(|n| mesh.nodes[n as usize]);
-            (q[0] - p[0]).hypot(q[1] - p[1])
-        })
-        .sum()
-}
-
-fn min_angle_degrees(mesh: &Mesh) -> f64 {
-    let mut least = f64::INFINITY;
-    for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
-        let p = t.map(|n| mesh.nodes[n as usize]);
-        for k in 0..3 {
-            let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
-            let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
-            let cos = (u[0] * v[0] + u[1] * v[1]) / (u[0].hypot(u[1]) * v[0].hypot(v[1]));
-            least = least.min(cos.clamp(-1.0, 1.0).acos().to_degrees());
-        }
-    }
-    least
 }
 
 #[test]
@@ -88,13 +65,7 @@ fn vertical_crack_is_split_and_opened_at_every_area_limit() {
         assert!((length(&mesh, &right) - 0.6).abs() < 1e-12);
         // Every crack segment on either side is a mesh edge of exactly one
         // triangle (the slit is open); every other interior edge has two.
-        let mut uses: HashMap<(u32, u32), usize> = HashMap::new();
-        for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
-            for k in 0..3 {
-                let (a, b) = (t[k], t[(k + 1) % 3]);
-                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
-            }
-        }
+        let uses = edge_uses(&mesh);
         for nodes in [&left, &right] {
             for w in nodes.windows(2) {
                 assert_eq!(uses.get(&(w[0].min(w[1]), w[0].max(w[1]))), Some(&1));

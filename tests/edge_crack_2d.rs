@@ -9,7 +9,10 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshError, MeshOptions, mesh_model};
 use geomc::span::SourceFile;
-use std::collections::{HashMap, HashSet};
+use std::collections::HashSet;
+
+mod mesh2d_common;
+use mesh2d_common::{edge_uses, key, length, min_angle_degrees};
 
 fn mesh(lines: &str, max_area: f64) -> Result<Mesh, MeshError> {
     let xml = format!(
@@ -41,44 +44,6 @@ fn line(name: &str, crack: bool, points: &[(f64, f64)]) -> String {
         })
         .collect();
     format!(r#"<poly_line name="{name}" crack="{crack}">{segments}</poly_line>"#)
-}
-
-fn length(mesh: &Mesh, nodes: &[u32]) -> f64 {
-    nodes
-        .windows(2)
-        .map(|w| {
-            let [p, q] = [w[0], w[1]].map(|n| mesh.nodes[n as usize]);
-            (q[0] - p[0]).hypot(q[1] - p[1])
-        })
-        .sum()
-}
-
-fn key(a: u32, b: u32) -> (u32, u32) {
-    (a.min(b), a.max(b))
-}
-
-fn edge_uses(mesh: &Mesh) -> HashMap<(u32, u32), usize> {
-    let mut uses = HashMap::new();
-    for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
-        for k in 0..3 {
-            *uses.entry(key(t[k], t[(k + 1) % 3])).or_default() += 1;
-        }
-    }
-    uses
-}
-
-fn min_angle_degrees(mesh: &Mesh) -> f64 {
-    let mut least = f64::INFINITY;
-    for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
-        let p = t.map(|n| mesh.nodes[n as usize]);
-        for k in 0..3 {
-            let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
-            let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
-            let cos = (u[0] * v[0] + u[1] * v[1]) / (u[0].hypot(u[1]) * v[0].hypot(v[1]));
-            least = least.min(cos.clamp(-1.0, 1.0).acos().to_degrees());
-        }
-    }
-    least
 }
 
 #[test]

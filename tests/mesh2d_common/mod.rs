@@ -1,0 +1,48 @@
+//! Facts about 2D meshes shared by the crack tests: chain lengths, how many
+//! triangles use each edge, and the smallest angle.
+#![allow(dead_code)]
+
+use geomc::mesh::Mesh;
+use std::collections::HashMap;
+
+/// The length of a node chain.
+pub fn length(mesh: &Mesh, nodes: &[u32]) -> f64 {
+    nodes
+        .windows(2)
+        .map(|w| {
+            let [p, q] = [w[0], w[1]].map(|n| mesh.nodes[n as usize]);
+            (q[0] - p[0]).hypot(q[1] - p[1])
+        })
+        .sum()
+}
+
+/// An undirected edge's key.
+pub fn key(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// How many triangles use each edge.
+pub fn edge_uses(mesh: &Mesh) -> HashMap<(u32, u32), usize> {
+    let mut uses = HashMap::new();
+    for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
+        for k in 0..3 {
+            *uses.entry(key(t[k], t[(k + 1) % 3])).or_default() += 1;
+        }
+    }
+    uses
+}
+
+/// The smallest angle of any triangle, in degrees.
+pub fn min_angle_degrees(mesh: &Mesh) -> f64 {
+    let mut least = f64::INFINITY;
+    for t in mesh.faces.iter().flat_map(|f| &f.triangles) {
+        let p = t.map(|n| mesh.nodes[n as usize]);
+        for k in 0..3 {
+            let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+            let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
+            let cos = (u[0] * v[0] + u[1] * v[1]) / (u[0].hypot(u[1]) * v[0].hypot(v[1]));
+            least = least.min(cos.clamp(-1.0, 1.0).acos().to_degrees());
+        }
+    }
+    least
+}
