@@ -73,8 +73,7 @@ pub fn sanity_check(mesh: &Mesh) -> Result<(), String> {
                 ));
             }
             let [a, b, c] = t.map(|i| nalgebra::Vector3::from(mesh.nodes[i as usize]));
-            let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-            if (b - a).cross(&(c - a)).norm() <= 1e-14 * longest * longest {
+            if no_area_width(&a, &b, &c).is_some() {
                 return Err(format!(
                     "face {} has a triangle of no area {t:?}",
                     face.name
@@ -234,4 +233,17 @@ pub fn quality(mesh: &Mesh) -> Quality {
         });
     }
     q
+}
+
+/// The width (twice the area over the longest side) of a triangle whose
+/// area is below 1e-14 of its longest side squared, or `None` for a triangle
+/// with area.
+pub(crate) fn no_area_width(
+    a: &nalgebra::Vector3<f64>,
+    b: &nalgebra::Vector3<f64>,
+    c: &nalgebra::Vector3<f64>,
+) -> Option<f64> {
+    let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
+    let twice = (b - a).cross(&(c - a)).norm();
+    (twice <= 1e-14 * longest * longest).then(|| twice / longest.max(f64::MIN_POSITIVE))
 }

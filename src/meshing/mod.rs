@@ -236,14 +236,11 @@ fn refuse_collapsed(mesh: &Mesh, tolerance: f64) -> Result<(), MeshError> {
             let [a, b, c] = t.map(|i| {
                 nalgebra::Vector3::from(mesh.nodes.get(i as usize).copied().unwrap_or_default())
             });
-            let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-            let twice = (b - a).cross(&(c - a)).norm();
-            if twice <= 1e-14 * longest * longest {
+            if let Some(width) = check::no_area_width(&a, &b, &c) {
                 return Err(MeshError::Face {
                     face: face.name.clone(),
                     reason: format!(
-                        "it is too thin to mesh: a triangle across it collapses to no area (width {:e}, under the tolerance {tolerance:e}); widen it or remove it",
-                        twice / longest.max(f64::MIN_POSITIVE)
+                        "it is too thin to mesh: a triangle across it collapses to no area (width {width:e}, under the tolerance {tolerance:e}); widen it or remove it"
                     ),
                 });
             }
