@@ -9,13 +9,10 @@
 //!   a keep-out disk around every boundary segment (¾ of its length about
 //!   its midpoint), which holds its diametral circle: no seed encroaches a
 //!   boundary segment, so seeding never makes refinement split the boundary.
-//! - First a front row: the inner apex of the equilateral triangle on each
-//!   boundary segment (so the triangles along the boundary are as fine as
-//!   the boundary). Then the vertices of a subdivision of one equilateral
-//!   triangle, refined where the chart's local size asks for it, kept when
-//!   no front point is within 0.4 of their triangle's side. The same input
-//!   gives the same points in the same order (rows of the lattice),
-//!   whatever the thread count.
+//! - Points are vertices of a subdivision of one equilateral triangle,
+//!   refined where the chart's local size asks for it: the same input gives
+//!   the same points in the same order (rows of the lattice), whatever the
+//!   thread count.
 //! - An empty result (nothing seeded) when the face is too small for a
 //!   point or the lattice would exceed `max_points`.
 //!
