@@ -43,10 +43,6 @@ const MAX_PASSES: usize = 60;
 /// boundary (another meshing round); at 6–8 a sphere face takes 2–3 passes
 /// instead of 9–10, with 8% more triangles at the same tolerance.
 const GUIDE_FACTOR: f64 = 8.0;
-/// The share of the tolerance a seeded triangle's chord may take
-/// (`seed_edge`): subdivision leaves sizes between half and all of the
-/// asked one, and the margin keeps the chordal passes from finding work.
-const SEED_SHARE: f64 = 0.9;
 /// Nodes one face may have.
 const MAX_FACE_VERTICES: usize = 2_000_000;
 
@@ -251,27 +247,6 @@ pub(crate) fn mesh_face(
     // sets on every call (a tenth of the meshing time); a single loop that is
     // the convex hull (a hemisphere's circle, a convex polygon) has no outside.
     let peel = polyline_segments.is_empty() && !loop_is_hull(&cdt, &uv_loops);
-    // Curved faces get their interior points up front, sized for the
-    // tolerance (`seed`): the passes of refinement and chordal insertion
-    // each scanned the whole face, and were most of the meshing time.
-    if !small_angle
-        && !framed
-        && polyline_segments.is_empty()
-        && let Some(edge) = seed_edge(&face.surface, settings)
-    {
-        let seeds = super::seed::lattice_points(&chart, &uv_loops, edge, MAX_FACE_VERTICES);
-        let mut hint = None;
-        for uv in seeds {
-            let inserted = match hint {
-                Some(h) => cdt.insert_with_hint(point2(uv), h),
-                None => cdt.insert(point2(uv)),
-            };
-            hint = Some(
-                inserted
-                    .map_err(|e| failed(format!("a seed point cannot be triangulated: {e:?}")))?,
-            );
-        }
-    }
     let mut parameters = RefinementParameters::<f64>::new()
         // Spade's peeling takes an open poly_line for a loop: with poly_lines
         // the outside is found here instead (`outside_faces`).
@@ -764,22 +739,6 @@ fn guide_area(uv_loops: &[Vec<[f64; 2]>], surface: &Surface) -> f64 {
     let rank = lengths.len() * 9 / 10;
     let (_, length, _) = lengths.select_nth_unstable_by(rank, f64::total_cmp);
     GUIDE_FACTOR * 3f64.sqrt() / 4.0 * *length * *length
-}
-
-/// The edge length on the surface of the seeded equilateral triangles of a
-/// sphere: circumradius ρ with the chord's depth ρ²/(2R) at `SEED_SHARE` of
-/// the tolerance, at most a uniform `--max-edge`. `None` (no seeding) for
-/// other surfaces, size fields and area limits.
-fn seed_edge(surface: &Surface, settings: &Settings) -> Option<f64> {
-    let Surface::Ellipsoid { frame } = surface else {
-        return None;
-    };
-    let radius = frame.similarity_scale()?;
-    if settings.max_area.is_finite() || !settings.sizing.is_uniform() {
-        return None;
-    }
-    let rho = (2.0 * radius * SEED_SHARE * settings.tolerance).sqrt();
-    Some((3f64.sqrt() * rho).min(settings.sizing.at(&frame.origin)))
 }
 
 /// The parameter t ∈ (0, 1) of `p` on the segment between vertices `a` and

@@ -34,7 +34,6 @@ mod guard;
 mod polyline_split;
 mod quadratic;
 mod report;
-mod seed;
 mod size;
 mod trimmed;
 pub use trimmed::TrimmedReport;
