@@ -5,9 +5,9 @@
 
 use super::MeshError;
 use super::guard::guarded;
+use crate::geom::Point3;
 use crate::ir::Model;
 use crate::mesh::{Mesh, MeshEdge, MeshFace};
-use crate::geom::Point3;
 use crate::trimmed::shared::coincide;
 use crate::trimmed::{
     TrimSettings, TrimmedMesh, TrimmedSurface, mesh_trimmed, mesh_trimmed_shared,
@@ -137,7 +137,12 @@ fn share(
         .iter()
         .enumerate()
         .filter(|(_, e)| e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last())
-        .map(|(i, e)| (ChainSource::Edge(i), e.nodes.iter().map(|&n| point(n)).collect()))
+        .map(|(i, e)| {
+            (
+                ChainSource::Edge(i),
+                e.nodes.iter().map(|&n| point(n)).collect(),
+            )
+        })
         .collect();
     let chain_points = |m: &TrimmedMesh, k: usize| -> Vec<Point3> {
         m.boundary[k].iter().map(|&n| m.nodes[n as usize]).collect()

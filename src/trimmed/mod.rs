@@ -8,8 +8,8 @@ pub(crate) mod boundary;
 mod chart;
 mod measure;
 mod pole;
-pub mod shared;
 pub mod program;
+pub mod shared;
 mod split;
 mod triangulate;
 

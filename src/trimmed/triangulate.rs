@@ -298,10 +298,8 @@ fn mesh_band(
         .iter()
         .map(|c| c.iter().all(|&h| nodes.sides[h] & !shared::SHARED == 0))
         .collect();
-    let shared: Vec<(usize, usize, usize)> = shared
-        .iter()
-        .map(|&(p, c, i)| (handles[p], c, i))
-        .collect();
+    let shared: Vec<(usize, usize, usize)> =
+        shared.iter().map(|&(p, c, i)| (handles[p], c, i)).collect();
     let (uvs, points3) = (nodes.uv, nodes.xyz);
     let mut mesh = assemble(&uvs, &points3, &inner, &remap, &boundary_chains, &shared);
     mesh.trim_loop = trim_loop;
