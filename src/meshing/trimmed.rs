@@ -44,7 +44,8 @@ pub(super) fn append(
         .par_iter()
         .map(|s| mesh_one(s, &[]))
         .collect::<Result<Vec<_>, MeshError>>()?;
-    let sources = share(model, mesh, &mut meshes, tolerance, &mesh_one)?;
+    let edges = closed_edges(mesh, |_| true);
+    let sources = share(model, &edges, &mut meshes, tolerance, &mesh_one)?;
     // Global node ids: each surface's own nodes in model order, then the
     // shared ones from the chain they were taken from.
     let mut ids: Vec<Vec<u32>> = Vec::with_capacity(meshes.len());
@@ -107,6 +108,21 @@ pub(super) fn append(
     Ok(())
 }
 
+/// The closed edges of `mesh` (first node repeated last) that `keep` keeps,
+/// as chains a trim loop may take.
+fn closed_edges(mesh: &Mesh, keep: impl Fn(&str) -> bool) -> Vec<(ChainSource, Vec<Point3>)> {
+    let point = |n: u32| {
+        let p = mesh.nodes.get(n as usize).copied().unwrap_or([f64::NAN; 3]);
+        Point3::new(p[0], p[1], p[2])
+    };
+    mesh.edges
+        .iter()
+        .enumerate()
+        .filter(|(_, e)| e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last() && keep(&e.name))
+        .map(|(i, e)| (ChainSource::Edge(i), e.nodes.iter().map(|&n| point(n)).collect()))
+        .collect()
+}
+
 /// Where a chain offered to a trimmed surface comes from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum ChainSource {
@@ -123,27 +139,11 @@ enum ChainSource {
 /// surface the sources of the chains it was given.
 fn share(
     model: &Model,
-    mesh: &Mesh,
+    edges: &[(ChainSource, Vec<Point3>)],
     meshes: &mut [TrimmedMesh],
     tolerance: f64,
     mesh_one: &(dyn Fn(&TrimmedSurface, &[Vec<Point3>]) -> Result<TrimmedMesh, MeshError> + Sync),
 ) -> Result<Vec<Vec<ChainSource>>, MeshError> {
-    let point = |n: u32| {
-        let p = mesh.nodes[n as usize];
-        Point3::new(p[0], p[1], p[2])
-    };
-    let edges: Vec<(ChainSource, Vec<Point3>)> = mesh
-        .edges
-        .iter()
-        .enumerate()
-        .filter(|(_, e)| e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last())
-        .map(|(i, e)| {
-            (
-                ChainSource::Edge(i),
-                e.nodes.iter().map(|&n| point(n)).collect(),
-            )
-        })
-        .collect();
     let chain_points = |m: &TrimmedMesh, k: usize| -> Vec<Point3> {
         m.boundary[k].iter().map(|&n| m.nodes[n as usize]).collect()
     };
@@ -176,7 +176,7 @@ fn share(
         .or_else(|| (0..n).find(|&j| pending[j]))
     {
         pending[j] = false;
-        let mut offered = edges.clone();
+        let mut offered = edges.to_vec();
         for (i, m) in meshes.iter().enumerate() {
             if i != j && !pending[i] {
                 for k in 0..m.boundary.len() {
@@ -204,10 +204,11 @@ pub struct TrimmedReport {
     pub area: f64,
 }
 
-/// Re-meshes each trimmed surface as `append` did (the result is the same)
-/// to measure it with its parameters at hand.
+/// Re-meshes each trimmed surface as `append` did, shared chains included
+/// (the result is the same), to measure it with its parameters at hand.
 pub(super) fn reports(
     model: &Model,
+    mesh: &Mesh,
     tolerance: f64,
     max_edge: Option<f64>,
     min_angle: f64,
@@ -217,20 +218,45 @@ pub(super) fn reports(
         min_angle,
         max_edge: max_edge.unwrap_or(f64::INFINITY),
     };
-    model
+    let mesh_one = |s: &TrimmedSurface, chains: &[Vec<Point3>]| {
+        mesh_trimmed_shared(s, settings, chains).map_err(|reason| MeshError::Face {
+            face: s.name.clone(),
+            reason,
+        })
+    };
+    let Ok(mut meshes) = model
         .trimmed
         .par_iter()
-        .filter_map(|s| {
-            let m = mesh_trimmed(s, settings).ok()?;
+        .map(|s| mesh_one(s, &[]))
+        .collect::<Result<Vec<_>, MeshError>>()
+    else {
+        return Vec::new();
+    };
+    // The model's own closed edges, not the trimmed chains appended after them.
+    let trimmed_chain = |name: &str| {
+        model
+            .trimmed
+            .iter()
+            .any(|s| name.strip_prefix(s.name.as_str()).is_some_and(|r| r.starts_with(".boundary[")))
+    };
+    let edges = closed_edges(mesh, |name| !trimmed_chain(name));
+    if share(model, &edges, &mut meshes, tolerance, &mesh_one).is_err() {
+        return Vec::new();
+    }
+    model
+        .trimmed
+        .iter()
+        .zip(&meshes)
+        .map(|(s, m)| {
             let q = m.quality(s);
-            Some(TrimmedReport {
+            TrimmedReport {
                 name: s.name.clone(),
                 triangles: m.triangles.len(),
                 min_angle: q.min_angle,
                 min_angle_histogram: q.histogram,
                 max_centroid_distance: q.max_centroid_distance,
                 area: q.area,
-            })
+            }
         })
         .collect()
 }
