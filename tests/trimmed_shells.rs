@@ -57,7 +57,10 @@ fn closed_volume(mesh: &Mesh, subdomain: &str) -> f64 {
         }
     }
     for (&(a, b), &n) in &directed {
-        assert_eq!(n, 1, "{subdomain}: edge {a}-{b} runs the same way {n} times");
+        assert_eq!(
+            n, 1,
+            "{subdomain}: edge {a}-{b} runs the same way {n} times"
+        );
         assert_eq!(
             directed.get(&(b, a)),
             Some(&1),
@@ -137,7 +140,10 @@ fn a_trimmed_face_between_two_subdomains_is_their_fragment() {
     let lower = closed_volume(&mesh, "lower");
     let upper = closed_volume(&mesh, "upper");
     assert!((lower - PI).abs() < 0.01 * PI, "lower {lower}");
-    assert!((upper - 0.36 * PI).abs() < 0.01 * 0.36 * PI, "upper {upper}");
+    assert!(
+        (upper - 0.36 * PI).abs() < 0.01 * 0.36 * PI,
+        "upper {upper}"
+    );
     let names = |f: &geomc::mesh::MeshFragment| -> Vec<String> {
         f.faces
             .iter()
@@ -150,10 +156,7 @@ fn a_trimmed_face_between_two_subdomains_is_their_fragment() {
         .map(|f| (f.name.clone(), names(f)))
         .collect();
     assert_eq!(by_name["lower|upper"], ["middle"]);
-    assert_eq!(
-        by_name["lower|exterior"],
-        ["base", "lower_tube", "ring"]
-    );
+    assert_eq!(by_name["lower|exterior"], ["base", "lower_tube", "ring"]);
     assert_eq!(by_name["upper|exterior"], ["upper_tube", "roof"]);
     // The middle disk faces out of `lower` and into `upper`.
     let flag = |sub: &str| {
@@ -179,7 +182,10 @@ fn gmsh_reads_the_trimmed_fragments_and_fills_both_volumes() {
         .expect("geomc runs");
     assert_eq!(status.status.code(), Some(0), "{status:?}");
     let report = run_json("python3", "check_mesh.py", &[&out, Path::new("--tetra")]);
-    assert_eq!(report["meshio"]["points"], report["gmsh"]["nodes"], "{report}");
+    assert_eq!(
+        report["meshio"]["points"], report["gmsh"]["nodes"],
+        "{report}"
+    );
     let triangles = |name: &str| {
         report["gmsh"]["groups"]
             .as_array()
@@ -191,7 +197,10 @@ fn gmsh_reads_the_trimmed_fragments_and_fills_both_volumes() {
     assert_eq!(triangles("lower|upper"), Some(middle));
     for volume in ["lower", "upper"] {
         let n = report["tetra"]["tetrahedra"][volume].as_u64().unwrap_or(0);
-        assert!(n > 100, "gmsh filled {volume} with {n} tetrahedra: {report}");
+        assert!(
+            n > 100,
+            "gmsh filled {volume} with {n} tetrahedra: {report}"
+        );
     }
 }
 

@@ -119,7 +119,12 @@ fn closed_edges(mesh: &Mesh, keep: impl Fn(&str) -> bool) -> Vec<(ChainSource, V
         .iter()
         .enumerate()
         .filter(|(_, e)| e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last() && keep(&e.name))
-        .map(|(i, e)| (ChainSource::Edge(i), e.nodes.iter().map(|&n| point(n)).collect()))
+        .map(|(i, e)| {
+            (
+                ChainSource::Edge(i),
+                e.nodes.iter().map(|&n| point(n)).collect(),
+            )
+        })
         .collect()
 }
 
@@ -234,10 +239,10 @@ pub(super) fn reports(
     };
     // The model's own closed edges, not the trimmed chains appended after them.
     let trimmed_chain = |name: &str| {
-        model
-            .trimmed
-            .iter()
-            .any(|s| name.strip_prefix(s.name.as_str()).is_some_and(|r| r.starts_with(".boundary[")))
+        model.trimmed.iter().any(|s| {
+            name.strip_prefix(s.name.as_str())
+                .is_some_and(|r| r.starts_with(".boundary["))
+        })
     };
     let edges = closed_edges(mesh, |name| !trimmed_chain(name));
     if share(model, &edges, &mut meshes, tolerance, &mesh_one).is_err() {
