@@ -9,9 +9,7 @@ use crate::geom::Point3;
 use crate::ir::Model;
 use crate::mesh::{Mesh, MeshEdge, MeshFace};
 use crate::trimmed::shared::coincide;
-use crate::trimmed::{
-    TrimSettings, TrimmedMesh, TrimmedSurface, mesh_trimmed, mesh_trimmed_shared,
-};
+use crate::trimmed::{TrimSettings, TrimmedMesh, TrimmedSurface, mesh_trimmed_shared};
 use rayon::prelude::*;
 
 pub(super) fn append(
@@ -128,6 +126,10 @@ fn closed_edges(mesh: &Mesh, keep: impl Fn(&str) -> bool) -> Vec<(ChainSource, V
         .collect()
 }
 
+/// Meshes one surface given the chains it may share.
+type MeshOne<'a> =
+    dyn Fn(&TrimmedSurface, &[Vec<Point3>]) -> Result<TrimmedMesh, MeshError> + Sync + 'a;
+
 /// Where a chain offered to a trimmed surface comes from.
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum ChainSource {
@@ -147,7 +149,7 @@ fn share(
     edges: &[(ChainSource, Vec<Point3>)],
     meshes: &mut [TrimmedMesh],
     tolerance: f64,
-    mesh_one: &(dyn Fn(&TrimmedSurface, &[Vec<Point3>]) -> Result<TrimmedMesh, MeshError> + Sync),
+    mesh_one: &MeshOne<'_>,
 ) -> Result<Vec<Vec<ChainSource>>, MeshError> {
     let chain_points = |m: &TrimmedMesh, k: usize| -> Vec<Point3> {
         m.boundary[k].iter().map(|&n| m.nodes[n as usize]).collect()
