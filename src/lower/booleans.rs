@@ -7,7 +7,7 @@ use super::Entities;
 use super::explicit::{lookup_entities, unknown_entity};
 use super::weld::FaceSamples;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::doc::{Document, SolidTree};
+use crate::doc::{SolidTree, SubdomainDef};
 use crate::geom::{Point3, Surface, Vec3, boundary_relation};
 use crate::ir::{
     Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId, SourceMap,
@@ -47,7 +47,7 @@ struct Built {
 }
 
 pub(super) fn lower_subdomains(
-    doc: &Document,
+    defs: Vec<SubdomainDef>,
     resolved: &Resolved,
     model: &mut Model,
     source_map: &mut SourceMap,
@@ -55,9 +55,11 @@ pub(super) fn lower_subdomains(
     face_samples: &FaceSamples,
     diags: &mut Diagnostics,
 ) {
-    let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(doc.subdomains.len());
-    model.subdomains.reserve(doc.subdomains.len());
-    for (def_index, def) in doc.subdomains.iter().enumerate() {
+    let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(defs.len());
+    model.subdomains.reserve(defs.len());
+    // Consumed: each definition is dropped once lowered, so none is alive
+    // during the overlap check (the memory peak on large files).
+    for (def_index, def) in defs.into_iter().enumerate() {
         let id = SubdomainId(model.subdomains.len() as u32);
         let cells = match (&def.faces, &def.tree) {
             (Some(_), Some(_)) => {
@@ -109,8 +111,8 @@ pub(super) fn lower_subdomains(
             }
         };
         model.subdomains.push(Subdomain {
-            name: def.name.text.clone(),
-            material: def.material.clone(),
+            name: def.name.text,
+            material: def.material,
             cells,
             solids: Vec::new(),
             max_area: resolved.subdomain_areas.get(def_index).copied().flatten(),
