@@ -399,7 +399,7 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
 }
 
 /// A well-mixed 64-bit hash of a grid cell (fixed, so runs are reproducible).
-fn cell_hash(cell: [i64; 3]) -> u64 {
+pub(super) fn cell_hash(cell: [i64; 3]) -> u64 {
     use std::hash::BuildHasher;
     foldhash::quality::FixedState::with_seed(0x5eed).hash_one(cell)
 }
