@@ -437,6 +437,9 @@ fn each2(o: &mut [f32], a: Opd, b: Opd, f: impl Fn(f32, f32) -> f32) {
     }
 }
 
+// Index loops: the operand getter `ga` is indexed like `b`, one loop shape
+// for every combination, which the compiler vectorises.
+#[allow(clippy::needless_range_loop)]
 #[inline(always)]
 fn with_b(o: &mut [f32], b: Opd, ga: impl Fn(usize) -> f32, f: impl Fn(f32, f32) -> f32) {
     let n = o.len();
