@@ -10,7 +10,8 @@
 //!
 //! Run: `cargo bench --bench implicit` (add `-- --quick` for 128 cells,
 //! `-- --no-fidget` to skip the slow peer, `-- --no-dense` to skip the dense
-//! evaluation of M2 and M3, `-- --model M1` to mesh only M1). Without `--bench` (as under
+//! evaluation of M2 and M3, `-- --model M1` to mesh only M1, `-- --dense-only` for the dense
+//! evaluation alone). Without `--bench` (as under
 //! `cargo test --all-targets`) a 32-cell smoke run without peers.
 
 use geomc::implicit::ir::{Binary, Ctx, Node, NodeId, Unary};
@@ -220,9 +221,10 @@ fn fidget_mesh(ssa: &Ssa, depth: u8) -> usize {
 }
 
 /// fidget's JIT float-slice evaluator on every point of the grid, a z plane
-/// per call, planes spread over rayon's pool as for geomc: (seconds, the
-/// samples with geomc's sign convention, inside > 0).
-fn fidget_dense(ssa: &Ssa, grid: &Grid) -> (Duration, Vec<f32>) {
+/// per call, planes spread over rayon's pool as for geomc, into `values`
+/// (with geomc's sign convention, inside > 0): the wall time (median of
+/// `reps`; the CPU time goes to `LAST_CPU`).
+fn fidget_dense(ssa: &Ssa, grid: &Grid, values: &mut [f32], reps: usize) -> Duration {
     use fidget::jit::JitShape;
     use rayon::prelude::*;
     let shape = JitShape::from(to_fidget(ssa));
@@ -230,26 +232,22 @@ fn fidget_dense(ssa: &Ssa, grid: &Grid) -> (Duration, Vec<f32>) {
     let plane = xs.len() * ys.len();
     let px: Vec<f32> = (0..plane).map(|p| xs[p % xs.len()] as f32).collect();
     let py: Vec<f32> = (0..plane).map(|p| ys[p / xs.len()] as f32).collect();
-    let mut values = vec![0.0f32; plane * zs.len()];
-    let (start, cpu) = (Instant::now(), cpu_time());
-    values.par_chunks_mut(plane).enumerate().for_each_init(
-        || {
-            let tape = shape.float_slice_tape(Default::default());
-            (JitShape::new_float_slice_eval(), tape, vec![0.0f32; plane])
-        },
-        |(eval, tape, pz), (k, out)| {
-            pz.fill(zs[k] as f32);
-            let v = eval.eval(tape, &px, &py, pz).expect("x, y, z only");
-            for (o, &v) in out.iter_mut().zip(v) {
-                *o = -v;
-            }
-        },
-    );
-    let wall = start.elapsed();
-    if let Ok(mut l) = LAST_CPU.lock() {
-        *l = cpu_time().saturating_sub(cpu);
-    }
-    (wall, values)
+    time(reps, || {
+        values.par_chunks_mut(plane).enumerate().for_each_init(
+            || {
+                let tape = shape.float_slice_tape(Default::default());
+                (JitShape::new_float_slice_eval(), tape, vec![0.0f32; plane])
+            },
+            |(eval, tape, pz), (k, out)| {
+                pz.fill(zs[k] as f32);
+                let v = eval.eval(tape, &px, &py, pz).expect("x, y, z only");
+                for (o, &v) in out.iter_mut().zip(v) {
+                    *o = -v;
+                }
+            },
+        );
+    })
+    .0
 }
 
 /// VTK flying edges on `values` through the Python peer: (seconds, triangles),
@@ -317,8 +315,9 @@ fn main() {
         .iter()
         .position(|a| a == "--model")
         .and_then(|p| args.get(p + 1));
+    let dense_only = args.iter().any(|a| a == "--dense-only");
     for (name, build) in models {
-        if only.is_some_and(|m| !name.starts_with(m.as_str())) {
+        if dense_only || only.is_some_and(|m| !name.starts_with(m.as_str())) {
             continue;
         }
         let (t, s) = time(reps, || {
@@ -374,40 +373,53 @@ fn main() {
     }
     let ssa = m1();
     let tape = geomc::implicit::rows::RowTape::new(&ssa);
-    let (t, v) = time(reps.max(3), || polygonize::sample_grid(&ssa, &grid));
-    let m1_cpu = last_cpu();
-    assert_eq!(v.len(), (n + 1).pow(3));
     let points = ((n + 1) as f64).powi(3);
+    // Fresh allocation each run (the first touch of 68 MB of new pages is
+    // in the time), as the meshing path does it.
+    let (t_fresh, v) = time(reps.max(3), || polygonize::sample_grid(&ssa, &grid));
+    let fresh_cpu = last_cpu();
+    assert_eq!(v.len(), (n + 1).pow(3));
+    println!(
+        "dense M1 evaluation into fresh memory: {:.1} M points/s ({:.3} s, cpu {fresh_cpu:.3} s)",
+        points / t_fresh.as_secs_f64() / 1e6,
+        t_fresh.as_secs_f64()
+    );
+    // Evaluation alone: into a buffer already mapped (both evaluators below).
+    let mut buf = vec![1.0f32; v.len()];
+    let (t, ()) = time(reps.max(5), || {
+        polygonize::sample_grid_into(&ssa, &grid, &mut buf)
+    });
+    let m1_cpu = last_cpu();
+    assert!(buf.iter().zip(&v).all(|(a, b)| a.to_bits() == b.to_bits()));
     let rate = points / t.as_secs_f64();
-    // 6 unions × 6 flops + 7 balls × 2 per point (the x, y and z terms are
-    // computed once per row); the 256-bit f32 peak of 2 cores at 2.6 GHz with
-    // 2 FMA pipes: 2 × 2 × 8 lanes × 2 flops × 2.6 GHz = 166 GFLOP/s.
+    // 6 Rvachev unions × 6 flops + 7 balls × 2 row terms per point (the x
+    // terms are computed once per set of x); the 256-bit f32 peak of 2
+    // cores at 2.6 GHz with 2 FMA pipes: 2 × 2 × 8 × 2 × 2.6 GHz = 166 GFLOP/s.
     let flops = rate * 50.0;
     println!(
-        "dense M1 evaluation (f32 lanes, {} lane instructions per point): {:.1} M points/s ({:.3} s, cpu {m1_cpu:.3} s, for {:.1} M points); {:.1} GFLOP/s = {:.1}% of the 166 GFLOP/s f32 AVX2 FMA peak",
+        "dense M1 evaluation (f32 lanes, {} lane passes per row): {:.1} M points/s ({:.3} s, cpu {m1_cpu:.3} s = {:.1} M points per CPU-second, for {:.1} M points); {:.1} GFLOP/s = {:.1}% of the 166 GFLOP/s f32 AVX2 FMA peak",
         tape.lane_len(),
         rate / 1e6,
         t.as_secs_f64(),
+        points / m1_cpu / 1e6,
         points / 1e6,
         flops / 1e9,
         flops / 166e9 * 100.0
     );
-    // Dense evaluation of every model by both evaluators in this run (one
-    // geomc run for M2 and M3, whose dense loops are not the product path).
+    // Dense evaluation of every model by both evaluators in this run, each
+    // into a mapped buffer (median of 5 for M1, one run for M2 and M3, whose
+    // dense loops are not the product path).
+    let mut fbuf = vec![1.0f32; v.len()];
     for (name, build) in models {
         if no_dense && !name.starts_with("M1") {
             continue;
         }
         let ssa = build();
-        let (tg, v) = if name.starts_with("M1") {
-            (t, v.clone())
+        let (tg, g_cpu) = if name.starts_with("M1") {
+            (t, m1_cpu)
         } else {
-            time(1, || polygonize::sample_grid(&ssa, &grid))
-        };
-        let g_cpu = if name.starts_with("M1") {
-            m1_cpu
-        } else {
-            last_cpu()
+            let (tg, ()) = time(1, || polygonize::sample_grid_into(&ssa, &grid, &mut buf));
+            (tg, last_cpu())
         };
         print!(
             "dense {name}: geomc {:.1} M points/s ({:.3} s, cpu {g_cpu:.3} s)",
@@ -415,11 +427,12 @@ fn main() {
             tg.as_secs_f64()
         );
         if with_fidget {
-            let (tf, fv) = fidget_dense(&ssa, &grid);
+            let f_reps = if name.starts_with("M1") { 5 } else { 1 };
+            let tf = fidget_dense(&ssa, &grid, &mut fbuf, f_reps);
             // The same points in f32: how many samples the two disagree on in sign.
-            let differ = fv
+            let differ = fbuf
                 .iter()
-                .zip(&v)
+                .zip(&buf)
                 .filter(|(a, b)| (**a > 0.0) != (**b > 0.0))
                 .count();
             print!(

@@ -4,8 +4,24 @@
 //! positions and indices) in the same run. Target: render time below read
 //! time. Also the SVG hidden-line drawing of a 50,000-triangle torus.
 //!
+//! The machine these runs share is loaded (load average 15–20 on 2 cores), so
+//! one wall-clock timing of either side swings several-fold. Two measures,
+//! each the median of repetitions made alternately (read, render, read,
+//! render, …) so both sides see the same load:
+//! - CPU time, summed over every thread of the process (`/proc/self/task/*/
+//!   schedstat`), is the verdict: the render's CPU time over all its threads
+//!   bounds its wall time on an idle machine, and the single-threaded read's
+//!   CPU time is its wall time there, so a CPU ratio below 1 means the render
+//!   is faster than the read on any idle machine with one core or more;
+//! - wall time, printed beside it with every pair's own ratio and the load.
+//!
 //! Run: `cargo bench --bench render`. Under `cargo test --all-targets` it runs
 //! as a smoke test on small meshes.
+
+// The allocator of the `geomc` command, so the render is timed as users run it
+// (the read gets it too).
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 use geomc::formats::{WriteOptions, write_mesh_file};
 use geomc::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};
@@ -91,13 +107,62 @@ fn read_glb(path: &std::path::Path) -> (Vec<[f32; 3]>, Vec<u32>) {
     (positions, indices)
 }
 
+/// `--child read GLB` or `--child render NU NV ANTIALIAS`: one timed step in
+/// a fresh process, as `geomc render` meets it (no memory left warm by earlier
+/// repetitions); prints its wall and CPU seconds.
+fn child(args: &[String]) {
+    let (wall, cpu) = match args {
+        [what, path] if what == "read" => {
+            let (wall, cpu, _) = timed(|| read_glb(std::path::Path::new(path)));
+            (wall, cpu)
+        }
+        [what, nu, nv, aa] if what == "render" => {
+            let parse = |v: &String| v.parse::<u32>().expect("a count");
+            let mesh = torus(parse(nu) as usize, parse(nv) as usize);
+            let options = RenderOptions {
+                width: 1024,
+                height: 1024,
+                antialias: parse(aa),
+                ..RenderOptions::default()
+            };
+            let (wall, cpu, _) = timed(|| render_png(&mesh, &options).expect("renders"));
+            (wall, cpu)
+        }
+        _ => panic!("--child read GLB | --child render NU NV ANTIALIAS"),
+    };
+    println!("{wall} {cpu}");
+}
+
+/// Runs one `--child` step of this benchmark in a fresh process: (wall, CPU) seconds.
+fn in_fresh_process(args: &[&str]) -> (f64, f64) {
+    let exe = std::env::current_exe().expect("the benchmark's own path");
+    let out = std::process::Command::new(exe)
+        .arg("--child")
+        .args(args)
+        .output()
+        .expect("runs itself");
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let text = String::from_utf8_lossy(&out.stdout);
+    let mut v = text
+        .split_whitespace()
+        .map(|v| v.parse::<f64>().expect("seconds"));
+    (v.next().expect("wall"), v.next().expect("cpu"))
+}
+
 fn main() {
     let args: Vec<String> = std::env::args().collect();
+    if let Some(at) = args.iter().position(|a| a == "--child") {
+        return child(&args[at + 1..]);
+    }
     let smoke = !args.iter().any(|a| a == "--bench");
-    let (nu, nv, svg_nu, svg_nv, runs) = if smoke {
-        (100, 50, 50, 25, 1)
+    let (nu, nv, svg_nu, svg_nv, runs, reps) = if smoke {
+        (100, 50, 50, 25, 1, 1)
     } else {
-        (1000, 500, 250, 100, 3)
+        (1000, 500, 250, 100, 3, 9)
     };
     let mesh = torus(nu, nv);
     let n_tris = mesh.faces[0].triangles.len();
@@ -111,42 +176,107 @@ fn main() {
         rayon::current_num_threads()
     );
 
-    let (read, (positions, indices)) = best_of(runs, || read_glb(&glb));
-    assert!(indices.len() >= 3 * n_tris);
-    assert!(positions.len() >= mesh.nodes.len());
     let options = RenderOptions {
         width: 1024,
         height: 1024,
         ..RenderOptions::default()
     };
-    let (render, (png, _)) = best_of(runs, || render_png(&mesh, &options).expect("renders"));
-    let (render_aa1, _) = best_of(runs, || {
-        render_png(
-            &mesh,
-            &RenderOptions {
-                antialias: 1,
-                ..options.clone()
-            },
+    let aa1 = RenderOptions {
+        antialias: 1,
+        ..options.clone()
+    };
+    let load_before = load_average();
+    // Alternate: read, render, render --antialias 1, and again.
+    let (mut reads, mut renders, mut renders_aa1) = (Vec::new(), Vec::new(), Vec::new());
+    let mut png_len = 0;
+    let (mut read_cpu, mut render_cpu, mut aa1_cpu) = (Vec::new(), Vec::new(), Vec::new());
+    for _ in 0..reps {
+        let (t, c, (positions, indices)) = timed(|| read_glb(&glb));
+        assert!(indices.len() >= 3 * n_tris);
+        assert!(positions.len() >= mesh.nodes.len());
+        reads.push(t);
+        read_cpu.push(c);
+        let (t, c, (png, _)) = timed(|| render_png(&mesh, &options).expect("renders"));
+        png_len = png.len();
+        renders.push(t);
+        render_cpu.push(c);
+        let (t, c, _) = timed(|| render_png(&mesh, &aa1).expect("renders"));
+        renders_aa1.push(t);
+        aa1_cpu.push(c);
+    }
+    // The same, each step in a fresh process (cold memory, as one CLI run).
+    let (mut cold_read, mut cold_render) = (Vec::new(), Vec::new());
+    let glb_arg = glb.to_string_lossy().to_string();
+    let (nu_arg, nv_arg) = (nu.to_string(), nv.to_string());
+    for _ in 0..reps {
+        cold_read.push(in_fresh_process(&["read", &glb_arg]));
+        cold_render.push(in_fresh_process(&["render", &nu_arg, &nv_arg, "2"]));
+    }
+    let load_after = load_average();
+    let pairs = |a: &[f64], b: &[f64]| {
+        (a.iter().zip(b))
+            .map(|(r, p)| format!("{:.2}", p / r))
+            .collect::<Vec<_>>()
+            .join(" ")
+    };
+    println!(
+        "  load average before / after: {load_before} / {load_after}; {reps} alternated repetitions, medians (min)"
+    );
+    println!("  {:<46} {:>16} {:>16}", "", "CPU, all threads", "wall");
+    let row = |what: &str, cpu: &[f64], wall: &[f64]| {
+        println!(
+            "  {what:<46} {:>7.3} ({:.3}) s {:>7.3} ({:.3}) s",
+            median(cpu),
+            min(cpu),
+            median(wall),
+            min(wall)
         )
-        .expect("renders")
-    });
-    let ratio = render.as_secs_f64() / read.as_secs_f64();
+    };
+    row(
+        "gltf crate: read GLB (positions + indices)",
+        &read_cpu,
+        &reads,
+    );
+    row(
+        "geomc render 1024x1024 PNG (default, 2x2 AA)",
+        &render_cpu,
+        &renders,
+    );
+    row(
+        "geomc render 1024x1024 PNG, --antialias 1",
+        &aa1_cpu,
+        &renders_aa1,
+    );
+    println!("  PNG {:.1} kB", png_len as f64 / 1e3);
     println!(
-        "  gltf crate: read GLB (positions + indices): {:8.3} s",
-        read.as_secs_f64()
+        "  render / read of each pair: CPU {}; wall {}",
+        pairs(&read_cpu, &render_cpu),
+        pairs(&reads, &renders)
+    );
+    let wall_of = |v: &[(f64, f64)]| v.iter().map(|p| p.0).collect::<Vec<_>>();
+    let cpu_of = |v: &[(f64, f64)]| v.iter().map(|p| p.1).collect::<Vec<_>>();
+    println!("  each step in a fresh process:");
+    row(
+        "gltf crate: read GLB (positions + indices)",
+        &cpu_of(&cold_read),
+        &wall_of(&cold_read),
+    );
+    row(
+        "geomc render 1024x1024 PNG (default, 2x2 AA)",
+        &cpu_of(&cold_render),
+        &wall_of(&cold_render),
     );
     println!(
-        "  geomc render 1024x1024 PNG (default, 2x2 AA): {:8.3} s  ({:.1} kB)",
-        render.as_secs_f64(),
-        png.len() as f64 / 1e3
+        "  render / read, fresh processes, medians: CPU {:.2}; wall {:.2}",
+        median(&cpu_of(&cold_render)) / median(&cpu_of(&cold_read)),
+        median(&wall_of(&cold_render)) / median(&wall_of(&cold_read)),
     );
+    let cpu_ratio = median(&render_cpu) / median(&read_cpu);
     println!(
-        "  geomc render 1024x1024 PNG, --antialias 1:    {:8.3} s",
-        render_aa1.as_secs_f64()
-    );
-    println!(
-        "  render / read: {ratio:.2} (target < 1) {}",
-        verdict(ratio < 1.0)
+        "  render / read, medians: CPU {cpu_ratio:.2} (target < 1) {}; wall {:.2}; --antialias 1 CPU {:.2}",
+        verdict(cpu_ratio < 1.0),
+        median(&renders) / median(&reads),
+        median(&aa1_cpu) / median(&read_cpu)
     );
 
     let small = torus(svg_nu, svg_nv);
@@ -177,6 +307,57 @@ fn main() {
         png_small.as_secs_f64()
     );
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// Wall and CPU seconds of `f`, and its value.
+fn timed<T>(f: impl FnOnce() -> T) -> (f64, f64, T) {
+    let cpu = process_cpu_seconds();
+    let start = Instant::now();
+    let value = f();
+    let wall = start.elapsed().as_secs_f64();
+    (wall, process_cpu_seconds() - cpu, value)
+}
+
+/// CPU time of every thread of this process so far (rayon's workers
+/// included), in seconds: the first field of each task's `schedstat` is its
+/// time on a CPU in nanoseconds. Zero where `/proc` is missing.
+fn process_cpu_seconds() -> f64 {
+    let Ok(tasks) = std::fs::read_dir("/proc/self/task") else {
+        return 0.0;
+    };
+    let mut ns: u64 = 0;
+    for task in tasks.flatten() {
+        if let Ok(stat) = std::fs::read_to_string(task.path().join("schedstat")) {
+            ns += stat
+                .split_whitespace()
+                .next()
+                .and_then(|v| v.parse::<u64>().ok())
+                .unwrap_or(0);
+        }
+    }
+    ns as f64 * 1e-9
+}
+
+fn median(times: &[f64]) -> f64 {
+    let mut sorted = times.to_vec();
+    sorted.sort_by(f64::total_cmp);
+    let n = sorted.len();
+    if n % 2 == 1 {
+        sorted[n / 2]
+    } else {
+        (sorted[n / 2 - 1] + sorted[n / 2]) / 2.0
+    }
+}
+
+fn min(times: &[f64]) -> f64 {
+    times.iter().copied().fold(f64::INFINITY, f64::min)
+}
+
+/// The 1-, 5- and 15-minute load averages, as `/proc/loadavg` gives them.
+fn load_average() -> String {
+    std::fs::read_to_string("/proc/loadavg")
+        .map(|l| l.split_whitespace().take(3).collect::<Vec<_>>().join(" "))
+        .unwrap_or_else(|_| "unknown".into())
 }
 
 fn verdict(ok: bool) -> &'static str {

@@ -295,3 +295,26 @@ fn optimisation_iterations_improve_the_joint_mesh() {
     let report = run_json("python3", "check_mesh.py", &[&msh, Path::new("--tetra")]);
     assert_eq!(report["tetra"]["ok"], true, "{report}");
 }
+
+#[test]
+fn the_joint_mesh_is_the_same_for_any_thread_count() {
+    // The root finding and dual contouring's points run in parallel; the
+    // numbering pass does not: nodes, triangles and tags must not depend on
+    // the thread count.
+    let dir = tempfile::tempdir().expect("temp dir");
+    let c = checked(dir.path());
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+            .install(|| {
+                let mut mesh = Mesh::default();
+                append(&mut mesh, &c.implicit, None, None);
+                format!("{:?} {:?}", mesh.nodes, mesh.faces)
+            })
+    };
+    let one = run(1);
+    assert!(one.len() > 10_000, "a real mesh");
+    assert_eq!(one, run(3));
+}

@@ -79,6 +79,42 @@ fn same_input_same_png_for_any_thread_count() {
     assert_eq!((image.width, image.height), (320, 240));
 }
 
+/// The default picture (no edge overlay) is drawn band by band, each band's
+/// samples resolved as soon as it is drawn: the same bytes for any thread
+/// count there too, with and without a section, at each anti-aliasing level.
+#[test]
+fn banded_picture_is_the_same_for_any_thread_count() {
+    let mesh = ball_in_box();
+    for (section, antialias) in [(None, 2), (Some(2.0), 2), (None, 1), (Some(2.0), 3)] {
+        let options = RenderOptions {
+            section: section.map(|value| Section { axis: 2, value }),
+            antialias,
+            width: 300,
+            height: 200,
+            ..RenderOptions::default()
+        };
+        assert_eq!(options.edges, Edges::None);
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool")
+                .install(|| render_png(&mesh, &options).expect("renders").0)
+        };
+        let one = run(1);
+        assert_eq!(one, run(2), "{section:?} antialias {antialias}");
+        assert_eq!(one, run(4), "{section:?} antialias {antialias}");
+        let image = decode_png(&one).expect("decodes");
+        // Something is drawn: the model covers pixels that are not the background.
+        let drawn = image
+            .rgba
+            .chunks(4)
+            .filter(|p| p != &[255, 255, 255, 255])
+            .count();
+        assert!(drawn > 300 * 200 / 10, "{drawn} pixels drawn");
+    }
+}
+
 #[test]
 fn sphere_covers_its_projected_disc_within_one_pixel_ring() {
     let mesh = mesh_of(

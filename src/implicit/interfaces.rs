@@ -30,6 +30,7 @@
 use super::polygonize::Grid;
 use super::tape::Ssa;
 use super::weld;
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Triangles between labels `pair.0 < pair.1`, oriented with normals
@@ -87,35 +88,47 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
         .map(|s| super::polygonize::sample_grid(&s.ssa, grid))
         .collect();
     let idx = |i: usize, j: usize, k: usize| (k * n1[1] + j) * n1[0] + i;
+    let face_key = |cell: [usize; 3], n: usize, s: usize| {
+        let mut base = cell;
+        base[n] += s;
+        (idx(base[0], base[1], base[2]) as u64) * 3 + n as u64
+    };
     let mut labels = vec![0u32; n1[0] * n1[1] * n1[2]];
-    for k in 1..n1[2].saturating_sub(1) {
-        for j in 1..n1[1].saturating_sub(1) {
-            for i in 1..n1[0].saturating_sub(1) {
-                let p = at(i, j, k);
-                let p_idx = idx(i, j, k);
-                let within = |s: &Solid| (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a]);
-                let first = |test: &dyn Fn(f32) -> bool| {
-                    solids
+    let plane = n1[0] * n1[1];
+    labels
+        .par_chunks_mut(plane)
+        .enumerate()
+        .for_each(|(k, layer)| {
+            if k == 0 || k + 1 >= n1[2] {
+                return;
+            }
+            for j in 1..n1[1].saturating_sub(1) {
+                for i in 1..n1[0].saturating_sub(1) {
+                    let p = at(i, j, k);
+                    let p_idx = idx(i, j, k);
+                    let within = |s: &Solid| (0..3).all(|a| s.min[a] <= p[a] && p[a] <= s.max[a]);
+                    let first = |test: &dyn Fn(f32) -> bool| {
+                        solids
+                            .iter()
+                            .zip(&samples)
+                            .position(|(s, v)| test(v[p_idx]) && within(s))
+                    };
+                    // A sample on the zero sets of two solids lies on their
+                    // interface, not in a gap between them: it takes the first
+                    // (else the two surfaces would pass on either side of it,
+                    // a sheet of exterior between them, as along the lines
+                    // where a pin of r = 0.3 touches the samples at 20³).
+                    let on_zero = solids
                         .iter()
                         .zip(&samples)
-                        .position(|(s, v)| test(v[p_idx]) && within(s))
-                };
-                // A sample on the zero sets of two solids lies on their
-                // interface, not in a gap between them: it takes the first
-                // (else the two surfaces would pass on either side of it,
-                // a sheet of exterior between them, as along the lines
-                // where a pin of r = 0.3 touches the samples at 20³).
-                let on_zero = solids
-                    .iter()
-                    .zip(&samples)
-                    .filter(|(s, v)| v[p_idx] == 0.0 && within(s))
-                    .count();
-                labels[p_idx] = first(&|v| v > 0.0)
-                    .or_else(|| (on_zero >= 2).then(|| first(&|v| v == 0.0)).flatten())
-                    .map_or(0, |s| s as u32 + 1);
+                        .filter(|(s, v)| v[p_idx] == 0.0 && within(s))
+                        .count();
+                    layer[p_idx - k * plane] = first(&|v| v > 0.0)
+                        .or_else(|| (on_zero >= 2).then(|| first(&|v| v == 0.0)).flatten())
+                        .map_or(0, |s| s as u32 + 1);
+                }
             }
-        }
-    }
+        });
     let label_at = |c: [usize; 3]| labels[idx(c[0], c[1], c[2])];
     // An exterior sample where solid `l` (label) is positive lies on the
     // grid's box or outside that solid's box: the surface between them is
@@ -124,227 +137,243 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
         let p_idx = idx(c[0], c[1], c[2]);
         l > 0 && samples.get(l as usize - 1).is_some_and(|v| v[p_idx] > 0.0)
     };
-    let mut out = Interfaces::default();
-    // Unit normals of the edge points (zero for face and cell points).
-    let mut normals: Vec<[f64; 3]> = Vec::new();
-    // Which nodes are edge points (on the surface of their edge's function).
-    let mut edge_point: Vec<bool> = Vec::new();
     let spacing = (0..3)
         .map(|a| (grid.max[a] - grid.min[a]) / grid.cells[a].max(1) as f64)
         .fold(f64::INFINITY, f64::min);
-    let mut edge_nodes: HashMap<u64, u32> = HashMap::new();
-    let mut face_nodes: HashMap<u64, u32> = HashMap::new();
-    let mut patches: HashMap<PatchKey, Vec<[u32; 3]>> = HashMap::new();
     let deciding_index = |a: u32, b: u32| deciding_solid(a, b, solids.len());
     let deciding = |a: u32, b: u32| deciding_index(a, b).map(|s| &solids[s].ssa);
     let cells = grid.cells;
-    for k in 0..cells[2] {
-        for j in 0..cells[1] {
-            for i in 0..cells[0] {
-                let corner = |c: usize| [i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)];
-                let l: [u32; 8] = std::array::from_fn(|c| label_at(corner(c)));
-                if l.iter().all(|&x| x == l[0]) {
+    // The point and unit normal of the grid edge from sample `pu` along
+    // axis `d`, whose ends carry labels a ≠ b.
+    let edge_geometry = |pu: [usize; 3], d: usize, a: u32, b: u32| -> EdgePoint {
+        let mut pw = pu;
+        pw[d] += 1;
+        let f = deciding(a, b);
+        let (xu, xw) = (at(pu[0], pu[1], pu[2]), at(pw[0], pw[1], pw[2]));
+        // A cap's point is where the edge leaves the solid's box (the
+        // exterior sample when that is the grid's box), its normal the box's.
+        let cut = if a == 0 && cut_at(pu, b) {
+            Some((b, xw, xu, -1.0))
+        } else if b == 0 && cut_at(pw, a) {
+            Some((a, xu, xw, 1.0))
+        } else {
+            None
+        };
+        match cut {
+            Some((s, inside, outside, sign)) => {
+                let s = &solids[s as usize - 1];
+                let bound = if outside[d] > s.max[d] {
+                    s.max[d]
+                } else if outside[d] < s.min[d] {
+                    s.min[d]
+                } else {
+                    outside[d]
+                };
+                let mut p = inside;
+                p[d] = bound.clamp(xu[d], xw[d]);
+                let mut n = [0.0; 3];
+                n[d] = sign;
+                (p, n)
+            }
+            None => {
+                let p = edge_root(f, xu, xw);
+                (p, f.map_or([0.0; 3], |f| unit_gradient(f, p, spacing)))
+            }
+        }
+    };
+    // The expensive geometry (root finding, dual contouring's points and
+    // their projection) runs in parallel over z planes; each point is a
+    // function of its own edge, face or cell only, so whichever thread
+    // computes it gives the same bits. The numbering pass below then walks
+    // the cells in order as a single thread would: output is identical for
+    // any thread count.
+    let edge_points: HashMap<u64, EdgePoint> = (0..n1[2])
+        .into_par_iter()
+        .map(|k| {
+            let mut found = Vec::new();
+            for j in 0..n1[1] {
+                for i in 0..n1[0] {
+                    let pu = [i, j, k];
+                    for d in 0..3 {
+                        let mut pw = pu;
+                        pw[d] += 1;
+                        if pw[d] >= n1[d] {
+                            continue;
+                        }
+                        let (a, b) = (label_at(pu), label_at(pw));
+                        if a != b {
+                            let key = (idx(i, j, k) as u64) * 3 + d as u64;
+                            found.push((key, edge_geometry(pu, d, a, b)));
+                        }
+                    }
+                }
+            }
+            found
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .flatten()
+        .collect();
+    // The point of a set of corners of cell `cell`: the mean of their crossed
+    // edges' points, projected when two labels meet there.
+    let centre = |cell: [usize; 3],
+                  l: &[u32; 8],
+                  ep: &[Option<EdgePoint>; 12],
+                  edges: &[usize],
+                  corners: &[usize]| {
+        let planes: Vec<EdgePoint> = edges.iter().filter_map(|&e| ep[e]).collect();
+        let mean: [f64; 3] = std::array::from_fn(|a| {
+            planes.iter().map(|(p, _)| p[a]).sum::<f64>() / planes.len().max(1) as f64
+        });
+        let mut ls: Vec<u32> = corners.iter().map(|&c| l[c]).collect();
+        ls.sort_unstable();
+        ls.dedup();
+        // The functions whose zero sets meet here: one on a surface
+        // (project onto it), more on a junction.
+        let mut fs: Vec<usize> = Vec::new();
+        for (x, &a) in ls.iter().enumerate() {
+            for &b in &ls[x + 1..] {
+                if let Some(f) = deciding_index(a, b) {
+                    if !fs.contains(&f) {
+                        fs.push(f);
+                    }
+                }
+            }
+        }
+        let (lo, hi) = inset_box(corners.iter().map(|&c| {
+            let q = corner_of(cell, c);
+            at(q[0], q[1], q[2])
+        }));
+        let q = qef_point(&planes, mean, lo, hi);
+        match fs[..] {
+            [f] => project(&solids[f].ssa, q, lo, hi),
+            _ => q,
+        }
+    };
+    // Per mixed cell, in order: its corner labels, the points of the faces
+    // it owns (its lower faces, and its upper ones on the grid's upper
+    // boundary) and its cell point.
+    let mixed: Vec<MixedCell> = (0..cells[2])
+        .into_par_iter()
+        .map(|k| {
+            let mut found = Vec::new();
+            for j in 0..cells[1] {
+                for i in 0..cells[0] {
+                    let cell = [i, j, k];
+                    let l: [u32; 8] = std::array::from_fn(|c| label_at(corner_of(cell, c)));
+                    if l.iter().all(|&x| x == l[0]) {
+                        continue;
+                    }
+                    let ep: [Option<EdgePoint>; 12] = std::array::from_fn(|e| {
+                        let (d, o) = (e / 4, e % 4);
+                        let (cu, cw) = edge_ends(d, o);
+                        if l[cu] == l[cw] {
+                            return None;
+                        }
+                        let pu = corner_of(cell, cu);
+                        edge_points
+                            .get(&((idx(pu[0], pu[1], pu[2]) as u64) * 3 + d as u64))
+                            .copied()
+                    });
+                    let mut faces = Vec::new();
+                    for n in 0..3 {
+                        for s in 0..2 {
+                            let fe = face_edges(n, s);
+                            if fe.iter().all(|&e| ep[e].is_none()) {
+                                continue;
+                            }
+                            if s == 1 && cell[n] + 1 < cells[n] {
+                                continue;
+                            }
+                            let key = face_key(cell, n, s);
+                            faces.push((key, centre(cell, &l, &ep, &fe, &face_corners(n, s))));
+                        }
+                    }
+                    let all: Vec<usize> = (0..12).collect();
+                    let corners: Vec<usize> = (0..8).collect();
+                    let point = centre(cell, &l, &ep, &all, &corners);
+                    found.push(MixedCell {
+                        cell,
+                        l,
+                        faces,
+                        point,
+                    });
+                }
+            }
+            found
+        })
+        .collect::<Vec<_>>()
+        .into_iter()
+        .flatten()
+        .collect();
+    let face_points: HashMap<u64, [f64; 3]> =
+        mixed.iter().flat_map(|m| m.faces.iter().copied()).collect();
+    let mut out = Interfaces::default();
+    // Which nodes are edge points (on the surface of their edge's function).
+    let mut edge_point: Vec<bool> = Vec::new();
+    let mut edge_nodes: HashMap<u64, u32> = HashMap::new();
+    let mut face_nodes: HashMap<u64, u32> = HashMap::new();
+    let mut patches: HashMap<PatchKey, Vec<[u32; 3]>> = HashMap::new();
+    for m in &mixed {
+        let (cell, l) = (m.cell, &m.l);
+        let corner = |c: usize| corner_of(cell, c);
+        let mut en = [u32::MAX; 12];
+        for d in 0..3 {
+            for o in 0..4 {
+                let (cu, cw) = edge_ends(d, o);
+                if l[cu] == l[cw] {
                     continue;
                 }
-                // Cell edge (d, o): along axis d, at offset o & 1 along
-                // d + 1 and o >> 1 along d + 2; its corners (lower, upper).
-                let ends = |d: usize, o: usize| {
-                    let mut lo = [0usize; 3];
-                    lo[(d + 1) % 3] = o & 1;
-                    lo[(d + 2) % 3] = o >> 1;
-                    let mut hi = lo;
-                    hi[d] = 1;
-                    (
-                        lo[0] | lo[1] << 1 | lo[2] << 2,
-                        hi[0] | hi[1] << 1 | hi[2] << 2,
-                    )
-                };
-                let mut en = [u32::MAX; 12];
-                for d in 0..3 {
-                    for o in 0..4 {
-                        let (cu, cw) = ends(d, o);
-                        let (a, b) = (l[cu], l[cw]);
-                        if a == b {
-                            continue;
-                        }
-                        let (pu, pw) = (corner(cu), corner(cw));
-                        let key = (idx(pu[0], pu[1], pu[2]) as u64) * 3 + d as u64;
-                        en[d * 4 + o] = *edge_nodes.entry(key).or_insert_with(|| {
-                            let f = deciding(a, b);
-                            let (xu, xw) = (at(pu[0], pu[1], pu[2]), at(pw[0], pw[1], pw[2]));
-                            // A cap's point is where the edge leaves the
-                            // solid's box (the exterior sample when that is
-                            // the grid's box), its normal the box's.
-                            let cut = if a == 0 && cut_at(pu, b) {
-                                Some((b, xw, xu, -1.0))
-                            } else if b == 0 && cut_at(pw, a) {
-                                Some((a, xu, xw, 1.0))
-                            } else {
-                                None
-                            };
-                            let (p, n) = match cut {
-                                Some((s, inside, outside, sign)) => {
-                                    let s = &solids[s as usize - 1];
-                                    let bound = if outside[d] > s.max[d] {
-                                        s.max[d]
-                                    } else if outside[d] < s.min[d] {
-                                        s.min[d]
-                                    } else {
-                                        outside[d]
-                                    };
-                                    let mut p = inside;
-                                    p[d] = bound.clamp(xu[d], xw[d]);
-                                    let mut n = [0.0; 3];
-                                    n[d] = sign;
-                                    (p, n)
-                                }
-                                None => {
-                                    let p = edge_root(f, xu, xw);
-                                    (p, f.map_or([0.0; 3], |f| unit_gradient(f, p, spacing)))
-                                }
-                            };
-                            out.positions.push(p);
-                            normals.push(n);
-                            edge_point.push(true);
-                            (out.positions.len() - 1) as u32
-                        });
-                    }
+                let pu = corner(cu);
+                let key = (idx(pu[0], pu[1], pu[2]) as u64) * 3 + d as u64;
+                en[d * 4 + o] = *edge_nodes.entry(key).or_insert_with(|| {
+                    let (p, _) = edge_points[&key];
+                    out.positions.push(p);
+                    edge_point.push(true);
+                    (out.positions.len() - 1) as u32
+                });
+            }
+        }
+        let mut fnode = [u32::MAX; 6];
+        for n in 0..3 {
+            for s in 0..2 {
+                if face_edges(n, s).iter().all(|&e| en[e] == u32::MAX) {
+                    continue;
                 }
-                let box_of = |c: &[usize]| -> ([f64; 3], [f64; 3]) {
-                    let ps: Vec<[f64; 3]> = c
-                        .iter()
-                        .map(|&c| {
-                            let q = corner(c);
-                            at(q[0], q[1], q[2])
-                        })
-                        .collect();
-                    let lo = std::array::from_fn(|a| {
-                        ps.iter().map(|p| p[a]).fold(f64::INFINITY, f64::min)
-                    });
-                    let hi: [f64; 3] = std::array::from_fn(|a| {
-                        ps.iter().map(|p| p[a]).fold(f64::NEG_INFINITY, f64::max)
-                    });
-                    let lo: [f64; 3] = lo;
-                    // Inset by INSET of the size: a point clamped onto the
-                    // box would be collinear with the edge points there.
-                    let d: [f64; 3] = std::array::from_fn(|a| INSET * (hi[a] - lo[a]));
-                    let lo = std::array::from_fn(|a| lo[a] + d[a]);
-                    let hi = std::array::from_fn(|a| hi[a] - d[a]);
-                    (lo, hi)
-                };
-                // The point of a set of corners: the mean of their crossed
-                // edges' points, projected when two labels meet there.
-                let centre = |edges: &[usize],
-                              corners: &[usize],
-                              positions: &[[f64; 3]],
-                              normals: &[[f64; 3]]| {
-                    let crossed: Vec<usize> = edges
-                        .iter()
-                        .filter(|&&e| en[e] != u32::MAX)
-                        .map(|&e| en[e] as usize)
-                        .collect();
-                    let pts: Vec<[f64; 3]> = crossed.iter().map(|&v| positions[v]).collect();
-                    let mean: [f64; 3] = std::array::from_fn(|a| {
-                        pts.iter().map(|p| p[a]).sum::<f64>() / pts.len().max(1) as f64
-                    });
-                    let mut ls: Vec<u32> = corners.iter().map(|&c| l[c]).collect();
-                    ls.sort_unstable();
-                    ls.dedup();
-                    // The functions whose zero sets meet here: one on a
-                    // surface (project onto it), more on a junction.
-                    let mut fs: Vec<usize> = Vec::new();
-                    for (x, &a) in ls.iter().enumerate() {
-                        for &b in &ls[x + 1..] {
-                            if let Some(f) = deciding_index(a, b) {
-                                if !fs.contains(&f) {
-                                    fs.push(f);
-                                }
-                            }
-                        }
-                    }
-                    let (lo, hi) = box_of(corners);
-                    let planes: Vec<([f64; 3], [f64; 3])> = crossed
-                        .iter()
-                        .map(|&v| (positions[v], normals[v]))
-                        .collect();
-                    let q = qef_point(&planes, mean, lo, hi);
-                    match fs[..] {
-                        [f] => project(&solids[f].ssa, q, lo, hi),
-                        _ => q,
-                    }
-                };
-                // Face (n, s): normal n, offset s; its edges (d, o) with d ≠ n.
-                let face_edges = |n: usize, s: usize| -> Vec<usize> {
-                    (0..3)
-                        .filter(|&d| d != n)
-                        .flat_map(|d| (0..4).map(move |o| (d, o)))
-                        .filter(|&(d, o)| {
-                            let off = if n == (d + 1) % 3 { o & 1 } else { o >> 1 };
-                            off == s
-                        })
-                        .map(|(d, o)| d * 4 + o)
-                        .collect()
-                };
-                let face_corners = |n: usize, s: usize| -> Vec<usize> {
-                    (0..8).filter(|&c| (c >> n) & 1 == s).collect()
-                };
-                let mut fnode = [u32::MAX; 6];
-                for n in 0..3 {
-                    for s in 0..2 {
-                        let fe = face_edges(n, s);
-                        if fe.iter().all(|&e| en[e] == u32::MAX) {
-                            continue;
-                        }
-                        let mut base = [i, j, k];
-                        base[n] += s;
-                        let key = (idx(base[0], base[1], base[2]) as u64) * 3 + n as u64;
-                        fnode[n * 2 + s] = match face_nodes.get(&key) {
-                            Some(&node) => node,
-                            None => {
-                                let p = centre(&fe, &face_corners(n, s), &out.positions, &normals);
-                                out.positions.push(p);
-                                normals.push([0.0; 3]);
-                                edge_point.push(false);
-                                let node = (out.positions.len() - 1) as u32;
-                                face_nodes.insert(key, node);
-                                node
-                            }
-                        };
-                    }
+                let key = face_key(cell, n, s);
+                fnode[n * 2 + s] = *face_nodes.entry(key).or_insert_with(|| {
+                    out.positions.push(face_points[&key]);
+                    edge_point.push(false);
+                    (out.positions.len() - 1) as u32
+                });
+            }
+        }
+        out.positions.push(m.point);
+        edge_point.push(false);
+        let c = (out.positions.len() - 1) as u32;
+        for d in 0..3 {
+            let (d1, d2) = ((d + 1) % 3, (d + 2) % 3);
+            for o in 0..4 {
+                let e = en[d * 4 + o];
+                if e == u32::MAX {
+                    continue;
                 }
-                let all: Vec<usize> = (0..12).collect();
-                let corners: Vec<usize> = (0..8).collect();
-                let p = centre(&all, &corners, &out.positions, &normals);
-                out.positions.push(p);
-                normals.push([0.0; 3]);
-                edge_point.push(false);
-                let c = (out.positions.len() - 1) as u32;
-                for d in 0..3 {
-                    let (d1, d2) = ((d + 1) % 3, (d + 2) % 3);
-                    for o in 0..4 {
-                        let e = en[d * 4 + o];
-                        if e == u32::MAX {
-                            continue;
-                        }
-                        let (o1, o2) = (o & 1, o >> 1);
-                        let (f1, f2) = (fnode[d1 * 2 + o1], fnode[d2 * 2 + o2]);
-                        let (cu, cw) = ends(d, o);
-                        let (a, b) = (l[cu], l[cw]);
-                        // E, F1, C, F2 turns about −d when o1 + o2 is even.
-                        let towards_plus_d = (o1 + o2) % 2 == 1;
-                        let forward = towards_plus_d == (a < b);
-                        let (tri1, tri2) = if forward {
-                            ([e, f1, c], [e, c, f2])
-                        } else {
-                            ([e, c, f1], [e, f2, c])
-                        };
-                        let cap =
-                            (a == 0 && cut_at(corner(cu), b)) || (b == 0 && cut_at(corner(cw), a));
-                        let list = patches.entry(((a.min(b), a.max(b)), cap)).or_default();
-                        list.push(tri1);
-                        list.push(tri2);
-                    }
-                }
+                let (o1, o2) = (o & 1, o >> 1);
+                let (f1, f2) = (fnode[d1 * 2 + o1], fnode[d2 * 2 + o2]);
+                let (cu, cw) = edge_ends(d, o);
+                let (a, b) = (l[cu], l[cw]);
+                // E, F1, C, F2 turns about −d when o1 + o2 is even.
+                let towards_plus_d = (o1 + o2) % 2 == 1;
+                let forward = towards_plus_d == (a < b);
+                let (tri1, tri2) = if forward {
+                    ([e, f1, c], [e, c, f2])
+                } else {
+                    ([e, c, f1], [e, f2, c])
+                };
+                let cap = (a == 0 && cut_at(corner(cu), b)) || (b == 0 && cut_at(corner(cw), a));
+                let list = patches.entry(((a.min(b), a.max(b)), cap)).or_default();
+                list.push(tri1);
+                list.push(tri2);
             }
         }
     }
@@ -360,6 +389,77 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
         })
         .collect();
     out
+}
+
+/// An edge point and its unit normal (a cap's point: the box face's).
+type EdgePoint = ([f64; 3], [f64; 3]);
+
+/// A cell some of whose corners differ in label, with what the parallel
+/// pass computed for it.
+struct MixedCell {
+    cell: [usize; 3],
+    l: [u32; 8],
+    /// (face key, point) of the faces this cell owns.
+    faces: Vec<(u64, [f64; 3])>,
+    point: [f64; 3],
+}
+
+/// Grid sample of corner `c` (bit a: +1 along axis a) of `cell`.
+fn corner_of(cell: [usize; 3], c: usize) -> [usize; 3] {
+    [
+        cell[0] + (c & 1),
+        cell[1] + (c >> 1 & 1),
+        cell[2] + (c >> 2 & 1),
+    ]
+}
+
+/// Cell edge (d, o): along axis d, at offset o & 1 along d + 1 and o >> 1
+/// along d + 2; its corners (lower, upper).
+fn edge_ends(d: usize, o: usize) -> (usize, usize) {
+    let mut lo = [0usize; 3];
+    lo[(d + 1) % 3] = o & 1;
+    lo[(d + 2) % 3] = o >> 1;
+    let mut hi = lo;
+    hi[d] = 1;
+    (
+        lo[0] | lo[1] << 1 | lo[2] << 2,
+        hi[0] | hi[1] << 1 | hi[2] << 2,
+    )
+}
+
+/// Face (n, s) of a cell (normal n, offset s): its edges (d, o) with d ≠ n,
+/// as indices d * 4 + o, in that order.
+fn face_edges(n: usize, s: usize) -> Vec<usize> {
+    (0..3)
+        .filter(|&d| d != n)
+        .flat_map(|d| (0..4).map(move |o| (d, o)))
+        .filter(|&(d, o)| {
+            let off = if n == (d + 1) % 3 { o & 1 } else { o >> 1 };
+            off == s
+        })
+        .map(|(d, o)| d * 4 + o)
+        .collect()
+}
+
+fn face_corners(n: usize, s: usize) -> Vec<usize> {
+    (0..8).filter(|&c| (c >> n) & 1 == s).collect()
+}
+
+/// The bounding box of `points`, inset by INSET of its size: a point
+/// clamped onto the box would be collinear with the edge points there.
+fn inset_box(points: impl Iterator<Item = [f64; 3]>) -> ([f64; 3], [f64; 3]) {
+    let (mut lo, mut hi) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    for p in points {
+        for a in 0..3 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let d: [f64; 3] = std::array::from_fn(|a| INSET * (hi[a] - lo[a]));
+    (
+        std::array::from_fn(|a| lo[a] + d[a]),
+        std::array::from_fn(|a| hi[a] - d[a]),
+    )
 }
 
 /// The solid whose function decides the surface between labels `a` and `b`

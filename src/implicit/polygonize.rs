@@ -125,10 +125,18 @@ impl Field {
 /// over z planes, row by row with the x terms computed once (`RowTape`).
 /// Used by the dense-throughput benchmark.
 pub fn sample_grid(ssa: &Ssa, grid: &Grid) -> Vec<f32> {
+    let mut values = vec![0.0f32; grid.cells.iter().map(|n| n + 1).product()];
+    sample_grid_into(ssa, grid, &mut values);
+    values
+}
+
+/// `sample_grid` into a buffer of the grid's sample count (x fastest), so
+/// repeated sampling reuses memory that is already mapped.
+pub fn sample_grid_into(ssa: &Ssa, grid: &Grid, values: &mut [f32]) {
     let tape = RowTape::new(ssa);
     let [xs, ys, zs] = [grid.coords(0), grid.coords(1), grid.coords(2)];
     let plane = xs.len() * ys.len();
-    let mut values = vec![0.0f32; plane * zs.len()];
+    assert_eq!(values.len(), plane * zs.len(), "one value per grid sample");
     values.par_chunks_mut(plane).enumerate().for_each_init(
         || tape.workspace(&xs),
         |ws, (k, out)| {
@@ -137,7 +145,6 @@ pub fn sample_grid(ssa: &Ssa, grid: &Grid) -> Vec<f32> {
             }
         },
     );
-    values
 }
 
 /// A block range [lo, hi) per axis of the block grid.

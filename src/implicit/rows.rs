@@ -7,7 +7,10 @@
 //! - x only: evaluated once per set of x coordinates, in f64, stored as f32
 //!   lanes (the x terms, sin 6x, …);
 //! - x and y or z: evaluated per row over f32 lanes, one tight loop per
-//!   instruction that the compiler vectorises (AVX2 when the CPU has it).
+//!   instruction that the compiler vectorises (AVX2 when the CPU has it);
+//!   `lane ± row scalar` (a ball's y and z terms) is folded into the operand
+//!   of the instruction that reads it, so M1's seven balls and six unions
+//!   take six lane passes per row, not twenty.
 //!
 //! Why f32 lanes: samples only decide the inside/outside sign of grid points
 //! and the first guess of each edge crossing; crossings are then refined on
@@ -24,6 +27,10 @@ use super::tape::{Ssa, children};
 enum Src {
     /// A lane slot.
     Lane(u32),
+    /// A lane slot plus two per-row offsets added in order, in f32
+    /// (`RowWorkspace::offs[2k]`, `[2k + 1]`): the folded form of up to two
+    /// additions or subtractions of per-row scalars (a ball's y and z terms).
+    Shifted(u32, u32),
     /// A per-row scalar (index into the SSA values).
     Scalar(u32),
 }
@@ -46,15 +53,30 @@ struct LaneInstr {
     b: Src,
 }
 
+/// One folded per-row term: the scalar node, negated for a subtraction.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Term {
+    negate: bool,
+    node: u32,
+}
+
 /// A program split into per-x, per-row and per-lane parts.
 #[derive(Debug, Clone)]
 pub struct RowTape {
     ssa: Ssa,
-    /// SSA nodes evaluated once per row (no x dependency), in order.
+    /// SSA nodes with no x dependency, in order (constants included).
     row_nodes: Vec<u32>,
+    /// Of those, the ones depending on z only, on y only, and on both y and
+    /// z: re-evaluated when z changes, when y changes, and every row.
+    z_nodes: Vec<u32>,
+    y_nodes: Vec<u32>,
+    yz_nodes: Vec<u32>,
     /// SSA nodes depending on x only, and the lane slot each is stored in.
     x_nodes: Vec<(u32, u32)>,
     lane: Vec<LaneInstr>,
+    /// The terms of each `Src::Shifted` offset pair (None: −0.0, which adds
+    /// exactly nothing, even to −0.0).
+    shifts: Vec<[Option<Term>; 2]>,
     slots: usize,
     out: Src,
     /// Nodes that depend on no coordinate.
@@ -62,11 +84,16 @@ pub struct RowTape {
 }
 
 /// Per-thread scratch: the lane slots, the x-only lanes for one set of x
-/// coordinates, and the per-row scalars.
+/// coordinates, the per-row scalars and the per-row offsets.
 pub struct RowWorkspace {
     width: usize,
     lanes: Vec<f32>,
     scalars: Vec<f64>,
+    offs: Vec<f32>,
+    /// The bits of the y and z the scalars were last evaluated at (a NaN's
+    /// at first, so the first row evaluates everything).
+    last_y: u64,
+    last_z: u64,
 }
 
 const X: u8 = 1;
@@ -74,17 +101,74 @@ const X: u8 = 1;
 impl RowTape {
     pub fn new(ssa: &Ssa) -> RowTape {
         let n = ssa.ops.len();
+        let root = n - 1;
         let mut mask = vec![0u8; n];
+        let mut uses = vec![0u32; n];
         for (i, op) in ssa.ops.iter().enumerate() {
             mask[i] = match *op {
                 Node::Var(a) => 1 << a,
                 _ => children(op).fold(0, |m, c| m | mask[c as usize]),
             };
+            for c in children(op) {
+                uses[c as usize] += 1;
+            }
         }
+        let mixed = |i: usize| mask[i] & X != 0 && mask[i] != X;
+        let lane_valued = |i: u32| mask[i as usize] & X != 0;
+        let row_valued = |i: u32| mask[i as usize] & X == 0;
+        // Fold `lane ± row scalar` (used once, by another lane instruction)
+        // into its consumer's operand: a lane plus up to two offsets. The
+        // consumer adds them in the same order and f32 rounding as the
+        // instructions it replaces (a − s is exactly a + (−s)), so values are
+        // bit-identical, and a ball's row costs one lane pass instead of three.
+        let mut shift: Vec<Option<(u32, Vec<Term>)>> = vec![None; n];
+        for (i, op) in ssa.ops.iter().enumerate() {
+            if !mixed(i) || i == root || uses[i] != 1 {
+                continue;
+            }
+            let (base, term) = match *op {
+                Node::Binary(Binary::Add, a, b) if lane_valued(a) && row_valued(b) => (
+                    a,
+                    Term {
+                        negate: false,
+                        node: b,
+                    },
+                ),
+                Node::Binary(Binary::Add, a, b) if row_valued(a) && lane_valued(b) => (
+                    b,
+                    Term {
+                        negate: false,
+                        node: a,
+                    },
+                ),
+                Node::Binary(Binary::Sub, a, b) if lane_valued(a) && row_valued(b) => (
+                    a,
+                    Term {
+                        negate: true,
+                        node: b,
+                    },
+                ),
+                _ => continue,
+            };
+            let (base, mut terms) = shift[base as usize].clone().unwrap_or((base, Vec::new()));
+            if terms.len() < 2 {
+                terms.push(term);
+                shift[i] = Some((base, terms));
+            }
+        }
+        // An operand as the instruction reading it sees it: the lane node it
+        // reads (through any fold) and the fold.
+        let resolve = |c: u32| match &shift[c as usize] {
+            Some((base, _)) => *base,
+            None => c,
+        };
+        let emitted = |i: usize| mixed(i) && shift[i].is_none();
         let mut last_use = vec![0usize; n];
         for (i, op) in ssa.ops.iter().enumerate() {
-            for c in children(op) {
-                last_use[c as usize] = i;
+            if emitted(i) {
+                for c in children(op) {
+                    last_use[resolve(c) as usize] = i;
+                }
             }
         }
         let mut row_nodes = Vec::new();
@@ -101,26 +185,28 @@ impl RowTape {
                 row_nodes.push(i as u32);
             }
         }
-        let src = |i: u32, slot_of: &[u32]| {
-            if mask[i as usize] & X == 0 {
-                Src::Scalar(i)
-            } else {
-                Src::Lane(slot_of[i as usize])
+        let mut shifts: Vec<[Option<Term>; 2]> = Vec::new();
+        let mut src = |i: u32, slot_of: &[u32]| match &shift[i as usize] {
+            Some((base, terms)) => {
+                shifts.push([terms.first().copied(), terms.get(1).copied()]);
+                Src::Shifted(slot_of[*base as usize], (shifts.len() - 1) as u32)
             }
+            None if row_valued(i) => Src::Scalar(i),
+            None => Src::Lane(slot_of[i as usize]),
         };
         let mut free: Vec<u32> = Vec::new();
         let mut lane = Vec::new();
         for (i, op) in ssa.ops.iter().enumerate() {
-            if mask[i] & X == 0 || mask[i] == X {
+            if !emitted(i) {
                 continue;
             }
             let out = free.pop().unwrap_or_else(|| {
                 slots += 1;
                 slots - 1
             });
-            let mut args = children(op).map(|c| src(c, &slot_of));
-            let a = args.next().unwrap_or(Src::Lane(out));
-            let b = args.next().unwrap_or(a);
+            let kids: Vec<u32> = children(op).collect();
+            let a = kids.first().map_or(Src::Lane(out), |&c| src(c, &slot_of));
+            let b = kids.get(1).map_or(a, |&c| src(c, &slot_of));
             let op = match *op {
                 Node::Unary(u, _) => Op::Unary(u),
                 Node::Binary(bin, _, _) => Op::Binary(bin),
@@ -135,22 +221,33 @@ impl RowTape {
             // Free mixed operands at their last use, after allocating the
             // output so it never aliases an input.
             let mut freed = [u32::MAX; 2];
-            for (k, c) in children(&ssa.ops[i]).enumerate() {
-                let c = c as usize;
-                let mixed = mask[c] & X != 0 && mask[c] != X;
-                if mixed && last_use[c] == i && !freed.contains(&(c as u32)) {
-                    free.push(slot_of[c]);
+            for (k, &c) in kids.iter().enumerate() {
+                let c = resolve(c);
+                if mixed(c as usize) && last_use[c as usize] == i && !freed.contains(&c) {
+                    free.push(slot_of[c as usize]);
                 }
-                freed[k] = c as u32;
+                freed[k] = c;
             }
         }
-        let root = (n - 1) as u32;
+        let out = src(root as u32, &slot_of);
+        let only = |m: u8| -> Vec<u32> {
+            row_nodes
+                .iter()
+                .copied()
+                .filter(|&i| mask[i as usize] == m)
+                .collect()
+        };
+        let (y_nodes, z_nodes, yz_nodes) = (only(2), only(4), only(6));
         RowTape {
-            out: src(root, &slot_of),
+            out,
             ssa: ssa.clone(),
+            z_nodes,
+            y_nodes,
+            yz_nodes,
             row_nodes,
             x_nodes,
             lane,
+            shifts,
             slots: slots as usize,
             consts_only: mask.iter().map(|&m| m == 0).collect(),
         }
@@ -168,6 +265,9 @@ impl RowTape {
             width,
             lanes: vec![0.0; self.slots.max(1) * width],
             scalars: vec![0.0; self.ssa.ops.len()],
+            offs: vec![-0.0; 2 * self.shifts.len()],
+            last_y: f64::NAN.to_bits(),
+            last_z: f64::NAN.to_bits(),
         };
         // x-only nodes, evaluated in f64 point by point (after the
         // constants they may use).
@@ -175,6 +275,7 @@ impl RowTape {
         for &i in &self.row_nodes {
             if self.consts_only[i as usize] {
                 vals[i as usize] = eval_node(self.ssa.ops[i as usize], &vals);
+                ws.scalars[i as usize] = vals[i as usize];
             }
         }
         for (lane, &x) in xs.iter().enumerate() {
@@ -192,19 +293,46 @@ impl RowTape {
 
     /// f on the row (xs of the workspace, y, z) into `out` (one per x).
     pub fn eval_row(&self, ws: &mut RowWorkspace, y: f64, z: f64, out: &mut [f32]) {
+        // Constants were set by `workspace`; z-only and y-only terms only
+        // change with z and y (a plane's rows share z).
         let s = &mut ws.scalars;
-        for &i in &self.row_nodes {
-            s[i as usize] = match self.ssa.ops[i as usize] {
-                Node::Var(1) => y,
-                Node::Var(_) => z,
-                op => eval_node(op, s),
-            };
+        let mut eval = |nodes: &[u32]| {
+            for &i in nodes {
+                s[i as usize] = match self.ssa.ops[i as usize] {
+                    Node::Var(1) => y,
+                    Node::Var(_) => z,
+                    op => eval_node(op, s),
+                };
+            }
+        };
+        if z.to_bits() != ws.last_z {
+            eval(&self.z_nodes);
+        }
+        if y.to_bits() != ws.last_y {
+            eval(&self.y_nodes);
+        }
+        eval(&self.yz_nodes);
+        (ws.last_y, ws.last_z) = (y.to_bits(), z.to_bits());
+        for (k, terms) in self.shifts.iter().enumerate() {
+            for (t, term) in terms.iter().enumerate() {
+                ws.offs[2 * k + t] = term.map_or(-0.0, |t| {
+                    let v = ws.scalars[t.node as usize] as f32;
+                    if t.negate { -v } else { v }
+                });
+            }
         }
         run(&self.lane, ws);
         let n = out.len();
         match self.out {
             Src::Lane(slot) => {
                 out.copy_from_slice(&ws.lanes[slot as usize * ws.width..][..n]);
+            }
+            Src::Shifted(slot, k) => {
+                let (c1, c2) = (ws.offs[2 * k as usize], ws.offs[2 * k as usize + 1]);
+                let lanes = &ws.lanes[slot as usize * ws.width..][..n];
+                for (o, &v) in out.iter_mut().zip(lanes) {
+                    *o = (v + c1) + c2;
+                }
             }
             Src::Scalar(i) => out.fill(ws.scalars[i as usize] as f32),
         }
@@ -241,6 +369,15 @@ fn run_avx2(lane: &[LaneInstr], ws: &mut RowWorkspace) {
     run_generic(lane, ws);
 }
 
+/// An operand of a lane loop.
+#[derive(Clone, Copy)]
+enum Opd<'a> {
+    Lane(&'a [f32]),
+    /// (lane + c1) + c2.
+    Shifted(&'a [f32], f32, f32),
+    Scalar(f32),
+}
+
 #[inline(always)]
 fn run_generic(lane: &[LaneInstr], ws: &mut RowWorkspace) {
     let w = ws.width;
@@ -248,17 +385,22 @@ fn run_generic(lane: &[LaneInstr], ws: &mut RowWorkspace) {
         let (lo, hi) = ws.lanes.split_at_mut(ins.out as usize * w);
         let (o, rest) = hi.split_at_mut(w);
         let o: &mut [f32] = o;
-        let pick = |s: Src| -> Result<&[f32], f32> {
+        let slot = |k: u32| -> &[f32] {
+            let k = k as usize;
+            if k < ins.out as usize {
+                &lo[k * w..][..w]
+            } else {
+                &rest[(k - ins.out as usize - 1) * w..][..w]
+            }
+        };
+        let pick = |s: Src| -> Opd {
             match s {
-                Src::Lane(k) => {
-                    let k = k as usize;
-                    Ok(if k < ins.out as usize {
-                        &lo[k * w..][..w]
-                    } else {
-                        &rest[(k - ins.out as usize - 1) * w..][..w]
-                    })
+                Src::Lane(k) => Opd::Lane(slot(k)),
+                Src::Shifted(k, c) => {
+                    let c = 2 * c as usize;
+                    Opd::Shifted(slot(k), ws.offs[c], ws.offs[c + 1])
                 }
-                Src::Scalar(i) => Err(ws.scalars[i as usize] as f32),
+                Src::Scalar(i) => Opd::Scalar(ws.scalars[i as usize] as f32),
             }
         };
         let (a, b) = (pick(ins.a), pick(ins.b));
@@ -273,48 +415,69 @@ fn run_generic(lane: &[LaneInstr], ws: &mut RowWorkspace) {
     }
 }
 
-/// One lane loop with each operand either a lane slot (Ok) or a scalar (Err).
+/// One lane loop over `o` with each operand a lane slot, a shifted lane
+/// slot or a scalar; monomorphised per combination so each is a plain loop
+/// the compiler vectorises.
 #[inline(always)]
-fn each2(
-    o: &mut [f32],
-    a: Result<&[f32], f32>,
-    b: Result<&[f32], f32>,
-    f: impl Fn(f32, f32) -> f32,
-) {
-    match (a, b) {
-        (Ok(a), Ok(b)) => {
-            for ((o, &a), &b) in o.iter_mut().zip(a).zip(b) {
-                *o = f(a, b);
+fn each2(o: &mut [f32], a: Opd, b: Opd, f: impl Fn(f32, f32) -> f32) {
+    let n = o.len();
+    match a {
+        Opd::Lane(a) => {
+            let a = &a[..n];
+            with_b(o, b, |i| a[i], f)
+        }
+        Opd::Shifted(a, c1, c2) => {
+            let a = &a[..n];
+            with_b(o, b, |i| (a[i] + c1) + c2, f)
+        }
+        Opd::Scalar(a) => match b {
+            Opd::Scalar(b) => o.fill(f(a, b)),
+            _ => with_b(o, b, |_| a, f),
+        },
+    }
+}
+
+// Index loops: the operand getter `ga` is indexed like `b`, one loop shape
+// for every combination, which the compiler vectorises.
+#[allow(clippy::needless_range_loop)]
+#[inline(always)]
+fn with_b(o: &mut [f32], b: Opd, ga: impl Fn(usize) -> f32, f: impl Fn(f32, f32) -> f32) {
+    let n = o.len();
+    match b {
+        Opd::Lane(b) => {
+            let b = &b[..n];
+            for i in 0..n {
+                o[i] = f(ga(i), b[i]);
             }
         }
-        (Ok(a), Err(b)) => {
-            for (o, &a) in o.iter_mut().zip(a) {
-                *o = f(a, b);
+        Opd::Shifted(b, c1, c2) => {
+            let b = &b[..n];
+            for i in 0..n {
+                o[i] = f(ga(i), (b[i] + c1) + c2);
             }
         }
-        (Err(a), Ok(b)) => {
-            for (o, &b) in o.iter_mut().zip(b) {
-                *o = f(a, b);
+        Opd::Scalar(b) => {
+            for (i, o) in o.iter_mut().enumerate() {
+                *o = f(ga(i), b);
             }
         }
-        (Err(a), Err(b)) => o.fill(f(a, b)),
     }
 }
 
 #[inline(always)]
-fn unary(u: Unary, o: &mut [f32], a: Result<&[f32], f32>) {
-    let each = |o: &mut [f32], f: &dyn Fn(f32) -> f32| each2(o, a, Err(0.0), |x, _| f(x));
+fn unary(u: Unary, o: &mut [f32], a: Opd) {
+    let z = Opd::Scalar(0.0);
     match u {
-        Unary::Neg => each2(o, a, Err(0.0), |x, _| -x),
-        Unary::Square => each2(o, a, Err(0.0), |x, _| x * x),
-        Unary::Sqrt => each2(o, a, Err(0.0), |x, _| x.sqrt()),
-        Unary::Abs => each2(o, a, Err(0.0), |x, _| x.abs()),
-        _ => each(o, &|x| u.apply(x as f64) as f32),
+        Unary::Neg => each2(o, a, z, |x, _| -x),
+        Unary::Square => each2(o, a, z, |x, _| x * x),
+        Unary::Sqrt => each2(o, a, z, |x, _| x.sqrt()),
+        Unary::Abs => each2(o, a, z, |x, _| x.abs()),
+        _ => each2(o, a, z, |x, _| u.apply(x as f64) as f32),
     }
 }
 
 #[inline(always)]
-fn binary(bin: Binary, o: &mut [f32], a: Result<&[f32], f32>, b: Result<&[f32], f32>) {
+fn binary(bin: Binary, o: &mut [f32], a: Opd, b: Opd) {
     match bin {
         Binary::Add => each2(o, a, b, |x, y| x + y),
         Binary::Sub => each2(o, a, b, |x, y| x - y),
@@ -368,5 +531,51 @@ mod tests {
         let mut ws = tape.workspace(&xs);
         tape.eval_row(&mut ws, 0.5, 0.0, &mut out);
         assert!(out.iter().all(|&v| v == 0.5f64.cos() as f32));
+    }
+
+    /// Folding a ball's y and z terms into the union's operands must give
+    /// the very f32 bits of the unfolded instructions (f32 subtractions of
+    /// the f64 row terms rounded to f32, in order).
+    #[test]
+    fn folded_ball_terms_are_bit_identical_to_the_unfolded_sequence() {
+        let balls = [
+            (0.7, [0.0, 0.0, 0.0]),
+            (0.3, [0.7, 0.0, 0.0]),
+            (0.3, [0.0, -0.7, 0.35]),
+        ];
+        let mut ctx = Ctx::new();
+        let (x, y, z) = (ctx.var(0), ctx.var(1), ctx.var(2));
+        let mut f = None;
+        for (r, c) in balls {
+            let rc = ctx.constant(r);
+            let mut b = ctx.square(rc);
+            for (v, c) in [x, y, z].into_iter().zip(c) {
+                let c = ctx.constant(c);
+                let d = ctx.sub(v, c);
+                let s = ctx.square(d);
+                b = ctx.sub(b, s);
+            }
+            f = Some(f.map_or(b, |acc| ctx.r_or(acc, b, 0.0)));
+        }
+        let ssa = Ssa::from_ctx(&ctx, f.expect("three balls"));
+        let tape = RowTape::new(&ssa);
+        assert_eq!(tape.lane_len(), 2, "two unions, the balls folded into them");
+        let xs: Vec<f64> = (0..41).map(|i| -1.0 + i as f64 * 0.05).collect();
+        let mut ws = tape.workspace(&xs);
+        let mut out = vec![0.0f32; xs.len()];
+        for (y, z) in [(0.0, 0.0), (0.3, -0.2), (-0.65, 0.35), (1.0, -1.0)] {
+            tape.eval_row(&mut ws, y, z, &mut out);
+            for (i, &x) in xs.iter().enumerate() {
+                let ball = |(r, c): (f64, [f64; 3])| {
+                    let xt = (r * r - (x - c[0]) * (x - c[0])) as f32;
+                    let yt = ((y - c[1]) * (y - c[1])) as f32;
+                    let zt = ((z - c[2]) * (z - c[2])) as f32;
+                    (xt - yt) - zt
+                };
+                let or = |a: f32, b: f32| a + b + (a * a + b * b).sqrt();
+                let want = or(or(ball(balls[0]), ball(balls[1])), ball(balls[2]));
+                assert_eq!(out[i].to_bits(), want.to_bits(), "{x} {y} {z}");
+            }
+        }
     }
 }

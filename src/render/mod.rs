@@ -314,11 +314,8 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
 
 fn sample_point(proj: &raster::Projected, node: u32) -> [f32; 3] {
     let p = proj.xy_f[node as usize];
-    [p[0], p[1], proj.z[node as usize]]
+    [p[0], p[1], proj.snapped[node as usize].z]
 }
-
-/// Nodes' sample-space positions before snapping, and their depths.
-type Unsnapped = (Vec<[f32; 2]>, Vec<f32>);
 
 /// Node positions in sample space, depths normalised to [0, 1].
 fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projected {
@@ -339,7 +336,7 @@ fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projecte
     let s = ss as f64;
     // Far outside the picture only the clamped bounding box matters.
     let limit = 1e6;
-    let (xy, (xy_f, z)): (Vec<[i64; 2]>, Unsnapped) = scene
+    let (snapped, xy_f): (Vec<raster::Snapped>, Vec<[f32; 2]>) = scene
         .points
         .par_iter()
         .map(|&q| {
@@ -348,22 +345,28 @@ fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projecte
                 (p[0] * s).clamp(-limit, limit),
                 (p[1] * s).clamp(-limit, limit),
             );
+            let z = ((p[2] - lo) / range) as f32;
             (
-                [snap(x), snap(y)],
-                ([x as f32, y as f32], ((p[2] - lo) / range) as f32),
+                raster::Snapped {
+                    x: snap(x),
+                    y: snap(y),
+                    z,
+                },
+                [x as f32, y as f32],
             )
         })
         .unzip();
-    raster::Projected { xy, xy_f, z }
+    raster::Projected { snapped, xy_f }
 }
 
 /// A sample-space coordinate in 1/16 sample steps, rounded half away from
 /// zero (`f64::round` is a library call on baseline x86-64; this is two
-/// instructions, and a million nodes make it count).
+/// instructions, and a million nodes make it count). `v` is within ±1e6
+/// samples, so the steps fit an `i32`.
 #[inline]
-fn snap(v: f64) -> i64 {
+fn snap(v: f64) -> i32 {
     let v = v * 16.0;
-    (v + 0.5f64.copysign(v)) as i64
+    (v + 0.5f64.copysign(v)) as i32
 }
 
 /// Renders and encodes a PNG.
