@@ -22,6 +22,7 @@
 //!   becomes [`MeshError::Internal`] naming the entity instead of a crash.
 //! - See the module docs of [`chart`] and [`face`] for per-surface limits.
 
+mod boundary_chain;
 mod chart;
 mod check;
 mod constraints;
@@ -217,9 +218,9 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             let mut mesh = assemble(model, &edge_nodes, face_meshes, &lines);
             refuse_collapsed(&mesh, tolerance)?;
             trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
-            crack::open(model, &mut mesh);
+            let origins = crack::open(model, &mut mesh);
             if options.order == 2 {
-                quadratic::elevate(model, &edge_nodes, &mut mesh);
+                quadratic::elevate(model, &edge_nodes, &origins, &mut mesh);
             }
             Ok(mesh)
         },
