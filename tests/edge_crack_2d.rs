@@ -307,7 +307,10 @@ fn second_order_mid_nodes_of_a_cut_curved_rim_lie_on_the_curve() {
                 let d = on_curve(mesh.nodes[m as usize]);
                 assert!(d.abs() < 1e-12, "a = {a}, edge {e}, mid {k}: off by {d}");
                 // The chord's middle lies inside the curve.
-                let (p, r) = (mesh.nodes[nodes[k] as usize], mesh.nodes[nodes[k + 1] as usize]);
+                let (p, r) = (
+                    mesh.nodes[nodes[k] as usize],
+                    mesh.nodes[nodes[k + 1] as usize],
+                );
                 let chord = on_curve([(p[0] + r[0]) / 2.0, (p[1] + r[1]) / 2.0, 0.0]);
                 assert!(chord < -1e-7, "a = {a}, edge {e}, chord {k}: {chord}");
             }

@@ -353,7 +353,11 @@ fn refinement_splits_on_close_circles_stay_on_the_circles() {
         for &n in &edge.nodes {
             let [px, py, _] = point(&m, n);
             let off = ((px - x).hypot(py - y) - r).abs();
-            assert!(off < 1e-12, "{}: node {n} off its circle by {off}", edge.name);
+            assert!(
+                off < 1e-12,
+                "{}: node {n} off its circle by {off}",
+                edge.name
+            );
         }
         rim_nodes += edge.nodes.len();
     }

@@ -28,9 +28,11 @@ pub(crate) fn elevate(
     let mut quadratic = QuadraticNodes::default();
     for (i, edge) in mesh.edges.iter().enumerate() {
         let mut per_segment = Vec::with_capacity(edge.nodes.len().saturating_sub(1));
-        let curve_params = origins.get(i).copied().flatten().and_then(|(m, first)| {
-            Some((model.edges.get(m)?, edge_nodes.get(m)?, first))
-        });
+        let curve_params = origins
+            .get(i)
+            .copied()
+            .flatten()
+            .and_then(|(m, first)| Some((model.edges.get(m)?, edge_nodes.get(m)?, first)));
         for (j, w) in edge.nodes.windows(2).enumerate() {
             let id = *mids.entry(key(w[0], w[1])).or_insert_with(|| {
                 let point = match curve_params {
