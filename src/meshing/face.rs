@@ -7,8 +7,10 @@
 //! - Boundary nodes are exactly the edges' nodes: when refinement wants to
 //!   split a boundary segment, the face returns [`Outcome::Split`] with the
 //!   curve parameters instead of a mesh, the caller adds those points to the
-//!   edge for every face that uses it, and meshes again. In the last round
-//!   (`keep_boundary`) splitting is forbidden instead.
+//!   edge for every face that uses it, and meshes again. On a plane the split
+//!   is kept instead (a point on a curve first moved onto it,
+//!   [`super::boundary_chain`]) and reported in [`FaceMesh::added`]. In the
+//!   last round (`keep_boundary`) splitting is forbidden instead.
 //! - Every triangle's distance from the surface at its centroid and edge
 //!   midpoints is at most `tolerance` and its longest edge at most `max_edge`,
 //!   unless the pass limit is reached first.
