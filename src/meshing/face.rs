@@ -361,6 +361,12 @@ pub(crate) fn mesh_face(
                 }
                 moved = true;
             }
+            // Without peeling the loop is the hull: a point moved inwards
+            // (a concave arc of one segment) would leave part of the hull
+            // outside the face and unexcluded.
+            if moved && !peel && !framed && !loop_is_hull(&cdt, &uv_loops) {
+                return Ok(sent_back(&chains));
+            }
             for chain in &chains {
                 let indices = boundary_chain::indices(&cdt, chain).ok_or_else(|| {
                     failed("a boundary node moved onto its curve was lost".into())
