@@ -59,6 +59,7 @@ pub(super) fn lower_subdomains(
     model.subdomains.reserve(doc.subdomains.len());
     for (def_index, def) in doc.subdomains.iter().enumerate() {
         let id = SubdomainId(model.subdomains.len() as u32);
+        let mut trimmed_faces = Vec::new();
         let cells = match (&def.faces, &def.tree) {
             (Some(_), Some(_)) => {
                 diags.push(
@@ -72,7 +73,10 @@ pub(super) fn lower_subdomains(
                 continue;
             }
             (Some((refs, _)), None) => match explicit_shell(model, entities, refs, diags) {
-                Some(boundary) => SubdomainCells::Volume { boundary },
+                Some((boundary, trimmed)) => {
+                    trimmed_faces = trimmed;
+                    SubdomainCells::Volume { boundary }
+                }
                 None => continue,
             },
             (None, Some(tree)) => {
@@ -114,6 +118,7 @@ pub(super) fn lower_subdomains(
             cells,
             solids: Vec::new(),
             max_area: resolved.subdomain_areas.get(def_index).copied().flatten(),
+            trimmed: trimmed_faces,
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
     }
@@ -717,8 +722,10 @@ fn explicit_shell(
     entities: &Entities,
     refs: &[crate::doc::Ref],
     diags: &mut Diagnostics,
-) -> Option<Vec<OrientedFace>> {
+) -> Option<(Vec<OrientedFace>, Vec<usize>)> {
     let mut faces: Vec<FaceId> = Vec::new();
+    // Trimmed surfaces are faces too, found by their element's name.
+    let mut trimmed: Vec<usize> = Vec::new();
     let mut seen: BTreeSet<FaceId> = BTreeSet::new();
     let mut ok = true;
     for r in refs {
@@ -740,16 +747,27 @@ fn explicit_shell(
                     }
                 }
             }
-            None => {
-                unknown_entity(r, "face", entities, diags);
-                ok = false;
-            }
+            None => match model.trimmed.iter().position(|s| s.name == r.text) {
+                Some(k) if trimmed.contains(&k) => diags.push(
+                    Diagnostic::new(
+                        Code::RepeatedFace,
+                        r.span,
+                        format!("face '{}' is already in this subdomain's faces= list; the repeat is ignored", r.text),
+                    )
+                    .with_help("remove the repeated name"),
+                ),
+                Some(k) => trimmed.push(k),
+                None => {
+                    unknown_entity(r, "face", entities, diags);
+                    ok = false;
+                }
+            },
         }
     }
     if !ok {
         return None;
     }
-    Some(orient_shell(model, &faces))
+    Some((orient_shell(model, &faces), trimmed))
 }
 
 /// Propagates outward flags across shared edges (an edge is run in opposite
