@@ -253,3 +253,75 @@ fn scikit_fem_sees_the_edge_crack_open_to_the_boundary() {
         "jump {jump} then {fine_jump}"
     );
 }
+
+/// Second order with an edge crack on a curved rim: the rim is cut at the
+/// mouth into `EDGE` and `EDGE.beyond.NAME`, and the mid nodes of both
+/// parts lie on the curve (circle x² + y² = 1, ellipse x²/4 + y² = 1), not
+/// on the chords.
+#[test]
+fn second_order_mid_nodes_of_a_cut_curved_rim_lie_on_the_curve() {
+    let shapes = [
+        (
+            r#"<circle name="disk"><center x="0" y="0"/><radius value="1"/></circle>"#,
+            1.0,
+        ),
+        (
+            r#"<ellipse name="disk"><center x="0" y="0"/><radius_vertex x="2" y="0"/><radius_vertex x="0" y="1"/></ellipse>"#,
+            2.0,
+        ),
+    ];
+    for (shape, a) in shapes {
+        // From the bottom of the rim (0, −1) up to (0.1, −0.4).
+        let crack = line("cr", true, &[(0.0, -1.0), (0.0, -0.7), (0.1, -0.4)]);
+        let xml = format!(
+            r#"<geometry version="1" dimension="2">{shape}{crack}
+              <subdomain name="body"><solid ref="disk"/></subdomain></geometry>"#
+        );
+        let checked = check_source(SourceFile::new("t.xml", &xml), &Options::default());
+        assert!(checked.is_valid(), "{:#?}", checked.diagnostics.items);
+        let model = checked.lowered.expect("a model").model;
+        let options = MeshOptions {
+            max_area: Some(0.01),
+            min_angle_degrees: 28.0,
+            order: 2,
+            ..MeshOptions::default()
+        };
+        let mesh = mesh_model(&model, &options).expect("meshes");
+        let q = mesh.quadratic.as_ref().expect("second order");
+        let on_curve = |p: [f64; 3]| ((p[0] / a).powi(2) + p[1] * p[1]).sqrt() - 1.0;
+        let beyond = mesh
+            .edges
+            .iter()
+            .position(|e| e.name.ends_with(".beyond.cr"))
+            .unwrap_or_else(|| panic!("a = {a}: no beyond part"));
+        let rim = mesh
+            .edges
+            .iter()
+            .position(|e| mesh.edges[beyond].name == format!("{}.beyond.cr", e.name))
+            .expect("the kept part of the rim");
+        for e in [rim, beyond] {
+            let nodes = &mesh.edges[e].nodes;
+            assert!(nodes.len() > 5, "a = {a}: {} nodes", nodes.len());
+            assert_eq!(q.edges[e].len(), nodes.len() - 1);
+            for (k, &m) in q.edges[e].iter().enumerate() {
+                let d = on_curve(mesh.nodes[m as usize]);
+                assert!(d.abs() < 1e-12, "a = {a}, edge {e}, mid {k}: off by {d}");
+                // The chord's middle lies inside the curve.
+                let (p, r) = (
+                    mesh.nodes[nodes[k] as usize],
+                    mesh.nodes[nodes[k + 1] as usize],
+                );
+                let chord = on_curve([(p[0] + r[0]) / 2.0, (p[1] + r[1]) / 2.0, 0.0]);
+                assert!(chord < -1e-7, "a = {a}, edge {e}, chord {k}: {chord}");
+            }
+        }
+        // The mouth splits the rim: the two parts share no inner node.
+        let first: HashSet<u32> = mesh.edges[rim].nodes.iter().copied().collect();
+        let shared = mesh.edges[beyond]
+            .nodes
+            .iter()
+            .filter(|n| first.contains(n))
+            .count();
+        assert!(shared <= 1, "a = {a}: {shared} shared nodes");
+    }
+}

@@ -320,3 +320,73 @@ fn inspect_mesh_reports_angles_and_areas_per_subdomain() {
     // The model's facts are the top-level object; the report sits under "mesh".
     assert_eq!(json["dimension"], 2, "{json}");
 }
+
+/// Holes close together make refinement split their circles (the gaps are
+/// narrower than the segments): the new nodes go onto the circles in the
+/// face's own triangulation. Every rim node is on its circle, the angle
+/// and area limits hold, and meshing twice gives the same mesh.
+#[test]
+fn refinement_splits_on_close_circles_stay_on_the_circles() {
+    let holes = [(-0.21, 0.0), (0.0, 0.0), (0.205, 0.02)];
+    let mut xml = String::from(
+        r#"<geometry version="1" dimension="2"><circle name="disk"><center x="0" y="0"/><radius value="1"/></circle>"#,
+    );
+    for (k, (x, y)) in holes.iter().enumerate() {
+        xml.push_str(&format!(
+            r#"<circle name="h{k}"><center x="{x}" y="{y}"/><radius value="0.1"/></circle>"#
+        ));
+    }
+    xml.push_str(r#"<subdomain name="plate"><difference><solid ref="disk"/><solid ref="h0"/><solid ref="h1"/><solid ref="h2"/></difference></subdomain></geometry>"#);
+    let model = model(&xml);
+    let options = MeshOptions {
+        min_angle_degrees: 28.0,
+        max_area: Some(0.01),
+        tolerance: Tolerance::Absolute(0.002),
+        ..MeshOptions::default()
+    };
+    let m = mesh(&model, &options);
+    let circles = [((0.0, 0.0), 1.0)]
+        .into_iter()
+        .chain(holes.iter().map(|&c| (c, 0.1)));
+    let mut rim_nodes = 0;
+    for (edge, ((x, y), r)) in m.edges.iter().zip(circles) {
+        for &n in &edge.nodes {
+            let [px, py, _] = point(&m, n);
+            let off = ((px - x).hypot(py - y) - r).abs();
+            assert!(
+                off < 1e-12,
+                "{}: node {n} off its circle by {off}",
+                edge.name
+            );
+        }
+        rim_nodes += edge.nodes.len();
+    }
+    let loose = mesh(
+        &model,
+        &MeshOptions {
+            min_angle_degrees: 5.0,
+            max_area: None,
+            ..options.clone()
+        },
+    );
+    let loose_nodes: usize = loose.edges.iter().map(|e| e.nodes.len()).sum();
+    // The 28° refinement split the circles (beyond what the 5° mesh needs).
+    assert!(
+        rim_nodes > loose_nodes,
+        "{rim_nodes} rim nodes against {loose_nodes} at 5°"
+    );
+    let triangles: Vec<[u32; 3]> = m.faces.iter().flat_map(|f| f.triangles.clone()).collect();
+    let least = triangles
+        .iter()
+        .map(|&t| min_angle(&m, t))
+        .fold(180.0, f64::min);
+    assert!(least >= 28.0 - 1e-9, "smallest angle {least}");
+    let largest = triangles
+        .iter()
+        .map(|&t| area(&m, t).abs())
+        .fold(0.0, f64::max);
+    assert!(largest <= 0.01, "largest area {largest}");
+    let again = mesh(&model, &options);
+    assert_eq!(again.nodes, m.nodes);
+    assert_eq!(again.faces, m.faces);
+}

@@ -25,8 +25,18 @@ use crate::ir::Model;
 use crate::mesh::{Mesh, MeshEdge, MeshFragment};
 use std::f64::consts::TAU;
 
-/// Opens every crack poly_line whose chain lies in the mesh's triangles.
-pub(crate) fn open(model: &Model, mesh: &mut Mesh) {
+/// Where each mesh edge's nodes come from: (model edge, index of its first
+/// node in that edge's discretisation), or `None` for edges that follow no
+/// model curve (crack sides, edges added after meshing).
+pub(crate) type EdgeOrigins = Vec<Option<(usize, usize)>>;
+
+/// Opens every crack poly_line whose chain lies in the mesh's triangles;
+/// returns the origin of every mesh edge, so that an `EDGE.beyond.NAME` part
+/// still knows its curve parameters (second-order mid nodes on the curve).
+pub(crate) fn open(model: &Model, mesh: &mut Mesh) -> EdgeOrigins {
+    let mut origins: EdgeOrigins = (0..mesh.edges.len())
+        .map(|i| (i < model.edges.len()).then_some((i, 0)))
+        .collect();
     for (index, line) in model.polylines.iter().enumerate() {
         if !line.crack {
             continue;
@@ -47,7 +57,7 @@ pub(crate) fn open(model: &Model, mesh: &mut Mesh) {
         let mut right = open_chain(mesh, face, &chain);
         for (m, k) in mouths.into_iter().zip([0, chain.len() - 1]) {
             if let Some(m) = m {
-                right[k] = open_mouth(mesh, face, &m, &line.name);
+                right[k] = open_mouth(mesh, face, &m, &line.name, &mut origins);
             }
         }
         let subdomain = mesh
@@ -71,6 +81,8 @@ pub(crate) fn open(model: &Model, mesh: &mut Mesh) {
             });
         }
     }
+    origins.resize(mesh.edges.len(), None);
+    origins
 }
 
 fn face_with_edge(mesh: &Mesh, a: u32, b: u32) -> Option<usize> {
@@ -195,7 +207,13 @@ fn mouth(mesh: &Mesh, face: usize, chain: &[u32], k: usize) -> Option<Mouth> {
 
 /// Duplicates a mouth node for the right side's triangles and cuts the
 /// boundary edge through it; returns the copy.
-fn open_mouth(mesh: &mut Mesh, face: usize, m: &Mouth, crack: &str) -> u32 {
+fn open_mouth(
+    mesh: &mut Mesh,
+    face: usize,
+    m: &Mouth,
+    crack: &str,
+    origins: &mut EdgeOrigins,
+) -> u32 {
     let copy = mesh.nodes.len() as u32;
     mesh.nodes.push(mesh.nodes[m.node as usize]);
     for &i in &m.right_triangles {
@@ -236,6 +254,14 @@ fn open_mouth(mesh: &mut Mesh, face: usize, m: &Mouth, crack: &str) -> u32 {
     let name = format!("{}.beyond.{crack}", mesh.edges[e].name);
     mesh.edges[e].nodes = head;
     mesh.edges.push(MeshEdge { name, nodes: tail });
+    // The new part starts `at` nodes into the cut edge's discretisation.
+    let origin = origins
+        .get(e)
+        .copied()
+        .flatten()
+        .map(|(model_edge, first)| (model_edge, first + at));
+    origins.resize(new as usize, None);
+    origins.push(origin);
     for f in &mut mesh.faces {
         if let Some(pos) = f.boundary.iter().position(|&(b, _)| b as usize == e) {
             // The new part comes after the kept one along the edge.

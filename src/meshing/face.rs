@@ -7,8 +7,10 @@
 //! - Boundary nodes are exactly the edges' nodes: when refinement wants to
 //!   split a boundary segment, the face returns [`Outcome::Split`] with the
 //!   curve parameters instead of a mesh, the caller adds those points to the
-//!   edge for every face that uses it, and meshes again. In the last round
-//!   (`keep_boundary`) splitting is forbidden instead.
+//!   edge for every face that uses it, and meshes again. On a plane the split
+//!   is kept instead (a point on a curve first moved onto it,
+//!   [`super::boundary_chain`]) and reported in [`FaceMesh::added`]. In the
+//!   last round (`keep_boundary`) splitting is forbidden instead.
 //! - Every triangle's distance from the surface at its centroid and edge
 //!   midpoints is at most `tolerance` and its longest edge at most `max_edge`,
 //!   unless the pass limit is reached first.
@@ -22,6 +24,7 @@
 //!   with several loops on a torus may place them a period apart.
 
 use super::MeshError;
+use super::boundary_chain;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
 use super::polyline_split;
@@ -101,7 +104,7 @@ struct LoopPoint {
 
 /// A boundary segment of the triangulation: its edge and curve parameters
 /// at its lower- and higher-numbered vertex.
-type Segments = BTreeMap<(usize, usize), (usize, f64, f64)>;
+pub(super) type Segments = BTreeMap<(usize, usize), (usize, f64, f64)>;
 
 pub(crate) fn mesh_face(
     model: &Model,
@@ -288,7 +291,7 @@ pub(crate) fn mesh_face(
     // Vertices from this index on have not been checked for boundary splits.
     let mut unchecked = fixed;
     let mut added = Vec::new();
-    for _ in 0..MAX_PASSES {
+    for pass in 0..MAX_PASSES {
         let result = cdt.refine(parameters.clone());
         if settings.keep_boundary && !polyline_segments.is_empty() {
             // Spade keeps the poly_lines whole with the loops: split them
@@ -319,32 +322,73 @@ pub(crate) fn mesh_face(
             return mesh_face(model, face, edges, &keep, constraints);
         }
         let mut kept = Vec::new();
+        let mut moved = false;
         if !settings.keep_boundary {
             // Only the vertices added since the last check.
-            let splits =
-                boundary_splits(&cdt, unchecked, &segments, &polyline_segments).map_err(failed)?;
-            // On a straight edge of a plane the split is already on the
-            // curve: keep it (the caller adds the node to the edge) instead
-            // of meshing the face again from scratch.
-            let straight = |&(edge, _, _): &(usize, usize, f64)| {
-                matches!(face.surface, Surface::Plane { .. })
-                    && matches!(
-                        model.edges.get(edge).map(|e| &e.curve),
-                        Some(crate::geom::Curve::Segment { .. })
-                    )
+            let mut chains = boundary_chain::chains(&cdt, unchecked, &segments, &polyline_segments)
+                .map_err(failed)?;
+            let plane = matches!(face.surface, Surface::Plane { .. });
+            let straight = |edge: usize| {
+                matches!(
+                    model.edges.get(edge).map(|e| &e.curve),
+                    Some(crate::geom::Curve::Segment { .. })
+                )
             };
-            if !splits.iter().all(straight) {
-                return Ok(Outcome::Split(
-                    splits.into_iter().map(|(e, _, s)| (e, s)).collect(),
-                ));
+            let sent_back = |chains: &[boundary_chain::Chain]| {
+                Outcome::Split(
+                    chains
+                        .iter()
+                        .flat_map(|c| c.inner.iter().map(|i| (c.edge, i.1)))
+                        .collect(),
+                )
+            };
+            // On a plane a split on a straight edge is on the curve already,
+            // and one on a curve moves onto it in place: the face keeps its
+            // triangulation (the caller adds the nodes to the edges) instead
+            // of being meshed again from scratch. Other surfaces send the
+            // splits back, as does a move spade cannot take.
+            if !chains.is_empty() && !plane {
+                return Ok(sent_back(&chains));
             }
-            kept = splits;
+            for chain in &mut chains {
+                if straight(chain.edge) {
+                    continue;
+                }
+                if pass + 1 == MAX_PASSES
+                    || boundary_chain::move_onto_curve(&mut cdt, &chart, model, chain).is_none()
+                {
+                    return Ok(sent_back(&chains));
+                }
+                moved = true;
+            }
+            // Without peeling the loop is the hull: a point moved inwards
+            // (a concave arc of one segment) would leave part of the hull
+            // outside the face and unexcluded.
+            if moved && !peel && !framed && !loop_is_hull(&cdt, &uv_loops) {
+                return Ok(sent_back(&chains));
+            }
+            for chain in &chains {
+                let indices = boundary_chain::indices(&cdt, chain).ok_or_else(|| {
+                    failed("a boundary node moved onto its curve was lost".into())
+                })?;
+                boundary_chain::update_segments(&mut segments, chain, &indices);
+                for (&v, &(_, s, node)) in indices.iter().zip(&chain.inner) {
+                    kept.push((chain.edge, v, s, node));
+                }
+            }
         }
         unchecked = cdt.num_vertices();
         lift_new_vertices(&cdt, &chart, &mut keys, &mut positions).map_err(failed)?;
-        for (edge, v, s) in kept {
+        for (edge, v, s, node) in kept {
             keys[v] = FacePoint::Edge { edge, s };
+            if let Some(node) = node {
+                positions[v] = node;
+            }
             added.push((edge, s));
+        }
+        if moved {
+            // Refine again around the moved points before the surface checks.
+            continue;
         }
         if polyline_segments.is_empty() {
             // Reused across passes: a fresh zeroed table per pass cost page faults.
@@ -591,49 +635,6 @@ fn winding_odd(loops: &[Vec<[f64; 2]>], p: [f64; 2]) -> bool {
         }
     }
     inside
-}
-
-/// Vertices from index `first` on that the refinement put on boundary
-/// segments: (edge, vertex, curve parameter).
-fn boundary_splits(
-    cdt: &Cdt,
-    first: usize,
-    segments: &Segments,
-    polyline_segments: &[(usize, usize)],
-) -> Result<Vec<(usize, usize, f64)>, String> {
-    let mut splits = Vec::new();
-    for v in first..cdt.num_vertices() {
-        let vertex = cdt.vertex(spade::handles::FixedVertexHandle::from_index(v));
-        if !vertex.out_edges().any(|e| e.is_constraint_edge()) {
-            continue;
-        }
-        let p = vertex.position();
-        if polyline_segments
-            .iter()
-            .any(|&(a, b)| on_segment(cdt, a, b, p).is_some())
-        {
-            continue;
-        }
-        let found = segments.iter().find_map(|(&(a, b), &(edge, sa, sb))| {
-            let pa = cdt
-                .vertex(spade::handles::FixedVertexHandle::from_index(a))
-                .position();
-            let pb = cdt
-                .vertex(spade::handles::FixedVertexHandle::from_index(b))
-                .position();
-            let (dx, dy) = (pb.x - pa.x, pb.y - pa.y);
-            let len2 = dx * dx + dy * dy;
-            let t = ((p.x - pa.x) * dx + (p.y - pa.y) * dy) / len2;
-            let off = ((p.x - pa.x) * dy - (p.y - pa.y) * dx).abs() / len2.sqrt();
-            (t > 0.0 && t < 1.0 && off <= 1e-9 * len2.sqrt()).then_some((
-                edge,
-                v,
-                sa + t * (sb - sa),
-            ))
-        });
-        splits.push(found.ok_or("refinement put a node on its boundary away from every edge")?);
-    }
-    Ok(splits)
 }
 
 /// True when the face has one loop and every convex-hull edge of the
@@ -1026,7 +1027,7 @@ fn shoelace(points: &[[f64; 2]]) -> f64 {
 
 /// Spade refuses coordinates below about 1e-43 in magnitude: such values
 /// are zero for meshing purposes.
-fn point2([u, v]: [f64; 2]) -> Point2<f64> {
+pub(super) fn point2([u, v]: [f64; 2]) -> Point2<f64> {
     let snap = |x: f64| if x.abs() < 1e-30 { 0.0 } else { x };
     Point2::new(snap(u), snap(v))
 }

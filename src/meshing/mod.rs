@@ -22,6 +22,7 @@
 //!   becomes [`MeshError::Internal`] naming the entity instead of a crash.
 //! - See the module docs of [`chart`] and [`face`] for per-surface limits.
 
+mod boundary_chain;
 mod chart;
 mod check;
 mod constraints;
@@ -220,9 +221,9 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             let first_trimmed = mesh.faces.len();
             trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
             trimmed_shell::join(model, &mut mesh, first_trimmed)?;
-            crack::open(model, &mut mesh);
+            let origins = crack::open(model, &mut mesh);
             if options.order == 2 {
-                quadratic::elevate(model, &edge_nodes, &mut mesh);
+                quadratic::elevate(model, &edge_nodes, &origins, &mut mesh);
             }
             Ok(mesh)
         },

@@ -8,23 +8,37 @@
 //! - On curved 3D surfaces face-interior mid nodes lie on the chord, not on
 //!   the surface.
 
+use super::crack::EdgeOrigins;
 use super::edges::EdgeNodes;
 use crate::ir::Model;
 use crate::mesh::{Mesh, QuadraticNodes};
 use std::collections::HashMap;
 
-pub(crate) fn elevate(model: &Model, edge_nodes: &[EdgeNodes], mesh: &mut Mesh) {
+/// `origins` (from [`super::crack::open`]) says which model edge, from which
+/// node on, each mesh edge follows: the parts of an edge cut at a crack
+/// mouth keep their mid nodes on the curve.
+pub(crate) fn elevate(
+    model: &Model,
+    edge_nodes: &[EdgeNodes],
+    origins: &EdgeOrigins,
+    mesh: &mut Mesh,
+) {
     let mut mids: HashMap<(u32, u32), u32> = HashMap::new();
     let key = |a: u32, b: u32| (a.min(b), a.max(b));
     let mut quadratic = QuadraticNodes::default();
     for (i, edge) in mesh.edges.iter().enumerate() {
         let mut per_segment = Vec::with_capacity(edge.nodes.len().saturating_sub(1));
-        let curve_params = model.edges.get(i).zip(edge_nodes.get(i));
+        let curve_params = origins
+            .get(i)
+            .copied()
+            .flatten()
+            .and_then(|(m, first)| Some((model.edges.get(m)?, edge_nodes.get(m)?, first)));
         for (j, w) in edge.nodes.windows(2).enumerate() {
             let id = *mids.entry(key(w[0], w[1])).or_insert_with(|| {
                 let point = match curve_params {
-                    Some((model_edge, disc)) if j + 1 < disc.params.len() => {
-                        let s = 0.5 * (disc.params[j] + disc.params[j + 1]);
+                    Some((model_edge, disc, first)) if first + j + 1 < disc.params.len() => {
+                        let k = first + j;
+                        let s = 0.5 * (disc.params[k] + disc.params[k + 1]);
                         let p = model_edge.curve.point(s);
                         [p.x, p.y, p.z]
                     }
