@@ -21,7 +21,8 @@ pub struct Args {
     /// The input format, when its ending or content does not tell.
     #[arg(long, value_name = "FORMAT")]
     from: Option<String>,
-    /// The output format, when the output's ending does not tell.
+    /// The output format, when the output's ending does not tell; `msh22`
+    /// writes Gmsh MSH 2.2 (a `.msh` file is otherwise MSH 4.1).
     #[arg(long, value_name = "FORMAT")]
     to: Option<String>,
     /// Text output for STL, MSH and VTU.
@@ -163,7 +164,7 @@ pub fn run(args: &Args) -> i32 {
                 Some(w) => *w,
                 None => {
                     eprintln!(
-                        "geomc: --to {name}: unknown format; use one of gltf glb obj stl msh vtu frag.xml"
+                        "geomc: --to {name}: unknown format; use one of gltf glb obj stl msh msh22 vtu frag.xml"
                     );
                     return EXIT_USAGE;
                 }
