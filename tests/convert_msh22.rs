@@ -144,11 +144,20 @@ fn msh22_round_trip_and_external_readers() {
         assert_eq!(report["meshio"]["cells"]["tetra"], tets, "{name}");
         assert_eq!(report["meshio"]["cells"]["triangle"], tris, "{name}");
         assert_eq!(report["meshio"]["points"], f["nodes"], "{name}");
-        for (group, element) in [("left", "tetrahedron"), ("interface", "triangle")] {
+        // meshio keeps MSH 2.2 names as field data (name -> [tag, dim]) and
+        // each cell's physical tag: every group has its name and its cells.
+        for (group, element) in [
+            ("left", "tetrahedron"),
+            ("right", "tetrahedron"),
+            ("outer", "triangle"),
+            ("interface", "triangle"),
+        ] {
+            let field = &report["meshio"]["field_data"][group];
+            let key = format!("{}:{}", field[1], field[0]);
             assert_eq!(
-                report["meshio"]["cell_sets"][group],
+                report["meshio"]["physical_cells"][&key],
                 count(group, element),
-                "{name}: meshio set {group}"
+                "{name}: meshio, {group} ({key})"
             );
         }
     }
