@@ -132,8 +132,7 @@ fn msh22_round_trip_and_external_readers() {
             );
         }
         assert_eq!(
-            report["gmsh"]["nodes"],
-            f["nodes"],
+            report["gmsh"]["nodes"], f["nodes"],
             "{name}: gmsh node count"
         );
         // meshio: the same cells, and the named sets.
@@ -165,10 +164,21 @@ fn msh22_round_trip_and_external_readers() {
     // The command line: `--to msh22` on a `.msh` output, binary on request.
     let out = Command::new(env!("CARGO_BIN_EXE_geomc"))
         .current_dir(dir.path())
-        .args(["convert", "--to", "msh22", "--binary", "tets41.msh", "cli22.msh"])
+        .args([
+            "convert",
+            "--to",
+            "msh22",
+            "--binary",
+            "tets41.msh",
+            "cli22.msh",
+        ])
         .output()
         .expect("run geomc");
-    assert!(out.status.success(), "{}", String::from_utf8_lossy(&out.stderr));
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
     let cli = std::fs::read(at("cli22.msh")).expect("cli output");
     assert!(cli.starts_with(b"$MeshFormat\n2.2 1 8\n"));
     assert_eq!(cli, std::fs::read(at("b22.msh")).expect("b22"));
@@ -190,7 +200,12 @@ fn msh41_volume_entities_list_their_bounding_surfaces() {
             + 1
     };
     let (outer, interface) = (face("outer"), face("interface"));
-    let names: Vec<&str> = source.mesh.volumes.iter().map(|v| v.name.as_str()).collect();
+    let names: Vec<&str> = source
+        .mesh
+        .volumes
+        .iter()
+        .map(|v| v.name.as_str())
+        .collect();
     assert_eq!(names, ["left", "right"]);
     for (name, encoding) in [("a41.msh", Encoding::Ascii), ("b41.msh", Encoding::Binary)] {
         let path = at(name);
@@ -216,11 +231,19 @@ fn msh41_volume_entities_list_their_bounding_surfaces() {
         assert_eq!(abs(&left), both, "{name}: left {left:?}");
         assert_eq!(abs(&right), both, "{name}: right {right:?}");
         let sign = |v: &[i64]| v.iter().find(|t| t.abs() == interface).map(|t| t.signum());
-        assert_eq!(sign(&left), sign(&right).map(|s| -s), "{name}: interface sides");
+        assert_eq!(
+            sign(&left),
+            sign(&right).map(|s| -s),
+            "{name}: interface sides"
+        );
         // meshio still reads the file, cells and sets.
         let f = &facts["tets41.msh"];
-        let tets = f["groups"]["left"]["elements"]["tetrahedron"].as_u64().unwrap_or(0)
-            + f["groups"]["right"]["elements"]["tetrahedron"].as_u64().unwrap_or(0);
+        let tets = f["groups"]["left"]["elements"]["tetrahedron"]
+            .as_u64()
+            .unwrap_or(0)
+            + f["groups"]["right"]["elements"]["tetrahedron"]
+                .as_u64()
+                .unwrap_or(0);
         assert_eq!(report["meshio"]["cells"]["tetra"], tets, "{name}");
         assert_eq!(
             report["meshio"]["cell_sets"]["interface"],

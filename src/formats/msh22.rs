@@ -143,7 +143,10 @@ fn write_all(
         .flat_map(|(dim, list)| list.iter().map(move |e| (dim, e)))
         .filter(|(_, e)| !e.elements.is_empty())
         .collect();
-    let total: usize = blocks.iter().map(|(_, e)| e.count() * e.physicals.len()).sum();
+    let total: usize = blocks
+        .iter()
+        .map(|(_, e)| e.count() * e.physicals.len())
+        .sum();
     o.text(&format!("$Elements\n{total}\n"))?;
     let mut id = 0i32;
     for (dim, e) in blocks {

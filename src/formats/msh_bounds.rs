@@ -33,7 +33,10 @@ pub(crate) fn volume_bounding(mesh: &Mesh) -> Vec<(String, Vec<i32>)> {
         }
     }
     if mesh.faces.is_empty() {
-        return names.into_iter().map(|n| (n.to_string(), Vec::new())).collect();
+        return names
+            .into_iter()
+            .map(|n| (n.to_string(), Vec::new()))
+            .collect();
     }
     names
         .into_iter()
@@ -155,8 +158,14 @@ mod tests {
         // which has a triangle on each.
         assert_eq!(b[0].0, "low");
         assert_eq!(b[1].0, "high");
-        assert_eq!(b[0].1.iter().map(|t| t.abs()).collect::<Vec<_>>(), [1, 2, 4]);
-        assert_eq!(b[1].1.iter().map(|t| t.abs()).collect::<Vec<_>>(), [1, 3, 4]);
+        assert_eq!(
+            b[0].1.iter().map(|t| t.abs()).collect::<Vec<_>>(),
+            [1, 2, 4]
+        );
+        assert_eq!(
+            b[1].1.iter().map(|t| t.abs()).collect::<Vec<_>>(),
+            [1, 3, 4]
+        );
         assert_eq!(b[0].1[0], 1, "the interface points out of `low`");
         assert_eq!(b[1].1[0], -1, "and into `high`");
     }

@@ -8,12 +8,12 @@
 //! warning and counts. Sections geomc does not use
 //! (`$NodeData`, `$Periodic`, …) are skipped.
 
-use rayon::prelude::*;
 use super::build::{Builder, FastMap};
 use super::text::{Scanner, Token, syntax};
 use super::{error_at, error_at_byte};
 use crate::diag::{Code, Diagnostic};
 use crate::mesh::CellKind;
+use rayon::prelude::*;
 use std::collections::BTreeMap;
 
 pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
