@@ -70,7 +70,7 @@ fn bounding_of(mesh: &Mesh, name: &str) -> Vec<i32> {
             }
         }
     }
-    faces.sort_unstable_by(|a, b| a.0.cmp(&b.0));
+    faces.sort_unstable_by_key(|f| f.0);
     let mut boundary: Vec<([u32; 3], [u32; 3])> = Vec::new();
     let mut i = 0;
     while i < faces.len() {
