@@ -164,7 +164,10 @@ fn run(
     // Everything later reads the resolved objects, not the document's: on large
     // files they are a fifth of the peak memory while the model is lowered.
     document.objects = Vec::new();
-    let mut lowered = lower::lower(&document, &resolved, diags);
+    // Lowering takes the subdomain definitions (dropped once lowered, before
+    // the overlap check at the memory peak); only their count is read later.
+    let defined_subdomains = document.subdomains.len();
+    let mut lowered = lower::lower(&mut document, &resolved, diags);
     if !extracted.is_empty() {
         let (subdomains, trims) = lower_implicit(source, options, &extracted, &resolved, diags);
         *implicit = subdomains;
@@ -180,7 +183,7 @@ fn run(
         &lowered.model,
         &lowered.source_map,
     ));
-    check_domain(&document, &lowered, diags);
+    check_domain(&document, defined_subdomains, &lowered, diags);
     if !extracted.subdomains.is_empty() {
         // The implicit subdomains describe the domain.
         diags.items.retain(|d| d.code != Code::EmptySubdomainList);
@@ -236,9 +239,15 @@ fn set_trims(model: &mut crate::ir::Model, trims: Vec<crate::implicit::xml::Lowe
 }
 
 /// Whole-model warnings: no subdomains, boundaries on no subdomain.
-fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnostics) {
+/// `defined_subdomains`: how many `<subdomain>` the document defined.
+fn check_domain(
+    document: &doc::Document,
+    defined_subdomains: usize,
+    lowered: &Lowered,
+    diags: &mut Diagnostics,
+) {
     let model = &lowered.model;
-    if model.subdomains.is_empty() && document.subdomains.is_empty() && !model.solids.is_empty() {
+    if model.subdomains.is_empty() && defined_subdomains == 0 && !model.solids.is_empty() {
         diags.push(
             Diagnostic::new(
                 Code::EmptySubdomainList,
@@ -278,7 +287,7 @@ fn check_domain(document: &doc::Document, lowered: &Lowered, diags: &mut Diagnos
     };
     // A subdomain that failed to lower was reported; the faces it would have
     // bounded must not be called stray on top of that.
-    if model.subdomains.len() < document.subdomains.len() {
+    if model.subdomains.len() < defined_subdomains {
         return;
     }
     for (b, def) in model.boundaries.iter().zip(&document.boundaries) {

@@ -73,6 +73,13 @@ impl Report {
                                     model.face(of.face).name
                                 )
                             })
+                            // Trimmed faces: oriented on the mesh, listed by name.
+                            .chain(s.trimmed.iter().filter_map(|&k| {
+                                model
+                                    .trimmed
+                                    .get(k)
+                                    .map(|t| format!("{} (trimmed)", t.name))
+                            }))
                             .collect(),
                         SubdomainCells::Region { faces } => {
                             faces.iter().map(|f| model.face(*f).name.clone()).collect()

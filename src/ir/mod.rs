@@ -106,6 +106,11 @@ pub struct Subdomain {
     pub solids: Vec<SolidId>,
     /// 2D: the largest triangle area its mesh may have (`area=`).
     pub max_area: Option<f64>,
+    /// 3D, given by faces: the trimmed surfaces (indices in
+    /// [`Model::trimmed`]) among its boundary faces. Their trim chains are
+    /// made at meshing, so their outward sides and the shell's closure are
+    /// settled on the mesh (`meshing/trimmed_shell.rs`).
+    pub trimmed: Vec<usize>,
 }
 
 /// A lowered primitive solid: its shape and the entities of its canonical

@@ -7,7 +7,7 @@ use super::Entities;
 use super::explicit::{lookup_entities, unknown_entity};
 use super::weld::FaceSamples;
 use crate::diag::{Code, Diagnostic, Diagnostics};
-use crate::doc::{Document, SolidTree};
+use crate::doc::{SolidTree, SubdomainDef};
 use crate::geom::{Point3, Surface, Vec3, boundary_relation};
 use crate::ir::{
     Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId, SourceMap,
@@ -47,7 +47,7 @@ struct Built {
 }
 
 pub(super) fn lower_subdomains(
-    doc: &Document,
+    defs: Vec<SubdomainDef>,
     resolved: &Resolved,
     model: &mut Model,
     source_map: &mut SourceMap,
@@ -55,10 +55,13 @@ pub(super) fn lower_subdomains(
     face_samples: &FaceSamples,
     diags: &mut Diagnostics,
 ) {
-    let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(doc.subdomains.len());
-    model.subdomains.reserve(doc.subdomains.len());
-    for (def_index, def) in doc.subdomains.iter().enumerate() {
+    let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(defs.len());
+    model.subdomains.reserve(defs.len());
+    // Consumed: each definition is dropped once lowered, so none is alive
+    // during the overlap check (the memory peak on large files).
+    for (def_index, def) in defs.into_iter().enumerate() {
         let id = SubdomainId(model.subdomains.len() as u32);
+        let mut trimmed_faces = Vec::new();
         let cells = match (&def.faces, &def.tree) {
             (Some(_), Some(_)) => {
                 diags.push(
@@ -72,7 +75,10 @@ pub(super) fn lower_subdomains(
                 continue;
             }
             (Some((refs, _)), None) => match explicit_shell(model, entities, refs, diags) {
-                Some(boundary) => SubdomainCells::Volume { boundary },
+                Some((boundary, trimmed)) => {
+                    trimmed_faces = trimmed;
+                    SubdomainCells::Volume { boundary }
+                }
                 None => continue,
             },
             (None, Some(tree)) => {
@@ -109,11 +115,12 @@ pub(super) fn lower_subdomains(
             }
         };
         model.subdomains.push(Subdomain {
-            name: def.name.text.clone(),
-            material: def.material.clone(),
+            name: def.name.text,
+            material: def.material,
             cells,
             solids: Vec::new(),
             max_area: resolved.subdomain_areas.get(def_index).copied().flatten(),
+            trimmed: trimmed_faces,
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
     }
@@ -397,7 +404,7 @@ fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)>
 }
 
 /// A well-mixed 64-bit hash of a grid cell (fixed, so runs are reproducible).
-fn cell_hash(cell: [i64; 3]) -> u64 {
+pub(super) fn cell_hash(cell: [i64; 3]) -> u64 {
     use std::hash::BuildHasher;
     foldhash::quality::FixedState::with_seed(0x5eed).hash_one(cell)
 }
@@ -584,7 +591,8 @@ fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<
 /// solids, or the winding number of its explicit faces.
 enum Member<'a> {
     Tree(&'a Built),
-    Shell(super::winding::ShellTriangles),
+    /// A shell of explicit faces, with its interior probes.
+    Shell(super::winding::ShellTriangles, Vec<Point3>),
 }
 
 /// Reports pairs of subdomains that share volume: a point just inside one
@@ -597,7 +605,22 @@ fn check_overlaps(
     diags: &mut Diagnostics,
 ) {
     let step = model.tolerance * 1000.0;
-    let mut members: Vec<(SubdomainId, Member, crate::geom::Aabb, Vec<Point3>)> = Vec::new();
+    let mut from_tree = vec![false; model.subdomains.len()];
+    for (t, _) in trees {
+        from_tree[t.index()] = true;
+    }
+    let is_shell = |k: usize, s: &crate::ir::Subdomain| {
+        !from_tree[k] && matches!(s.cells, SubdomainCells::Volume { .. })
+    };
+    let shells = (model.subdomains.iter().enumerate())
+        .filter(|(k, s)| is_shell(*k, s))
+        .count();
+    // Sized once, and a member's box kept apart in `boxes` (what
+    // `candidate_pairs` reads). A solid tree's probes are made only when it is
+    // in a candidate pair: on large models most subdomains are in none, and a
+    // probe vector per subdomain was megabytes at the memory peak.
+    let mut members: Vec<(SubdomainId, Member)> = Vec::with_capacity(trees.len() + shells);
+    let mut boxes: Vec<crate::geom::Aabb> = Vec::with_capacity(trees.len() + shells);
     for (id, built) in trees {
         let bbox = built
             .leaves
@@ -605,20 +628,12 @@ fn check_overlaps(
             .fold(crate::geom::Aabb::empty(), |acc, l| {
                 acc.union(&model.solids[l.index()].shape.bbox())
             });
-        members.push((
-            *id,
-            Member::Tree(built),
-            bbox,
-            interior_probes(model, *id, samples, step),
-        ));
-    }
-    let mut from_tree = vec![false; model.subdomains.len()];
-    for (t, _) in trees {
-        from_tree[t.index()] = true;
+        members.push((*id, Member::Tree(built)));
+        boxes.push(bbox);
     }
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         let id = SubdomainId(k as u32);
-        if from_tree[k] {
+        if !is_shell(k, subdomain) {
             continue;
         }
         let SubdomainCells::Volume { boundary } = &subdomain.cells else {
@@ -638,17 +653,32 @@ fn check_overlaps(
             }
         }
         let probes = interior_probes(model, id, &face_points, step);
-        members.push((id, Member::Shell(shell), bbox, probes));
+        members.push((id, Member::Shell(shell, probes)));
+        boxes.push(bbox);
     }
     let inside = |member: &Member, p: &Point3| match member {
         Member::Tree(built) => built
             .tree
             .eval(&|i| model.solids[built.leaves[i].index()].shape.value(p) > 0.0),
-        Member::Shell(shell) => shell.contains(p),
+        Member::Shell(shell, _) => shell.contains(p),
     };
-    let boxes: Vec<crate::geom::Aabb> = members.iter().map(|m| m.2).collect();
+    // Tree probes made so far, by member index (same points as made eagerly).
+    let mut tree_probes: HashMap<usize, Vec<Point3>> = HashMap::new();
     for (i, j) in candidate_pairs(&boxes, model.tolerance) {
-        let ((a, member_a, _, probes_a), (b, member_b, _, probes_b)) = (&members[i], &members[j]);
+        for k in [i, j] {
+            if let (id, Member::Tree(_)) = &members[k] {
+                (tree_probes.entry(k))
+                    .or_insert_with(|| interior_probes(model, *id, samples, step));
+            }
+        }
+        let probes_of = |k: usize| -> &[Point3] {
+            match &members[k] {
+                (_, Member::Shell(_, probes)) => probes,
+                (_, Member::Tree(_)) => tree_probes.get(&k).map_or(&[], Vec::as_slice),
+            }
+        };
+        let (probes_a, probes_b) = (probes_of(i), probes_of(j));
+        let ((a, member_a), (b, member_b)) = (&members[i], &members[j]);
         let overlap = probes_a
             .iter()
             .any(|p| inside(member_b, p) && inside(member_a, p))
@@ -717,8 +747,10 @@ fn explicit_shell(
     entities: &Entities,
     refs: &[crate::doc::Ref],
     diags: &mut Diagnostics,
-) -> Option<Vec<OrientedFace>> {
+) -> Option<(Vec<OrientedFace>, Vec<usize>)> {
     let mut faces: Vec<FaceId> = Vec::new();
+    // Trimmed surfaces are faces too, found by their element's name.
+    let mut trimmed: Vec<usize> = Vec::new();
     let mut seen: BTreeSet<FaceId> = BTreeSet::new();
     let mut ok = true;
     for r in refs {
@@ -740,16 +772,27 @@ fn explicit_shell(
                     }
                 }
             }
-            None => {
-                unknown_entity(r, "face", entities, diags);
-                ok = false;
-            }
+            None => match model.trimmed.iter().position(|s| s.name == r.text) {
+                Some(k) if trimmed.contains(&k) => diags.push(
+                    Diagnostic::new(
+                        Code::RepeatedFace,
+                        r.span,
+                        format!("face '{}' is already in this subdomain's faces= list; the repeat is ignored", r.text),
+                    )
+                    .with_help("remove the repeated name"),
+                ),
+                Some(k) => trimmed.push(k),
+                None => {
+                    unknown_entity(r, "face", entities, diags);
+                    ok = false;
+                }
+            },
         }
     }
     if !ok {
         return None;
     }
-    Some(orient_shell(model, &faces))
+    Some((orient_shell(model, &faces), trimmed))
 }
 
 /// Propagates outward flags across shared edges (an edge is run in opposite

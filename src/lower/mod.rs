@@ -93,8 +93,9 @@ impl Entities {
 }
 
 /// Reads the document's subdomains and boundaries; every object comes from
-/// `resolved` (the driver drops the document's objects before lowering).
-pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
+/// `resolved` (the driver drops the document's objects before lowering). The
+/// subdomain definitions are taken out of `doc` and dropped once lowered.
+pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
     } else {
@@ -160,7 +161,7 @@ pub fn lower(doc: &Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lo
         entities.add_solid_entities(&model);
     }
     booleans::lower_subdomains(
-        doc,
+        std::mem::take(&mut doc.subdomains),
         resolved,
         &mut model,
         &mut source_map,

@@ -6,6 +6,7 @@
 //! chains through per-entity `next` links, so a lookup allocates nothing and
 //! candidates are visited in creation order.
 
+use super::booleans::cell_hash;
 use crate::geom::{Curve, Point3};
 use crate::ir::{Edge, EdgeId, Face, FaceId, Model, OrientedEdge, Vertex, VertexId};
 use std::collections::HashMap;
@@ -89,7 +90,10 @@ impl<K: Hash + Eq> Chains<K> {
 pub struct Welder {
     tol: f64,
     cell: f64,
-    vertex_grid: Chains<[i64; 3]>,
+    /// Vertices by a hash of their grid cell (16-byte entries instead of 32:
+    /// this table is the largest at the memory peak). Vertices of colliding
+    /// cells only add candidates, which the distance test discards.
+    vertex_grid: Chains<u64>,
     edges_by_ends: Chains<(VertexId, VertexId)>,
     /// Faces by a hash of their sorted edge list (compared exactly on a hit).
     faces_by_edges: Chains<u64>,
@@ -145,7 +149,7 @@ impl Welder {
         for x in range(0) {
             for y in range(1) {
                 for z in range(2) {
-                    for id in self.vertex_grid.iter(&[x, y, z]) {
+                    for id in self.vertex_grid.iter(&cell_hash([x, y, z])) {
                         if (model.vertices[id as usize].position - position).norm() <= self.tol {
                             return (VertexId(id), false);
                         }
@@ -158,7 +162,7 @@ impl Welder {
             name: name(),
             position,
         });
-        self.vertex_grid.push(key, id.0);
+        self.vertex_grid.push(cell_hash(key), id.0);
         (id, true)
     }
 

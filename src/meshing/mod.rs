@@ -36,6 +36,7 @@ mod quadratic;
 mod report;
 mod size;
 mod trimmed;
+mod trimmed_shell;
 pub use trimmed::TrimmedReport;
 
 pub use check::{Quality, SubdomainMeasure, quality, sanity_check};
@@ -216,7 +217,9 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         || {
             let mut mesh = assemble(model, &edge_nodes, face_meshes, &lines);
             refuse_collapsed(&mesh, tolerance)?;
+            let first_trimmed = mesh.faces.len();
             trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
+            trimmed_shell::join(model, &mut mesh, first_trimmed)?;
             crack::open(model, &mut mesh);
             if options.order == 2 {
                 quadratic::elevate(model, &edge_nodes, &mut mesh);

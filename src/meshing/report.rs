@@ -185,7 +185,7 @@ impl MeshReport {
                 0.0
             },
             subdomains,
-            trimmed: super::trimmed::reports(model, tolerance, max_edge, min_angle_target),
+            trimmed: super::trimmed::reports(model, mesh, tolerance, max_edge, min_angle_target),
         }
     }
 

@@ -9,11 +9,12 @@ mod chart;
 mod measure;
 mod pole;
 pub mod program;
+pub mod shared;
 mod split;
 mod triangulate;
 
 pub use measure::{TrimmedQuality, centroid_distance};
-pub use triangulate::{TrimSettings, TrimmedMesh, mesh_trimmed};
+pub use triangulate::{TrimSettings, TrimmedMesh, mesh_trimmed, mesh_trimmed_shared};
 
 use crate::geom::point_calculus::Patch9;
 use crate::geom::{Frame, Point3, Vec3};

@@ -10,6 +10,7 @@ use super::TrimmedSurface;
 use super::boundary::{self, U_MAX, V_MAX};
 use super::chart::ArcChart;
 use super::pole;
+use super::shared;
 use super::split::{Cdt, Nodes, SEAM, split_constraint};
 use crate::geom::{Point3, Vec3};
 use spade::{AngleLimit, Point2, RefinementParameters, Triangulation};
@@ -34,6 +35,11 @@ pub struct TrimmedMesh {
     /// its first node at the end). Sides joined by a periodic seam are not
     /// boundary.
     pub boundary: Vec<Vec<u32>>,
+    /// Per boundary chain: true when it is a closed trim loop (no point on a
+    /// patch side), which can take the nodes of a chain it coincides with.
+    pub trim_loop: Vec<bool>,
+    /// Nodes taken from shared chains: (node, chain, index in the chain).
+    pub shared: Vec<(u32, usize, usize)>,
 }
 
 /// How finely to mesh.
@@ -45,6 +51,17 @@ pub struct TrimSettings {
 }
 
 pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<TrimmedMesh, String> {
+    mesh_trimmed_shared(s, settings, &[])
+}
+
+/// As [`mesh_trimmed`], with each closed trim loop that coincides (within
+/// twice the tolerance) with a closed chain of `chains` meshed on that
+/// chain's nodes (`shared.rs`).
+pub fn mesh_trimmed_shared(
+    s: &TrimmedSurface,
+    settings: TrimSettings,
+    chains: &[Vec<Point3>],
+) -> Result<TrimmedMesh, String> {
     let [u0, u1, v0, v1] = s.rect;
     if !(u1 > u0 && v1 > v0) {
         return Err(format!(
@@ -56,15 +73,19 @@ pub fn mesh_trimmed(s: &TrimmedSurface, settings: TrimSettings) -> Result<Trimme
     let h = element_size(lu, lv, &settings);
     let caps = pole::plan(s, &settings, h)?;
     if caps.is_empty() {
-        return mesh_band(s, settings, &[]);
+        return mesh_band(s, settings, &[], chains);
     }
     let mut band = s.clone();
     for c in &caps {
         band.rect[c.side_index()] = c.u_ring;
     }
-    let mut mesh = mesh_band(&band, settings, &caps)?;
+    let mut mesh = mesh_band(&band, settings, &caps, chains)?;
     for c in caps.iter().filter(|c| c.material) {
         pole::close(&mut mesh, s, c);
+    }
+    // A cap changes the side chains: only closed trim loops stay sharable.
+    if mesh.trim_loop.len() != mesh.boundary.len() {
+        mesh.trim_loop = vec![false; mesh.boundary.len()];
     }
     Ok(mesh)
 }
@@ -85,6 +106,7 @@ fn mesh_band(
     s: &TrimmedSurface,
     settings: TrimSettings,
     caps: &[pole::Cap],
+    chains: &[Vec<Point3>],
 ) -> Result<TrimmedMesh, String> {
     let arc = ArcChart::new(s)?;
     let (lu, lv) = arc.lengths();
@@ -107,6 +129,7 @@ fn mesh_band(
     // (a seam edge with its twin) where they are encroached.
     let side = h.max(0.5 * cell);
     b.refine_chords(s, 0.5 * tol, side);
+    let shared = shared::share_loops(s, &mut b, chains, 2.0 * tol);
     if b.loops.is_empty() {
         return Err("the trim leaves no material on the surface".into());
     }
@@ -271,8 +294,16 @@ fn mesh_band(
     if periodic.contains(&true) {
         weld_seams(&nodes, periodic, &mut remap, &mut boundary_chains);
     }
+    let trim_loop: Vec<bool> = boundary_chains
+        .iter()
+        .map(|c| c.iter().all(|&h| nodes.sides[h] & !shared::SHARED == 0))
+        .collect();
+    let shared: Vec<(usize, usize, usize)> =
+        shared.iter().map(|&(p, c, i)| (handles[p], c, i)).collect();
     let (uvs, points3) = (nodes.uv, nodes.xyz);
-    Ok(assemble(&uvs, &points3, &inner, &remap, &boundary_chains))
+    let mut mesh = assemble(&uvs, &points3, &inner, &remap, &boundary_chains, &shared);
+    mesh.trim_loop = trim_loop;
+    Ok(mesh)
 }
 
 /// True when the two sides across parameter `axis` (0: u = u_min and
@@ -578,6 +609,7 @@ fn assemble(
     inner: &[[usize; 3]],
     remap: &[usize],
     chains: &[Vec<usize>],
+    shared: &[(usize, usize, usize)],
 ) -> TrimmedMesh {
     let mut number = vec![u32::MAX; uvs.len()];
     let mut mesh = TrimmedMesh::default();
@@ -602,6 +634,10 @@ fn assemble(
             .map(|&h| node(h, &mut mesh, &mut number))
             .collect();
         mesh.boundary.push(c);
+    }
+    for &(h, c, i) in shared {
+        let n = node(h, &mut mesh, &mut number);
+        mesh.shared.push((n, c, i));
     }
     mesh
 }

@@ -316,6 +316,11 @@ pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut
         let SubdomainCells::Volume { boundary } = &subdomain.cells else {
             continue;
         };
+        // With trimmed faces the shell closes on the mesh (their chains are
+        // made there); meshing checks it.
+        if !subdomain.trimmed.is_empty() {
+            continue;
+        }
         let id = SubdomainId(k as u32);
         let uses = edge_uses(model, boundary);
         let mut manifold = true;
