@@ -151,10 +151,10 @@ fn msh22_round_trip_and_external_readers() {
             ("outer", "triangle"),
             ("interface", "triangle"),
         ] {
-            let field = &report["meshio"]["field_data"][group];
+            let field = &report["meshio_physical"]["field_data"][group];
             let key = format!("{}:{}", field[1], field[0]);
             assert_eq!(
-                report["meshio"]["physical_cells"][&key],
+                report["meshio_physical"]["physical_cells"][&key],
                 count(group, element),
                 "{name}: meshio, {group} ({key})"
             );

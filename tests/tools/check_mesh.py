@@ -79,8 +79,10 @@ def check_msh(path, tetra):
             for name, blocks in m.cell_sets.items()
             if name != "gmsh:bounding_entities"
         },
-        # MSH 2.2 has no cell sets in meshio: its names are field data
-        # (name -> [tag, dim]) and each cell's physical tag is cell data.
+    }
+    # MSH 2.2 has no cell sets in meshio: its names are field data
+    # (name -> [tag, dim]) and each cell's physical tag is cell data.
+    out["meshio_physical"] = {
         "field_data": {name: [int(v) for v in vals] for name, vals in m.field_data.items()},
         "physical_cells": physical_cells(m),
     }
