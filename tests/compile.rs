@@ -55,7 +55,8 @@ fn every_valid_fixture_compiles_to_every_format() {
             }
         }
         let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("x");
-        for writer in WRITERS {
+        // Writers reached by file ending (MSH 2.2 only by name, `--to msh22`).
+        for writer in WRITERS.iter().filter(|w| !w.extensions().is_empty()) {
             let out = dir
                 .path()
                 .join(format!("{stem}.{}", writer.extensions()[0]));

@@ -62,7 +62,7 @@ fn formats_are_detected_by_extension() {
     assert_eq!(name("b.xml"), None);
     assert_eq!(name("frag.xml"), None, "a bare extension is no file name");
     assert_eq!(name("b.ply"), None);
-    assert_eq!(WRITERS.len(), 7);
+    assert_eq!(WRITERS.len(), 8);
     let err =
         geomc::formats::write_mesh_file(Path::new("x.ply"), &unit_cube(), &WriteOptions::default())
             .expect_err("unknown format");

@@ -5,7 +5,7 @@
 use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, Format, out};
 use geomc::convert::{ConvertOptions, apply, inspect::MeshReport};
 use geomc::diag::{Code, Diagnostic, render_human};
-use geomc::formats::read::{ReadFormat, ReadLimits, load_mesh_limited};
+use geomc::formats::read::{ReadFormat, ReadLimits, load_mesh_limited, load_mesh_unchecked};
 use geomc::formats::{
     Encoding, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic, writer_for_path,
 };
@@ -21,7 +21,8 @@ pub struct Args {
     /// The input format, when its ending or content does not tell.
     #[arg(long, value_name = "FORMAT")]
     from: Option<String>,
-    /// The output format, when the output's ending does not tell.
+    /// The output format, when the output's ending does not tell; `msh22`
+    /// writes Gmsh MSH 2.2 (a `.msh` file is otherwise MSH 4.1).
     #[arg(long, value_name = "FORMAT")]
     to: Option<String>,
     /// Text output for STL, MSH and VTU.
@@ -127,14 +128,16 @@ fn load(
     from: Option<ReadFormat>,
     limits: &ReadLimits,
 ) -> Result<geomc::formats::read::Loaded, i32> {
-    load_mesh_limited(path, from, limits).map_err(|diagnostics| {
-        report(path, &diagnostics);
-        if diagnostics.iter().any(|d| d.code == Code::MeshReadFailed) {
-            EXIT_USAGE
-        } else {
-            EXIT_INVALID
-        }
-    })
+    load_mesh_limited(path, from, limits).map_err(|d| read_failed(path, &d))
+}
+
+fn read_failed(path: &Path, diagnostics: &[Diagnostic]) -> i32 {
+    report(path, diagnostics);
+    if diagnostics.iter().any(|d| d.code == Code::MeshReadFailed) {
+        EXIT_USAGE
+    } else {
+        EXIT_INVALID
+    }
 }
 
 /// A mesh with nothing a writer could carry.
@@ -161,7 +164,7 @@ pub fn run(args: &Args) -> i32 {
                 Some(w) => *w,
                 None => {
                     eprintln!(
-                        "geomc: --to {name}: unknown format; use one of gltf glb obj stl msh vtu frag.xml"
+                        "geomc: --to {name}: unknown format; use one of gltf glb obj stl msh msh22 vtu frag.xml"
                     );
                     return EXIT_USAGE;
                 }
@@ -186,9 +189,9 @@ pub fn run(args: &Args) -> i32 {
         max_file_size: args.max_file_size,
         max_elements: args.max_mesh_elements,
     };
-    let mut loaded = match load(&args.input, from, &limits) {
+    let (mut loaded, checked) = match load_mesh_unchecked(&args.input, from, &limits) {
         Ok(l) => l,
-        Err(code) => return code,
+        Err(d) => return read_failed(&args.input, &d),
     };
     if is_empty(&loaded.mesh) {
         report(
@@ -202,7 +205,6 @@ pub fn run(args: &Args) -> i32 {
         );
         return EXIT_INVALID;
     }
-    report(&args.input, &loaded.warnings);
     let options = ConvertOptions {
         groups: args.groups.clone(),
         scale: args.scale,
@@ -211,6 +213,17 @@ pub fn run(args: &Args) -> i32 {
         weld: args.weld,
         normals: args.normals,
     };
+    // The surface checks only warn: when nothing changes the mesh before it
+    // is written, they run on a second thread while the writer runs, and
+    // their warnings are printed where they would have been.
+    let volumes_only = !writer.keeps_volume_cells()
+        && !loaded.mesh.volumes.is_empty()
+        && loaded.mesh.faces.iter().all(|f| f.triangles.is_empty());
+    let check_while_writing = !checked && options == ConvertOptions::default() && !volumes_only;
+    if !checked && !check_while_writing {
+        loaded.check();
+    }
+    report(&args.input, &loaded.warnings);
     match apply(&mut loaded.mesh, &options) {
         Ok(applied) => {
             for note in applied.notes {
@@ -262,7 +275,17 @@ pub fn run(args: &Args) -> i32 {
             .map(String::from),
         mesh_file: None,
     };
-    match write(&args.output, writer, &loaded.mesh, &write_options) {
+    let written = if check_while_writing {
+        let (checks, written) = rayon::join(
+            || geomc::formats::read::clean::check(&loaded.mesh),
+            || write(&args.output, writer, &loaded.mesh, &write_options),
+        );
+        report(&args.input, &checks.warnings());
+        written
+    } else {
+        write(&args.output, writer, &loaded.mesh, &write_options)
+    };
+    match written {
         Ok(warnings) => {
             let source = SourceFile::new(args.output.display().to_string(), "");
             for w in warnings {

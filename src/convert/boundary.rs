@@ -15,7 +15,7 @@ pub struct Boundary {
 
 /// Each cell face's corners, outward for a cell of positive volume (Gmsh's
 /// corner order); quadrilaterals are split along their first diagonal.
-fn faces(kind: CellKind) -> &'static [&'static [usize]] {
+pub(crate) fn faces(kind: CellKind) -> &'static [&'static [usize]] {
     match kind {
         CellKind::Tetrahedron => &[&[0, 2, 1], &[0, 1, 3], &[1, 2, 3], &[0, 3, 2]],
         CellKind::Hexahedron => &[

@@ -1,5 +1,5 @@
 //! Mesh writers: the output mesh IR ([`crate::mesh::Mesh`]) to files for
-//! viewers (glTF, OBJ, STL) and solvers (Gmsh MSH 4.1, VTK `.vtu`), plus the
+//! viewers (glTF, OBJ, STL) and solvers (Gmsh MSH 4.1 and 2.2, VTK `.vtu`), plus the
 //! `.frag.xml` side description of subdomains and fragments.
 //!
 //! Every writer implements [`MeshWriter`] and is listed in [`WRITERS`];
@@ -15,6 +15,8 @@ pub mod frag;
 mod gltf;
 mod groups;
 mod msh;
+mod msh22;
+mod msh_bounds;
 mod obj;
 pub mod read;
 mod stl;
@@ -120,6 +122,7 @@ pub static WRITERS: &[&dyn MeshWriter] = &[
     &obj::Obj,
     &stl::Stl,
     &msh::Msh,
+    &msh22::Msh22,
     &vtu::Vtu,
     &frag::FragXml,
 ];

@@ -2,7 +2,8 @@
 //! topology: points are the model vertices, curves the edges with their end
 //! points (begin positive, end negative: Gmsh's own convention), surfaces the
 //! faces with their signed bounding curves, volumes (3D) the subdomains with
-//! their signed boundary surfaces. Each mesh node is written once, on the
+//! their signed boundary surfaces, and volume cells read from another file
+//! the faces on their group's boundary (`msh_bounds`). Each mesh node is written once, on the
 //! lowest-dimensional entity that uses it. Physical groups: every fragment
 //! (dim 2 in 3D, 1 in 2D), every subdomain (dim 3 in 3D; in 2D its region
 //! faces, dim 2), faces in neither kind of group (dim 2, by face name),
@@ -45,51 +46,70 @@ impl MeshWriter for Msh {
     ) -> Result<Vec<Warning>, WriteError> {
         groups::check(mesh)?;
         let model = Model::of(mesh);
-        let mut warnings = Vec::new();
-        if model.renamed > 0 {
-            warnings.push(warning(
-                "msh",
-                format!(
-                    "MSH names cannot hold `\"`: replaced by `'` in {}",
-                    count(model.renamed, "name")
-                ),
-            ));
-        }
-        if model.unused_nodes > 0 {
-            warnings.push(warning(
-                "msh",
-                format!(
-                    "{} used by no vertex, edge, face, poly_line or point set: not written",
-                    count(model.unused_nodes, "node")
-                ),
-            ));
-        }
+        let warnings = model_warnings(&model);
         let binary = options.encoding == Some(Encoding::Binary);
         write_all(&model, mesh, binary, out)?;
         Ok(warnings)
     }
 }
 
+/// What an MSH file (either version) cannot hold of the mesh.
+pub(super) fn model_warnings(model: &Model) -> Vec<Warning> {
+    let mut warnings = Vec::new();
+    if model.renamed > 0 {
+        warnings.push(warning(
+            "msh",
+            format!(
+                "MSH names cannot hold `\"`: replaced by `'` in {}",
+                count(model.renamed, "name")
+            ),
+        ));
+    }
+    if model.unused_nodes > 0 {
+        warnings.push(warning(
+            "msh",
+            format!(
+                "{} used by no vertex, edge, face, poly_line or point set: not written",
+                count(model.unused_nodes, "node")
+            ),
+        ));
+    }
+    warnings
+}
+
 /// An entity of the Gmsh model.
-struct Entity {
-    tag: i32,
-    physicals: Vec<i32>,
+pub(super) struct Entity {
+    pub(super) tag: i32,
+    pub(super) physicals: Vec<i32>,
     /// Signed tags of the bounding entities one dimension down.
     bounding: Vec<i32>,
     /// Mesh nodes whose bounding box the entity has (all it uses).
     used: Vec<u32>,
     /// Elements, as mesh node lists of `per` nodes each, one after the
     /// other (one allocation per entity, not per element).
-    elements: Vec<u32>,
-    per: usize,
+    pub(super) elements: Vec<u32>,
+    pub(super) per: usize,
     /// The Gmsh element type when `per` does not tell it (volume cells).
     gmsh_type: Option<i32>,
 }
 
 impl Entity {
     /// How many elements it holds.
-    fn count(&self) -> usize {
+    pub(super) fn count(&self) -> usize {
         self.elements.len() / self.per
+    }
+
+    /// Its Gmsh element type (the same numbers in MSH 2.2 and 4.1): 15
+    /// point, 1 line, 8 3-node line, 2 triangle, 9 6-node triangle, or the
+    /// volume cell's.
+    pub(super) fn element_type(&self, dim: usize) -> i32 {
+        self.gmsh_type.unwrap_or(match (dim, self.per) {
+            (0, _) => 15,
+            (1, 3) => 8,
+            (1, _) => 1,
+            (_, 6) => 9,
+            _ => 2,
+        })
     }
 
     fn new(tag: usize) -> Entity {
@@ -106,20 +126,20 @@ impl Entity {
 }
 
 /// The MSH view of a mesh: entities per dimension, physical names, node owners.
-struct Model {
+pub(super) struct Model {
     /// Index = dimension.
-    entities: [Vec<Entity>; 4],
+    pub(super) entities: [Vec<Entity>; 4],
     /// (dim, tag, name).
-    physical_names: Vec<(u8, i32, String)>,
+    pub(super) physical_names: Vec<(u8, i32, String)>,
     /// The (dimension, entity index) owning each node; `None` for nodes no
     /// element uses.
-    owner: Vec<Option<(u8, usize)>>,
+    pub(super) owner: Vec<Option<(u8, usize)>>,
     renamed: usize,
     unused_nodes: usize,
 }
 
 impl Model {
-    fn of(mesh: &Mesh) -> Model {
+    pub(super) fn of(mesh: &Mesh) -> Model {
         let three = mesh.dimension == 3;
         let vertex_of_node: BTreeMap<u32, usize> = mesh
             .vertices
@@ -238,6 +258,7 @@ impl Model {
                 }
             }
         }
+        let bounding = super::msh_bounds::volume_bounding(mesh);
         for v in &mesh.volumes {
             // One physical group per name, shared with a subdomain of that name.
             let tag = names
@@ -252,6 +273,9 @@ impl Model {
             e.elements = v.nodes.clone();
             e.per = v.kind.corners();
             e.gmsh_type = Some(v.kind.gmsh_type());
+            if let Some((_, b)) = bounding.iter().find(|(n, _)| *n == v.name) {
+                e.bounding = b.clone();
+            }
             volumes.push(e);
         }
         for (i, face) in mesh.faces.iter().enumerate() {
@@ -666,15 +690,7 @@ fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
     s.end_line()?;
     let mut tag = 0usize;
     for (dim, e) in blocks {
-        // Gmsh element types: 15 point, 1 line, 8 3-node line, 2 triangle,
-        // 9 6-node triangle.
-        let kind = e.gmsh_type.unwrap_or(match (dim, e.per) {
-            (0, _) => 15,
-            (1, 3) => 8,
-            (1, _) => 1,
-            (_, 6) => 9,
-            _ => 2,
-        });
+        let kind = e.element_type(dim);
         s.int(dim as i32)?;
         s.int(e.tag)?;
         s.int(kind)?;

@@ -80,7 +80,25 @@ def check_msh(path, tetra):
             if name != "gmsh:bounding_entities"
         },
     }
+    # MSH 2.2 has no cell sets in meshio: its names are field data
+    # (name -> [tag, dim]) and each cell's physical tag is cell data.
+    out["meshio_physical"] = {
+        "field_data": {name: [int(v) for v in vals] for name, vals in m.field_data.items()},
+        "physical_cells": physical_cells(m),
+    }
     return out
+
+
+def physical_cells(m):
+    """Cells per (dim:tag) of meshio's gmsh:physical cell data."""
+    counts = {}
+    dims = {"vertex": 0, "line": 1, "line3": 1, "triangle": 2, "triangle6": 2, "quad": 2}
+    for block, tags in zip(m.cells, m.cell_data.get("gmsh:physical", [])):
+        dim = dims.get(block.type, 3)
+        for t in tags:
+            key = f"{dim}:{int(t)}"
+            counts[key] = counts.get(key, 0) + 1
+    return counts
 
 
 def tetrahedralize():

@@ -79,7 +79,15 @@ impl Builder {
 
     /// The mesh and its checks. Indices are the readers' to check; this
     /// checks them again so that no reader bug can reach a writer.
-    pub fn finish(mut self) -> Result<Loaded, Vec<Diagnostic>> {
+    pub fn finish(self) -> Result<Loaded, Vec<Diagnostic>> {
+        let mut loaded = self.finish_unchecked()?;
+        loaded.check();
+        Ok(loaded)
+    }
+
+    /// [`Builder::finish`] without the surface checks ([`Loaded::check`]
+    /// runs them later, e.g. while `convert` writes).
+    pub fn finish_unchecked(mut self) -> Result<Loaded, Vec<Diagnostic>> {
         let n = self.nodes.len();
         for g in &self.groups {
             let bad = g.triangles.iter().flatten().any(|&v| v as usize >= n)
@@ -145,13 +153,10 @@ impl Builder {
             }
         }
         attach_fragments(&mut mesh, &self.subdomains, &self.fragments, &face_of_group);
-        let report = clean::check(&mesh);
-        let mut warnings = self.warnings;
-        warnings.extend(report.warnings());
         Ok(Loaded {
             mesh,
-            warnings,
-            report,
+            warnings: self.warnings,
+            report: clean::CleanReport::default(),
             binary: None,
         })
     }

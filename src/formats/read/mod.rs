@@ -20,6 +20,7 @@ pub mod clean;
 mod f32_nodes;
 mod frag;
 mod gltf;
+mod mapped;
 mod msh;
 mod obj;
 mod stl;
@@ -163,21 +164,46 @@ pub fn load_mesh_limited(
     format: Option<ReadFormat>,
     limits: &ReadLimits,
 ) -> Result<Loaded, Vec<Diagnostic>> {
+    let (mut loaded, checked) = load_mesh_unchecked(path, format, limits)?;
+    if !checked {
+        loaded.check();
+    }
+    Ok(loaded)
+}
+
+impl Loaded {
+    /// Runs the surface checks: fills `report` and adds its warnings.
+    pub fn check(&mut self) {
+        self.report = clean::check(&self.mesh);
+        self.warnings.extend(self.report.warnings());
+    }
+}
+
+/// [`load_mesh_limited`] that may leave the surface checks to the caller:
+/// the flag says whether they ran (a `.frag.xml` runs them on its mesh
+/// file); when not, [`Loaded::check`] gives what `load_mesh_limited` would.
+/// `convert` uses it to check while it writes.
+pub fn load_mesh_unchecked(
+    path: &Path,
+    format: Option<ReadFormat>,
+    limits: &ReadLimits,
+) -> Result<(Loaded, bool), Vec<Diagnostic>> {
     if matches!(format, None | Some(ReadFormat::Stl))
         && let Some(read) = stl::read_binary_file(path, format.is_some())
     {
-        let mut loaded = read?.finish()?;
+        let mut loaded = read?.finish_unchecked()?;
         loaded.binary = Some(true);
-        return Ok(loaded);
+        return Ok((loaded, false));
     }
-    let bytes = std::fs::read(path).map_err(|e| {
+    let file = mapped::FileBytes::open(path).map_err(|e| {
         vec![Diagnostic::new(
             Code::MeshReadFailed,
             None,
             format!("cannot read {}: {e}", path.display()),
         )]
     })?;
-    let format = match format.or_else(|| detect(path, &bytes)) {
+    let bytes: &[u8] = &file;
+    let format = match format.or_else(|| detect(path, bytes)) {
         Some(f) => f,
         None => {
             return Err(vec![
@@ -194,15 +220,15 @@ pub fn load_mesh_limited(
         }
     };
     if format == ReadFormat::FragXml {
-        return frag::load(path, &bytes, limits);
+        return frag::load(path, bytes, limits).map(|l| (l, true));
     }
     let folder = path.parent().unwrap_or(Path::new(""));
-    let (builder, binary) = parse(format, &bytes, folder, limits)?;
+    let (builder, binary) = parse(format, bytes, folder, limits)?;
     // The file's bytes are not needed for the checks: free them first.
-    drop(bytes);
-    let mut loaded = builder.finish()?;
+    drop(file);
+    let mut loaded = builder.finish_unchecked()?;
     loaded.binary = binary;
-    Ok(loaded)
+    Ok((loaded, false))
 }
 
 /// Reads a mesh from bytes already in memory. `folder` is where relative
