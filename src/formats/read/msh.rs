@@ -28,7 +28,7 @@ pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
         kinds: BTreeMap::new(),
         multi_physical: 0,
         group_of: FastMap::default(),
-        section_closed: true,
+        section: None,
     };
     r.read().map_err(|d| vec![d])?;
     let binary = r.binary;
@@ -137,9 +137,11 @@ struct Reader<'a> {
     multi_physical: usize,
     /// (dim, physical or −entity) → group index, filled lazily.
     group_of: FastMap<(i32, i64), usize>,
-    /// Whether the current section's `$End…` line is in the file: when it
-    /// is not, a count the data cannot satisfy means the file was cut short.
-    section_closed: bool,
+    /// The current section's `$End…` marker and where its data starts: a
+    /// count the data cannot satisfy means the file was cut short when the
+    /// marker is missing. Looked for only then (see [`Reader::section_closed`]):
+    /// a search on every section would read the whole file once more.
+    section: Option<(String, usize)>,
 }
 
 impl<'a> Reader<'a> {
@@ -151,9 +153,7 @@ impl<'a> Reader<'a> {
                 return Err(syntax(t, "a section such as `$Nodes`"));
             }
             let name = t.lossy().get(1..).unwrap_or_default().to_string();
-            let end = format!("$End{name}");
-            let rest = self.s.bytes.get(self.s.pos..).unwrap_or_default();
-            self.section_closed = memchr::memmem::find(rest, end.as_bytes()).is_some();
+            self.section = Some((format!("$End{name}"), self.s.pos));
             self.section_start();
             match name.as_str() {
                 "PhysicalNames" => self.physical_names()?,
@@ -240,6 +240,16 @@ impl<'a> Reader<'a> {
         }
         self.s.keyword("$EndMeshFormat")?;
         Ok(())
+    }
+
+    /// Whether the current section's `$End…` marker follows its start (true
+    /// outside any section).
+    fn section_closed(&self) -> bool {
+        let Some((end, from)) = &self.section else {
+            return true;
+        };
+        let rest = self.s.bytes.get(*from..).unwrap_or_default();
+        memchr::memmem::find(rest, end.as_bytes()).is_some()
     }
 
     /// After a section's name line: skips the one line end before binary data.
@@ -368,12 +378,13 @@ impl<'a> Reader<'a> {
     ) -> Result<usize, Diagnostic> {
         let left = (self.s.bytes.len() - self.s.pos.min(self.s.bytes.len())) as u64;
         if n.saturating_mul(min_bytes) > left + 1 {
-            let code = if self.section_closed {
+            let closed = self.section_closed();
+            let code = if closed {
                 Code::MeshCountMismatch
             } else {
                 Code::MeshTruncated
             };
-            let message = if self.section_closed {
+            let message = if closed {
                 format!(
                     "the file says {n} {what}, but only {left} bytes follow: the count does not match the data"
                 )
