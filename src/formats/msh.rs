@@ -408,8 +408,9 @@ fn end_points(nodes: &[u32], vertex_of_node: &BTreeMap<u32, usize>) -> Vec<i32> 
 }
 
 /// Writes values as ASCII tokens on lines, or as little-endian binary (the
-/// header's integer 1 tells readers the byte order).
-struct Sink<'a> {
+/// header's integer 1 tells readers the byte order). Shared with the MSH 2.2
+/// writer (`msh22.rs`).
+pub(super) struct Sink<'a> {
     out: &'a mut dyn Write,
     binary: bool,
     /// ASCII lines gathered the same way.
@@ -424,7 +425,17 @@ struct Sink<'a> {
 /// How many binary bytes [`Sink`] gathers before writing them out.
 const CHUNK: usize = 1 << 16;
 
-impl Sink<'_> {
+impl<'a> Sink<'a> {
+    pub(super) fn new(out: &'a mut dyn Write, binary: bool) -> Sink<'a> {
+        Sink {
+            out,
+            binary,
+            line: String::with_capacity(if binary { 0 } else { CHUNK + 256 }),
+            fresh_line: true,
+            bytes: Vec::with_capacity(if binary { CHUNK + 64 } else { 0 }),
+        }
+    }
+
     /// Starts a token: a space unless it is the first on its line.
     fn space(&mut self) {
         if !self.fresh_line {
@@ -441,7 +452,7 @@ impl Sink<'_> {
         Ok(())
     }
 
-    fn flush(&mut self) -> std::io::Result<()> {
+    pub(super) fn flush(&mut self) -> std::io::Result<()> {
         self.out.write_all(&self.bytes)?;
         self.bytes.clear();
         self.out.write_all(self.line.as_bytes())?;
@@ -449,7 +460,7 @@ impl Sink<'_> {
         Ok(())
     }
 
-    fn int(&mut self, v: i32) -> std::io::Result<()> {
+    pub(super) fn int(&mut self, v: i32) -> std::io::Result<()> {
         if self.binary {
             self.raw(&v.to_le_bytes())
         } else {
@@ -459,7 +470,7 @@ impl Sink<'_> {
         }
     }
 
-    fn size(&mut self, v: usize) -> std::io::Result<()> {
+    pub(super) fn size(&mut self, v: usize) -> std::io::Result<()> {
         if self.binary {
             self.raw(&(v as u64).to_le_bytes())
         } else {
@@ -469,7 +480,7 @@ impl Sink<'_> {
         }
     }
 
-    fn real(&mut self, v: f64) -> std::io::Result<()> {
+    pub(super) fn real(&mut self, v: f64) -> std::io::Result<()> {
         if self.binary {
             self.raw(&v.to_le_bytes())
         } else {
@@ -479,7 +490,7 @@ impl Sink<'_> {
         }
     }
 
-    fn end_line(&mut self) -> std::io::Result<()> {
+    pub(super) fn end_line(&mut self) -> std::io::Result<()> {
         if !self.binary {
             // Lines gathered like binary values: one dynamic write per piece.
             self.line.push('\n');
@@ -492,7 +503,7 @@ impl Sink<'_> {
         Ok(())
     }
 
-    fn text(&mut self, s: &str) -> std::io::Result<()> {
+    pub(super) fn text(&mut self, s: &str) -> std::io::Result<()> {
         self.flush()?;
         self.out.write_all(s.as_bytes())
     }
@@ -532,7 +543,7 @@ impl Sink<'_> {
     }
 
     /// Ends a section; binary data is followed by a newline before `$End…`.
-    fn end_section(&mut self, name: &str) -> std::io::Result<()> {
+    pub(super) fn end_section(&mut self, name: &str) -> std::io::Result<()> {
         if self.binary {
             self.text("\n")?;
         }
@@ -546,24 +557,27 @@ fn write_all(
     binary: bool,
     out: &mut dyn Write,
 ) -> Result<(), WriteError> {
-    let mut s = Sink {
-        out,
-        binary,
-        line: String::with_capacity(if binary { 0 } else { CHUNK + 256 }),
-        fresh_line: true,
-        bytes: Vec::with_capacity(if binary { CHUNK + 64 } else { 0 }),
-    };
+    let mut s = Sink::new(out, binary);
+    write_preamble(&mut s, "4.1", model)?;
+    write_entities(&mut s, model, mesh)?;
+    write_nodes(&mut s, model, mesh)?;
+    write_elements(&mut s, model)?;
+    s.flush()?;
+    Ok(())
+}
+
+/// `$MeshFormat` for `version` in the sink's encoding, then `$PhysicalNames`
+/// (always ASCII): the same in MSH 4.1 and 2.2.
+pub(super) fn write_preamble(s: &mut Sink, version: &str, model: &Model) -> std::io::Result<()> {
     s.text("$MeshFormat\n")?;
-    if binary {
-        s.text("4.1 1 8\n")?;
+    if s.binary {
+        s.text(&format!("{version} 1 8\n"))?;
         s.raw(&1i32.to_le_bytes())?;
         s.text("\n")?;
     } else {
-        s.text("4.1 0 8\n")?;
+        s.text(&format!("{version} 0 8\n"))?;
     }
     s.text("$EndMeshFormat\n")?;
-
-    // Always ASCII, in both encodings.
     if !model.physical_names.is_empty() {
         s.text("$PhysicalNames\n")?;
         s.text(&format!("{}\n", model.physical_names.len()))?;
@@ -572,11 +586,6 @@ fn write_all(
         }
         s.text("$EndPhysicalNames\n")?;
     }
-
-    write_entities(&mut s, model, mesh)?;
-    write_nodes(&mut s, model, mesh)?;
-    write_elements(&mut s, model)?;
-    s.flush()?;
     Ok(())
 }
 

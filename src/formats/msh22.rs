@@ -6,8 +6,8 @@
 //! several physical groups is written once per group, as Gmsh does. Nodes
 //! are numbered 1..N over the nodes the elements use, in mesh order.
 
-use super::msh::{Model, model_warnings};
-use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, groups, push_num};
+use super::msh::{Model, Sink, model_warnings, write_preamble};
+use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, groups};
 use crate::mesh::Mesh;
 use std::io::Write;
 
@@ -41,62 +41,14 @@ impl MeshWriter for Msh22 {
     }
 }
 
-/// Bytes gathered before each write to `out`.
-const CHUNK: usize = 1 << 16;
-
-struct Out<'a> {
-    out: &'a mut dyn Write,
-    buf: Vec<u8>,
-}
-
-impl Out<'_> {
-    fn put(&mut self, bytes: &[u8]) -> std::io::Result<()> {
-        self.buf.extend_from_slice(bytes);
-        if self.buf.len() >= CHUNK {
-            self.flush()?;
-        }
-        Ok(())
-    }
-
-    fn text(&mut self, s: &str) -> std::io::Result<()> {
-        self.put(s.as_bytes())
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.out.write_all(&self.buf)?;
-        self.buf.clear();
-        Ok(())
-    }
-}
-
 fn write_all(
     model: &Model,
     mesh: &Mesh,
     binary: bool,
     out: &mut dyn Write,
 ) -> Result<(), WriteError> {
-    let mut o = Out {
-        out,
-        buf: Vec::with_capacity(CHUNK + 1024),
-    };
-    o.text("$MeshFormat\n")?;
-    if binary {
-        o.text("2.2 1 8\n")?;
-        // The integer 1 tells readers the byte order.
-        o.put(&1i32.to_le_bytes())?;
-        o.text("\n")?;
-    } else {
-        o.text("2.2 0 8\n")?;
-    }
-    o.text("$EndMeshFormat\n")?;
-    if !model.physical_names.is_empty() {
-        o.text("$PhysicalNames\n")?;
-        o.text(&format!("{}\n", model.physical_names.len()))?;
-        for (dim, tag, name) in &model.physical_names {
-            o.text(&format!("{dim} {tag} \"{name}\"\n"))?;
-        }
-        o.text("$EndPhysicalNames\n")?;
-    }
+    let mut o = Sink::new(out, binary);
+    write_preamble(&mut o, "2.2", model)?;
 
     // Node numbers: 1.. over the written nodes, in mesh order.
     let mut number = vec![0u32; mesh.nodes.len()];
@@ -108,32 +60,18 @@ fn write_all(
         }
     }
     o.text(&format!("$Nodes\n{written}\n"))?;
-    let mut line = String::new();
     for (n, p) in mesh.nodes.iter().enumerate() {
         let id = number[n];
         if id == 0 {
             continue;
         }
-        if binary {
-            o.put(&(id as i32).to_le_bytes())?;
-            for c in p {
-                o.put(&c.to_le_bytes())?;
-            }
-        } else {
-            line.clear();
-            line.push_str(&id.to_string());
-            for &c in p {
-                line.push(' ');
-                push_num(&mut line, c);
-            }
-            line.push('\n');
-            o.text(&line)?;
+        o.int(id as i32)?;
+        for &c in p {
+            o.real(c)?;
         }
+        o.end_line()?;
     }
-    if binary {
-        o.text("\n")?;
-    }
-    o.text("$EndNodes\n")?;
+    o.end_section("Nodes")?;
 
     // One record per element and physical group, entity by entity.
     let blocks: Vec<(usize, &super::msh::Entity)> = model
@@ -155,35 +93,28 @@ fn write_all(
             if binary {
                 // A block header: type, how many follow, two tags each.
                 for v in [kind, e.count() as i32, 2] {
-                    o.put(&v.to_le_bytes())?;
+                    o.int(v)?;
                 }
             }
             for element in e.elements.chunks_exact(e.per) {
                 id += 1;
-                if binary {
-                    for v in [id, physical, e.tag] {
-                        o.put(&v.to_le_bytes())?;
-                    }
-                    for &n in element {
-                        o.put(&(number[n as usize] as i32).to_le_bytes())?;
-                    }
+                // ASCII also names the type and the tag count on each line.
+                let head: &[i32] = if binary {
+                    &[id, physical, e.tag]
                 } else {
-                    line.clear();
-                    line.push_str(&format!("{id} {kind} 2 {physical} {}", e.tag));
-                    for &n in element {
-                        line.push(' ');
-                        line.push_str(&number[n as usize].to_string());
-                    }
-                    line.push('\n');
-                    o.text(&line)?;
+                    &[id, kind, 2, physical, e.tag]
+                };
+                for &v in head {
+                    o.int(v)?;
                 }
+                for &n in element {
+                    o.int(number[n as usize] as i32)?;
+                }
+                o.end_line()?;
             }
         }
     }
-    if binary {
-        o.text("\n")?;
-    }
-    o.text("$EndElements\n")?;
+    o.end_section("Elements")?;
     o.flush()?;
     Ok(())
 }
