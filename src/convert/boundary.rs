@@ -45,11 +45,23 @@ pub(crate) fn faces(kind: CellKind) -> &'static [&'static [usize]] {
 
 /// A face's corners sorted (a triangle's fourth slot `u32::MAX`): the same
 /// key for the face seen from either of its cells.
-fn key(corners: &[u32]) -> [u32; 4] {
+pub(crate) fn key(corners: &[u32]) -> [u32; 4] {
     let mut k = [u32::MAX; 4];
     k[..corners.len()].copy_from_slice(corners);
     k.sort_unstable();
     k
+}
+
+/// The values of the keys that stand once in `sorted` (sorted by key): the
+/// faces used by one cell only.
+pub(crate) fn used_once<T>(sorted: &[([u32; 4], T)]) -> Vec<&T> {
+    sorted
+        .chunk_by(|a, b| a.0 == b.0)
+        .filter_map(|run| match run {
+            [(_, only)] => Some(only),
+            _ => None,
+        })
+        .collect()
 }
 
 /// Adds the boundary of the volume cells as mesh faces named after their
@@ -69,16 +81,8 @@ pub fn extract(mesh: &mut Mesh) -> Boundary {
     }
     keyed.sort_unstable();
     let mut boundary = vec![false; keyed.len()];
-    let mut i = 0;
-    while i < keyed.len() {
-        let mut j = i + 1;
-        while j < keyed.len() && keyed[j].0 == keyed[i].0 {
-            j += 1;
-        }
-        if j == i + 1 {
-            boundary[keyed[i].1 as usize] = true;
-        }
-        i = j;
+    for &id in used_once(&keyed) {
+        boundary[id as usize] = true;
     }
     drop(keyed);
 

@@ -6,7 +6,7 @@
 //! as for a subdomain's faces. Gmsh reads these as the volume's boundary
 //! (`gmsh.model.getBoundary`), which it needs to mesh the volume again.
 
-use crate::convert::boundary::faces as cell_faces;
+use crate::convert::boundary::{faces as cell_faces, key as face_key, used_once};
 use crate::mesh::Mesh;
 use crate::mesh::volume::cell_volume;
 
@@ -63,26 +63,16 @@ fn bounding_of(mesh: &Mesh, name: &str) -> Vec<i32> {
                     .into_iter()
                     .map(|[a, b, d]| if flip { [a, d, b] } else { [a, b, d] })
                     .collect();
-                let mut k = [u32::MAX; 4];
-                k[..c.len()].copy_from_slice(&c);
-                k.sort_unstable();
-                faces.push((k, tris));
+                faces.push((face_key(&c), tris));
             }
         }
     }
     faces.sort_unstable_by_key(|f| f.0);
-    let mut boundary: Vec<([u32; 3], [u32; 3])> = Vec::new();
-    let mut i = 0;
-    while i < faces.len() {
-        let mut j = i + 1;
-        while j < faces.len() && faces[j].0 == faces[i].0 {
-            j += 1;
-        }
-        if j == i + 1 {
-            boundary.extend(faces[i].1.iter().map(|&t| (key(t), t)));
-        }
-        i = j;
-    }
+    let mut boundary: Vec<([u32; 3], [u32; 3])> = used_once(&faces)
+        .into_iter()
+        .flatten()
+        .map(|&t| (key(t), t))
+        .collect();
     drop(faces);
     boundary.sort_unstable();
     let mut out = Vec::new();
