@@ -10,6 +10,7 @@
 // Bad input must become a diagnostic, never a panic (docs/reliability.md).
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
+pub mod allocator;
 pub mod diag;
 pub mod doc;
 pub mod driver;

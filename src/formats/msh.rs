@@ -19,6 +19,7 @@ use super::groups;
 use super::{Encoding, MeshWriter, Warning, WriteError, WriteOptions, count, push_num, warning};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
+use std::borrow::Cow;
 use std::collections::BTreeMap;
 use std::fmt::Write as _;
 use std::io::Write;
@@ -54,7 +55,7 @@ impl MeshWriter for Msh {
 }
 
 /// What an MSH file (either version) cannot hold of the mesh.
-pub(super) fn model_warnings(model: &Model) -> Vec<Warning> {
+pub(super) fn model_warnings(model: &Model<'_>) -> Vec<Warning> {
     let mut warnings = Vec::new();
     if model.renamed > 0 {
         warnings.push(warning(
@@ -78,22 +79,26 @@ pub(super) fn model_warnings(model: &Model) -> Vec<Warning> {
 }
 
 /// An entity of the Gmsh model.
-pub(super) struct Entity {
+pub(super) struct Entity<'a> {
     pub(super) tag: i32,
     pub(super) physicals: Vec<i32>,
     /// Signed tags of the bounding entities one dimension down.
     bounding: Vec<i32>,
-    /// Mesh nodes whose bounding box the entity has (all it uses).
-    used: Vec<u32>,
+    /// Mesh nodes whose bounding box the entity has (all it uses), in
+    /// pieces: a surface's are its face's triangles and a volume's its
+    /// faces', borrowed from the mesh rather than copied (the copies were a
+    /// third of the peak memory of writing a large mesh).
+    used: Vec<Cow<'a, [u32]>>,
     /// Elements, as mesh node lists of `per` nodes each, one after the
-    /// other (one allocation per entity, not per element).
-    pub(super) elements: Vec<u32>,
+    /// other (one allocation per entity, not per element; a face's
+    /// triangles are borrowed as they are).
+    pub(super) elements: Cow<'a, [u32]>,
     pub(super) per: usize,
     /// The Gmsh element type when `per` does not tell it (volume cells).
     gmsh_type: Option<i32>,
 }
 
-impl Entity {
+impl<'a> Entity<'a> {
     /// How many elements it holds.
     pub(super) fn count(&self) -> usize {
         self.elements.len() / self.per
@@ -112,13 +117,13 @@ impl Entity {
         })
     }
 
-    fn new(tag: usize) -> Entity {
+    fn new(tag: usize) -> Entity<'a> {
         Entity {
             tag: tag as i32,
             physicals: Vec::new(),
             bounding: Vec::new(),
             used: Vec::new(),
-            elements: Vec::new(),
+            elements: Cow::Borrowed(&[]),
             per: 1,
             gmsh_type: None,
         }
@@ -126,9 +131,9 @@ impl Entity {
 }
 
 /// The MSH view of a mesh: entities per dimension, physical names, node owners.
-pub(super) struct Model {
+pub(super) struct Model<'a> {
     /// Index = dimension.
-    pub(super) entities: [Vec<Entity>; 4],
+    pub(super) entities: [Vec<Entity<'a>>; 4],
     /// (dim, tag, name).
     pub(super) physical_names: Vec<(u8, i32, String)>,
     /// The (dimension, entity index) owning each node; `None` for nodes no
@@ -138,8 +143,8 @@ pub(super) struct Model {
     unused_nodes: usize,
 }
 
-impl Model {
-    pub(super) fn of(mesh: &Mesh) -> Model {
+impl<'a> Model<'a> {
+    pub(super) fn of(mesh: &'a Mesh) -> Model<'a> {
         let three = mesh.dimension == 3;
         let vertex_of_node: BTreeMap<u32, usize> = mesh
             .vertices
@@ -155,8 +160,8 @@ impl Model {
             .enumerate()
             .map(|(i, v)| {
                 let mut e = Entity::new(i + 1);
-                e.used = vec![v.node];
-                e.elements = vec![v.node];
+                e.used = vec![Cow::Owned(vec![v.node])];
+                e.elements = Cow::Owned(vec![v.node]);
                 e
             })
             .collect();
@@ -167,8 +172,8 @@ impl Model {
             .map(|(i, edge)| {
                 let mut e = Entity::new(i + 1);
                 e.bounding = end_points(&edge.nodes, &vertex_of_node);
-                e.used = edge.nodes.clone();
-                e.elements = segment_nodes(&edge.nodes);
+                e.used = vec![Cow::Borrowed(&edge.nodes[..])];
+                e.elements = Cow::Owned(segment_nodes(&edge.nodes));
                 e.per = 2;
                 if let Some(q) = &mesh.quadratic {
                     add_mid_nodes(&mut e, q.edges.get(i).map(|m| m.as_slice()));
@@ -187,8 +192,8 @@ impl Model {
                     .iter()
                     .map(|&(edge, fwd)| signed(edge as usize + 1, fwd))
                     .collect();
-                e.used = face.triangles.iter().flatten().copied().collect();
-                e.elements = face.triangles.as_flattened().to_vec();
+                e.used = vec![Cow::Borrowed(face.triangles.as_flattened())];
+                e.elements = Cow::Borrowed(face.triangles.as_flattened());
                 e.per = 3;
                 if let Some(q) = &mesh.quadratic {
                     let mids: Vec<u32> = q
@@ -220,9 +225,8 @@ impl Model {
                     e.used = s
                         .faces
                         .iter()
-                        .flat_map(|&(f, _)| {
-                            mesh.faces[f as usize].triangles.iter().flatten().copied()
-                        })
+                        .filter_map(|&(f, _)| mesh.faces.get(f as usize))
+                        .map(|f| Cow::Borrowed(f.triangles.as_flattened()))
                         .collect();
                     e
                 })
@@ -269,8 +273,8 @@ impl Model {
                 .unwrap_or_else(|| names.add(3, &v.name));
             let mut e = Entity::new(volumes.len() + 1);
             e.physicals.push(tag);
-            e.used = v.nodes.clone();
-            e.elements = v.nodes.clone();
+            e.used = vec![Cow::Borrowed(&v.nodes[..])];
+            e.elements = Cow::Borrowed(&v.nodes[..]);
             e.per = v.kind.corners();
             e.gmsh_type = Some(v.kind.gmsh_type());
             if let Some((_, b)) = bounding.iter().find(|(n, _)| *n == v.name) {
@@ -290,8 +294,8 @@ impl Model {
             e.physicals.push(tag);
             // Only when a poly_line ends on model vertices does it have bounding points.
             e.bounding = end_points(&p.nodes, &vertex_of_node);
-            e.used = p.nodes.clone();
-            e.elements = segment_nodes(&p.nodes);
+            e.used = vec![Cow::Borrowed(&p.nodes[..])];
+            e.elements = Cow::Owned(segment_nodes(&p.nodes));
             e.per = 2;
             if let Some(q) = &mesh.quadratic {
                 add_mid_nodes(&mut e, q.polylines.get(line_index).map(|m| m.as_slice()));
@@ -303,8 +307,8 @@ impl Model {
             for &node in &p.nodes {
                 let mut e = Entity::new(points.len() + 1);
                 e.physicals.push(tag);
-                e.used = vec![node];
-                e.elements = vec![node];
+                e.used = vec![Cow::Owned(vec![node])];
+                e.elements = Cow::Owned(vec![node]);
                 points.push(e);
             }
         }
@@ -315,7 +319,7 @@ impl Model {
         let mut owner: Vec<Option<(u8, usize)>> = vec![None; mesh.nodes.len()];
         for (dim, list) in entities.iter().enumerate() {
             for (i, e) in list.iter().enumerate() {
-                for &n in &e.used {
+                for &n in e.used.iter().flat_map(|piece| piece.iter()) {
                     let slot = &mut owner[n as usize];
                     if slot.is_none() {
                         *slot = Some((dim as u8, i));
@@ -328,7 +332,7 @@ impl Model {
         // physical tag. The entities and their nodes stay.
         for e in entities.iter_mut().flatten() {
             if e.physicals.is_empty() {
-                e.elements.clear();
+                e.elements = Cow::Borrowed(&[]);
             }
         }
         let unused_nodes = owner.iter().filter(|o| o.is_none()).count();
@@ -344,13 +348,13 @@ impl Model {
 
 /// Appends each segment's mid node (3-node lines); segments without one
 /// stay linear.
-fn add_mid_nodes(e: &mut Entity, mids: Option<&[u32]>) {
+fn add_mid_nodes(e: &mut Entity<'_>, mids: Option<&[u32]>) {
     add_mid_nodes_grouped(e, mids.unwrap_or(&[]), 1);
 }
 
 /// Appends `per` mid nodes to each element (6-node triangles: 3), when
 /// there is exactly one group per element.
-fn add_mid_nodes_grouped(e: &mut Entity, mids: &[u32], per: usize) {
+fn add_mid_nodes_grouped(e: &mut Entity<'_>, mids: &[u32], per: usize) {
     if mids.len() != e.count() * per || mids.is_empty() {
         return;
     }
@@ -359,9 +363,9 @@ fn add_mid_nodes_grouped(e: &mut Entity, mids: &[u32], per: usize) {
         elements.extend_from_slice(element);
         elements.extend_from_slice(extra);
     }
-    e.elements = elements;
+    e.elements = Cow::Owned(elements);
     e.per += per;
-    e.used.extend_from_slice(mids);
+    e.used.push(Cow::Owned(mids.to_vec()));
 }
 
 /// Consecutive node pairs of a polyline, flat.
@@ -552,7 +556,7 @@ impl<'a> Sink<'a> {
 }
 
 fn write_all(
-    model: &Model,
+    model: &Model<'_>,
     mesh: &Mesh,
     binary: bool,
     out: &mut dyn Write,
@@ -568,7 +572,11 @@ fn write_all(
 
 /// `$MeshFormat` for `version` in the sink's encoding, then `$PhysicalNames`
 /// (always ASCII): the same in MSH 4.1 and 2.2.
-pub(super) fn write_preamble(s: &mut Sink, version: &str, model: &Model) -> std::io::Result<()> {
+pub(super) fn write_preamble(
+    s: &mut Sink,
+    version: &str,
+    model: &Model<'_>,
+) -> std::io::Result<()> {
     s.text("$MeshFormat\n")?;
     if s.binary {
         s.text(&format!("{version} 1 8\n"))?;
@@ -589,7 +597,7 @@ pub(super) fn write_preamble(s: &mut Sink, version: &str, model: &Model) -> std:
     Ok(())
 }
 
-fn write_entities(s: &mut Sink, model: &Model, mesh: &Mesh) -> std::io::Result<()> {
+fn write_entities(s: &mut Sink, model: &Model<'_>, mesh: &Mesh) -> std::io::Result<()> {
     s.text("$Entities\n")?;
     for list in &model.entities {
         s.size(list.len())?;
@@ -599,13 +607,15 @@ fn write_entities(s: &mut Sink, model: &Model, mesh: &Mesh) -> std::io::Result<(
         for e in list {
             s.int(e.tag)?;
             if dim == 0 {
-                let p = e.used.first().map_or([0.0; 3], |&n| mesh.nodes[n as usize]);
+                let first = e.used.iter().flat_map(|piece| piece.iter()).next();
+                let p = first.map_or([0.0; 3], |&n| mesh.nodes[n as usize]);
                 for c in p {
                     s.real(c)?;
                 }
             } else {
                 let (lo, hi) =
-                    groups::bounds(mesh, e.used.iter().copied()).unwrap_or(([0.0; 3], [0.0; 3]));
+                    groups::bounds(mesh, e.used.iter().flat_map(|piece| piece.iter().copied()))
+                        .unwrap_or(([0.0; 3], [0.0; 3]));
                 for c in lo.into_iter().chain(hi) {
                     s.real(c)?;
                 }
@@ -626,7 +636,7 @@ fn write_entities(s: &mut Sink, model: &Model, mesh: &Mesh) -> std::io::Result<(
     s.end_section("Entities")
 }
 
-fn write_nodes(s: &mut Sink, model: &Model, mesh: &Mesh) -> std::io::Result<()> {
+fn write_nodes(s: &mut Sink, model: &Model<'_>, mesh: &Mesh) -> std::io::Result<()> {
     // Owned nodes per entity, in node order.
     let mut blocks: BTreeMap<(u8, usize), Vec<u32>> = BTreeMap::new();
     for (n, o) in model.owner.iter().enumerate() {
@@ -682,8 +692,8 @@ fn write_nodes(s: &mut Sink, model: &Model, mesh: &Mesh) -> std::io::Result<()> 
     s.end_section("Nodes")
 }
 
-fn write_elements(s: &mut Sink, model: &Model) -> std::io::Result<()> {
-    let blocks: Vec<(usize, &Entity)> = model
+fn write_elements(s: &mut Sink, model: &Model<'_>) -> std::io::Result<()> {
+    let blocks: Vec<(usize, &Entity<'_>)> = model
         .entities
         .iter()
         .enumerate()

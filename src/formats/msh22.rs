@@ -42,7 +42,7 @@ impl MeshWriter for Msh22 {
 }
 
 fn write_all(
-    model: &Model,
+    model: &Model<'_>,
     mesh: &Mesh,
     binary: bool,
     out: &mut dyn Write,
@@ -74,7 +74,7 @@ fn write_all(
     o.end_section("Nodes")?;
 
     // One record per element and physical group, entity by entity.
-    let blocks: Vec<(usize, &super::msh::Entity)> = model
+    let blocks: Vec<(usize, &super::msh::Entity<'_>)> = model
         .entities
         .iter()
         .enumerate()

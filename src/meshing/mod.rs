@@ -35,6 +35,7 @@ mod guard;
 mod polyline_split;
 mod quadratic;
 mod report;
+mod schedule;
 mod size;
 mod trimmed;
 mod trimmed_shell;
@@ -51,7 +52,6 @@ use crate::mesh::{
 };
 use edges::EdgeNodes;
 use face::{FaceMesh, FacePoint, Outcome, Settings};
-use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Rounds of "mesh faces, add the boundary points they asked for" before
@@ -313,9 +313,12 @@ fn mesh_faces(
         // parallel, with results taken in face order (deterministic, and the
         // first error in face order wins as it would sequentially).
         let edges_now: &[EdgeNodes] = edge_nodes;
-        let outcomes: Vec<(usize, Result<Outcome, MeshError>)> = todo
-            .par_iter()
-            .map(|&f| {
+        let weighted: Vec<(usize, u64)> = todo
+            .iter()
+            .map(|&f| (f, face_weight(model, f, edges_now)))
+            .collect();
+        let outcomes: Vec<(usize, Result<Outcome, MeshError>)> =
+            schedule::run_bounded(&weighted, memory_budget(&weighted), |f| {
                 let face = &model.faces[f];
                 let settings = Settings {
                     keep_boundary: round == MAX_ROUNDS,
@@ -323,13 +326,11 @@ fn mesh_faces(
                     ..base
                 };
                 let face_constraints = constraints.get(&f).map_or(&[][..], |c| c.as_slice());
-                let outcome = guard::guarded(
+                guard::guarded(
                     || format!("face `{}`", face.name),
                     || face::mesh_face(model, face, edges_now, &settings, face_constraints),
-                );
-                (f, outcome)
-            })
-            .collect();
+                )
+            });
         // Faces whose mesh already has an edge's new nodes (kept splits on
         // straight edges): they need no new round for that edge.
         let mut has_them: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
@@ -383,6 +384,31 @@ fn mesh_faces(
         }
     }
     Ok(meshes)
+}
+
+/// A face's share of meshing memory, up to a constant: its interior grows
+/// as the square of its boundary's node count.
+fn face_weight(model: &Model, f: usize, edges: &[EdgeNodes]) -> u64 {
+    let boundary: u64 = model.faces[f]
+        .loops
+        .iter()
+        .flatten()
+        .map(|oe| {
+            edges
+                .get(oe.edge.index())
+                .map_or(0, |e| e.points.len() as u64)
+        })
+        .sum();
+    boundary.saturating_mul(boundary)
+}
+
+/// The face weight that may be meshed at once: the largest face beside half
+/// its weight of others, or a quarter of all faces where there are many of
+/// about the same size (so a model of equal faces still meshes in parallel).
+fn memory_budget(weighted: &[(usize, u64)]) -> u64 {
+    let largest = weighted.iter().map(|w| w.1).max().unwrap_or(0);
+    let total: u64 = weighted.iter().map(|w| w.1).fold(0, u64::saturating_add);
+    largest.saturating_add(largest / 2).max(total / 4)
 }
 
 /// Numbers the nodes (vertices, then edge interiors, then face interiors,
