@@ -217,6 +217,8 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         || "the assembly of the mesh".to_string(),
         || {
             let mut mesh = assemble(model, &edge_nodes, face_meshes, &lines);
+            // The face meshes are gone: the writers can have their pages.
+            crate::allocator::release_freed_memory();
             refuse_collapsed(&mesh, tolerance)?;
             let first_trimmed = mesh.faces.len();
             trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
@@ -326,10 +328,13 @@ fn mesh_faces(
                     ..base
                 };
                 let face_constraints = constraints.get(&f).map_or(&[][..], |c| c.as_slice());
-                guard::guarded(
+                let outcome = guard::guarded(
                     || format!("face `{}`", face.name),
                     || face::mesh_face(model, face, edges_now, &settings, face_constraints),
-                )
+                );
+                // The face's triangulation is gone: its pages serve the next face.
+                crate::allocator::release_freed_memory();
+                outcome
             });
         // Faces whose mesh already has an edge's new nodes (kept splits on
         // straight edges): they need no new round for that edge.
