@@ -323,7 +323,7 @@ fn check_relations(
 
 /// Pairs of boxes that may overlap, found with a uniform grid whose cell is
 /// the median box size; boxes spanning many cells are compared with all.
-fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
+pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
     let mut sizes: Vec<f64> = boxes.iter().map(|b| (b.max - b.min).max()).collect();
     let middle = sizes.len() / 2;
     let median =
