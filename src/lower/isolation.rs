@@ -51,8 +51,12 @@ pub(super) fn isolated(shapes: &[&SolidShape], tol: f64) -> Vec<bool> {
             bbox
         })
         .collect();
-    let finite =
-        |b: &Aabb| [b.min, b.max].iter().all(|p| p.iter().all(|c| c.is_finite())) && !b.is_empty();
+    let finite = |b: &Aabb| {
+        [b.min, b.max]
+            .iter()
+            .all(|p| p.iter().all(|c| c.is_finite()))
+            && !b.is_empty()
+    };
     let mut isolated: Vec<bool> = boxes.iter().map(finite).collect();
     // Non-finite boxes are left out of the pairs (and not isolated above).
     for (i, j) in super::booleans::candidate_pairs(&boxes, 2.0 * tol) {
@@ -60,4 +64,43 @@ pub(super) fn isolated(shapes: &[&SolidShape], tol: f64) -> Vec<bool> {
         isolated[j] = false;
     }
     isolated
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Frame, Mat3, Point3, Vec3};
+
+    fn unit_box(x: f64, y: f64, z: f64) -> SolidShape {
+        SolidShape::Box {
+            frame: Frame {
+                origin: Point3::new(x, y, z),
+                linear: Mat3::from_diagonal(&Vec3::new(1.0, 1.0, 1.0)),
+            },
+        }
+    }
+
+    #[test]
+    fn touching_solids_are_not_isolated_and_distant_ones_are() {
+        let tol = 1e-6;
+        // The first two share the face x = 1; the third is 2 away; the fourth
+        // is 1.5 tolerances away from the third's corner x = 4 (within the
+        // doubled margin), the fifth 0.001 away from everything.
+        let shapes = [
+            unit_box(0.0, 0.0, 0.0),
+            unit_box(1.0, 0.0, 0.0),
+            unit_box(3.0, 0.0, 0.0),
+            unit_box(4.0 + 1.5e-6, 0.0, 0.0),
+            unit_box(0.0, 0.0, 1.001),
+        ];
+        let refs: Vec<&SolidShape> = shapes.iter().collect();
+        assert_eq!(isolated(&refs, tol), vec![false, false, false, false, true]);
+    }
+
+    #[test]
+    fn a_solid_with_a_non_finite_position_is_never_isolated() {
+        let shapes = [unit_box(f64::NAN, 0.0, 0.0), unit_box(5.0, 0.0, 0.0)];
+        let refs: Vec<&SolidShape> = shapes.iter().collect();
+        assert_eq!(isolated(&refs, 1e-6), vec![false, true]);
+    }
 }

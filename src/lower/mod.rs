@@ -116,6 +116,7 @@ pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -
     let edge_lines = point_calculus::edge_lines(resolved);
     let shapes = isolation::solid_shapes(resolved, &edge_lines);
     let isolated = isolation::isolated(&shapes, model.tolerance);
+    entities.solids.reserve(shapes.len());
     let mut shared = Expected::default();
     for (shape, _) in shapes.iter().zip(&isolated).filter(|(_, i)| !**i) {
         shared.add(shape);
