@@ -5,6 +5,7 @@
 
 use super::WriteError;
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 use std::borrow::Cow;
 
 /// Rejects a mesh whose indices leave their tables or whose coordinates are
@@ -22,8 +23,8 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
     }
     if let Some(i) = mesh
         .nodes
-        .iter()
-        .position(|p| p.iter().any(|c| !c.is_finite()))
+        .par_iter()
+        .position_first(|p| p.iter().any(|c| !c.is_finite()))
     {
         return bad(format!("node {i} has a coordinate that is not finite"));
     }
@@ -43,7 +44,7 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
         }
     }
     for f in &mesh.faces {
-        if !f.triangles.iter().flatten().all(node_ok) {
+        if !f.triangles.par_iter().all(|t| t.iter().all(node_ok)) {
             return bad(format!("face `{}` refers to a node out of range", f.name));
         }
         if f.boundary
