@@ -21,10 +21,14 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
             mesh.nodes.len()
         ));
     }
+    let not_finite = |p: &[f64; 3]| p.iter().any(|c| !c.is_finite());
+    // Checked in parallel pieces; the first bad node (rare) found in order.
     if let Some(i) = mesh
         .nodes
-        .par_iter()
-        .position_first(|p| p.iter().any(|c| !c.is_finite()))
+        .par_chunks(1 << 14)
+        .any(|piece| piece.iter().any(not_finite))
+        .then(|| mesh.nodes.iter().position(not_finite))
+        .flatten()
     {
         return bad(format!("node {i} has a coordinate that is not finite"));
     }
@@ -44,7 +48,11 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
         }
     }
     for f in &mesh.faces {
-        if !f.triangles.par_iter().all(|t| t.iter().all(node_ok)) {
+        if !f
+            .triangles
+            .par_chunks(1 << 14)
+            .all(|piece| piece.as_flattened().iter().all(node_ok))
+        {
             return bad(format!("face `{}` refers to a node out of range", f.name));
         }
         if f.boundary

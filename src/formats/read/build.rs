@@ -93,7 +93,10 @@ impl Builder {
         for g in &self.groups {
             // In parallel: millions of triangles on large meshes (a yes/no
             // answer, the same on any thread count).
-            let bad = g.triangles.par_iter().any(|t| t.iter().any(|&v| v as usize >= n))
+            let bad = g
+                .triangles
+                .par_chunks(1 << 14)
+                .any(|piece| piece.as_flattened().iter().any(|&v| v as usize >= n))
                 || g.lines.iter().flatten().any(|&v| v as usize >= n)
                 || g.points.iter().any(|&v| v as usize >= n)
                 || g.volumes.iter().flatten().any(|&v| v as usize >= n);
@@ -105,10 +108,14 @@ impl Builder {
                 )]);
             }
         }
+        let not_finite = |p: &[f64; 3]| p.iter().any(|c| !c.is_finite());
+        // Checked in parallel pieces; the first bad node (rare) found in order.
         if let Some(i) = self
             .nodes
-            .par_iter()
-            .position_first(|p| p.iter().any(|c| !c.is_finite()))
+            .par_chunks(1 << 14)
+            .any(|piece| piece.iter().any(not_finite))
+            .then(|| self.nodes.iter().position(not_finite))
+            .flatten()
         {
             return Err(vec![Diagnostic::new(
                 Code::MeshNonFinite,

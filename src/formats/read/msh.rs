@@ -550,10 +550,16 @@ impl<'a> Reader<'a> {
         let (tags, coordinates) = block.split_at(8 * n);
         let coordinates_at = start + 8 * n;
         let value = |c: &[u8], at: usize| super::bytes_at::<8>(c, at).map_or(0.0, f64::from_le_bytes);
-        let non_finite = coordinates
-            .par_chunks_exact(8)
-            .with_min_len(1 << 14)
-            .position_first(|c| !value(c, 0).is_finite());
+        // Looked for in parallel pieces, found (rarely) in order.
+        let finite = |c: &[u8]| value(c, 0).is_finite();
+        let non_finite = if coordinates
+            .par_chunks(8 << 14)
+            .all(|piece| piece.chunks_exact(8).all(finite))
+        {
+            None
+        } else {
+            coordinates.chunks_exact(8).position(|c| !finite(c))
+        };
         let bad_node = non_finite.map_or(n, |v| v / 3);
         let base = self.b.nodes.len();
         self.b.nodes.par_extend(
