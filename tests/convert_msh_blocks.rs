@@ -114,7 +114,10 @@ fn a_duplicate_tag_names_its_byte_and_comes_before_a_later_bad_coordinate() {
     );
     assert_eq!(error(&dup), expected);
     let later_inf = msh(
-        &[(&[1, 2, 2, 4], &[C[0], C[1], C[2], [f64::INFINITY, 0.0, 0.0]])],
+        &[(
+            &[1, 2, 2, 4],
+            &[C[0], C[1], C[2], [f64::INFINITY, 0.0, 0.0]],
+        )],
         &[[1, 2, 4]],
     );
     assert_eq!(error(&later_inf), expected);
@@ -123,7 +126,10 @@ fn a_duplicate_tag_names_its_byte_and_comes_before_a_later_bad_coordinate() {
 #[test]
 fn a_bad_coordinate_comes_before_its_own_nodes_duplicate_tag() {
     let same_node = msh(
-        &[(&[1, 2, 2, 4], &[C[0], C[1], [0.0, 0.0, f64::NEG_INFINITY], C[3]])],
+        &[(
+            &[1, 2, 2, 4],
+            &[C[0], C[1], [0.0, 0.0, f64::NEG_INFINITY], C[3]],
+        )],
         &[[1, 2, 4]],
     );
     assert_eq!(
@@ -153,8 +159,7 @@ fn a_triangle_on_an_unknown_node_names_its_byte() {
         error(&bytes),
         (
             Code::MeshIndexOutOfRange,
-            "at byte 356: an element refers to node 9, which `$Nodes` does not define"
-                .to_string()
+            "at byte 356: an element refers to node 9, which `$Nodes` does not define".to_string()
         )
     );
 }

@@ -126,7 +126,10 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
             piece
                 .iter()
                 .filter(|t| {
-                    t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || twice_area(nodes, **t) <= area_floor
+                    t[0] == t[1]
+                        || t[1] == t[2]
+                        || t[0] == t[2]
+                        || twice_area(nodes, **t) <= area_floor
                 })
                 .count()
         })

@@ -549,7 +549,8 @@ impl<'a> Reader<'a> {
         };
         let (tags, coordinates) = block.split_at(8 * n);
         let coordinates_at = start + 8 * n;
-        let value = |c: &[u8], at: usize| super::bytes_at::<8>(c, at).map_or(0.0, f64::from_le_bytes);
+        let value =
+            |c: &[u8], at: usize| super::bytes_at::<8>(c, at).map_or(0.0, f64::from_le_bytes);
         // Looked for in parallel pieces, found (rarely) in order.
         let finite = |c: &[u8]| value(c, 0).is_finite();
         let non_finite = if coordinates
@@ -699,15 +700,16 @@ impl<'a> Reader<'a> {
         // Collected straight into the group's reserved room (no zero fill
         // first), each piece by the thread that converts it.
         let unknown = AtomicBool::new(false);
-        g.triangles.par_extend(block.par_chunks_exact(32).with_min_len(PIECE).map(|r| {
-            match (tag(r, 8), tag(r, 16), tag(r, 24)) {
-                (Some(a), Some(b), Some(c)) => [a, b, c],
-                _ => {
-                    unknown.store(true, Ordering::Relaxed);
-                    [0; 3]
+        g.triangles
+            .par_extend(block.par_chunks_exact(32).with_min_len(PIECE).map(|r| {
+                match (tag(r, 8), tag(r, 16), tag(r, 24)) {
+                    (Some(a), Some(b), Some(c)) => [a, b, c],
+                    _ => {
+                        unknown.store(true, Ordering::Relaxed);
+                        [0; 3]
+                    }
                 }
-            }
-        }));
+            }));
         let known = !unknown.load(Ordering::Relaxed);
         if !known {
             g.triangles.truncate(base);
