@@ -9,6 +9,7 @@ mod explicit;
 mod point_calculus;
 mod prune;
 pub mod rfunction_region;
+pub mod trimmed_topology;
 mod weld;
 mod winding;
 

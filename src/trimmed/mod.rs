@@ -11,6 +11,7 @@ mod pole;
 pub mod program;
 pub mod shared;
 mod split;
+pub mod topology;
 mod triangulate;
 
 pub use measure::{TrimmedQuality, centroid_distance};
@@ -119,6 +120,39 @@ impl TrimmedSurface {
         let du = (self.point(u + hu, v) - self.point(u - hu, v)) / (2.0 * hu);
         let dv = (self.point(u, v + hv) - self.point(u, v - hv)) / (2.0 * hv);
         (du, dv)
+    }
+
+    /// The surface point nearest `p` (best of a 16 × 16 parameter grid, then
+    /// Gauss–Newton, kept in the rectangle) with the unit normal
+    /// R_u × R_v there; `None` where the normal is undefined.
+    pub fn project(&self, p: &Point3) -> Option<(Point3, Vec3)> {
+        let [u0, u1, v0, v1] = self.rect;
+        let n = 16;
+        let mut best = (f64::INFINITY, [u0, v0]);
+        for i in 0..=n {
+            for j in 0..=n {
+                let uv = [
+                    u0 + (u1 - u0) * i as f64 / n as f64,
+                    v0 + (v1 - v0) * j as f64 / n as f64,
+                ];
+                let d = (self.point(uv[0], uv[1]) - p).norm_squared();
+                if d < best.0 {
+                    best = (d, uv);
+                }
+            }
+        }
+        let uv = triangulate::nearest_parameter(self, *p, best.1);
+        let uv = [uv[0].clamp(u0, u1), uv[1].clamp(v0, v1)];
+        let uv = if uv[0].is_finite() && uv[1].is_finite() {
+            uv
+        } else {
+            best.1
+        };
+        let q = self.point(uv[0], uv[1]);
+        let (du, dv) = self.tangents(uv[0], uv[1]);
+        let normal = du.cross(&dv);
+        let len = normal.norm();
+        (len > 0.0 && len.is_finite()).then(|| (q, normal / len))
     }
 
     /// W(u, v): the trim value with the material sign positive (1 without a trim).
