@@ -90,5 +90,49 @@ pub fn pieces(s: &TrimmedSurface, tolerance: f64) -> Result<Vec<Vec<Piece>>, Str
         });
         out.push(pieces);
     }
+    join_across_seams(&mut out, 2.0 * tolerance);
     Ok(out)
+}
+
+/// Joins trim pieces that a periodic seam cut (one ends where another
+/// begins, at a point no side piece touches), so a hole across the seam is
+/// one closed trim piece, as the mesh joins its chain again.
+fn join_across_seams(loops: &mut [Vec<Piece>], distance: f64) {
+    let ends = |p: &Piece| (p.points[0], p.points[p.points.len() - 1]);
+    loop {
+        let all: Vec<(usize, usize)> = (0..loops.len())
+            .flat_map(|l| (0..loops[l].len()).map(move |i| (l, i)))
+            .collect();
+        let touches_side = |q: &Point3, loops: &[Vec<Piece>]| {
+            loops.iter().flatten().filter(|p| p.side != 0).any(|p| {
+                let (a, b) = ends(p);
+                (a - q).norm() <= distance || (b - q).norm() <= distance
+            })
+        };
+        let pair = all.iter().find_map(|&(l, i)| {
+            let p = &loops[l][i];
+            let (a, b) = ends(p);
+            if p.side != 0 || (a - b).norm() <= distance || touches_side(&b, loops) {
+                return None;
+            }
+            all.iter()
+                .find(|&&(l2, j)| {
+                    let q = &loops[l2][j];
+                    (l2, j) != (l, i) && q.side == 0 && (ends(q).0 - b).norm() <= distance
+                })
+                .map(|&(l2, j)| ((l, i), (l2, j)))
+        });
+        let Some(((l, i), (l2, j))) = pair else {
+            return;
+        };
+        let tail = loops[l2][j].points[1..].to_vec();
+        loops[l][i].points.extend(tail);
+        loops[l2].remove(j);
+        let p = &mut loops[l][i];
+        let (a, b) = ends(p);
+        if (a - b).norm() <= distance {
+            let n = p.points.len();
+            p.points[n - 1] = a;
+        }
+    }
 }
