@@ -40,6 +40,10 @@ pub enum Carrier {
     Expressions { xyz: Box<[Ssa; 3]> },
     /// Paper 003's 9-point parabolic patch (point calculus), u, v ∈ [0, 1].
     Patch9(Box<Patch9>),
+    /// The inner carrier with u and v exchanged: R(u, v) = inner(v, u). A
+    /// surface with a pole on a side v = const is meshed as its transpose
+    /// (`TrimmedSurface::transposed`), the pole then on a side u = const.
+    Swapped(Box<Carrier>),
 }
 
 /// The trim: F over global x, y, z; material where F ≥ 0, or F ≤ 0 when `negative`.
@@ -73,7 +77,28 @@ pub struct TrimmedSurface {
 impl TrimmedSurface {
     /// R(u, v) in global coordinates (NaN when an expression fails).
     pub fn point(&self, u: f64, v: f64) -> Point3 {
-        let local = match &self.carrier {
+        self.frame.to_global(&local_point(&self.carrier, u, v))
+    }
+
+    /// The same surface with u and v exchanged (its normal R_u × R_v turned over).
+    pub fn transposed(&self) -> TrimmedSurface {
+        let carrier = match &self.carrier {
+            Carrier::Swapped(inner) => (**inner).clone(),
+            c => Carrier::Swapped(Box::new(c.clone())),
+        };
+        let [u0, u1, v0, v1] = self.rect;
+        TrimmedSurface {
+            carrier,
+            rect: [v0, v1, u0, u1],
+            ..self.clone()
+        }
+    }
+}
+
+/// R(u, v) of a carrier in its local frame (NaN when an expression fails).
+fn local_point(carrier: &Carrier, u: f64, v: f64) -> Point3 {
+    {
+        match carrier {
             Carrier::Bezier { rows } => bezier(rows, u, v),
             Carrier::Cone { r1, r2, length } => {
                 let r = r1 + (r2 - r1) * u / length;
@@ -96,10 +121,12 @@ impl TrimmedSurface {
                     xyz[2].eval_point(p),
                 )
             }
-        };
-        self.frame.to_global(&local)
+            Carrier::Swapped(inner) => local_point(inner, v, u),
+        }
     }
+}
 
+impl TrimmedSurface {
     /// Surface points on an (n + 1) × (n + 1) parameter grid.
     pub fn samples(&self, n: usize) -> Vec<Point3> {
         let [u0, u1, v0, v1] = self.rect;
