@@ -179,6 +179,10 @@ fn run(
         *implicit = subdomains;
         set_trims(&mut lowered.model, trims);
     }
+    if lowered.model.dimension == crate::ir::Dimension::Three {
+        // Trimmed surfaces become faces, edges and vertices (issue 9).
+        lower::trimmed_topology::add(&mut lowered.model);
+    }
     if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
         // 2D R-function regions become model entities (issue 6).
         let (model, map) = (&mut lowered.model, &mut lowered.source_map);

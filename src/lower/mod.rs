@@ -10,6 +10,7 @@ mod isolation;
 mod point_calculus;
 mod prune;
 pub mod rfunction_region;
+pub mod trimmed_topology;
 mod weld;
 mod winding;
 
