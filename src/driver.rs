@@ -22,7 +22,7 @@ pub struct Options {
     pub expressions: crate::expr::ExprLimits,
     /// Called where a stage's large inputs have just been dropped, so the
     /// allocator can hand their memory back before the next stage allocates
-    /// (the `geomc` binary returns mimalloc's freed pages; see `main.rs`).
+    /// (the `geomc` binary passes `allocator::release_freed_memory`).
     pub release_memory: Option<fn()>,
 }
 

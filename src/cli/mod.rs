@@ -103,7 +103,7 @@ impl InputOptions {
             },
             allowed_paths: self.allow_path.clone(),
             expressions: self.expressions.limits(),
-            release_memory: Some(crate::release_freed_memory),
+            release_memory: Some(geomc::allocator::release_freed_memory),
         })
     }
 }
