@@ -952,7 +952,10 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
             |maps, k| {
                 fill(&mut maps[0], k, true);
                 fill(&mut maps[1], k + 1, true);
-                let mut tris = Vec::new();
+                // About two triangles per crossed edge (growing the vector
+                // by doubling cost copies and page faults).
+                let crossed = planes[k].keys.len() + planes[k + 1].keys.len();
+                let mut tris = Vec::with_capacity(crossed + crossed / 4);
                 let mut centres = Vec::new();
                 let mut ids = Vec::with_capacity(12);
                 for j in 0..grid.cells[1] {
