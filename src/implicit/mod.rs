@@ -5,6 +5,7 @@
 //! polygonization ([`polygonize`]) into geomc's mesh IR.
 
 pub mod caps;
+pub mod cell_table;
 pub mod expr_ops;
 pub mod interfaces;
 pub mod interval;

@@ -23,6 +23,7 @@
 //! on the box face. Triangles are oriented with normals pointing out of the
 //! solid (towards decreasing f).
 
+use super::cell_table::CellTable;
 use super::interval::{self, Interval, Sign};
 use super::rows::RowTape;
 use super::signs::{self, SignRows};
@@ -367,26 +368,30 @@ fn plane_vertices(
     // sort: a comparison sort of a plane's edges cost more than the root
     // finding; the grouping does not change any vertex).
     let nb = field.nb;
+    let layer = &field.blocks[(k / BS) * nb[0] * nb[1]..][..nb[0] * nb[1]];
+    let any_kernel = layer.iter().any(|b| matches!(b, Block::Mixed(_)));
     let block_of = |e: usize| {
         let key = keys[e] as usize / 3;
         (key / n1[0] / BS) * nb[0] + (key % n1[0]) / BS
     };
-    let mut first = vec![0u32; nb[0] * nb[1] + 1];
-    for e in 0..keys.len() {
+    // Given samples (no kernel in this block layer): nothing to refine.
+    let groups = if any_kernel { nb[0] * nb[1] } else { 0 };
+    let mut first = vec![0u32; groups + 1];
+    for e in (0..keys.len()).filter(|_| any_kernel) {
         first[block_of(e) + 1] += 1;
     }
-    for b in 0..nb[0] * nb[1] {
+    for b in 0..groups {
         first[b + 1] += first[b];
     }
-    let mut order = vec![0usize; keys.len()];
+    let mut order = vec![0usize; if any_kernel { keys.len() } else { 0 }];
     let mut next = first.clone();
-    for e in 0..keys.len() {
+    for e in (0..keys.len()).filter(|_| any_kernel) {
         let b = block_of(e);
         order[next[b] as usize] = e;
         next[b] += 1;
     }
     let (mut ws, mut group) = (Workspace::default(), Vec::new());
-    for b in 0..nb[0] * nb[1] {
+    for b in 0..groups {
         let (start, end) = (first[b] as usize, first[b + 1] as usize);
         if start == end {
             continue;
@@ -591,7 +596,7 @@ fn illinois(
 }
 
 /// Corner c of a cell is at offset (c & 1, c >> 1 & 1, c >> 2 & 1).
-const EDGES: [(u8, u8); 12] = [
+pub(super) const EDGES: [(u8, u8); 12] = [
     (0, 1),
     (2, 3),
     (4, 5),
@@ -606,7 +611,7 @@ const EDGES: [(u8, u8); 12] = [
     (3, 7),
 ];
 /// The six faces, corners counter-clockwise seen from outside the cell.
-const FACES: [[u8; 4]; 6] = [
+pub(super) const FACES: [[u8; 4]; 6] = [
     [0, 4, 6, 2],
     [1, 3, 7, 5],
     [0, 1, 5, 4],
@@ -643,16 +648,32 @@ const fn face_masks() -> [u8; 12] {
     m
 }
 /// Which faces each cell edge lies on.
-const FACE_MASK: [u8; 12] = face_masks();
+pub(super) const FACE_MASK: [u8; 12] = face_masks();
 
 /// The successor of each crossed edge in its cycle (u8::MAX: not crossed):
 /// on every face each exit crossing (inside → outside, counter-clockwise
 /// seen from outside) is joined to an entry crossing.
 pub fn cell_links(v: &[f64; 8]) -> [u8; 12] {
+    let inside = std::array::from_fn(|c| v[c] > 0.0);
+    // Asymptotic decider: the bilinear interpolant's saddle value
+    // (v0 v2 − v1 v3) / (v0 + v2 − v1 − v3) has a positive denominator
+    // (p[0] is an inside corner), so the centre is inside when v0 v2 > v1 v3.
+    links(inside, |_, p| {
+        let val = |c: u8| v[c as usize];
+        val(p[0]) * val(p[2]) > val(p[1]) * val(p[3])
+    })
+}
+
+/// [`cell_links`] from the corner signs, with `centre_inside(face, p)`
+/// deciding each face with four crossings (`p`: the face's corners starting
+/// at an inside one, counter-clockwise seen from outside).
+pub(super) fn links(
+    inside: [bool; 8],
+    mut centre_inside: impl FnMut(usize, [u8; 4]) -> bool,
+) -> [u8; 12] {
     let mut next = [u8::MAX; 12];
-    let inside = |c: u8| v[c as usize] > 0.0;
-    for q in FACES {
-        let ins = q.map(inside);
+    for (f, q) in FACES.into_iter().enumerate() {
+        let ins = q.map(|c| inside[c as usize]);
         let crossings = (0..4).filter(|&s| ins[s] != ins[(s + 1) % 4]).count();
         let edge = |a: u8, b: u8| EDGE_OF[a as usize][b as usize];
         if crossings == 2 {
@@ -662,20 +683,14 @@ pub fn cell_links(v: &[f64; 8]) -> [u8; 12] {
                 next[edge(q[x], q[(x + 1) % 4]) as usize] = edge(q[n], q[(n + 1) % 4]);
             }
         } else if crossings == 4 {
-            let r = if ins[0] { 0 } else { 1 };
-            let p = [q[r], q[(r + 1) % 4], q[(r + 2) % 4], q[(r + 3) % 4]];
-            let val = |c: u8| v[c as usize];
-            // Asymptotic decider: the bilinear interpolant's saddle value
-            // (v0 v2 − v1 v3) / (v0 + v2 − v1 − v3) has a positive denominator
-            // here, so the centre is inside when v0 v2 > v1 v3.
-            let centre_inside = val(p[0]) * val(p[2]) > val(p[1]) * val(p[3]);
+            let p = saddle_corners(q, ins[0]);
             let (e0, e1, e2, e3) = (
                 edge(p[0], p[1]),
                 edge(p[1], p[2]),
                 edge(p[2], p[3]),
                 edge(p[3], p[0]),
             );
-            if centre_inside {
+            if centre_inside(f, p) {
                 next[e0 as usize] = e1;
                 next[e2 as usize] = e3;
             } else {
@@ -685,6 +700,13 @@ pub fn cell_links(v: &[f64; 8]) -> [u8; 12] {
         }
     }
     next
+}
+
+/// A face's corners rotated to start at an inside one (faces with four
+/// crossings alternate inside and outside).
+pub(super) fn saddle_corners(q: [u8; 4], first_inside: bool) -> [u8; 4] {
+    let r = if first_inside { 0 } else { 1 };
+    [q[r], q[(r + 1) % 4], q[(r + 2) % 4], q[(r + 3) % 4]]
 }
 
 /// A cell's cycles, kept on the stack (the polygonizer calls this for every
@@ -712,7 +734,11 @@ impl Cycles {
 /// The cycles of a cell, each as its cell edges in the order that gives
 /// outward-facing triangles.
 pub fn cell_cycles(v: &[f64; 8]) -> Cycles {
-    let next = cell_links(v);
+    cycles_of(&cell_links(v))
+}
+
+/// The cycles of a cell's links ([`cell_links`]).
+pub(super) fn cycles_of(next: &[u8; 12]) -> Cycles {
     let mut seen = [false; 12];
     let mut cycles = Cycles {
         edges: [0; 12],
@@ -753,8 +779,10 @@ type SlabOutput = (Vec<[u32; 3]>, Vec<[f64; 3]>);
 /// pair); for quads the shorter valid diagonal. When no such fan exists (a
 /// face whose two segments both belong to this cycle) the cycle is fanned
 /// around a new vertex at its centroid.
+/// `valid_starts`: bit s set when the fan from vertex s is such a fan
+/// (`cell_table::CaseCycles::valid`).
 fn triangulate(
-    edges: &[u8],
+    valid_starts: u16,
     ids: &[u32],
     positions: &[[f64; 3]],
     out: &mut Vec<[u32; 3]>,
@@ -764,10 +792,7 @@ fn triangulate(
     if n < 3 {
         return;
     }
-    let valid = |s: usize| {
-        (2..n - 1)
-            .all(|d| FACE_MASK[edges[s] as usize] & FACE_MASK[edges[(s + d) % n] as usize] == 0)
-    };
+    let valid = |s: usize| valid_starts >> s & 1 == 1;
     let start = if n == 4 {
         let len = |a: usize, b: usize| {
             let (p, q) = (positions[ids[a] as usize], positions[ids[b] as usize]);
@@ -802,6 +827,33 @@ fn triangulate(
             }
         }
     }
+}
+
+/// The parts one after the other, each item mapped by `map(part, item)`,
+/// copied in parallel: the order is the parts' order for any thread count.
+fn concat<T: Copy + Sync, U: Send>(parts: &[&[T]], map: impl Fn(usize, T) -> U + Sync) -> Vec<U> {
+    let total = parts.iter().map(|p| p.len()).sum();
+    let mut out: Vec<U> = Vec::with_capacity(total);
+    let mut rest = &mut out.spare_capacity_mut()[..total];
+    let mut slots = Vec::with_capacity(parts.len());
+    for part in parts {
+        let (here, after) = rest.split_at_mut(part.len());
+        slots.push(here);
+        rest = after;
+    }
+    slots
+        .into_par_iter()
+        .zip(parts.par_iter())
+        .enumerate()
+        .for_each(|(i, (slot, part))| {
+            for (d, &x) in slot.iter_mut().zip(part.iter()) {
+                d.write(map(i, x));
+            }
+        });
+    // SAFETY: the slots cover the first `total` elements and every one of
+    // them was written above.
+    unsafe { out.set_len(total) };
+    out
 }
 
 /// Polygonizes {f = 0} of `ssa` over the grid.
@@ -870,14 +922,14 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
         offsets.push(total);
         total += p.keys.len() as u32;
     }
-    let positions: Vec<[f64; 3]> = planes
-        .iter()
-        .flat_map(|p| p.positions.iter().copied())
-        .collect();
-    let at_sample: Vec<u64> = planes
-        .iter()
-        .flat_map(|p| p.at_sample.iter().copied())
-        .collect();
+    let at_sample: Vec<u64> = concat(
+        &planes.iter().map(|p| &p.at_sample[..]).collect::<Vec<_>>(),
+        |_, s| s,
+    );
+    let positions: Vec<[f64; 3]> = concat(
+        &planes.iter().map(|p| &p.positions[..]).collect::<Vec<_>>(),
+        |_, p| p,
+    );
     // Edge key → vertex id for one plane, in a buffer reused per thread
     // (only the entries set are cleared afterwards).
     let fill = |map: &mut Vec<u32>, k: usize, on: bool| {
@@ -892,6 +944,7 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
         let b = [i / BS, j / BS, k / BS];
         (0..3).any(|a| b[a] == 0 || (b[a] * BS + BS) >= n1[a] - 1)
     };
+    let table = CellTable::get();
     let slabs: Vec<SlabOutput> = (0..grid.cells[2])
         .into_par_iter()
         .map_init(
@@ -899,7 +952,10 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
             |maps, k| {
                 fill(&mut maps[0], k, true);
                 fill(&mut maps[1], k + 1, true);
-                let mut tris = Vec::new();
+                // About two triangles per crossed edge (growing the vector
+                // by doubling cost copies and page faults).
+                let crossed = planes[k].keys.len() + planes[k + 1].keys.len();
+                let mut tris = Vec::with_capacity(crossed + crossed / 4);
                 let mut centres = Vec::new();
                 let mut ids = Vec::with_capacity(12);
                 for j in 0..grid.cells[1] {
@@ -928,11 +984,9 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
                             field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))]
                                 as f64
                         });
-                        let first = v[0] > 0.0;
-                        if v.iter().all(|&x| (x > 0.0) == first) {
-                            continue;
-                        }
-                        for cycle in cell_cycles(&v).iter() {
+                        let cycles = table.lookup(&v);
+                        for c in 0..cycles.count as usize {
+                            let (cycle, valid_starts) = cycles.cycle(c);
                             ids.clear();
                             for &e in cycle {
                                 let (a, b) = EDGES[e as usize];
@@ -944,7 +998,7 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
                             if ids.contains(&u32::MAX) {
                                 continue;
                             }
-                            triangulate(cycle, &ids, &positions, &mut tris, &mut centres);
+                            triangulate(valid_starts, &ids, &positions, &mut tris, &mut centres);
                         }
                     }
                 }
@@ -955,20 +1009,24 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
         )
         .collect();
     let mut positions = positions;
-    let mut triangles = Vec::with_capacity(slabs.iter().map(|s| s.0.len()).sum());
-    for (tris, centres) in slabs {
-        let base = positions.len() as u32;
-        triangles.extend(tris.into_iter().map(|t| {
+    // Each slab's centres follow the edge vertices, slab after slab.
+    let mut bases = Vec::with_capacity(slabs.len());
+    for (_, centres) in &slabs {
+        bases.push(positions.len() as u32);
+        positions.extend_from_slice(centres);
+    }
+    let triangles = concat(
+        &slabs.iter().map(|s| &s.0[..]).collect::<Vec<_>>(),
+        |slab, t| {
             t.map(|id| {
                 if id & CENTRE != 0 {
-                    base + (id & !CENTRE)
+                    bases[slab] + (id & !CENTRE)
                 } else {
                     id
                 }
             })
-        }));
-        positions.extend(centres);
-    }
+        },
+    );
     let pruned_blocks = field
         .blocks
         .iter()
