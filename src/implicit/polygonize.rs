@@ -891,6 +891,21 @@ pub fn polygonize_samples(values: Vec<f64>, grid: &Grid, options: &Options) -> S
 /// # Panics
 /// If `values` does not hold one value per grid point (a caller bug).
 pub fn polygonize_samples_f32(values: Vec<f32>, grid: &Grid, options: &Options) -> Surface {
+    polygonize_samples_f32_returning(values, grid, options).0
+}
+
+/// [`polygonize_samples_f32`] that hands the sample buffer back (its values
+/// outside the box closed), so the caller decides when its memory is freed:
+/// the implicit bench times contouring as VTK's is timed, without freeing the
+/// input.
+///
+/// # Panics
+/// If `values` does not hold one value per grid point (a caller bug).
+pub fn polygonize_samples_f32_returning(
+    values: Vec<f32>,
+    grid: &Grid,
+    options: &Options,
+) -> (Surface, Vec<f32>) {
     let n1 = grid.cells.map(|n| n + 1);
     assert_eq!(
         values.len(),
@@ -905,7 +920,8 @@ pub fn polygonize_samples_f32(values: Vec<f32>, grid: &Grid, options: &Options) 
         blocks: vec![Block::Sampled; nb[0] * nb[1] * nb[2]],
     };
     close_at_box(&mut field, options);
-    mesh_field(&field, grid, options)
+    let surface = mesh_field(&field, grid, options);
+    (surface, field.values)
 }
 
 fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
