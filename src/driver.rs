@@ -20,6 +20,10 @@ pub struct Options {
     pub allowed_paths: Vec<std::path::PathBuf>,
     /// Size bounds of one attribute expression (`--max-expression-nodes`, `--max-expression-depth`).
     pub expressions: crate::expr::ExprLimits,
+    /// Called where a stage's large inputs have just been dropped, so the
+    /// allocator can hand their memory back before the next stage allocates
+    /// (the `geomc` binary returns mimalloc's freed pages; see `main.rs`).
+    pub release_memory: Option<fn()>,
 }
 
 /// The outcome of checking one source.
@@ -160,10 +164,12 @@ fn run(
     // Each stage's input is dropped as soon as the next no longer needs it,
     // which keeps the peak memory of large files down.
     drop(root);
+    release(options);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     // Everything later reads the resolved objects, not the document's: on large
     // files they are a fifth of the peak memory while the model is lowered.
     document.objects = Vec::new();
+    release(options);
     // Lowering takes the subdomain definitions (dropped once lowered, before
     // the overlap check at the memory peak); only their count is read later.
     let defined_subdomains = document.subdomains.len();
@@ -173,12 +179,17 @@ fn run(
         *implicit = subdomains;
         set_trims(&mut lowered.model, trims);
     }
+    if lowered.model.dimension == crate::ir::Dimension::Three {
+        // Trimmed surfaces become faces, edges and vertices (issue 9).
+        lower::trimmed_topology::add(&mut lowered.model);
+    }
     if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
         // 2D R-function regions become model entities (issue 6).
         let (model, map) = (&mut lowered.model, &mut lowered.source_map);
         lower::rfunction_region::add_regions(model, map, implicit, diags);
     }
     drop(resolved);
+    release(options);
     diags.extend(crate::valid::check_topology(
         &lowered.model,
         &lowered.source_map,
@@ -194,6 +205,12 @@ fn run(
         diags.items.retain(|d| d.code != Code::Dangling);
     }
     Some(lowered)
+}
+
+fn release(options: &Options) {
+    if let Some(release) = options.release_memory {
+        release();
+    }
 }
 
 /// Lowers the implicit elements; parameters they use are no longer unused (W006).

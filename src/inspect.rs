@@ -67,19 +67,25 @@ impl Report {
                         SubdomainCells::Volume { boundary } => boundary
                             .iter()
                             .map(|of| {
-                                format!(
-                                    "{}{}",
-                                    if of.outward { "" } else { "-" },
-                                    model.face(of.face).name
-                                )
+                                let face = model.face(of.face);
+                                // Trimmed faces: oriented on the mesh, marked.
+                                if matches!(face.surface, crate::geom::Surface::Parametric(_)) {
+                                    return format!("{} (trimmed)", face.name);
+                                }
+                                format!("{}{}", if of.outward { "" } else { "-" }, face.name)
                             })
-                            // Trimmed faces: oriented on the mesh, listed by name.
-                            .chain(s.trimmed.iter().filter_map(|&k| {
-                                model
-                                    .trimmed
-                                    .get(k)
-                                    .map(|t| format!("{} (trimmed)", t.name))
-                            }))
+                            // Trimmed faces without topology (a 2D model).
+                            .chain(
+                                s.trimmed
+                                    .iter()
+                                    .filter(|&&k| model.trimmed_face(k).is_none())
+                                    .filter_map(|&k| {
+                                        model
+                                            .trimmed
+                                            .get(k)
+                                            .map(|t| format!("{} (trimmed)", t.name))
+                                    }),
+                            )
                             .collect(),
                         SubdomainCells::Region { faces } => {
                             faces.iter().map(|f| model.face(*f).name.clone()).collect()

@@ -103,6 +103,7 @@ impl InputOptions {
             },
             allowed_paths: self.allow_path.clone(),
             expressions: self.expressions.limits(),
+            release_memory: Some(crate::release_freed_memory),
         })
     }
 }

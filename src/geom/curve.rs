@@ -29,6 +29,10 @@ pub enum Curve {
     /// A curve of paper 003's point calculus (segment, conic, Desargues or
     /// parabolic arc), over its own u = s.
     PointCalculus(Box<PcCurve>),
+    /// A boundary chain of a trimmed parametric surface (issue 9: a trim
+    /// curve or a patch side), sampled at the model tolerance; its mesh nodes
+    /// come from the surface's own meshing, not from this polyline.
+    Chain { points: Vec<Point3> },
 }
 
 impl Curve {
@@ -56,6 +60,7 @@ impl Curve {
                 }
             }
             Curve::PointCalculus(c) => c.point(s),
+            Curve::Chain { points } => polyline_at(points, s).0,
         }
     }
 
@@ -106,6 +111,7 @@ impl Curve {
                 if t.norm() > 0.0 { t } else { unit(direction) }
             }
             Curve::PointCalculus(c) => c.tangent(s),
+            Curve::Chain { points } => unit(polyline_at(points, s.clamp(0.0, 1.0)).1),
         }
     }
 
@@ -115,6 +121,9 @@ impl Curve {
             Curve::Ellipse { t0, t1, .. } => (t1 - t0).abs() >= TAU * (1.0 - 1e-12),
             Curve::Intersection { a, b, .. } => same_point(a, b),
             Curve::PointCalculus(c) => same_point(&c.begin(), &c.end()),
+            Curve::Chain { points } => {
+                points.len() > 2 && same_point(&points[0], &points[points.len() - 1])
+            }
         }
     }
 
@@ -175,6 +184,7 @@ impl Curve {
                 points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
             }
             Curve::PointCalculus(c) => c.length(),
+            Curve::Chain { points } => points.windows(2).map(|w| (w[1] - w[0]).norm()).sum(),
         }
     }
 
@@ -210,6 +220,7 @@ impl Curve {
                 let t = c.tangent(u);
                 (t.norm() > 0.0).then_some((q, t))
             }
+            Curve::Chain { points } => nearest_on_polyline(points, p),
         }
     }
 
@@ -283,4 +294,23 @@ fn unit(v: Vec3) -> Vec3 {
     } else {
         Vec3::zeros()
     }
+}
+
+/// The point of a polyline nearest `p` with the unit direction of its segment.
+fn nearest_on_polyline(line: &[Point3], p: &Point3) -> Option<(Point3, Vec3)> {
+    let mut best: Option<(f64, Point3, Vec3)> = None;
+    for w in line.windows(2) {
+        let d = w[1] - w[0];
+        let len2 = d.norm_squared();
+        if len2 <= 0.0 {
+            continue;
+        }
+        let t = ((p - w[0]).dot(&d) / len2).clamp(0.0, 1.0);
+        let q = w[0] + d * t;
+        let dist = (q - p).norm_squared();
+        if best.as_ref().is_none_or(|b| dist < b.0) {
+            best = Some((dist, q, unit(d)));
+        }
+    }
+    best.map(|(_, q, t)| (q, t))
 }

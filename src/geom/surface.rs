@@ -32,6 +32,10 @@ pub enum Surface {
     /// Paper 003's 9-point parabolic patch. Its value is the signed distance
     /// along the patch normal ∂M/∂u × ∂M/∂v from the nearest patch point.
     Patch9(Box<Patch9>),
+    /// A trimmed parametric surface (issue 9). Its value is the signed
+    /// distance along R_u × R_v from the nearest surface point; it is meshed
+    /// by `crate::trimmed`, never through a chart.
+    Parametric(Box<crate::trimmed::TrimmedSurface>),
 }
 
 impl Surface {
@@ -87,6 +91,7 @@ impl Surface {
                 None => self.newton_project(p),
             },
             Surface::Patch9(patch) => patch.project(p).map(|(_, q)| q),
+            Surface::Parametric(s) => s.project(p).map(|(q, _)| q),
             _ => self.newton_project(p),
         }
     }
@@ -134,6 +139,10 @@ impl Surface {
                     let n = patch.normal(uv[0], uv[1]);
                     (n.dot(&(p - q)), n)
                 }
+                None => nan,
+            },
+            Surface::Parametric(s) => match s.project(p) {
+                Some((q, n)) => (n.dot(&(p - q)), n),
                 None => nan,
             },
         }

@@ -173,6 +173,10 @@ pub struct Model {
     pub tolerance: f64,
     /// Paper 002's trimmed parametric surfaces, each meshed as a face of its own.
     pub trimmed: Vec<crate::trimmed::TrimmedSurface>,
+    /// The counts of vertices, edges and faces before the trimmed surfaces'
+    /// own entities (`lower/trimmed_topology.rs` appends them last: chain
+    /// ends, chains, one face per surface in `trimmed` order), if any.
+    pub trimmed_start: Option<[usize; 3]>,
 }
 
 impl Model {
@@ -190,7 +194,39 @@ impl Model {
             parameters: Vec::new(),
             tolerance: 1e-12,
             trimmed: Vec::new(),
+            trimmed_start: None,
         }
+    }
+
+    /// The face of trimmed surface `k`, when the topology was built.
+    pub fn trimmed_face(&self, k: usize) -> Option<FaceId> {
+        self.trimmed_start
+            .map(|[_, _, f]| FaceId((f + k) as u32))
+            .filter(|f| f.index() < self.faces.len())
+    }
+
+    /// The model without the trimmed surfaces' own vertices, edges and faces
+    /// (the surfaces stay in `trimmed`): what the chart mesher works on, the
+    /// trimmed faces being meshed by `crate::trimmed` and appended after.
+    pub fn without_trimmed_entities(&self) -> Model {
+        let Some([v, e, f]) = self.trimmed_start else {
+            return self.clone();
+        };
+        let mut out = self.clone();
+        out.vertices.truncate(v);
+        out.edges.truncate(e);
+        out.faces.truncate(f);
+        for s in &mut out.subdomains {
+            if let SubdomainCells::Volume { boundary } = &mut s.cells {
+                boundary.retain(|of| of.face.index() < f);
+            }
+        }
+        for b in &mut out.boundaries {
+            b.faces.retain(|id| id.index() < f);
+            b.edges.retain(|id| id.index() < e);
+        }
+        out.trimmed_start = None;
+        out
     }
 
     pub fn vertex(&self, id: VertexId) -> &Vertex {

@@ -322,13 +322,18 @@ fn check_relations(
 }
 
 /// Pairs of boxes that may overlap, found with a uniform grid whose cell is
-/// the median box size; boxes spanning many cells are compared with all.
-fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
+/// twice the median box size (a typical box then covers 1 to 8 cells, 3.4 on
+/// average, instead of 8 with cells of its own size: fewer entries to sort,
+/// and the pairs do not depend on the cell); boxes spanning many cells are
+/// compared with all.
+pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
     let mut sizes: Vec<f64> = boxes.iter().map(|b| (b.max - b.min).max()).collect();
     let middle = sizes.len() / 2;
     let median =
         (middle < sizes.len()).then(|| *sizes.select_nth_unstable_by(middle, f64::total_cmp).1);
-    let cell = median.unwrap_or(1.0).max(tol * 1e3).max(f64::MIN_POSITIVE);
+    let cell = (2.0 * median.unwrap_or(0.5))
+        .max(tol * 1e3)
+        .max(f64::MIN_POSITIVE);
     let key = |v: f64| (v / cell).floor() as i64;
     // A sorted list of (cell, box) instead of a map of cells: boxes sharing a
     // cell are adjacent after sorting, and nothing is allocated per cell.

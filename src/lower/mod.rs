@@ -6,9 +6,11 @@
 mod booleans;
 mod brep;
 mod explicit;
+mod isolation;
 mod point_calculus;
 mod prune;
 pub mod rfunction_region;
+pub mod trimmed_topology;
 mod weld;
 mod winding;
 
@@ -111,9 +113,18 @@ pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -
     model.edges.reserve(expected.edges);
     model.faces.reserve(expected.faces);
     model.solids.reserve(expected.solids);
-    let mut welder = weld::Welder::with_capacity(model.tolerance, &expected);
     // Curves that carry edges are part of the topology, not standalone lines.
     let edge_lines = point_calculus::edge_lines(resolved);
+    let shapes = isolation::solid_shapes(resolved, &edge_lines);
+    let isolated = isolation::isolated(&shapes, model.tolerance);
+    entities.solids.reserve(shapes.len());
+    let mut shared = Expected::default();
+    for (shape, _) in shapes.iter().zip(&isolated).filter(|(_, i)| !**i) {
+        shared.add(shape);
+    }
+    drop(shapes);
+    let mut welder =
+        weld::Welder::with_capacity(model.tolerance, &shared, expected.faces, isolated);
     point_calculus::report_unused_patches(resolved, diags);
 
     for object in &resolved.objects {
@@ -186,22 +197,27 @@ pub(crate) struct Expected {
     pub solids: usize,
 }
 
+impl Expected {
+    /// Counts one primitive solid.
+    pub(crate) fn add(&mut self, shape: &SolidShape) {
+        // A box has the most entities of the canonical primitives;
+        // the round ones have fewer (an estimate is enough).
+        let (v, e, f) = match shape {
+            SolidShape::Box { .. } => (8, 12, 6),
+            SolidShape::Polygon { vertices, .. } => (vertices.len(), vertices.len(), 1),
+            _ => (2, 3, 3),
+        };
+        self.vertices += v;
+        self.edges += e;
+        self.faces += f;
+        self.solids += 1;
+    }
+}
+
 fn expected_entities(resolved: &Resolved) -> Expected {
     fn visit(g: &Geometry, n: &mut Expected) {
         match g {
-            Geometry::Solid(shape) => {
-                // A box has the most entities of the canonical primitives;
-                // the round ones have fewer (an estimate is enough).
-                let (v, e, f) = match shape {
-                    SolidShape::Box { .. } => (8, 12, 6),
-                    SolidShape::Polygon { vertices, .. } => (vertices.len(), vertices.len(), 1),
-                    _ => (2, 3, 3),
-                };
-                n.vertices += v;
-                n.edges += e;
-                n.faces += f;
-                n.solids += 1;
-            }
+            Geometry::Solid(shape) => n.add(shape),
             Geometry::Group(members) => members.iter().for_each(|m| visit(m, n)),
             _ => {}
         }
@@ -286,6 +302,7 @@ fn lower_solid(
 ) -> SolidId {
     let origin = Origin { span };
     let brep = brep::of(shape);
+    welder.begin_solid(model);
     // Entity names are made only for new entities; the name tables for
     // faces= and edges= lists are built later, and only when a file has such lists.
     let vertex_ids: Vec<_> = brep

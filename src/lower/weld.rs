@@ -35,10 +35,12 @@ impl FaceSamples {
 }
 
 /// Chains of entity ids sharing a key: the map holds (first, last) of each
-/// chain, `next` links an id to the following one.
+/// chain, `next` links an id to the following one. Ids are at least `base`
+/// (`next` is indexed from there, so tables restarted per solid stay small).
 struct Chains<K> {
     heads: FastMap<K, (u32, u32)>,
     next: Vec<u32>,
+    base: u32,
 }
 
 impl<K> Default for Chains<K> {
@@ -46,6 +48,7 @@ impl<K> Default for Chains<K> {
         Chains {
             heads: FastMap::default(),
             next: Vec::new(),
+            base: 0,
         }
     }
 }
@@ -55,16 +58,25 @@ impl<K: Hash + Eq> Chains<K> {
         Chains {
             heads: FastMap::with_capacity_and_hasher(capacity, Default::default()),
             next: Vec::with_capacity(capacity),
+            base: 0,
         }
     }
 
+    /// Empties the chains; later ids are at least `base`.
+    fn restart(&mut self, base: usize) {
+        self.heads.clear();
+        self.next.clear();
+        self.base = base as u32;
+    }
+
     fn push(&mut self, key: K, id: u32) {
-        if self.next.len() <= id as usize {
-            self.next.resize(id as usize + 1, NONE);
+        let at = (id - self.base) as usize;
+        if self.next.len() <= at {
+            self.next.resize(at + 1, NONE);
         }
         match self.heads.get_mut(&key) {
             Some((_, last)) => {
-                self.next[*last as usize] = id;
+                self.next[(*last - self.base) as usize] = id;
                 *last = id;
             }
             None => {
@@ -81,15 +93,19 @@ impl<K: Hash + Eq> Chains<K> {
                 return None;
             }
             let id = at;
-            at = self.next.get(id as usize).copied().unwrap_or(NONE);
+            at = self
+                .next
+                .get((id - self.base) as usize)
+                .copied()
+                .unwrap_or(NONE);
             Some(id)
         })
     }
 }
 
-pub struct Welder {
-    tol: f64,
-    cell: f64,
+/// The candidate tables of one welding scope.
+#[derive(Default)]
+struct Tables {
     /// Vertices by a hash of their grid cell (16-byte entries instead of 32:
     /// this table is the largest at the memory peak). Vertices of colliding
     /// cells only add candidates, which the distance test discards.
@@ -97,6 +113,36 @@ pub struct Welder {
     edges_by_ends: Chains<(VertexId, VertexId)>,
     /// Faces by a hash of their sorted edge list (compared exactly on a hit).
     faces_by_edges: Chains<u64>,
+}
+
+impl Tables {
+    fn with_capacity(expected: &super::Expected) -> Tables {
+        Tables {
+            vertex_grid: Chains::with_capacity(expected.vertices),
+            edges_by_ends: Chains::with_capacity(expected.edges),
+            faces_by_edges: Chains::with_capacity(expected.faces),
+        }
+    }
+}
+
+pub struct Welder {
+    tol: f64,
+    cell: f64,
+    /// Entities of solids that may weld with another solid's.
+    shared: Tables,
+    /// Entities of the current solid when it is isolated (no other solid's
+    /// entities within the tolerance): restarted per solid, so the large
+    /// tables hold only the solids that can weld across (on large files of
+    /// separate primitives, none) and lookups stay in cache. The result is
+    /// the same as with one table set: an isolated solid's entities can only
+    /// match each other.
+    local: Tables,
+    /// Per solid, in lowering order: whether it is isolated.
+    isolated: Vec<bool>,
+    /// The next solid's index in `isolated`.
+    solid: usize,
+    /// Whether the current solid uses `local`.
+    in_local: bool,
     /// Canonical interior point of every face (welded faces: the first's).
     pub face_samples: FaceSamples,
     scratch: Vec<EdgeId>,
@@ -107,22 +153,49 @@ impl Welder {
         Welder {
             tol,
             cell: (tol * 4.0).max(f64::MIN_POSITIVE),
-            vertex_grid: Chains::default(),
-            edges_by_ends: Chains::default(),
-            faces_by_edges: Chains::default(),
+            shared: Tables::default(),
+            local: Tables::default(),
+            isolated: Vec::new(),
+            solid: 0,
+            in_local: false,
             face_samples: FaceSamples::default(),
             scratch: Vec::new(),
         }
     }
 
-    /// A welder whose tables are sized for `expected` entities.
-    pub(crate) fn with_capacity(tol: f64, expected: &super::Expected) -> Welder {
+    /// A welder whose shared tables are sized for `shared` entities (those
+    /// of solids that are not isolated), with `faces` faces expected in all.
+    /// `isolated`: per solid in lowering order, whether it is isolated.
+    pub(crate) fn with_capacity(
+        tol: f64,
+        shared: &super::Expected,
+        faces: usize,
+        isolated: Vec<bool>,
+    ) -> Welder {
         Welder {
-            vertex_grid: Chains::with_capacity(expected.vertices),
-            edges_by_ends: Chains::with_capacity(expected.edges),
-            faces_by_edges: Chains::with_capacity(expected.faces),
-            face_samples: FaceSamples(Vec::with_capacity(expected.faces)),
+            shared: Tables::with_capacity(shared),
+            face_samples: FaceSamples(Vec::with_capacity(faces)),
+            isolated,
             ..Welder::new(tol)
+        }
+    }
+
+    /// Called before each solid's entities are welded, in lowering order.
+    pub fn begin_solid(&mut self, model: &Model) {
+        self.in_local = self.isolated.get(self.solid).copied().unwrap_or(false);
+        self.solid += 1;
+        if self.in_local {
+            self.local.vertex_grid.restart(model.vertices.len());
+            self.local.edges_by_ends.restart(model.edges.len());
+            self.local.faces_by_edges.restart(model.faces.len());
+        }
+    }
+
+    fn tables(&mut self) -> &mut Tables {
+        if self.in_local {
+            &mut self.local
+        } else {
+            &mut self.shared
         }
     }
 
@@ -146,10 +219,15 @@ impl Welder {
         let hi = self.key(&(position + crate::geom::Vec3::repeat(self.tol)));
         let range =
             |k: usize| lo[k].max(key[k].saturating_sub(1))..=hi[k].min(key[k].saturating_add(1));
+        let tables = if self.in_local {
+            &self.local
+        } else {
+            &self.shared
+        };
         for x in range(0) {
             for y in range(1) {
                 for z in range(2) {
-                    for id in self.vertex_grid.iter(&cell_hash([x, y, z])) {
+                    for id in tables.vertex_grid.iter(&cell_hash([x, y, z])) {
                         if (model.vertices[id as usize].position - position).norm() <= self.tol {
                             return (VertexId(id), false);
                         }
@@ -162,7 +240,7 @@ impl Welder {
             name: name(),
             position,
         });
-        self.vertex_grid.push(cell_hash(key), id.0);
+        self.tables().vertex_grid.push(cell_hash(key), id.0);
         (id, true)
     }
 
@@ -183,7 +261,12 @@ impl Welder {
             (end, begin)
         };
         let mut probes = None;
-        for id in self.edges_by_ends.iter(&key) {
+        let tables = if self.in_local {
+            &self.local
+        } else {
+            &self.shared
+        };
+        for id in tables.edges_by_ends.iter(&key) {
             let probes = *probes.get_or_insert_with(|| probe_points(&curve));
             let existing = &model.edges[id as usize];
             let theirs = probe_points(&existing.curve);
@@ -211,7 +294,7 @@ impl Welder {
             begin,
             end,
         });
-        self.edges_by_ends.push(key, id.0);
+        self.tables().edges_by_ends.push(key, id.0);
         (id, false, true)
     }
 
@@ -221,7 +304,12 @@ impl Welder {
 
         let key = foldhash::fast::FixedState::default().hash_one(&self.scratch);
         let mut theirs = Vec::new();
-        for id in self.faces_by_edges.iter(&key) {
+        let tables = if self.in_local {
+            &self.local
+        } else {
+            &self.shared
+        };
+        for id in tables.faces_by_edges.iter(&key) {
             sorted_edges(&model.faces[id as usize], &mut theirs);
             if theirs != self.scratch {
                 continue;
@@ -234,7 +322,7 @@ impl Welder {
         }
         let id = FaceId(model.faces.len() as u32);
         model.faces.push(face);
-        self.faces_by_edges.push(key, id.0);
+        self.tables().faces_by_edges.push(key, id.0);
         self.face_samples.insert(id, sample);
         (id, true)
     }

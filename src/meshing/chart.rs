@@ -146,6 +146,8 @@ impl Chart {
                     scale_v: sv,
                 })
             }
+            // Meshed by `crate::trimmed` (the mesher skips these faces).
+            Surface::Parametric(_) => Err("a trimmed surface has no chart".into()),
             Surface::Quadric { .. } | Surface::Implicit { .. } => {
                 let normal = if area_vector.norm() > 0.0 {
                     area_vector.normalize()

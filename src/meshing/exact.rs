@@ -135,7 +135,10 @@ fn face_measure(model: &Model, face: &Face, gauss: &GaussLegendre) -> Option<Fac
             });
             scale_flux(m, sign)
         }
-        Surface::Quadric { .. } | Surface::Implicit { .. } | Surface::Patch9(_) => return None,
+        Surface::Quadric { .. }
+        | Surface::Implicit { .. }
+        | Surface::Patch9(_)
+        | Surface::Parametric(_) => return None,
     };
     (measure.area.is_finite() && measure.flux.is_finite()).then_some(measure)
 }
@@ -180,7 +183,7 @@ fn loop_integral(curve: &Curve) -> Option<Vec3> {
             let chord = major * (t1.cos() - t0.cos()) + minor * (t1.sin() - t0.sin());
             Some(center.coords.cross(&chord) + major.cross(minor) * (t1 - t0))
         }
-        Curve::Intersection { .. } | Curve::PointCalculus(_) => None,
+        Curve::Intersection { .. } | Curve::PointCalculus(_) | Curve::Chain { .. } => None,
     }
 }
 

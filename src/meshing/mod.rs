@@ -136,6 +136,15 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             "the tolerance must be positive and finite (got {tolerance})"
         )));
     }
+    // Trimmed surfaces' faces are meshed by `trimmed::append`, not by charts.
+    let stripped;
+    let model = match model.trimmed_start {
+        Some(_) => {
+            stripped = model.without_trimmed_entities();
+            &stripped
+        }
+        None => model,
+    };
     let max_edge = options.max_edge.unwrap_or(f64::INFINITY);
     if max_edge.is_nan() || max_edge <= 0.0 {
         return Err(MeshError::Options(format!(

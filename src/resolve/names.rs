@@ -52,6 +52,8 @@ impl NameTable {
                 .map(|b| (b.name.text.as_str(), "boundary", b.name.span)),
         );
         all.sort_by_key(|&(_, _, span)| span);
+        // Sized once: large files define hundreds of thousands of names.
+        table.defs.reserve(all.len());
         for (name, kind, span) in all {
             if name.is_empty() {
                 continue;

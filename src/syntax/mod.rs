@@ -69,12 +69,17 @@ pub fn parse<'s>(source: &'s SourceFile, limits: &Limits) -> Result<Element<'s>,
     Ok(tree::build(root))
 }
 
+/// The first "<!DOCTYPE", in any case. "<!" has no case variants, so only
+/// its occurrences (found by the standard library's fast substring search,
+/// instead of comparing a window at every byte) can start one.
 fn find_doctype(text: &str) -> Option<usize> {
     let bytes = text.as_bytes();
     let needle = b"<!DOCTYPE";
-    bytes
-        .windows(needle.len())
-        .position(|w| w.eq_ignore_ascii_case(needle))
+    text.match_indices("<!").map(|(pos, _)| pos).find(|&pos| {
+        bytes
+            .get(pos..pos + needle.len())
+            .is_some_and(|w| w.eq_ignore_ascii_case(needle))
+    })
 }
 
 /// Depth check without recursion, so a hostile file cannot overflow the stack.

@@ -11,6 +11,7 @@ mod pole;
 pub mod program;
 pub mod shared;
 mod split;
+pub mod topology;
 mod triangulate;
 
 pub use measure::{TrimmedQuality, centroid_distance};
@@ -39,6 +40,10 @@ pub enum Carrier {
     Expressions { xyz: Box<[Ssa; 3]> },
     /// Paper 003's 9-point parabolic patch (point calculus), u, v ∈ [0, 1].
     Patch9(Box<Patch9>),
+    /// The inner carrier with u and v exchanged: R(u, v) = inner(v, u). A
+    /// surface with a pole on a side v = const is meshed as its transpose
+    /// (`TrimmedSurface::transposed`), the pole then on a side u = const.
+    Swapped(Box<Carrier>),
 }
 
 /// The trim: F over global x, y, z; material where F ≥ 0, or F ≤ 0 when `negative`.
@@ -72,7 +77,28 @@ pub struct TrimmedSurface {
 impl TrimmedSurface {
     /// R(u, v) in global coordinates (NaN when an expression fails).
     pub fn point(&self, u: f64, v: f64) -> Point3 {
-        let local = match &self.carrier {
+        self.frame.to_global(&local_point(&self.carrier, u, v))
+    }
+
+    /// The same surface with u and v exchanged (its normal R_u × R_v turned over).
+    pub fn transposed(&self) -> TrimmedSurface {
+        let carrier = match &self.carrier {
+            Carrier::Swapped(inner) => (**inner).clone(),
+            c => Carrier::Swapped(Box::new(c.clone())),
+        };
+        let [u0, u1, v0, v1] = self.rect;
+        TrimmedSurface {
+            carrier,
+            rect: [v0, v1, u0, u1],
+            ..self.clone()
+        }
+    }
+}
+
+/// R(u, v) of a carrier in its local frame (NaN when an expression fails).
+fn local_point(carrier: &Carrier, u: f64, v: f64) -> Point3 {
+    {
+        match carrier {
             Carrier::Bezier { rows } => bezier(rows, u, v),
             Carrier::Cone { r1, r2, length } => {
                 let r = r1 + (r2 - r1) * u / length;
@@ -95,10 +121,12 @@ impl TrimmedSurface {
                     xyz[2].eval_point(p),
                 )
             }
-        };
-        self.frame.to_global(&local)
+            Carrier::Swapped(inner) => local_point(inner, v, u),
+        }
     }
+}
 
+impl TrimmedSurface {
     /// Surface points on an (n + 1) × (n + 1) parameter grid.
     pub fn samples(&self, n: usize) -> Vec<Point3> {
         let [u0, u1, v0, v1] = self.rect;
@@ -119,6 +147,39 @@ impl TrimmedSurface {
         let du = (self.point(u + hu, v) - self.point(u - hu, v)) / (2.0 * hu);
         let dv = (self.point(u, v + hv) - self.point(u, v - hv)) / (2.0 * hv);
         (du, dv)
+    }
+
+    /// The surface point nearest `p` (best of a 16 × 16 parameter grid, then
+    /// Gauss–Newton, kept in the rectangle) with the unit normal
+    /// R_u × R_v there; `None` where the normal is undefined.
+    pub fn project(&self, p: &Point3) -> Option<(Point3, Vec3)> {
+        let [u0, u1, v0, v1] = self.rect;
+        let n = 16;
+        let mut best = (f64::INFINITY, [u0, v0]);
+        for i in 0..=n {
+            for j in 0..=n {
+                let uv = [
+                    u0 + (u1 - u0) * i as f64 / n as f64,
+                    v0 + (v1 - v0) * j as f64 / n as f64,
+                ];
+                let d = (self.point(uv[0], uv[1]) - p).norm_squared();
+                if d < best.0 {
+                    best = (d, uv);
+                }
+            }
+        }
+        let uv = triangulate::nearest_parameter(self, *p, best.1);
+        let uv = [uv[0].clamp(u0, u1), uv[1].clamp(v0, v1)];
+        let uv = if uv[0].is_finite() && uv[1].is_finite() {
+            uv
+        } else {
+            best.1
+        };
+        let q = self.point(uv[0], uv[1]);
+        let (du, dv) = self.tangents(uv[0], uv[1]);
+        let normal = du.cross(&dv);
+        let len = normal.norm();
+        (len > 0.0 && len.is_finite()).then(|| (q, normal / len))
     }
 
     /// W(u, v): the trim value with the material sign positive (1 without a trim).

@@ -42,6 +42,37 @@ impl Cap {
     }
 }
 
+/// True when a side v = const of `s` is a single point (a pole there):
+/// such a surface is meshed as its transpose (`TrimmedSurface::transposed`).
+pub fn has_v_pole(s: &TrimmedSurface) -> bool {
+    let [u0, u1, v0, v1] = s.rect;
+    let samples = s.samples(16);
+    let (lo, hi) = samples.iter().fold(
+        (
+            Point3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY),
+            Point3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY),
+        ),
+        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
+    );
+    let scale = (hi - lo).norm();
+    if !scale.is_finite() || scale <= 0.0 {
+        return false;
+    }
+    let point_side = |fixed_u: bool, t: f64| {
+        let at = |x: f64| {
+            if fixed_u {
+                s.point(t, x)
+            } else {
+                s.point(x, t)
+            }
+        };
+        let (a, b) = if fixed_u { (v0, v1) } else { (u0, u1) };
+        let first = at(a);
+        (1..=16).all(|k| (at(a + (b - a) * k as f64 / 16.0) - first).norm() <= 1e-9 * scale)
+    };
+    [v0, v1].into_iter().any(|v| point_side(false, v))
+}
+
 /// The caps of the degenerate sides of `s` (none for most surfaces).
 pub fn plan(s: &TrimmedSurface, settings: &TrimSettings, h: f64) -> Result<Vec<Cap>, String> {
     let [u0, u1, v0, v1] = s.rect;
@@ -72,8 +103,9 @@ pub fn plan(s: &TrimmedSurface, settings: &TrimSettings, h: f64) -> Result<Vec<C
     for v in [v0, v1] {
         if point_side(false, v) {
             return Err(format!(
-                "the side v = {v} of the parameter rectangle is a single point (a pole); \
-                 poles are supported on the sides u = const: swap u and v"
+                "the side v = {v} of the parameter rectangle is a single point (a pole), and so \
+                 is a side u = const; poles are supported along one parameter only: split the \
+                 rectangle so that each part has its poles on sides of one kind"
             ));
         }
     }

@@ -311,3 +311,72 @@ fn cone_apex_is_one_vertex() {
     assert!(q.min_angle >= 20.0, "{q:?}");
     assert!(q.max_centroid_distance <= 0.002, "{q:?}");
 }
+
+/// A sphere with its poles on the sides v = const (the latitude as v).
+fn sphere_latitude_in_v(radius: f64, latitudes: [f64; 2], trim: Option<Trim>) -> TrimmedSurface {
+    let s = sphere(radius, latitudes, trim).transposed();
+    assert!(matches!(s.carrier, Carrier::Swapped(_)));
+    s
+}
+
+#[test]
+fn poles_on_the_v_sides_are_meshed_through_the_transpose() {
+    let r = 1.5;
+    let s = sphere_latitude_in_v(r, [-90.0, 90.0], None);
+    assert_eq!(s.rect[2], -FRAC_PI_2);
+    let m = mesh_trimmed(&s, settings(0.15)).expect("meshable");
+    assert_eq!(check_manifold(&m), 0, "no boundary segments");
+    assert_eq!(euler(&m), 2);
+    let poles = m
+        .nodes
+        .iter()
+        .filter(|p| (p.y.abs() - r).abs() < 1e-9)
+        .count();
+    assert_eq!(poles, 2);
+    let q = m.quality(&s);
+    let exact = 2.0 * TAU * r * r;
+    assert!(
+        (q.area - exact).abs() / exact < 2e-3,
+        "{} vs {exact}",
+        q.area
+    );
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    assert!(q.max_centroid_distance <= 0.002, "{q:?}");
+    // The triangles turn about R_u × R_v of the surface as given, which
+    // the transpose turns over: the enclosed volumes have opposite signs.
+    let volume = |m: &TrimmedMesh| {
+        m.triangles
+            .iter()
+            .map(|t| {
+                let [a, b, c] = t.map(|i| m.nodes[i as usize].coords);
+                a.dot(&b.cross(&c)) / 6.0
+            })
+            .sum::<f64>()
+    };
+    let original = mesh_trimmed(&sphere(r, [-90.0, 90.0], None), settings(0.15)).expect("meshable");
+    let exact = 4.0 / 3.0 * PI * r * r * r;
+    let (v, v0) = (volume(&m), volume(&original));
+    assert!(
+        v0.abs() > 0.99 * exact && v.abs() > 0.99 * exact,
+        "{v} {v0}"
+    );
+    assert!(v * v0 < 0.0, "{v} {v0}");
+}
+
+#[test]
+fn a_north_cap_cut_from_a_v_pole_sphere_keeps_the_zone_area() {
+    // Material below y = 0.75 on the sphere of radius 1.5: the zone from
+    // the south pole up to height 0.75 has area 2π r (0.75 + r).
+    let r = 1.5;
+    let s = sphere_latitude_in_v(r, [-90.0, 90.0], Some(below(0.75)));
+    let m = mesh_trimmed(&s, settings(0.15)).expect("meshable");
+    let q = m.quality(&s);
+    let exact = TAU * r * (0.75 + r);
+    assert!(
+        (q.area - exact).abs() / exact < 3e-3,
+        "{} vs {exact}",
+        q.area
+    );
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    assert_eq!(m.boundary.len(), 1, "the cut circle");
+}

@@ -68,6 +68,24 @@ pub fn mesh_trimmed_shared(
             "the parameter rectangle [{u0}, {u1}] × [{v0}, {v1}] is empty"
         ));
     }
+    if pole::has_v_pole(s) {
+        // Poles are capped on sides u = const: mesh the transpose, then
+        // turn its parameters, triangles and chains back.
+        let t = s.transposed();
+        if pole::has_v_pole(&t) {
+            return Err(format!(
+                "sides u = const and v = const of the parameter rectangle [{u0}, {u1}] × \
+                 [{v0}, {v1}] are both single points (poles); poles are supported along one \
+                 parameter only: split the rectangle so that each part has its poles on sides \
+                 of one kind"
+            ));
+        }
+        let mut m = mesh_trimmed_shared(&t, settings, chains)?;
+        m.uv.iter_mut().for_each(|uv| uv.swap(0, 1));
+        m.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+        m.boundary.iter_mut().for_each(|c| c.reverse());
+        return Ok(m);
+    }
     let arc = ArcChart::new(s)?;
     let (lu, lv) = arc.lengths();
     let h = element_size(lu, lv, &settings);

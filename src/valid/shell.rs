@@ -55,6 +55,10 @@ fn curve_is_closed(curve: &Curve, tolerance: f64) -> bool {
         }
         Curve::Intersection { a, b, .. } => (a - b).norm() <= tolerance,
         Curve::PointCalculus(c) => (c.begin() - c.end()).norm() <= tolerance,
+        Curve::Chain { points } => match (points.first(), points.last()) {
+            (Some(a), Some(b)) => points.len() > 2 && (a - b).norm() <= tolerance,
+            _ => false,
+        },
     }
 }
 
@@ -64,6 +68,7 @@ fn curve_description(curve: &Curve) -> String {
         Curve::Ellipse { t0, t1, .. } => format!("an arc spanning {:.6} rad, not 2π", t1 - t0),
         Curve::Intersection { .. } => "an intersection curve with distinct ends".to_string(),
         Curve::PointCalculus(c) => format!("a {} with distinct ends", c.element()),
+        Curve::Chain { .. } => "a trimmed surface's chain with distinct ends".to_string(),
     }
 }
 
