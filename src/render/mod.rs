@@ -281,8 +281,7 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
                 .collect();
         let is_cap = |value: u64| {
             let id = value & 0xffff_ffff;
-            let face = scene.tri_face[(id >> 1) as usize] as usize;
-            scene.groups[scene.face_sides[face][(id & 1) as usize] as usize].cap
+            scene.groups[scene.side_group((id >> 1) as usize, (id & 1) as usize) as usize].cap
         };
         raster::mark_edges(&zbuf, &segments, 0.75 * ss as f32, 0.01, is_cap, &mut mask);
         resolve::resolve(&scene, &proj, &zbuf, &mask, ss, options.background)

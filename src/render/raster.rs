@@ -83,7 +83,7 @@ fn setup(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], [f32; 3], u32)
 
 #[inline]
 fn visible_side(scene: &Scene, tri: usize, back: u32) -> bool {
-    scene.face_sides[scene.tri_face[tri] as usize][back as usize] != HIDDEN
+    scene.side_group(tri, back as usize) != HIDDEN
 }
 
 /// First and last sample centre (index) within snapped coordinates `lo..=hi`,

@@ -58,7 +58,7 @@ fn shade(
 ) -> [u8; 3] {
     let tri = (id >> 1) as usize;
     let back = (id & 1) as usize;
-    let group = &scene.groups[scene.face_sides[scene.tri_face[tri] as usize][back] as usize];
+    let group = &scene.groups[scene.side_group(tri, back) as usize];
     let light = if group.cap {
         // Section caps are flat and hatched, as drawings show cut material.
         if (px + py) % 8 < 2 { 0.6 } else { 0.95 }
@@ -109,10 +109,7 @@ fn uniform(
         return None;
     }
     let first_id = first & 0xffff_ffff;
-    let group_of = |id: u64| {
-        let tri = (id >> 1) as usize;
-        scene.face_sides[scene.tri_face[tri] as usize][(id & 1) as usize]
-    };
+    let group_of = |id: u64| scene.side_group((id >> 1) as usize, (id & 1) as usize);
     let group = group_of(first_id);
     if scene.groups[group as usize].cap {
         return None;

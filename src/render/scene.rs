@@ -27,9 +27,15 @@ pub struct Scene<'a> {
     /// Model coordinates: the mesh's nodes, then nodes made by the section.
     pub points: Cow<'a, [[f64; 3]]>,
     pub tris: Cow<'a, [[u32; 3]]>,
+    /// Each triangle's face; empty when every triangle lies on `one_face`
+    /// (a large one-face mesh then has no per-triangle array to fill).
     pub tri_face: Vec<u32>,
+    pub one_face: Option<u32>,
     /// Per face: the group shown on its front (normal) side and on its back.
     pub face_sides: Vec<[u32; 2]>,
+    /// The pair every face shares, when they all show the same groups (one
+    /// face, or faces of one colour): the side lookups then skip `tri_face`.
+    pub same_sides: Option<[u32; 2]>,
     /// Per triangle corner: an index into `light`.
     /// (The triangles themselves when smooth shading one face: a node's own slot.)
     pub corner_slots: Cow<'a, [[u32; 3]]>,
@@ -53,6 +59,26 @@ const PALETTE: [[u8; 3]; 12] = [
     [250, 200, 60],
     [120, 80, 160],
 ];
+
+impl Scene<'_> {
+    /// The group shown on triangle `tri`'s front (`back` 0) or back side, or [`HIDDEN`].
+    #[inline]
+    pub fn side_group(&self, tri: usize, back: usize) -> u32 {
+        match self.same_sides {
+            Some(sides) => sides[back],
+            None => self.face_sides[self.face_of(tri) as usize][back],
+        }
+    }
+
+    /// The face triangle `tri` lies on.
+    #[inline]
+    pub fn face_of(&self, tri: usize) -> u32 {
+        match self.one_face {
+            Some(f) => f,
+            None => self.tri_face[tri],
+        }
+    }
+}
 
 pub fn group_color(i: usize) -> [u8; 3] {
     let base = PALETTE[i % PALETTE.len()];
@@ -198,11 +224,17 @@ pub fn build<'a>(mesh: &'a Mesh, options: &RenderOptions, camera: &Camera) -> Sc
         })
         .collect();
 
-    let (tris, tri_face) = triangles(mesh);
+    let same_sides = face_sides
+        .first()
+        .copied()
+        .filter(|first| face_sides.iter().all(|s| s == first));
+    let (tris, tri_face, one_face) = triangles(mesh);
     let mut scene = Scene {
+        same_sides,
         points: Cow::Borrowed(&mesh.nodes),
         tris,
         tri_face,
+        one_face,
         face_sides,
         groups,
         ..Scene::default()
@@ -235,15 +267,15 @@ fn intensity(normal: [f64; 3], light: [f64; 3]) -> [f32; 2] {
 }
 
 /// The mesh's triangles grouped by face in face order, with their face; those
-/// naming a node the mesh lacks are left out. Borrowed when one face holds them all.
-fn triangles(mesh: &Mesh) -> (Cow<'_, [[u32; 3]]>, Vec<u32>) {
+/// naming a node the mesh lacks are left out. Borrowed, with no per-triangle
+/// face array, when one face holds them all.
+fn triangles(mesh: &Mesh) -> (Cow<'_, [[u32; 3]]>, Vec<u32>, Option<u32>) {
     let n = mesh.nodes.len();
     let valid = |t: &[u32; 3]| t.iter().all(|&i| (i as usize) < n);
     let all_valid = mesh.faces.iter().all(|f| f.triangles.par_iter().all(valid));
     let mut filled = (mesh.faces.iter().enumerate()).filter(|(_, f)| !f.triangles.is_empty());
     if let (true, Some((f, face)), None) = (all_valid, filled.next(), filled.next()) {
-        let tri_face = vec![f as u32; face.triangles.len()];
-        return (Cow::Borrowed(&face.triangles), tri_face);
+        return (Cow::Borrowed(&face.triangles), Vec::new(), Some(f as u32));
     }
     let total: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
     let mut tris = Vec::with_capacity(total);
@@ -254,7 +286,7 @@ fn triangles(mesh: &Mesh) -> (Cow<'_, [[u32; 3]]>, Vec<u32>) {
             tri_face.push(f as u32);
         }
     }
-    (Cow::Owned(tris), tri_face)
+    (Cow::Owned(tris), tri_face, None)
 }
 
 /// Light per corner: flat gives each triangle one slot; smooth averages the
@@ -301,12 +333,16 @@ fn cut(scene: &mut Scene<'_>, section: Section) {
     let mut slots = Vec::with_capacity(old_tris.len());
     // Points made on a crossed edge, shared by the triangles on both sides of it.
     let mut made: std::collections::HashMap<(u32, u32), u32> = std::collections::HashMap::new();
-    for ((&t, f), &s) in old_tris.iter().zip(old_faces).zip(old_slots.iter()) {
+    let one_face = scene.one_face;
+    for (i, (&t, &s)) in old_tris.iter().zip(old_slots.iter()).enumerate() {
+        let f = one_face.unwrap_or_else(|| old_faces[i]);
         let d = t.map(|n| scene.points[n as usize][axis] - value);
         let kept = d.iter().filter(|&&v| v <= 0.0).count();
         if kept == 3 {
             tris.push(t);
-            scene.tri_face.push(f);
+            if one_face.is_none() {
+                scene.tri_face.push(f);
+            }
             slots.push(s);
             continue;
         }
@@ -347,7 +383,9 @@ fn cut(scene: &mut Scene<'_>, section: Section) {
         for k in 1..poly.len().saturating_sub(1) {
             tris.push([poly[0].0, poly[k].0, poly[k + 1].0]);
             slots.push([poly[0].1, poly[k].1, poly[k + 1].1]);
-            scene.tri_face.push(f);
+            if one_face.is_none() {
+                scene.tri_face.push(f);
+            }
         }
     }
     scene.tris = Cow::Owned(tris);

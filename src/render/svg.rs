@@ -48,7 +48,7 @@ pub fn edge_segments(
     let group_of = |tris: &[u32]| -> u32 {
         // The colour seen on the first triangle showing a side.
         tris.iter()
-            .map(|&t| scene.face_sides[scene.tri_face[t as usize] as usize][facing(t)])
+            .map(|&t| scene.side_group(t as usize, facing(t)))
             .find(|&g| g != HIDDEN)
             .unwrap_or(HIDDEN)
     };
