@@ -18,8 +18,9 @@
 //!   lies beyond one is not inserted: the segment is split instead (at its
 //!   middle, or on a power-of-two shell around an input vertex where two
 //!   segments meet at an acute angle) and the triangle is tried again.
-//! - The order of work is a FIFO over spade's handles: the same input gives
-//!   the same mesh, whatever the thread count.
+//! - The order of work depends only on the triangulation (segments first
+//!   in FIFO order, then bad triangles by shortest edge and discovery): the
+//!   same input gives the same mesh, whatever the thread count.
 //!
 //! # Limitations
 //! - For plane faces without poly_lines, small input angles or a kept
@@ -29,7 +30,8 @@ use super::face::Cdt;
 use robust::{Coord, incircle, orient2d};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{Point2, Triangulation};
-use std::collections::VecDeque;
+use std::cmp::Reverse;
+use std::collections::{BinaryHeap, VecDeque};
 
 pub(super) struct Params {
     pub min_angle_degrees: f64,
@@ -51,8 +53,15 @@ pub(super) struct Refined {
 struct Refiner<'a> {
     cdt: &'a mut Cdt,
     outside: Vec<bool>,
-    queued: Vec<bool>,
-    triangles: VecDeque<FixedFaceHandle<InnerTag>>,
+    /// Bad triangles, shortest edge first (Triangle's order: fewer points
+    /// than first-come), then in the order they were found: (bucket of the
+    /// shortest edge's squared length by factors of √2, sequence, face,
+    /// its corners when queued).
+    triangles: BinaryHeap<Reverse<(i32, u64, FixedFaceHandle<InnerTag>, [usize; 3])>>,
+    sequence: u64,
+    /// Reused per insertion: the faces around the new vertex.
+    around: Vec<(FixedFaceHandle<InnerTag>, bool)>,
+    opposite: Vec<(FixedVertexHandle, FixedVertexHandle)>,
     segments: VecDeque<(FixedVertexHandle, FixedVertexHandle)>,
     /// Input vertices (below this index) where two segments meet at an acute
     /// angle: splits next to them go on power-of-two shells.
@@ -85,8 +94,10 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
     let mut r = Refiner {
         cdt,
         outside,
-        queued: Vec::new(),
-        triangles: VecDeque::new(),
+        triangles: BinaryHeap::new(),
+        sequence: 0,
+        around: Vec::new(),
+        opposite: Vec::new(),
         segments: VecDeque::new(),
         acute,
         cos_limit: (params.min_angle_degrees + 1e-6).to_radians().cos(),
@@ -120,7 +131,9 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
     r.segments.extend(segments);
     let faces: Vec<_> = r.cdt.fixed_inner_faces().collect();
     for f in faces {
-        r.push_triangle(f);
+        if !r.outside[f.index()] {
+            r.push_triangle(f);
+        }
     }
     let mut complete = true;
     loop {
@@ -134,11 +147,16 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
             }
             continue;
         }
-        let Some(face) = r.triangles.pop_front() else {
+        let Some(Reverse((_, _, face, corners))) = r.triangles.pop() else {
             break;
         };
-        r.queued[face.index()] = false;
-        if r.outside[face.index()] {
+        let index = face.index();
+        // Gone since it was queued (its slot now holds another triangle,
+        // queued on its own when it was made).
+        if index >= r.cdt.num_all_faces()
+            || r.cdt.face(face).vertices().map(|v| v.fix().index()) != corners
+            || r.outside[index]
+        {
             continue;
         }
         if let Some(point) = r.bad_triangle_point(face) {
@@ -178,15 +196,40 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
 }
 
 impl Refiner<'_> {
+    /// Queues the triangle when it is bad.
     fn push_triangle(&mut self, f: FixedFaceHandle<InnerTag>) {
-        let i = f.index();
-        if self.queued.len() <= i {
-            self.queued.resize(i + 1, false);
+        let face = self.cdt.face(f);
+        let p = face.positions();
+        if let Some(shortest) = self.badness(p) {
+            let bucket = if shortest > 0.0 {
+                (2.0 * shortest.log2()).floor().clamp(-1e9, 1e9) as i32
+            } else {
+                i32::MIN
+            };
+            let corners = face.vertices().map(|v| v.fix().index());
+            self.sequence += 1;
+            self.triangles
+                .push(Reverse((bucket, self.sequence, f, corners)));
         }
-        if !self.queued[i] {
-            self.queued[i] = true;
-            self.triangles.push_back(f);
-        }
+    }
+
+    /// The squared length of the triangle's shortest edge when it is below
+    /// the angle bound or above the area limit.
+    fn badness(&self, p: [Point2<f64>; 3]) -> Option<f64> {
+        let d = |i: usize| {
+            let (a, b) = (p[i], p[(i + 1) % 3]);
+            (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)
+        };
+        let lengths = [d(0), d(1), d(2)];
+        let k = (0..3)
+            .min_by(|&i, &j| lengths[i].total_cmp(&lengths[j]))
+            .unwrap_or(0);
+        let (o, q, r) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+        let (u, v) = ([o.x - r.x, o.y - r.y], [q.x - r.x, q.y - r.y]);
+        let cross = (q.x - o.x) * (r.y - o.y) - (q.y - o.y) * (r.x - o.x);
+        let skinny = (u[0] * v[0] + u[1] * v[1])
+            > self.cos_limit * (lengths[(k + 1) % 3] * lengths[(k + 2) % 3]).sqrt();
+        (skinny || 0.5 * cross > self.max_area).then_some(lengths[k])
     }
 
     /// Whether the apex of an inside triangle next to segment a–b lies in
@@ -224,6 +267,7 @@ impl Refiner<'_> {
     /// limit (its off-centre or circumcentre), or `None` when it is fine.
     fn bad_triangle_point(&self, face: FixedFaceHandle<InnerTag>) -> Option<Point2<f64>> {
         let p = self.cdt.face(face).positions();
+        self.badness(p)?;
         let d = |i: usize| {
             let (a, b) = (p[i], p[(i + 1) % 3]);
             (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)
@@ -235,13 +279,6 @@ impl Refiner<'_> {
             .min_by(|&i, &j| lengths[i].total_cmp(&lengths[j]))
             .unwrap_or(0);
         let (o, q, r) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
-        let (u, v) = ([o.x - r.x, o.y - r.y], [q.x - r.x, q.y - r.y]);
-        let cross = (q.x - o.x) * (r.y - o.y) - (q.y - o.y) * (r.x - o.x);
-        let skinny = (u[0] * v[0] + u[1] * v[1])
-            > self.cos_limit * (lengths[(k + 1) % 3] * lengths[(k + 2) % 3]).sqrt();
-        if !skinny && 0.5 * cross <= self.max_area {
-            return None;
-        }
         // Circumcentre relative to o.
         let (bx, by, cx, cy) = (q.x - o.x, q.y - o.y, r.x - o.x, r.y - o.y);
         let det = 2.0 * (bx * cy - by * cx);
@@ -439,8 +476,10 @@ impl Refiner<'_> {
         if self.outside.len() < n {
             self.outside.resize(n, true);
         }
-        let mut faces = Vec::with_capacity(8);
-        let mut opposite = Vec::with_capacity(8);
+        let mut faces = std::mem::take(&mut self.around);
+        let mut opposite = std::mem::take(&mut self.opposite);
+        faces.clear();
+        opposite.clear();
         for e in self.cdt.vertex(v).out_edges() {
             if let Some(f) = e.face().as_inner() {
                 let status = match side {
@@ -468,13 +507,15 @@ impl Refiner<'_> {
                 }
             }
         }
-        for (f, status) in faces {
+        for &(f, status) in &faces {
             self.outside[f.index()] = status;
             if !status {
                 self.push_triangle(f);
             }
         }
-        self.segments.extend(opposite);
+        self.segments.extend(opposite.iter().copied());
+        self.around = faces;
+        self.opposite = opposite;
     }
 }
 
