@@ -30,8 +30,7 @@ use super::face::Cdt;
 use robust::{Coord, incircle, orient2d};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{Point2, Triangulation};
-use std::cmp::Reverse;
-use std::collections::{BinaryHeap, VecDeque};
+use std::collections::VecDeque;
 
 pub(super) struct Params {
     pub min_angle_degrees: f64,
@@ -54,11 +53,8 @@ struct Refiner<'a> {
     cdt: &'a mut Cdt,
     outside: Vec<bool>,
     /// Bad triangles, shortest edge first (Triangle's order: fewer points
-    /// than first-come), then in the order they were found: (bucket of the
-    /// shortest edge's squared length by factors of √2, sequence, face,
-    /// its corners when queued).
-    triangles: BinaryHeap<Reverse<(i32, u64, FixedFaceHandle<InnerTag>, [usize; 3])>>,
-    sequence: u64,
+    /// than first-come), then in the order they were found.
+    triangles: BucketQueue,
     /// Reused per insertion: the faces around the new vertex.
     around: Vec<(FixedFaceHandle<InnerTag>, bool)>,
     opposite: Vec<(FixedVertexHandle, FixedVertexHandle)>,
@@ -94,8 +90,7 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
     let mut r = Refiner {
         cdt,
         outside,
-        triangles: BinaryHeap::new(),
-        sequence: 0,
+        triangles: BucketQueue::new(),
         around: Vec::new(),
         opposite: Vec::new(),
         segments: VecDeque::new(),
@@ -147,7 +142,7 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
             }
             continue;
         }
-        let Some(Reverse((_, _, face, corners))) = r.triangles.pop() else {
+        let Some((face, corners)) = r.triangles.pop() else {
             break;
         };
         let index = face.index();
@@ -201,15 +196,8 @@ impl Refiner<'_> {
         let face = self.cdt.face(f);
         let p = face.positions();
         if let Some(shortest) = self.badness(p) {
-            let bucket = if shortest > 0.0 {
-                (2.0 * shortest.log2()).floor().clamp(-1e9, 1e9) as i32
-            } else {
-                i32::MIN
-            };
             let corners = face.vertices().map(|v| v.fix().index());
-            self.sequence += 1;
-            self.triangles
-                .push(Reverse((bucket, self.sequence, f, corners)));
+            self.triangles.push(shortest, (f, corners));
         }
     }
 
@@ -533,4 +521,58 @@ enum Side {
     },
     /// Already known from a new flood fill.
     Flooded,
+}
+
+/// A queued bad triangle: its face and its corners when queued.
+type Queued = (FixedFaceHandle<InnerTag>, [usize; 3]);
+
+/// Triangle's bad-triangle queue: 4,096 FIFO buckets by the shortest edge's
+/// squared length in factors of √2, shortest first. Push and pop take
+/// constant time (a binary heap's pop was 40% of the refinement time at 1.5
+/// million triangles).
+struct BucketQueue {
+    buckets: Vec<VecDeque<Queued>>,
+    /// No bucket below this one holds anything.
+    lowest: usize,
+    len: usize,
+}
+
+const BUCKETS: usize = 4096;
+
+impl BucketQueue {
+    fn new() -> Self {
+        BucketQueue {
+            buckets: (0..BUCKETS).map(|_| VecDeque::new()).collect(),
+            lowest: BUCKETS,
+            len: 0,
+        }
+    }
+
+    fn push(&mut self, shortest_squared: f64, item: Queued) {
+        // 2·log2 of the squared length, from about −2,100 to 2,050 for
+        // finite positive doubles, shifted into 0..4,096.
+        let bucket = if shortest_squared > 0.0 {
+            let k = (2.0 * shortest_squared.log2()).floor() + 2048.0;
+            k.clamp(0.0, (BUCKETS - 1) as f64) as usize
+        } else {
+            0
+        };
+        self.buckets[bucket].push_back(item);
+        self.lowest = self.lowest.min(bucket);
+        self.len += 1;
+    }
+
+    fn pop(&mut self) -> Option<Queued> {
+        if self.len == 0 {
+            return None;
+        }
+        while self.lowest < BUCKETS {
+            if let Some(item) = self.buckets[self.lowest].pop_front() {
+                self.len -= 1;
+                return Some(item);
+            }
+            self.lowest += 1;
+        }
+        None
+    }
 }
