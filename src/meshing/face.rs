@@ -300,7 +300,12 @@ pub(crate) fn mesh_face(
         && !small_angle
         && !settings.keep_boundary
         && polyline_segments.is_empty();
-    let budget = vertex_budget(&uv_loops, settings.max_area.min(guide), settings, small_angle);
+    let budget = vertex_budget(
+        &uv_loops,
+        settings.max_area.min(guide),
+        settings,
+        small_angle,
+    );
     for pass in 0..MAX_PASSES {
         let result = if own {
             let outside = if peel {

@@ -248,7 +248,8 @@ impl Refiner<'_> {
         let (u, v) = ([a.x - p.x, a.y - p.y], [b.x - p.x, b.y - p.y]);
         let dot = u[0] * v[0] + u[1] * v[1];
         dot < 0.0
-            && dot * dot >= self.lens_cos2 * (u[0] * u[0] + u[1] * u[1]) * (v[0] * v[0] + v[1] * v[1])
+            && dot * dot
+                >= self.lens_cos2 * (u[0] * u[0] + u[1] * u[1]) * (v[0] * v[0] + v[1] * v[1])
     }
 
     /// The point to insert for a triangle below the angle or above the area
@@ -277,17 +278,13 @@ impl Refiner<'_> {
         let (ux, uy) = ((cy * b2 - by * c2) / det, (bx * c2 - cx * b2) / det);
         // Off-centre: on the bisector of o–q, on r's side (left of o → q).
         let (mx, my) = (0.5 * bx, 0.5 * by);
-        let (offx, offy) = (
-            mx - self.off_constant * by,
-            my + self.off_constant * bx,
-        );
-        let (dx, dy) = if (offx - mx).powi(2) + (offy - my).powi(2)
-            < (ux - mx).powi(2) + (uy - my).powi(2)
-        {
-            (offx, offy)
-        } else {
-            (ux, uy)
-        };
+        let (offx, offy) = (mx - self.off_constant * by, my + self.off_constant * bx);
+        let (dx, dy) =
+            if (offx - mx).powi(2) + (offy - my).powi(2) < (ux - mx).powi(2) + (uy - my).powi(2) {
+                (offx, offy)
+            } else {
+                (ux, uy)
+            };
         Some(Point2::new(o.x + dx, o.y + dy))
     }
 
@@ -473,12 +470,7 @@ impl Refiner<'_> {
                 let status = match side {
                     Side::Inside => false,
                     Side::Flooded => self.outside[f.fix().index()],
-                    Side::Split {
-                        a,
-                        b,
-                        left,
-                        right,
-                    } => {
+                    Side::Split { a, b, left, right } => {
                         let [p, q, r] = f.positions();
                         let c = Point2::new((p.x + q.x + r.x) / 3.0, (p.y + q.y + r.y) / 3.0);
                         if orient2d(coord(a), coord(b), coord(c)) > 0.0 {
