@@ -168,24 +168,30 @@ fn coord(p: Point2<f64>) -> Coord<f64> {
     Coord { x: p.x, y: p.y }
 }
 
-/// Input vertices where two constraint edges meet at less than 90°.
+/// Input vertices where two constraint edges meet at less than 90°
+/// (checked without a per-vertex allocation: this runs over every vertex
+/// at each refinement call).
 fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
     cdt.vertices()
         .map(|v| {
             let p = v.position();
-            let dirs: Vec<[f64; 2]> = v
-                .out_edges()
-                .filter(|e| e.is_constraint_edge())
-                .map(|e| {
-                    let q = e.to().position();
-                    [q.x - p.x, q.y - p.y]
-                })
-                .collect();
-            dirs.iter().enumerate().any(|(i, a)| {
-                dirs[i + 1..]
+            let mut dirs = [[0.0f64; 2]; 8];
+            let mut n = 0;
+            for e in v.out_edges().filter(|e| e.is_constraint_edge()) {
+                let q = e.to().position();
+                let d = [q.x - p.x, q.y - p.y];
+                if dirs[..n.min(8)]
                     .iter()
-                    .any(|b| a[0] * b[0] + a[1] * b[1] > 0.0)
-            })
+                    .any(|a| a[0] * d[0] + a[1] * d[1] > 0.0)
+                {
+                    return true;
+                }
+                if n < 8 {
+                    dirs[n] = d;
+                }
+                n += 1;
+            }
+            false
         })
         .collect()
 }
