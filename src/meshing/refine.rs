@@ -176,8 +176,7 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
         .map(|v| {
             let p = v.position();
             let mut dirs = [[0.0f64; 2]; 8];
-            let mut n = 0;
-            for e in v.out_edges().filter(|e| e.is_constraint_edge()) {
+            for (n, e) in v.out_edges().filter(|e| e.is_constraint_edge()).enumerate() {
                 let q = e.to().position();
                 let d = [q.x - p.x, q.y - p.y];
                 if dirs[..n.min(8)]
@@ -189,7 +188,6 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
                 if n < 8 {
                     dirs[n] = d;
                 }
-                n += 1;
             }
             false
         })
