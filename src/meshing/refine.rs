@@ -96,14 +96,11 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
         segments: VecDeque::new(),
         acute,
         cos_limit: (params.min_angle_degrees + 1e-6).to_radians().cos(),
-        lens_cos2: {
-            let c = 2.0 * cos_alpha * cos_alpha - 1.0;
-            if alpha < std::f64::consts::FRAC_PI_4 {
-                c * c
-            } else {
-                0.0
-            }
-        },
+        // Diametral circles (any obtuse apex encroaches), not Triangle's
+        // lenses: with lenses the interface of two materials kept
+        // triangles up to 124° against it and the flux across it (fem_2d)
+        // jumped 6% instead of under 3%.
+        lens_cos2: 0.0,
         // Triangle's 0.475 rather than 0.5: the new triangle ends a little
         // above the bound, not on it.
         off_constant: 0.475 * ((1.0 + cos_alpha) / (1.0 - cos_alpha)).sqrt(),
