@@ -28,6 +28,7 @@ use super::boundary_chain;
 use super::chart::Chart;
 use super::edges::EdgeNodes;
 use super::polyline_split;
+use super::refine;
 use super::size::Sizing;
 use crate::geom::{Point3, Surface, Vec3};
 use crate::ir::{Face, Model};
@@ -280,7 +281,7 @@ pub(crate) fn mesh_face(
     // (its corner nodes, which never move) that was fine there. Later passes
     // only check the triangles insertions created or moved.
     let mut fine: Vec<u64> = Vec::new();
-    let mut excluded: Vec<bool> = Vec::new();
+    let mut excluded: Vec<bool>;
     let deviation = Deviation::of(&face.surface);
     let coarse = Coarse {
         deviation: &deviation,
@@ -291,8 +292,49 @@ pub(crate) fn mesh_face(
     // Vertices from this index on have not been checked for boundary splits.
     let mut unchecked = fixed;
     let mut added = Vec::new();
+    // A plane face without poly_lines or small input angles is refined by
+    // geomc's own off-centre refinement (`refine`): spade's inserts
+    // circumcentres (a third more triangles than Triangle on a long polygon).
+    let own = matches!(face.surface, Surface::Plane { .. })
+        && !framed
+        && !small_angle
+        && !settings.keep_boundary
+        && polyline_segments.is_empty();
+    let budget = vertex_budget(
+        &uv_loops,
+        settings.max_area.min(guide),
+        settings,
+        small_angle,
+    );
     for pass in 0..MAX_PASSES {
-        let result = cdt.refine(parameters.clone());
+        let result = if own {
+            let outside = if peel {
+                outside_faces(&cdt, &[])
+            } else {
+                vec![false; cdt.num_all_faces()]
+            };
+            refine::refine(
+                &mut cdt,
+                refine::Params {
+                    min_angle_degrees: settings.min_angle,
+                    max_area: settings.max_area.min(guide),
+                    max_additional_vertices: budget,
+                    outside,
+                },
+            )
+        } else {
+            let result = cdt.refine(parameters.clone());
+            let mut outside = vec![false; cdt.num_all_faces()];
+            for f in &result.excluded_faces {
+                if let Some(slot) = outside.get_mut(f.index()) {
+                    *slot = true;
+                }
+            }
+            refine::Refined {
+                outside,
+                complete: result.refinement_complete,
+            }
+        };
         if settings.keep_boundary && !polyline_segments.is_empty() {
             // Spade keeps the poly_lines whole with the loops: split them
             // here where they are in the way, and refine again.
@@ -311,7 +353,7 @@ pub(crate) fn mesh_face(
                 cdt.refine(parameters.clone());
             }
         }
-        if small_angle && !result.refinement_complete && !settings.keep_boundary {
+        if small_angle && !result.complete && !settings.keep_boundary {
             // Segments at a tiny angle split each other without end, and
             // each round would start over from the splits sent back: mesh
             // the face against its boundary as it is instead.
@@ -391,14 +433,8 @@ pub(crate) fn mesh_face(
             continue;
         }
         if polyline_segments.is_empty() {
-            // Reused across passes: a fresh zeroed table per pass cost page faults.
-            excluded.clear();
-            excluded.resize(cdt.num_all_faces(), false);
-            for f in &result.excluded_faces {
-                if let Some(slot) = excluded.get_mut(f.index()) {
-                    *slot = true;
-                }
-            }
+            excluded = result.outside;
+            excluded.resize(cdt.num_all_faces(), true);
         } else {
             excluded = outside_faces(&cdt, &polyline_segments);
         }
@@ -761,7 +797,7 @@ pub(super) fn on_segment(cdt: &Cdt, a: usize, b: usize, p: Point2<f64>) -> Optio
 /// Faces outside the loops (indexed by face index): a flood fill from the
 /// convex hull that flips inside/outside when it crosses a loop segment but
 /// not a poly_line.
-fn outside_faces(cdt: &Cdt, polyline_segments: &[(usize, usize)]) -> Vec<bool> {
+pub(super) fn outside_faces(cdt: &Cdt, polyline_segments: &[(usize, usize)]) -> Vec<bool> {
     let mut outside: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
     let crosses_loop = |constraint: bool, ia: usize, ib: usize| {
         if !constraint {

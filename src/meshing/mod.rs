@@ -34,6 +34,7 @@ mod face;
 mod guard;
 mod polyline_split;
 mod quadratic;
+mod refine;
 mod report;
 mod schedule;
 mod size;
