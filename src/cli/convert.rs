@@ -305,9 +305,6 @@ pub fn run(args: &Args) -> i32 {
                 mesh.faces.iter().map(|f| f.triangles.len()).sum::<usize>(),
                 mesh.faces.len() + mesh.polylines.len() + mesh.point_sets.len()
             );
-            // The process exits next and the kernel takes back all its pages
-            // at once: freeing the mesh's large vectors first only added work.
-            std::mem::forget(loaded);
             EXIT_OK
         }
         Err(WriteError::Unsupported(message)) => {

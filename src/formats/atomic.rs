@@ -4,7 +4,6 @@
 //! removes the temporary file so nothing partial is left behind.
 
 use super::WriteError;
-use super::writeback::Writeback;
 use std::fs::{File, OpenOptions};
 use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
@@ -43,10 +42,9 @@ fn fill_and_sync<T>(
     fill: impl FnOnce(&mut dyn Write) -> Result<T, WriteError>,
 ) -> Result<T, WriteError> {
     // Large writes: the writers' pieces reach the kernel in few system calls.
-    // Written back to disk as it goes: the `sync_all` below waits for the tail.
-    let mut out = BufWriter::with_capacity(1 << 20, Writeback::new(file));
+    let mut out = BufWriter::with_capacity(1 << 20, file);
     let value = fill(&mut out)?;
-    let file = out.into_inner().map_err(|e| e.into_error())?.into_file();
+    let file = out.into_inner().map_err(|e| e.into_error())?;
     file.sync_all()?;
     Ok(value)
 }

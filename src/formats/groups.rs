@@ -5,7 +5,6 @@
 
 use super::WriteError;
 use crate::mesh::Mesh;
-use rayon::prelude::*;
 use std::borrow::Cow;
 
 /// Rejects a mesh whose indices leave their tables or whose coordinates are
@@ -21,14 +20,10 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
             mesh.nodes.len()
         ));
     }
-    let not_finite = |p: &[f64; 3]| p.iter().any(|c| !c.is_finite());
-    // Checked in parallel pieces; the first bad node (rare) found in order.
     if let Some(i) = mesh
         .nodes
-        .par_chunks(1 << 14)
-        .any(|piece| piece.iter().any(not_finite))
-        .then(|| mesh.nodes.iter().position(not_finite))
-        .flatten()
+        .iter()
+        .position(|p| p.iter().any(|c| !c.is_finite()))
     {
         return bad(format!("node {i} has a coordinate that is not finite"));
     }
@@ -48,11 +43,7 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
         }
     }
     for f in &mesh.faces {
-        if !f
-            .triangles
-            .par_chunks(1 << 14)
-            .all(|piece| piece.as_flattened().iter().all(node_ok))
-        {
+        if !f.triangles.iter().flatten().all(node_ok) {
             return bad(format!("face `{}` refers to a node out of range", f.name));
         }
         if f.boundary

@@ -21,7 +21,6 @@ mod obj;
 pub mod read;
 mod stl;
 mod vtu;
-mod writeback;
 
 pub use atomic::write_atomic;
 pub use frag::{FragDocument, read_frag_xml};

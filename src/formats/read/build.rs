@@ -9,7 +9,6 @@ use crate::diag::{Code, Diagnostic};
 use crate::mesh::{
     CellKind, Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain, MeshVolume,
 };
-use rayon::prelude::*;
 use std::collections::HashMap;
 
 /// Elements of one named group.
@@ -91,12 +90,7 @@ impl Builder {
     pub fn finish_unchecked(mut self) -> Result<Loaded, Vec<Diagnostic>> {
         let n = self.nodes.len();
         for g in &self.groups {
-            // In parallel: millions of triangles on large meshes (a yes/no
-            // answer, the same on any thread count).
-            let bad = g
-                .triangles
-                .par_chunks(1 << 14)
-                .any(|piece| piece.as_flattened().iter().any(|&v| v as usize >= n))
+            let bad = g.triangles.iter().flatten().any(|&v| v as usize >= n)
                 || g.lines.iter().flatten().any(|&v| v as usize >= n)
                 || g.points.iter().any(|&v| v as usize >= n)
                 || g.volumes.iter().flatten().any(|&v| v as usize >= n);
@@ -108,14 +102,10 @@ impl Builder {
                 )]);
             }
         }
-        let not_finite = |p: &[f64; 3]| p.iter().any(|c| !c.is_finite());
-        // Checked in parallel pieces; the first bad node (rare) found in order.
         if let Some(i) = self
             .nodes
-            .par_chunks(1 << 14)
-            .any(|piece| piece.iter().any(not_finite))
-            .then(|| self.nodes.iter().position(not_finite))
-            .flatten()
+            .iter()
+            .position(|p| p.iter().any(|c| !c.is_finite()))
         {
             return Err(vec![Diagnostic::new(
                 Code::MeshNonFinite,

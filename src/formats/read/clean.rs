@@ -6,7 +6,6 @@
 
 use crate::diag::{Code, Diagnostic};
 use crate::mesh::Mesh;
-use rayon::prelude::*;
 
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
 pub struct EdgeCounts {
@@ -115,49 +114,13 @@ fn diagonal(mesh: &Mesh) -> f64 {
 /// Edge use counts: half-edges bucketed by their lower node (a counting
 /// sort: two passes over the triangles, `(higher << 1) | direction` in
 /// 4 bytes each), then each node's few entries sorted in place. Linear in
-/// the mesh. The nodes are split into one range per thread, each range's
-/// edges counted on its own (every edge belongs to the range of its lower
-/// node): the counts are whole numbers, the same on any thread count.
+/// the mesh, and the same on any thread count.
 pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCounts {
-    let area_floor = (scale * scale) * 1e-14;
-    let degenerate = triangles
-        .par_chunks(1 << 14)
-        .map(|piece| {
-            piece
-                .iter()
-                .filter(|t| {
-                    t[0] == t[1]
-                        || t[1] == t[2]
-                        || t[0] == t[2]
-                        || twice_area(nodes, **t) <= area_floor
-                })
-                .count()
-        })
-        .sum();
-    let n = nodes.len();
-    let parts = rayon::current_num_threads().clamp(1, 64);
-    let span = n.div_ceil(parts).max(1);
-    let mut out = (0..parts)
-        .into_par_iter()
-        .map(|p| range_counts(triangles, n, (p * span).min(n)..((p + 1) * span).min(n)))
-        .reduce(EdgeCounts::default, |a, b| EdgeCounts {
-            edges: a.edges + b.edges,
-            open: a.open + b.open,
-            non_manifold: a.non_manifold + b.non_manifold,
-            inconsistent: a.inconsistent + b.inconsistent,
-            degenerate: 0,
-        });
-    out.degenerate = degenerate;
-    out
-}
-
-/// The counts of the edges whose lower node is in `range` (of `n` nodes).
-fn range_counts(triangles: &[[u32; 3]], n: usize, range: std::ops::Range<usize>) -> EdgeCounts {
     let mut out = EdgeCounts::default();
-    let (first, len) = (range.start, range.len());
-    // The half-edges of a triangle as (lower node − first, higher << 1 |
-    // direction), for lower nodes in the range; edges of repeated or unknown
-    // nodes are skipped.
+    let area_floor = (scale * scale) * 1e-14;
+    let n = nodes.len();
+    // The half-edges of a triangle as (lower node, higher << 1 | direction);
+    // edges of repeated or unknown nodes are skipped.
     let halves = |t: &[u32; 3]| {
         [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]
             .into_iter()
@@ -169,15 +132,14 @@ fn range_counts(triangles: &[[u32; 3]], n: usize, range: std::ops::Range<usize>)
                     (b, (a << 1) | 1)
                 }
             })
-            .filter_map(move |(lo, entry)| {
-                let local = (lo as usize).checked_sub(first).filter(|&l| l < len)?;
-                Some((local, entry))
-            })
     };
-    let mut start = vec![0u32; len + 1];
+    let mut start = vec![0u32; n + 1];
     for t in triangles {
+        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || twice_area(nodes, *t) <= area_floor {
+            out.degenerate += 1;
+        }
         for (lo, _) in halves(t) {
-            if let Some(c) = start.get_mut(lo + 1) {
+            if let Some(c) = start.get_mut(lo as usize + 1) {
                 *c += 1;
             }
         }
@@ -192,7 +154,7 @@ fn range_counts(triangles: &[[u32; 3]], n: usize, range: std::ops::Range<usize>)
     let mut slots = vec![0u32; start.last().copied().unwrap_or(0) as usize];
     for t in triangles {
         for (lo, entry) in halves(t) {
-            if let Some(f) = fill.get_mut(lo)
+            if let Some(f) = fill.get_mut(lo as usize)
                 && let Some(slot) = slots.get_mut(*f as usize)
             {
                 *slot = entry;

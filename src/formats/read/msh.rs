@@ -15,7 +15,6 @@ use crate::diag::{Code, Diagnostic};
 use crate::mesh::CellKind;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
     let mut r = Reader {
@@ -489,20 +488,16 @@ impl<'a> Reader<'a> {
             let at = self.here();
             let n = self.size("the number of nodes in a block")?;
             let n = self.plausible(n, per_node, "nodes in a block", at)?;
-            let extra = if parametric != 0 {
-                _dim.clamp(0, 3) as usize
-            } else {
-                0
-            };
-            if self.binary && extra == 0 && self.binary_node_block(n, dense_limit)? {
-                read += n;
-                continue;
-            }
             tags.clear();
             for _ in 0..n {
                 let at = self.here();
                 tags.push((self.size("a node tag")?, at));
             }
+            let extra = if parametric != 0 {
+                _dim.clamp(0, 3) as usize
+            } else {
+                0
+            };
             if self.binary && extra == 0 && self.binary_coordinates(&tags, dense_limit)? {
                 read += n;
                 continue;
@@ -529,80 +524,6 @@ impl<'a> Reader<'a> {
             ));
         }
         Ok(())
-    }
-
-    /// A whole binary node block (its tags, then their coordinates) read
-    /// straight from the file's bytes, when the file holds all of it (else
-    /// `false`, with nothing read: the value-by-value path says where it
-    /// ends). The coordinates are checked and copied in parallel pieces, the
-    /// tags numbered in order; the first bad node gives the error the
-    /// value-by-value path gives (a non-finite coordinate before its
-    /// node's duplicate tag), at the same byte offset.
-    fn binary_node_block(&mut self, n: usize, dense_limit: u64) -> Result<bool, Diagnostic> {
-        let bytes = self.s.bytes;
-        let start = self.s.pos;
-        let Some(block) = n
-            .checked_mul(32)
-            .and_then(|len| bytes.get(start..)?.get(..len))
-        else {
-            return Ok(false);
-        };
-        let (tags, coordinates) = block.split_at(8 * n);
-        let coordinates_at = start + 8 * n;
-        let value =
-            |c: &[u8], at: usize| super::bytes_at::<8>(c, at).map_or(0.0, f64::from_le_bytes);
-        // Looked for in parallel pieces, found (rarely) in order.
-        let finite = |c: &[u8]| value(c, 0).is_finite();
-        let non_finite = if coordinates
-            .par_chunks(8 << 14)
-            .all(|piece| piece.chunks_exact(8).all(finite))
-        {
-            None
-        } else {
-            coordinates.chunks_exact(8).position(|c| !finite(c))
-        };
-        let bad_node = non_finite.map_or(n, |v| v / 3);
-        let base = self.b.nodes.len();
-        self.b.nodes.par_extend(
-            coordinates
-                .par_chunks_exact(24)
-                .with_min_len(1 << 14)
-                .map(|r| [value(r, 0), value(r, 8), value(r, 16)]),
-        );
-        // Tags below the dense limit go into a table: sized once for the
-        // block's largest such tag instead of one step per tag.
-        let largest = tags
-            .chunks_exact(8)
-            .map(|t| u64::from_le_bytes(super::array(t).unwrap_or([0; 8])))
-            .filter(|&t| t < dense_limit)
-            .max();
-        if let Some(largest) = largest
-            && largest as usize >= self.nodes.dense.len()
-        {
-            self.nodes.dense.resize(largest as usize + 1, NONE);
-        }
-        for (i, t) in tags.chunks_exact(8).enumerate() {
-            if i == bad_node {
-                let v = non_finite.unwrap_or(0);
-                let x = value(coordinates, 8 * v);
-                return Err(error_at_byte(
-                    Code::MeshNonFinite,
-                    coordinates_at + 8 * v,
-                    format!("a node coordinate is {x}, not a finite number"),
-                ));
-            }
-            let tag = u64::from_le_bytes(super::array(t).unwrap_or([0; 8]));
-            if !self.nodes.insert(tag, (base + i) as u32, dense_limit) {
-                return Err(self.err(
-                    Code::MeshCountMismatch,
-                    start + 8 * i,
-                    1,
-                    format!("node tag {tag} is given twice"),
-                ));
-            }
-        }
-        self.s.pos = start + block.len();
-        Ok(true)
     }
 
     /// A binary block of node coordinates read at once, when the file holds
@@ -697,20 +618,24 @@ impl<'a> Reader<'a> {
             super::bytes_at::<8>(r, at).and_then(|b| nodes.get(u64::from_le_bytes(b)))
         };
         let base = g.triangles.len();
-        // Collected straight into the group's reserved room (no zero fill
-        // first), each piece by the thread that converts it.
-        let unknown = AtomicBool::new(false);
-        g.triangles
-            .par_extend(block.par_chunks_exact(32).with_min_len(PIECE).map(|r| {
-                match (tag(r, 8), tag(r, 16), tag(r, 24)) {
-                    (Some(a), Some(b), Some(c)) => [a, b, c],
-                    _ => {
-                        unknown.store(true, Ordering::Relaxed);
-                        [0; 3]
+        g.triangles.resize(base + block.len() / 32, [0; 3]);
+        let known = g
+            .triangles
+            .get_mut(base..)
+            .unwrap_or_default()
+            .par_chunks_mut(PIECE)
+            .zip(block.par_chunks(32 * PIECE))
+            .all(|(out, piece)| {
+                out.iter_mut().zip(piece.chunks_exact(32)).all(|(t, r)| {
+                    match (tag(r, 8), tag(r, 16), tag(r, 24)) {
+                        (Some(a), Some(b), Some(c)) => {
+                            *t = [a, b, c];
+                            true
+                        }
+                        _ => false,
                     }
-                }
-            }));
-        let known = !unknown.load(Ordering::Relaxed);
+                })
+            });
         if !known {
             g.triangles.truncate(base);
         }
