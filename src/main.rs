@@ -12,7 +12,6 @@ mod cli;
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn main() {
-    geomc::allocator::return_freed_memory_promptly();
     let code = cli::run();
     // Any subcommand: `GEOMC_STATS=1` prints the peak memory, so tests can
     // bound it for compile and convert too (`validate --stats` prints time as well).
