@@ -16,6 +16,7 @@ use crate::ir::{
     Edge, EdgeId, Face, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex, VertexId,
 };
 use crate::trimmed::boundary::{U_MAX, U_MIN, V_MAX, V_MIN};
+use crate::trimmed::shared::{bbox, distance_to_polyline};
 use crate::trimmed::topology::{Piece, pieces};
 
 /// Appends the vertices, edges and faces of `model.trimmed` (3D models).
@@ -209,31 +210,4 @@ fn chain_loops(pieces: &[(OrientedEdge, VertexId, VertexId)]) -> Vec<Vec<Oriente
         loops.push(lp);
     }
     loops
-}
-
-fn bbox(points: &[Point3]) -> ([f64; 3], [f64; 3]) {
-    let mut lo = [f64::INFINITY; 3];
-    let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
-        for k in 0..3 {
-            lo[k] = lo[k].min(p[k]);
-            hi[k] = hi[k].max(p[k]);
-        }
-    }
-    (lo, hi)
-}
-
-fn distance_to_polyline(line: &[Point3], p: &Point3) -> f64 {
-    line.windows(2)
-        .map(|w| {
-            let d = w[1] - w[0];
-            let len2 = d.norm_squared();
-            let t = if len2 > 0.0 {
-                ((p - w[0]).dot(&d) / len2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            (w[0] + d * t - p).norm()
-        })
-        .fold(f64::INFINITY, f64::min)
 }

@@ -205,14 +205,7 @@ impl Refiner<'_> {
     /// The squared length of the triangle's shortest edge when it is below
     /// the angle bound or above the area limit.
     fn badness(&self, p: [Point2<f64>; 3]) -> Option<f64> {
-        let d = |i: usize| {
-            let (a, b) = (p[i], p[(i + 1) % 3]);
-            (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)
-        };
-        let lengths = [d(0), d(1), d(2)];
-        let k = (0..3)
-            .min_by(|&i, &j| lengths[i].total_cmp(&lengths[j]))
-            .unwrap_or(0);
+        let (lengths, k) = shortest_edge(p);
         let (o, q, r) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
         let (u, v) = ([o.x - r.x, o.y - r.y], [q.x - r.x, q.y - r.y]);
         let cross = (q.x - o.x) * (r.y - o.y) - (q.y - o.y) * (r.x - o.x);
@@ -258,16 +251,9 @@ impl Refiner<'_> {
     fn bad_triangle_point(&self, face: FixedFaceHandle<InnerTag>) -> Option<Point2<f64>> {
         let p = self.cdt.face(face).positions();
         self.badness(p)?;
-        let d = |i: usize| {
-            let (a, b) = (p[i], p[(i + 1) % 3]);
-            (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)
-        };
-        let lengths = [d(0), d(1), d(2)];
         // The shortest edge k runs from p[k] to p[k + 1]; its opposite
         // corner holds the smallest angle.
-        let k = (0..3)
-            .min_by(|&i, &j| lengths[i].total_cmp(&lengths[j]))
-            .unwrap_or(0);
+        let (_, k) = shortest_edge(p);
         let (o, q, r) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
         // Circumcentre relative to o.
         let (bx, by, cx, cy) = (q.x - o.x, q.y - o.y, r.x - o.x, r.y - o.y);
@@ -568,4 +554,18 @@ impl BucketQueue {
         }
         None
     }
+}
+
+/// The squared edge lengths of a triangle (edge i from corner i to i + 1)
+/// and the index of the shortest.
+fn shortest_edge(p: [Point2<f64>; 3]) -> ([f64; 3], usize) {
+    let d = |i: usize| {
+        let (a, b) = (p[i], p[(i + 1) % 3]);
+        (b.x - a.x) * (b.x - a.x) + (b.y - a.y) * (b.y - a.y)
+    };
+    let lengths = [d(0), d(1), d(2)];
+    let k = (0..3)
+        .min_by(|&i, &j| lengths[i].total_cmp(&lengths[j]))
+        .unwrap_or(0);
+    (lengths, k)
 }

@@ -45,9 +45,19 @@ impl Cap {
 /// True when a side v = const of `s` is a single point (a pole there):
 /// such a surface is meshed as its transpose (`TrimmedSurface::transposed`).
 pub fn has_v_pole(s: &TrimmedSurface) -> bool {
-    let [u0, u1, v0, v1] = s.rect;
-    let samples = s.samples(16);
-    let (lo, hi) = samples.iter().fold(
+    let [_, _, v0, v1] = s.rect;
+    let Some(scale) = sample_scale(s) else {
+        return false;
+    };
+    [v0, v1]
+        .into_iter()
+        .any(|v| is_point_side(s, scale, false, v))
+}
+
+/// The diagonal of the box of a 16×16 sample of `s`, or `None` for an
+/// empty or unbounded sample.
+fn sample_scale(s: &TrimmedSurface) -> Option<f64> {
+    let (lo, hi) = s.samples(16).iter().fold(
         (
             Point3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY),
             Point3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY),
@@ -55,51 +65,32 @@ pub fn has_v_pole(s: &TrimmedSurface) -> bool {
         |(lo, hi), p| (lo.inf(p), hi.sup(p)),
     );
     let scale = (hi - lo).norm();
-    if !scale.is_finite() || scale <= 0.0 {
-        return false;
-    }
-    let point_side = |fixed_u: bool, t: f64| {
-        let at = |x: f64| {
-            if fixed_u {
-                s.point(t, x)
-            } else {
-                s.point(x, t)
-            }
-        };
-        let (a, b) = if fixed_u { (v0, v1) } else { (u0, u1) };
-        let first = at(a);
-        (1..=16).all(|k| (at(a + (b - a) * k as f64 / 16.0) - first).norm() <= 1e-9 * scale)
+    (scale.is_finite() && scale > 0.0).then_some(scale)
+}
+
+/// True when the side `u = t` (`fixed_u`) or `v = t` of `s` is a single
+/// point within 1e-9 of `scale` (a pole).
+fn is_point_side(s: &TrimmedSurface, scale: f64, fixed_u: bool, t: f64) -> bool {
+    let [u0, u1, v0, v1] = s.rect;
+    let at = |x: f64| {
+        if fixed_u {
+            s.point(t, x)
+        } else {
+            s.point(x, t)
+        }
     };
-    [v0, v1].into_iter().any(|v| point_side(false, v))
+    let (a, b) = if fixed_u { (v0, v1) } else { (u0, u1) };
+    let first = at(a);
+    (1..=16).all(|k| (at(a + (b - a) * k as f64 / 16.0) - first).norm() <= 1e-9 * scale)
 }
 
 /// The caps of the degenerate sides of `s` (none for most surfaces).
 pub fn plan(s: &TrimmedSurface, settings: &TrimSettings, h: f64) -> Result<Vec<Cap>, String> {
     let [u0, u1, v0, v1] = s.rect;
-    let samples = s.samples(16);
-    let (lo, hi) = samples.iter().fold(
-        (
-            Point3::new(f64::INFINITY, f64::INFINITY, f64::INFINITY),
-            Point3::new(f64::NEG_INFINITY, f64::NEG_INFINITY, f64::NEG_INFINITY),
-        ),
-        |(lo, hi), p| (lo.inf(p), hi.sup(p)),
-    );
-    let scale = (hi - lo).norm();
-    if !scale.is_finite() || scale <= 0.0 {
+    let Some(scale) = sample_scale(s) else {
         return Ok(Vec::new());
-    }
-    let point_side = |fixed_u: bool, t: f64| {
-        let at = |x: f64| {
-            if fixed_u {
-                s.point(t, x)
-            } else {
-                s.point(x, t)
-            }
-        };
-        let (a, b) = if fixed_u { (v0, v1) } else { (u0, u1) };
-        let first = at(a);
-        (1..=16).all(|k| (at(a + (b - a) * k as f64 / 16.0) - first).norm() <= 1e-9 * scale)
     };
+    let point_side = |fixed_u: bool, t: f64| is_point_side(s, scale, fixed_u, t);
     for v in [v0, v1] {
         if point_side(false, v) {
             return Err(format!(

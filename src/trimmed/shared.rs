@@ -94,7 +94,8 @@ pub fn coincide(loop_points: &[Point3], chain: &[Point3], distance: f64) -> bool
             .all(|p| distance_to_polyline(&closed, p) <= distance)
 }
 
-fn bbox(points: &[Point3]) -> ([f64; 3], [f64; 3]) {
+/// The axis-aligned box of `points` (min corner, max corner).
+pub(crate) fn bbox(points: &[Point3]) -> ([f64; 3], [f64; 3]) {
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
     for p in points {
@@ -106,7 +107,8 @@ fn bbox(points: &[Point3]) -> ([f64; 3], [f64; 3]) {
     (lo, hi)
 }
 
-fn distance_to_polyline(line: &[Point3], p: &Point3) -> f64 {
+/// The distance from `p` to the nearest point of an open polyline.
+pub(crate) fn distance_to_polyline(line: &[Point3], p: &Point3) -> f64 {
     line.windows(2)
         .map(|w| {
             let d = w[1] - w[0];
