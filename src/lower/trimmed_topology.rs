@@ -16,7 +16,7 @@ use crate::ir::{
     Edge, EdgeId, Face, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex, VertexId,
 };
 use crate::trimmed::boundary::{U_MAX, U_MIN, V_MAX, V_MIN};
-use crate::trimmed::shared::{bbox, distance_to_polyline};
+use crate::trimmed::shared::{bbox, distance_to_polyline, nearest_point};
 use crate::trimmed::topology::{Piece, pieces};
 
 /// Appends the vertices, edges and faces of `model.trimmed` (3D models).
@@ -162,8 +162,8 @@ fn shared_edge(model: &Model, piece: &Piece) -> Option<OrientedEdge> {
         // The direction: the index steps along the edge's points from the
         // piece's first point to a point an eighth of the way along it.
         let n = line.len() - 1;
-        let i0 = nearest(&line[..n], &own[0]) as i64;
-        let i1 = nearest(&line[..n], &own[(own.len() / 8).max(1)]) as i64;
+        let i0 = nearest_point(&line[..n], &own[0]) as i64;
+        let i1 = nearest_point(&line[..n], &own[(own.len() / 8).max(1)]) as i64;
         let n = n as i64;
         let step = (i1 - i0 + n + n / 2).rem_euclid(n) - n / 2;
         return Some(OrientedEdge {
@@ -172,17 +172,6 @@ fn shared_edge(model: &Model, piece: &Piece) -> Option<OrientedEdge> {
         });
     }
     None
-}
-
-fn nearest(points: &[Point3], p: &Point3) -> usize {
-    let mut best = (f64::INFINITY, 0);
-    for (i, q) in points.iter().enumerate() {
-        let d = (q - p).norm_squared();
-        if d < best.0 {
-            best = (d, i);
-        }
-    }
-    best.1
 }
 
 /// The face's loops: the oriented pieces chained end to begin (a closed

@@ -123,7 +123,8 @@ pub(crate) fn distance_to_polyline(line: &[Point3], p: &Point3) -> f64 {
         .fold(f64::INFINITY, f64::min)
 }
 
-fn nearest_point(points: &[Point3], p: &Point3) -> usize {
+/// The index of the point of `points` nearest to `p` (0 when empty).
+pub(crate) fn nearest_point(points: &[Point3], p: &Point3) -> usize {
     let mut best = (f64::INFINITY, 0);
     for (i, q) in points.iter().enumerate() {
         let d = (q - p).norm_squared();
