@@ -64,6 +64,16 @@ pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
 
 /// [`parse`] with the size bounds given.
 pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
+    if limits.max_nodes >= 1 {
+        if let Some(expr) = plain_number(text, base) {
+            return Ok(expr);
+        }
+    }
+    parse_tokens(text, base, limits)
+}
+
+/// The general path of [`parse_with`]: tokens, then the Pratt parser.
+fn parse_tokens(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
     let tokens = lex(text, base)?;
     let end = base + text.len();
     let mut parser = Parser {
@@ -91,6 +101,19 @@ pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, 
         });
     }
     Ok(expr)
+}
+
+/// The expression of a text that is one unsigned literal without exponent
+/// (most attributes), made without the token list; the same value and span as
+/// the general path. Anything else, or a literal that does not parse, is `None`.
+fn plain_number(text: &str, base: usize) -> Option<Expr> {
+    let space = [' ', '\t', '\n', '\r'];
+    let body = text.trim_matches(space);
+    let start = text.len() - text.trim_start_matches(space).len();
+    let plain = !body.is_empty() && body.bytes().all(|b| b.is_ascii_digit() || b == b'.');
+    let value: f64 = plain.then(|| body.parse().ok())??;
+    let span = Span::new(base + start, base + start + body.len());
+    Some(Expr::number(value, span))
 }
 
 fn describe(token: &Token) -> String {
@@ -359,5 +382,38 @@ impl Parser {
                 message: "expected ')' but the expression ends".into(),
             }),
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn plain_numbers_parse_as_the_general_path_does() {
+        let limits = ExprLimits::default();
+        for text in [
+            "2",
+            " 0.5 ",
+            "10.25",
+            ".5",
+            "1.",
+            "007",
+            "\t3\n",
+            "123456789.125",
+        ] {
+            let general = parse_tokens(text, 40, &limits).expect("a number");
+            assert_eq!(plain_number(text, 40), Some(general), "{text:?}");
+        }
+        for text in [
+            "1.2.3", ".", "", "  ", "1e5", "-2", "r", "2*r", "1 2", "1,5",
+        ] {
+            assert_eq!(plain_number(text, 40), None, "{text:?}");
+        }
+        // Invalid literals still get the general path's error.
+        assert!(matches!(
+            parse_with("1.2.3", 0, &limits),
+            Err(ParseError::Syntax { .. })
+        ));
     }
 }

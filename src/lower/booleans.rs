@@ -14,6 +14,7 @@ use crate::ir::{
     Subdomain, SubdomainCells, SubdomainId,
 };
 use crate::resolve::{Geometry, Resolved};
+use rayon::slice::ParallelSliceMut;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// A boolean tree over leaf solids (indices into `leaves`).
@@ -383,7 +384,9 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
             }
         }
     }
-    cells.sort_unstable();
+    // In parallel: entries equal under the order are identical, so the sorted
+    // list does not depend on the threads.
+    cells.par_sort_unstable();
     let mut pairs = Vec::new();
     for run in cells.chunk_by(|a, b| a.0 == b.0) {
         for (k, &(_, i)) in run.iter().enumerate() {

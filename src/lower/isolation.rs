@@ -6,6 +6,7 @@
 use super::brep;
 use crate::geom::{Aabb, SolidShape};
 use crate::resolve::{Geometry, Resolved};
+use rayon::prelude::*;
 use std::collections::HashSet;
 
 /// The primitive solids in the order `lower` lowers them (objects in order,
@@ -41,8 +42,10 @@ pub(super) fn solid_shapes<'r>(
 /// (a margin for rounding), meets no other solid's. A box that is not finite
 /// (a position the welder cannot place) is never called isolated.
 pub(super) fn isolated(shapes: &[&SolidShape], tol: f64) -> Vec<bool> {
+    // Each box is a pure function of its shape: made in parallel, in order.
     let boxes: Vec<Aabb> = shapes
-        .iter()
+        .par_iter()
+        .with_min_len(1024)
         .map(|shape| {
             let brep = brep::of(shape);
             let mut bbox = Aabb::empty();

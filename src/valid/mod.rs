@@ -14,10 +14,24 @@ use crate::ir::{Model, SourceMap};
 /// [`shell::check_face_usage`] (E406, W004). The diagnostics are in that
 /// order; callers sort them by position with [`Diagnostics::sort`].
 pub fn check_topology(model: &Model, source_map: &SourceMap) -> Diagnostics {
-    let mut diags = Diagnostics::default();
-    shell::check_faces(model, source_map, &mut diags);
-    shell::check_subdomain_shells(model, source_map, &mut diags);
-    shell::check_face_usage(model, source_map, &mut diags);
+    // The three checks only read the model, so they run side by side; their
+    // findings are joined in the fixed order, whatever the threads.
+    let check = |f: fn(&Model, &SourceMap, &mut Diagnostics)| {
+        let mut diags = Diagnostics::default();
+        f(model, source_map, &mut diags);
+        diags
+    };
+    let ((mut diags, shells), usage) = rayon::join(
+        || {
+            rayon::join(
+                || check(shell::check_faces),
+                || check(shell::check_subdomain_shells),
+            )
+        },
+        || check(shell::check_face_usage),
+    );
+    diags.extend(shells);
+    diags.extend(usage);
     diags
 }
 

@@ -12,7 +12,8 @@ use crate::ir::{
     EdgeId, FaceId, Model, OrientedFace, SourceMap, SubdomainCells, SubdomainId, VertexId,
 };
 use crate::span::Span;
-use std::collections::{BTreeMap, BTreeSet, VecDeque};
+use rayon::prelude::*;
+use std::collections::{BTreeSet, VecDeque};
 
 /// How close t1 − t0 of an ellipse must be to 2π for the curve to be closed.
 const ANGLE_TOLERANCE: f64 = 1e-9;
@@ -100,17 +101,20 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
     for (i, face) in model.faces.iter().enumerate() {
         let id = FaceId(i as u32);
         for (l, edges) in face.loops.iter().enumerate() {
-            let which = if face.loops.len() == 1 {
-                format!("the loop of face '{}'", face.name)
-            } else {
-                format!("loop {} of face '{}'", l + 1, face.name)
+            // Formatted only for a finding: this runs for every loop of the model.
+            let which = || {
+                if face.loops.len() == 1 {
+                    format!("the loop of face '{}'", face.name)
+                } else {
+                    format!("loop {} of face '{}'", l + 1, face.name)
+                }
             };
             if edges.is_empty() {
                 diags.push(
                     Diagnostic::new(
                         Code::OpenLoop,
                         source_map.face(id),
-                        format!("{which} has no edges"),
+                        format!("{} has no edges", which()),
                     )
                     .with_help("list the edges of the loop, or remove the empty loop"),
                 );
@@ -118,34 +122,36 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
             }
             // (edge, tail, head) as the loop runs; a dangling edge id is
             // another stage's error, so the loop is not judged.
-            let chain: Option<Vec<(EdgeId, VertexId, VertexId)>> = edges
-                .iter()
-                .map(|oe| {
-                    let e = model.edges.get(oe.edge.index())?;
-                    Some(if oe.forward {
-                        (oe.edge, e.begin, e.end)
-                    } else {
-                        (oe.edge, e.end, e.begin)
-                    })
-                })
-                .collect();
-            let Some(chain) = chain else { continue };
-            let n = chain.len();
-            let broken = (0..n).find(|&k| chain[k].2 != chain[(k + 1) % n].1);
+            if edges.iter().any(|oe| oe.edge.index() >= model.edges.len()) {
+                continue;
+            }
+            let step = |k: usize| {
+                let oe = edges[k];
+                let e = &model.edges[oe.edge.index()];
+                if oe.forward {
+                    (oe.edge, e.begin, e.end)
+                } else {
+                    (oe.edge, e.end, e.begin)
+                }
+            };
+            let n = edges.len();
+            let broken = (0..n).find(|&k| step(k).2 != step((k + 1) % n).1);
             let Some(k) = broken else { continue };
-            let (edge, tail, head) = chain[k];
-            let (next, next_tail, _) = chain[(k + 1) % n];
+            let (edge, tail, head) = step(k);
+            let (next, next_tail, _) = step((k + 1) % n);
             let message = if n == 1 {
                 format!(
-                    "{which} is not closed: its only edge '{}' runs from vertex '{}' to vertex '{}'",
+                    "{} is not closed: its only edge '{}' runs from vertex '{}' to vertex '{}'",
+                    which(),
                     edge_name(model, edge),
                     vertex_name(model, tail),
                     vertex_name(model, head)
                 )
             } else {
                 format!(
-                    "{which} is not closed: edge '{}' ends at vertex '{}' but the next edge '{}' \
+                    "{} is not closed: edge '{}' ends at vertex '{}' but the next edge '{}' \
                      begins at vertex '{}'",
+                    which(),
                     edge_name(model, edge),
                     vertex_name(model, head),
                     edge_name(model, next),
@@ -171,60 +177,76 @@ struct EdgeUse {
     forward: bool,
 }
 
-/// Every use of every edge by the listed faces, per edge id.
-fn edge_uses(model: &Model, boundary: &[OrientedFace]) -> BTreeMap<EdgeId, Vec<EdgeUse>> {
-    let mut uses: BTreeMap<EdgeId, Vec<EdgeUse>> = BTreeMap::new();
-    for (entry, of) in boundary.iter().enumerate() {
-        let Some(face) = model.faces.get(of.face.index()) else {
-            continue;
-        };
-        for oe in face.loops.iter().flatten() {
-            if oe.edge.index() < model.edges.len() {
-                uses.entry(oe.edge).or_default().push(EdgeUse {
-                    entry,
-                    forward: oe.forward,
-                });
+/// Every use of every edge by the listed faces, grouped by edge id
+/// (ascending), each group in boundary order. One flat vector sorted by edge
+/// instead of a map of vectors: this runs for every subdomain of the model.
+struct EdgeUses {
+    uses: Vec<(EdgeId, EdgeUse)>,
+}
+
+impl EdgeUses {
+    fn of(model: &Model, boundary: &[OrientedFace]) -> EdgeUses {
+        let mut uses = Vec::new();
+        for (entry, of) in boundary.iter().enumerate() {
+            let Some(face) = model.faces.get(of.face.index()) else {
+                continue;
+            };
+            for oe in face.loops.iter().flatten() {
+                if oe.edge.index() < model.edges.len() {
+                    let forward = oe.forward;
+                    uses.push((oe.edge, EdgeUse { entry, forward }));
+                }
             }
         }
+        // Stable: within an edge the uses stay in boundary order.
+        uses.sort_by_key(|&(edge, _)| edge);
+        EdgeUses { uses }
     }
-    uses
+
+    /// The uses of every used edge, ascending by edge, without copying.
+    fn lists(&self) -> impl Iterator<Item = (EdgeId, &[(EdgeId, EdgeUse)])> + '_ {
+        self.uses
+            .chunk_by(|a, b| a.0 == b.0)
+            .map(|group| (group[0].0, group))
+    }
 }
 
 /// Groups boundary entries (with a valid face) connected through shared
 /// edges; components are ordered by their first entry, entries ascending.
-fn components(
-    model: &Model,
-    boundary: &[OrientedFace],
-    uses: &BTreeMap<EdgeId, Vec<EdgeUse>>,
-) -> Vec<Vec<usize>> {
+fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<Vec<usize>> {
+    // Union–find over the entries rather than adjacency sets and a search:
+    // the same components, without an allocation per face.
     let n = boundary.len();
-    let mut adjacent: Vec<BTreeSet<usize>> = vec![BTreeSet::new(); n];
-    for list in uses.values() {
+    let mut parent: Vec<usize> = (0..n).collect();
+    fn root(parent: &mut [usize], mut a: usize) -> usize {
+        while parent[a] != a {
+            parent[a] = parent[parent[a]];
+            a = parent[a];
+        }
+        a
+    }
+    for (_, list) in uses.lists() {
         for pair in list.windows(2) {
-            adjacent[pair[0].entry].insert(pair[1].entry);
-            adjacent[pair[1].entry].insert(pair[0].entry);
+            let (a, b) = (
+                root(&mut parent, pair[0].1.entry),
+                root(&mut parent, pair[1].1.entry),
+            );
+            parent[a.max(b)] = a.min(b);
         }
     }
-    let mut seen = vec![false; n];
-    let mut out = Vec::new();
-    for start in 0..n {
-        if seen[start] || boundary[start].face.index() >= model.faces.len() {
+    // Entries in ascending order: a component starts at its first entry.
+    let mut component_of_root = vec![usize::MAX; n];
+    let mut out: Vec<Vec<usize>> = Vec::new();
+    for entry in 0..n {
+        if boundary[entry].face.index() >= model.faces.len() {
             continue;
         }
-        seen[start] = true;
-        let mut members = vec![start];
-        let mut queue = VecDeque::from([start]);
-        while let Some(a) = queue.pop_front() {
-            for &b in &adjacent[a] {
-                if !seen[b] {
-                    seen[b] = true;
-                    members.push(b);
-                    queue.push_back(b);
-                }
-            }
+        let r = root(&mut parent, entry);
+        if component_of_root[r] == usize::MAX {
+            component_of_root[r] = out.len();
+            out.push(Vec::new());
         }
-        members.sort_unstable();
-        out.push(members);
+        out[component_of_root[r]].push(entry);
     }
     out
 }
@@ -254,13 +276,12 @@ impl Shell {
     }
 }
 
-fn shells_of(model: &Model, boundary: &[OrientedFace]) -> Vec<Shell> {
-    let uses = edge_uses(model, boundary);
-    components(model, boundary, &uses)
+fn shells_of(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<Shell> {
+    components(model, boundary, uses)
         .into_iter()
         .map(|members| {
-            let mut vertices = BTreeSet::new();
-            let mut edges = BTreeSet::new();
+            let mut vertices = Vec::new();
+            let mut edges = Vec::new();
             let mut loops = 0;
             let mut faces = Vec::with_capacity(members.len());
             for &entry in &members {
@@ -272,43 +293,50 @@ fn shells_of(model: &Model, boundary: &[OrientedFace]) -> Vec<Shell> {
                 loops += face.loops.len();
                 for oe in face.loops.iter().flatten() {
                     if let Some(edge) = model.edges.get(oe.edge.index()) {
-                        edges.insert(oe.edge);
-                        vertices.insert(edge.begin);
-                        vertices.insert(edge.end);
+                        edges.push(oe.edge);
+                        vertices.extend([edge.begin, edge.end]);
                     }
                 }
             }
             Shell {
                 faces,
-                vertices: vertices.len(),
-                edges: edges.len(),
+                vertices: count_distinct(&mut vertices),
+                edges: count_distinct(&mut edges),
                 loops,
             }
         })
         .collect()
 }
 
+/// How many different values `items` holds (sorting it).
+fn count_distinct<T: Ord>(items: &mut Vec<T>) -> usize {
+    items.sort_unstable();
+    items.dedup();
+    items.len()
+}
+
 fn distinct_vertices(model: &Model, boundary: &[OrientedFace]) -> usize {
-    let mut vertices = BTreeSet::new();
+    let mut vertices = Vec::new();
     for of in boundary {
         let Some(face) = model.faces.get(of.face.index()) else {
             continue;
         };
         for oe in face.loops.iter().flatten() {
             if let Some(edge) = model.edges.get(oe.edge.index()) {
-                vertices.insert(edge.begin);
-                vertices.insert(edge.end);
+                vertices.extend([edge.begin, edge.end]);
             }
         }
     }
-    vertices.len()
+    count_distinct(&mut vertices)
 }
 
 /// The connected shells of a 3D subdomain's boundary; empty for a 2D region
 /// or an id out of range.
 pub fn shells(model: &Model, subdomain: SubdomainId) -> Vec<Shell> {
     match model.subdomains.get(subdomain.index()).map(|s| &s.cells) {
-        Some(SubdomainCells::Volume { boundary }) => shells_of(model, boundary),
+        Some(SubdomainCells::Volume { boundary }) => {
+            shells_of(model, boundary, &EdgeUses::of(model, boundary))
+        }
         _ => Vec::new(),
     }
 }
@@ -317,77 +345,107 @@ pub fn shells(model: &Model, subdomain: SubdomainId) -> Vec<Shell> {
 /// boundaries only (so one missing face does not cascade), E404 (consistent
 /// outward orientation) and E405 (Euler–Poincaré per connected shell).
 pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut Diagnostics) {
-    for (k, subdomain) in model.subdomains.iter().enumerate() {
-        let SubdomainCells::Volume { boundary } = &subdomain.cells else {
-            continue;
-        };
-        // With trimmed faces the shell closes on the mesh (their chains are
-        // made there); meshing checks it.
-        if !subdomain.trimmed.is_empty() {
-            continue;
-        }
-        let id = SubdomainId(k as u32);
-        let uses = edge_uses(model, boundary);
-        let mut manifold = true;
-        for (&edge, list) in &uses {
-            let span = source_map.subdomain(id).or_else(|| source_map.edge(edge));
-            match list.len() {
-                2 => {}
-                1 => {
-                    manifold = false;
-                    let face = face_name(model, boundary[list[0].entry].face);
-                    diags.push(
-                        Diagnostic::new(
-                            Code::OpenShell,
-                            span,
-                            format!(
-                                "the boundary of subdomain '{}' is not closed: edge '{}' is used \
-                                 only by face '{face}'",
-                                subdomain.name,
-                                edge_name(model, edge)
-                            ),
-                        )
-                        .with_help(format!(
-                            "add the missing face across edge '{}' to subdomain '{}', or check \
-                             that the neighbouring face names the same edge",
+    // Each subdomain's shell is checked on its own, in parallel; the findings
+    // are appended in subdomain order, so they do not depend on the threads.
+    let findings: Vec<Diagnostics> = model
+        .subdomains
+        .par_iter()
+        .enumerate()
+        .with_min_len(1024)
+        .map(|(k, subdomain)| {
+            let mut found = Diagnostics::default();
+            check_shell(
+                model,
+                source_map,
+                SubdomainId(k as u32),
+                subdomain,
+                &mut found,
+            );
+            found
+        })
+        .filter(|found| !found.items.is_empty())
+        .collect();
+    for found in findings {
+        diags.extend(found);
+    }
+}
+
+/// The checks of [`check_subdomain_shells`] for one subdomain.
+fn check_shell(
+    model: &Model,
+    source_map: &SourceMap,
+    id: SubdomainId,
+    subdomain: &crate::ir::Subdomain,
+    diags: &mut Diagnostics,
+) {
+    let SubdomainCells::Volume { boundary } = &subdomain.cells else {
+        return;
+    };
+    // With trimmed faces the shell closes on the mesh (their chains are
+    // made there); meshing checks it.
+    if !subdomain.trimmed.is_empty() {
+        return;
+    }
+    let uses = EdgeUses::of(model, boundary);
+    let mut manifold = true;
+    for (edge, list) in uses.lists() {
+        let span = source_map.subdomain(id).or_else(|| source_map.edge(edge));
+        match list.len() {
+            2 => {}
+            1 => {
+                manifold = false;
+                let face = face_name(model, boundary[list[0].1.entry].face);
+                diags.push(
+                    Diagnostic::new(
+                        Code::OpenShell,
+                        span,
+                        format!(
+                            "the boundary of subdomain '{}' is not closed: edge '{}' is used \
+                             only by face '{face}'",
+                            subdomain.name,
+                            edge_name(model, edge)
+                        ),
+                    )
+                    .with_help(format!(
+                        "add the missing face across edge '{}' to subdomain '{}', or check \
+                         that the neighbouring face names the same edge",
+                        edge_name(model, edge),
+                        subdomain.name
+                    )),
+                );
+            }
+            n => {
+                manifold = false;
+                let faces: BTreeSet<String> = list
+                    .iter()
+                    .map(|(_, u)| format!("'{}'", face_name(model, boundary[u.entry].face)))
+                    .collect();
+                diags.push(
+                    Diagnostic::new(
+                        Code::NonManifoldEdge,
+                        span,
+                        format!(
+                            "edge '{}' is used {n} times in the boundary of subdomain '{}' \
+                             (faces {}), more than twice",
                             edge_name(model, edge),
-                            subdomain.name
-                        )),
-                    );
-                }
-                n => {
-                    manifold = false;
-                    let faces: BTreeSet<String> = list
-                        .iter()
-                        .map(|u| format!("'{}'", face_name(model, boundary[u.entry].face)))
-                        .collect();
-                    diags.push(
-                        Diagnostic::new(
-                            Code::NonManifoldEdge,
-                            span,
-                            format!(
-                                "edge '{}' is used {n} times in the boundary of subdomain '{}' \
-                                 (faces {}), more than twice",
-                                edge_name(model, edge),
-                                subdomain.name,
-                                faces.into_iter().collect::<Vec<_>>().join(", ")
-                            ),
-                        )
-                        .with_help(format!(
-                            "split subdomain '{}' so that each edge of a boundary is shared by \
-                             exactly two of its faces",
-                            subdomain.name
-                        )),
-                    );
-                }
+                            subdomain.name,
+                            faces.into_iter().collect::<Vec<_>>().join(", ")
+                        ),
+                    )
+                    .with_help(format!(
+                        "split subdomain '{}' so that each edge of a boundary is shared by \
+                         exactly two of its faces",
+                        subdomain.name
+                    )),
+                );
             }
         }
-        if !manifold {
-            continue;
-        }
-        check_orientation(model, source_map, id, boundary, &uses, diags);
-        check_euler(model, source_map, id, boundary, diags);
     }
+    if !manifold {
+        return;
+    }
+    check_orientation(model, source_map, id, boundary, &uses, diags);
+    check_euler(model, source_map, id, boundary, &uses, diags);
 }
 
 /// Two faces sharing an edge must traverse it in opposite directions once
@@ -400,7 +458,7 @@ fn check_orientation(
     source_map: &SourceMap,
     id: SubdomainId,
     boundary: &[OrientedFace],
-    uses: &BTreeMap<EdgeId, Vec<EdgeUse>>,
+    uses: &EdgeUses,
     diags: &mut Diagnostics,
 ) {
     let name = subdomain_name(model, id);
@@ -409,8 +467,8 @@ fn check_orientation(
     let mut adjacent: Vec<Vec<(usize, bool, EdgeId)>> = vec![Vec::new(); n];
     // A seam used twice the same way by one face makes that face one-sided.
     let mut seam_conflict: Vec<Option<EdgeId>> = vec![None; n];
-    for (&edge, list) in uses {
-        let [a, b] = list.as_slice() else { continue };
+    for (edge, list) in uses.lists() {
+        let [(_, a), (_, b)] = list else { continue };
         let differ = a.forward == b.forward;
         if a.entry == b.entry {
             if differ {
@@ -524,10 +582,11 @@ fn check_euler(
     source_map: &SourceMap,
     id: SubdomainId,
     boundary: &[OrientedFace],
+    uses: &EdgeUses,
     diags: &mut Diagnostics,
 ) {
     let name = subdomain_name(model, id);
-    let shells = shells_of(model, boundary);
+    let shells = shells_of(model, boundary, uses);
     let shared_vertices =
         shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices(model, boundary);
     if shared_vertices > 0 && shells.iter().all(|s| s.genus().is_some()) {
