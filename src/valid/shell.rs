@@ -1168,4 +1168,38 @@ mod tests {
         let _ = crate::ir::IncidenceMatrices::of(&b.model);
         let _ = crate::ir::derive_fragments(&b.model);
     }
+
+    #[test]
+    fn shell_findings_do_not_depend_on_the_threads() {
+        // More subdomains than one parallel job takes (1,024), each a unit
+        // cube with one face left out: four E402 each, in subdomain order.
+        let mut b = Builder::new(Dimension::Three);
+        for k in 0..1100 {
+            let mut faces = b.unit_box_faces(&format!("b{k}"), [2.0 * k as f64, 0.0, 0.0]);
+            faces.remove(k % 6);
+            b.push_subdomain(&format!("d{k}"), SubdomainCells::Volume { boundary: faces });
+        }
+        let run = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool")
+                .install(|| check_topology(&b.model, &b.map))
+        };
+        let one = run(1);
+        let open: Vec<&Diagnostic> = (one.items.iter())
+            .filter(|d| d.code == Code::OpenShell)
+            .collect();
+        assert_eq!(open.len(), 4400);
+        for (k, four) in open.chunks(4).enumerate() {
+            for d in four {
+                assert!(
+                    d.message.contains(&format!("subdomain 'd{k}'")),
+                    "{}",
+                    d.message
+                );
+            }
+        }
+        assert_eq!(run(4).items, one.items);
+    }
 }
