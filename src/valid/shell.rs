@@ -15,6 +15,10 @@ use crate::span::Span;
 use rayon::prelude::*;
 use std::collections::{BTreeSet, VecDeque};
 
+/// The fewest subdomains one parallel job of the shell checks takes (a
+/// shell check is a few microseconds; fewer per job would cost more than it saves).
+const SHELLS_PER_JOB: usize = 64;
+
 /// How close t1 − t0 of an ellipse must be to 2π for the curve to be closed.
 const ANGLE_TOLERANCE: f64 = 1e-9;
 
@@ -351,7 +355,7 @@ pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut
         .subdomains
         .par_iter()
         .enumerate()
-        .with_min_len(1024)
+        .with_min_len(SHELLS_PER_JOB)
         .map(|(k, subdomain)| {
             let mut found = Diagnostics::default();
             check_shell(
@@ -1171,10 +1175,11 @@ mod tests {
 
     #[test]
     fn shell_findings_do_not_depend_on_the_threads() {
-        // More subdomains than one parallel job takes (1,024), each a unit
-        // cube with one face left out: four E402 each, in subdomain order.
+        // More subdomains than two parallel jobs take, each a unit cube with
+        // one face left out: four E402 each, in subdomain order.
+        let n = 2 * SHELLS_PER_JOB + 5;
         let mut b = Builder::new(Dimension::Three);
-        for k in 0..1100 {
+        for k in 0..n {
             let mut faces = b.unit_box_faces(&format!("b{k}"), [2.0 * k as f64, 0.0, 0.0]);
             faces.remove(k % 6);
             b.push_subdomain(&format!("d{k}"), SubdomainCells::Volume { boundary: faces });
@@ -1190,7 +1195,7 @@ mod tests {
         let open: Vec<&Diagnostic> = (one.items.iter())
             .filter(|d| d.code == Code::OpenShell)
             .collect();
-        assert_eq!(open.len(), 4400);
+        assert_eq!(open.len(), 4 * n);
         for (k, four) in open.chunks(4).enumerate() {
             for d in four {
                 assert!(
