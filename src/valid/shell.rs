@@ -241,8 +241,8 @@ fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<
     // Entries in ascending order: a component starts at its first entry.
     let mut component_of_root = vec![usize::MAX; n];
     let mut out: Vec<Vec<usize>> = Vec::new();
-    for entry in 0..n {
-        if boundary[entry].face.index() >= model.faces.len() {
+    for (entry, of) in boundary.iter().enumerate() {
+        if of.face.index() >= model.faces.len() {
             continue;
         }
         let r = root(&mut parent, entry);
