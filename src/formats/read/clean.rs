@@ -331,7 +331,8 @@ mod tests {
         tris.push([0, rim(5), rim(6)]);
         let c = counts(&nodes, &tris, 2.8);
         assert_eq!((c.edges, c.non_manifold, c.open), (120, 3, 0));
-        // Without the bottom: the 40 rim edges are open.
+        // Without the duplicate and the bottom: the 40 rim edges are open.
+        tris.pop();
         let top: Vec<[u32; 3]> = tris.iter().step_by(2).copied().collect();
         let c = counts(&nodes, &top, 2.8);
         assert_eq!((c.edges, c.open, c.non_manifold), (80, 40, 0));
