@@ -90,7 +90,10 @@ impl Builder {
     pub fn finish_unchecked(mut self) -> Result<Loaded, Vec<Diagnostic>> {
         let n = self.nodes.len();
         for g in &self.groups {
-            let bad = g.triangles.iter().flatten().any(|&v| v as usize >= n)
+            // The largest index, in a loop the compiler vectorises (a
+            // short-circuiting `any` is a branch per index).
+            let largest = g.triangles.as_flattened().iter().fold(0, |m, &v| m.max(v));
+            let bad = (!g.triangles.is_empty() && largest as usize >= n)
                 || g.lines.iter().flatten().any(|&v| v as usize >= n)
                 || g.points.iter().any(|&v| v as usize >= n)
                 || g.volumes.iter().flatten().any(|&v| v as usize >= n);

@@ -113,11 +113,19 @@ fn diagonal(mesh: &Mesh) -> f64 {
 
 /// Edge use counts: half-edges bucketed by their lower node (a counting
 /// sort: two passes over the triangles, `(higher << 1) | direction` in
-/// 4 bytes each), then each node's few entries sorted in place. Linear in
+/// 4 bytes each), then each node's few entries grouped by edge. Linear in
 /// the mesh, and the same on any thread count.
 pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCounts {
     let mut out = EdgeCounts::default();
     let area_floor = (scale * scale) * 1e-14;
+    // Above this squared area the square root cannot be at or under the floor
+    // (the margin covers the rounding of the square): most triangles skip it.
+    let floor_squared = area_floor * area_floor;
+    let clearly_above = if floor_squared.is_normal() {
+        floor_squared * (1.0 + 1e-9)
+    } else {
+        f64::INFINITY
+    };
     let n = nodes.len();
     // The half-edges of a triangle as (lower node, higher << 1 | direction);
     // edges of repeated or unknown nodes are skipped.
@@ -133,43 +141,57 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
                 }
             })
     };
-    let mut start = vec![0u32; n + 1];
+    // `end[v + 1]` counts node v's half-edges, then (prefix sums) ends its
+    // bucket; filling steps each end back, so `end[v + 1]` finally starts
+    // bucket v and `end[v + 2]` ends it (one table, no copy for the fill).
+    let mut end = vec![0u32; n + 2];
     for t in triangles {
-        if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] || twice_area(nodes, *t) <= area_floor {
+        if t[0] == t[1]
+            || t[1] == t[2]
+            || t[0] == t[2]
+            || twice_area_at_most(nodes, *t, area_floor, clearly_above)
+        {
             out.degenerate += 1;
         }
         for (lo, _) in halves(t) {
-            if let Some(c) = start.get_mut(lo as usize + 1) {
+            if let Some(c) = end.get_mut(lo as usize + 1) {
                 *c += 1;
             }
         }
     }
-    for i in 1..start.len() {
-        let before = start.get(i - 1).copied().unwrap_or(0);
-        if let Some(c) = start.get_mut(i) {
+    for i in 1..end.len() {
+        let before = end.get(i - 1).copied().unwrap_or(0);
+        if let Some(c) = end.get_mut(i) {
             *c += before;
         }
     }
-    let mut fill = start.clone();
-    let mut slots = vec![0u32; start.last().copied().unwrap_or(0) as usize];
+    let mut slots = vec![0u32; end.last().copied().unwrap_or(0) as usize];
     for t in triangles {
         for (lo, entry) in halves(t) {
-            if let Some(f) = fill.get_mut(lo as usize)
-                && let Some(slot) = slots.get_mut(*f as usize)
-            {
-                *slot = entry;
-                *f += 1;
+            if let Some(e) = end.get_mut(lo as usize + 1) {
+                *e = e.saturating_sub(1);
+                if let Some(slot) = slots.get_mut(*e as usize) {
+                    *slot = entry;
+                }
             }
         }
     }
-    drop(fill);
-    for w in start.windows(2) {
+    for w in end.get(1..).unwrap_or_default().windows(2) {
         let &[from, to] = w else {
             continue;
         };
-        let Some(bucket) = slots.get_mut(from as usize..to as usize) else {
-            continue;
-        };
+        if let Some(bucket) = slots.get_mut(from as usize..to as usize) {
+            count_bucket(bucket, &mut out);
+        }
+    }
+    out
+}
+
+/// Adds the edges of one node's bucket to the counts. A bucket holds a few
+/// entries (about six on a closed surface): up to 32 are grouped by a
+/// pairwise scan with a bit mask of those already counted, larger ones sorted.
+fn count_bucket(bucket: &mut [u32], out: &mut EdgeCounts) {
+    if bucket.len() > 32 {
         bucket.sort_unstable();
         let mut i = 0;
         while let Some(&first) = bucket.get(i) {
@@ -184,23 +206,57 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
                 }
                 j += 1;
             }
-            out.edges += 1;
-            match forward + backward {
-                1 => out.open += 1,
-                2 => {
-                    if forward != 1 {
-                        out.inconsistent += 1;
-                    }
-                }
-                _ => out.non_manifold += 1,
-            }
+            tally(forward, backward, out);
             i = j;
         }
+        return;
     }
-    out
+    let mut counted = 0u32;
+    for (i, &h) in bucket.iter().enumerate() {
+        if counted & (1 << i) != 0 {
+            continue;
+        }
+        let key = h >> 1;
+        let (mut forward, mut backward) = (0usize, 0usize);
+        for (j, &g) in bucket.iter().enumerate().skip(i) {
+            if g >> 1 == key {
+                counted |= 1 << j;
+                if g & 1 == 0 {
+                    forward += 1;
+                } else {
+                    backward += 1;
+                }
+            }
+        }
+        tally(forward, backward, out);
+    }
 }
 
-fn twice_area(nodes: &[[f64; 3]], [a, b, c]: [u32; 3]) -> f64 {
+/// One edge used `forward` times in its direction and `backward` against it.
+fn tally(forward: usize, backward: usize, out: &mut EdgeCounts) {
+    out.edges += 1;
+    match forward + backward {
+        1 => out.open += 1,
+        2 => {
+            if forward != 1 {
+                out.inconsistent += 1;
+            }
+        }
+        _ => out.non_manifold += 1,
+    }
+}
+
+/// `twice_area(..) <= floor`, without the square root when the squared
+/// area is clearly above `floor²` (`clearly_above`).
+fn twice_area_at_most(nodes: &[[f64; 3]], t: [u32; 3], floor: f64, clearly_above: f64) -> bool {
+    let squared = twice_area_squared(nodes, t);
+    if squared > clearly_above {
+        return false;
+    }
+    squared.sqrt() <= floor
+}
+
+fn twice_area_squared(nodes: &[[f64; 3]], [a, b, c]: [u32; 3]) -> f64 {
     let (Some(p), Some(q), Some(r)) = (
         nodes.get(a as usize),
         nodes.get(b as usize),
@@ -215,7 +271,7 @@ fn twice_area(nodes: &[[f64; 3]], [a, b, c]: [u32; 3]) -> f64 {
         u[2] * v[0] - u[0] * v[2],
         u[0] * v[1] - u[1] * v[0],
     ];
-    (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+    n[0] * n[0] + n[1] * n[1] + n[2] * n[2]
 }
 
 #[cfg(test)]
@@ -241,5 +297,61 @@ mod tests {
         assert_eq!(c.open, 3);
         let c = counts(&nodes, &[[0, 1, 1], [0, 1, 2]], 1.7);
         assert_eq!(c.degenerate, 1);
+    }
+
+    /// A double cone of 40 segments: the apex's bucket holds 80 half-edges
+    /// (the sorting path), the rim nodes' a few (the scanning path).
+    #[test]
+    fn double_cone_counts_edges_through_both_bucket_paths() {
+        let segments = 40u32;
+        let mut nodes = vec![[0.0, 0.0, 1.0]];
+        for i in 0..segments {
+            let a = std::f64::consts::TAU * f64::from(i) / f64::from(segments);
+            nodes.push([a.cos(), a.sin(), 0.0]);
+        }
+        nodes.push([0.0, 0.0, -1.0]);
+        let rim = |i: u32| 1 + i % segments;
+        let mut tris = Vec::new();
+        for i in 0..segments {
+            tris.push([0, rim(i), rim(i + 1)]);
+            tris.push([segments + 1, rim(i + 1), rim(i)]);
+        }
+        let c = counts(&nodes, &tris, 2.8);
+        assert_eq!(
+            (c.edges, c.open, c.non_manifold, c.inconsistent),
+            (120, 0, 0, 0)
+        );
+        assert!(c.watertight());
+        // One apex triangle reversed: its three edges run like their neighbours'.
+        tris[0] = [0, rim(1), rim(0)];
+        let c = counts(&nodes, &tris, 2.8);
+        assert_eq!((c.edges, c.inconsistent), (120, 3));
+        tris[0] = [0, rim(0), rim(1)];
+        // A triangle given twice: its edges are used three times.
+        tris.push([0, rim(5), rim(6)]);
+        let c = counts(&nodes, &tris, 2.8);
+        assert_eq!((c.edges, c.non_manifold, c.open), (120, 3, 0));
+        // Without the duplicate and the bottom: the 40 rim edges are open.
+        tris.pop();
+        let top: Vec<[u32; 3]> = tris.iter().step_by(2).copied().collect();
+        let c = counts(&nodes, &top, 2.8);
+        assert_eq!((c.edges, c.open, c.non_manifold), (80, 40, 0));
+    }
+
+    #[test]
+    fn degenerate_test_without_the_root_agrees_near_the_floor() {
+        // Twice the area of this right triangle is exactly 2 * 2^-40 = 2^-39.
+        let h = 2f64.powi(-20);
+        let nodes = [[0.0, 0.0, 0.0], [2.0 * h, 0.0, 0.0], [0.0, h, 0.0]];
+        let tri = [[0, 1, 2]];
+        let floor = |scale: f64| scale * scale * 1e-14;
+        // Scale with the floor exactly at the area, just below and just above.
+        let at = (2f64.powi(-39) / 1e-14).sqrt();
+        for (scale, degenerate) in [(at * 1.001, 1), (at * 0.999, 0), (at * 0.9999999999, 0)] {
+            let c = counts(&nodes, &tri, scale);
+            let expected = usize::from(2f64.powi(-39) <= floor(scale));
+            assert_eq!(c.degenerate, expected, "scale {scale}");
+            assert_eq!(c.degenerate, degenerate, "scale {scale}");
+        }
     }
 }
