@@ -121,6 +121,19 @@ impl Camera {
             -dot(d, self.toward_eye),
         ]
     }
+
+    /// The depth [`Camera::project`] gives, alone (the same arithmetic, so
+    /// the same bits): the depth range of a million nodes costs one dot
+    /// product each instead of three.
+    #[inline]
+    pub fn depth(&self, p: [f64; 3]) -> f64 {
+        let d = [
+            p[0] - self.center[0],
+            p[1] - self.center[1],
+            p[2] - self.center[2],
+        ];
+        -dot(d, self.toward_eye)
+    }
 }
 
 pub fn dot(a: [f64; 3], b: [f64; 3]) -> f64 {

@@ -322,7 +322,7 @@ fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projecte
     let (lo, hi) = scene
         .points
         .par_iter()
-        .map(|&q| camera.project(q)[2])
+        .map(|&q| camera.depth(q))
         .fold(
             || (f64::INFINITY, f64::NEG_INFINITY),
             |(l, h), z| (l.min(z), h.max(z)),

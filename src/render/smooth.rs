@@ -10,7 +10,7 @@ use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Triangles per chunk of partial sums.
-const CHUNK: usize = 1 << 14;
+pub const CHUNK: usize = 1 << 14;
 /// Nodes per block of the final reduction.
 const BLOCK: usize = 1 << 12;
 /// Widest node range a chunk sums over in an array of its own; a mesh whose
@@ -37,10 +37,13 @@ fn add(sum: &mut [f64; 3], n: [f64; 3]) {
 /// (face, node) pairs of later faces get slots after the nodes, in sorted order.
 /// The slots are `None` when they are the triangles' own nodes (one face).
 /// `tri_face` must be non-decreasing (triangles grouped by face in face order).
+/// `spans`, when given for a one-face mesh, are [`node_spans`] of `tris`
+/// (the caller's validity check made them; they are not made twice).
 pub fn per_slot<T: Copy + Default + Send + Sync>(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     tri_face: &[u32],
+    spans: Option<&[(usize, usize)]>,
     finish: impl Fn([f64; 3]) -> T + Sync,
 ) -> (Option<Vec<[u32; 3]>>, Vec<T>) {
     let n = points.len();
@@ -52,15 +55,17 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
     };
     let corner_slots: &[[u32; 3]] = own_slots.as_deref().unwrap_or(tris);
     // Each chunk's node range over the corners of its first faces.
-    let spans: Vec<(usize, usize)> = corner_slots
-        .par_chunks(CHUNK)
-        .map(|chunk| {
-            let owned = chunk.iter().flatten().filter(|&&s| (s as usize) < n);
-            owned.fold((usize::MAX, 0), |(lo, hi), &s| {
-                (lo.min(s as usize), hi.max(s as usize + 1))
-            })
-        })
-        .collect();
+    let made;
+    let spans: &[(usize, usize)] = match spans {
+        Some(given) if own_slots.is_none() && given.len() == tris.len().div_ceil(CHUNK) => given,
+        _ => {
+            made = corner_slots
+                .par_chunks(CHUNK)
+                .map(|chunk| span(chunk, n))
+                .collect::<Vec<_>>();
+            &made
+        }
+    };
     let local = spans
         .iter()
         .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
@@ -80,7 +85,7 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
     let partials: Vec<Partial> = tris
         .par_chunks(CHUNK)
         .zip(corner_slots.par_chunks(CHUNK))
-        .zip(&spans)
+        .zip(spans)
         .map(|((ts, ss), &(lo, hi))| {
             let mut part = vec![[0.0; 3]; hi.saturating_sub(lo)];
             let mut later = Vec::new();
@@ -126,6 +131,25 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
         *o = finish(v);
     }
     (own_slots, out)
+}
+
+/// The node range `lo..hi` of the slots below `n` in one chunk of corners.
+#[inline]
+fn span(chunk: &[[u32; 3]], n: usize) -> (usize, usize) {
+    let owned = chunk.iter().flatten().filter(|&&s| (s as usize) < n);
+    owned.fold((usize::MAX, 0), |(lo, hi), &s| {
+        (lo.min(s as usize), hi.max(s as usize + 1))
+    })
+}
+
+/// Per [`CHUNK`] of triangles, the range of the nodes its corners name,
+/// over all of them (`hi` is past the largest): a triangle names a node
+/// past `n` exactly when some chunk's `hi > n`. For triangles that name
+/// none, these are the spans [`per_slot`] sums one face over.
+pub fn node_spans(tris: &[[u32; 3]]) -> Vec<(usize, usize)> {
+    tris.par_chunks(CHUNK)
+        .map(|chunk| span(chunk, usize::MAX))
+        .collect()
 }
 
 /// The slots of a mesh of several faces, and the (face, node) pairs of the
@@ -214,7 +238,7 @@ mod tests {
     }
 
     fn check(points: &[[f64; 3]], tris: &[[u32; 3]], tri_face: &[u32], (nx, ny): (usize, usize)) {
-        let (slots, sums) = per_slot(points, tris, tri_face, |v| v);
+        let (slots, sums) = per_slot(points, tris, tri_face, None, |v| v);
         let one_face = tri_face.iter().all(|&f| f == 0);
         assert_eq!(slots.is_none(), one_face);
         let slots = slots.unwrap_or_else(|| tris.to_vec());
