@@ -112,7 +112,10 @@ fn percent_encode(s: &str) -> String {
 /// copy of the whole buffer is built before the output.
 enum Piece<'a> {
     /// Vectors written as three little-endian `f32`.
-    Vec3(Cow<'a, [[f64; 3]]>),
+    Vec3(&'a [[f64; 3]]),
+    /// Vectors made for this output (an expansion's positions and normals),
+    /// kept as the `f32` they are written as: half the memory of `f64`.
+    Vec3F32(Vec<[f32; 3]>),
     /// Triangle corners written as little-endian `u32`.
     Triangles(Cow<'a, [[u32; 3]]>),
     /// Indices written as little-endian `u32`.
@@ -123,6 +126,7 @@ impl Piece<'_> {
     fn byte_len(&self) -> usize {
         match self {
             Piece::Vec3(v) => 12 * v.len(),
+            Piece::Vec3F32(v) => 12 * v.len(),
             Piece::Triangles(t) => 12 * t.len(),
             Piece::Indices(i) => 4 * i.len(),
         }
@@ -134,6 +138,7 @@ impl Piece<'_> {
             Piece::Vec3(v) => {
                 write_blocks(v.as_flattened(), block, out, |c| (c as f32).to_le_bytes())
             }
+            Piece::Vec3F32(v) => write_blocks(v.as_flattened(), block, out, f32::to_le_bytes),
             Piece::Triangles(t) => write_blocks(t.as_flattened(), block, out, u32::to_le_bytes),
             Piece::Indices(i) => write_blocks(i, block, out, u32::to_le_bytes),
         }
@@ -276,7 +281,14 @@ impl<'a> Document<'a> {
                 }
             }
         }
-        let view = self.view(Piece::Vec3(values), ARRAY_BUFFER);
+        let piece = match values {
+            Cow::Borrowed(v) => Piece::Vec3(v),
+            // Converted now (the same `as f32` the write would do) and the
+            // `f64` copy freed: the document holds every group's vectors
+            // until the buffer is written.
+            Cow::Owned(v) => Piece::Vec3F32(v.iter().map(|p| p.map(|c| c as f32)).collect()),
+        };
+        let view = self.view(piece, ARRAY_BUFFER);
         let mut accessor = json!({
             "bufferView": view,
             "componentType": FLOAT,

@@ -50,7 +50,8 @@ const GUIDE_FACTOR: f64 = 8.0;
 /// Nodes one face may have.
 const MAX_FACE_VERTICES: usize = 2_000_000;
 
-/// A node of a face mesh before global numbering.
+/// A node of a face mesh that is a node of the model's edges, before
+/// global numbering. Every other node of a face mesh is interior to it.
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) enum FacePoint {
     Vertex(u32),
@@ -61,16 +62,21 @@ pub(crate) enum FacePoint {
         edge: usize,
         s: f64,
     },
-    Interior(Point3),
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub(crate) struct FaceMesh {
-    pub points: Vec<FacePoint>,
-    /// Indices into `points` (a face has at most `MAX_FACE_VERTICES` nodes).
+    /// Every node's position (24 bytes a node: interior nodes, the bulk of
+    /// a curved face, carry no key beside it).
+    pub positions: Vec<Point3>,
+    /// The nodes that belong to the model's edges, as (index into
+    /// `positions`, key), each index once, in increasing order; the others
+    /// are interior nodes.
+    pub on_edges: Vec<(u32, FacePoint)>,
+    /// Indices into `positions` (a face has at most `MAX_FACE_VERTICES` nodes).
     pub triangles: Vec<[u32; 3]>,
     /// Constrained poly_lines: (poly_line index, its points in order, as
-    /// indices into `points`, refinement points included).
+    /// indices into `positions`, refinement points included).
     pub polylines: Vec<(usize, Vec<usize>)>,
     /// Nodes refinement added on straight boundary edges and kept (edge,
     /// curve parameter): the caller adds them to the edges and re-meshes
@@ -130,7 +136,10 @@ pub(crate) fn mesh_face(
         settings.max_area.min(guide_area(&uv_loops, &face.surface)),
     );
     let mut cdt = Cdt::with_capacity(expected, 3 * expected, 2 * expected);
-    let mut keys: Vec<FacePoint> = Vec::with_capacity(expected);
+    // Keys of the loops' nodes, which come first; later nodes are interior
+    // unless a plane face keeps a boundary split (`kept_keys`).
+    let mut keys: Vec<FacePoint> = Vec::new();
+    let mut kept_keys: Vec<(u32, FacePoint)> = Vec::new();
     let mut positions: Vec<Point3> = Vec::with_capacity(expected);
     let mut segments = Segments::new();
     for (lp, uv) in loops.iter().zip(&uv_loops) {
@@ -140,7 +149,7 @@ pub(crate) fn mesh_face(
                 .insert(point2(*uv))
                 .map_err(|e| failed(format!("a boundary node cannot be triangulated: {e:?}")))?;
             let index = handle.index();
-            if index == keys.len() {
+            if index == positions.len() {
                 keys.push(point.key.clone());
                 positions.push(point.point);
             } else if keys.get(index) != Some(&point.key) {
@@ -173,8 +182,7 @@ pub(crate) fn mesh_face(
         let handle = cdt
             .insert(Point2::new(uv[0], uv[1]))
             .map_err(|e| failed(format!("the apex cannot be triangulated: {e:?}")))?;
-        if handle.index() == keys.len() {
-            keys.push(FacePoint::Interior(p));
+        if handle.index() == positions.len() {
             positions.push(p);
         }
     }
@@ -182,7 +190,7 @@ pub(crate) fn mesh_face(
     let mut polyline_handles: Vec<(usize, Vec<usize>)> = Vec::new();
     // A poly_line tip may be a boundary node (`constraints::assign` put it
     // on a boundary edge); no other poly_line point may coincide with one.
-    let boundary_nodes = keys.len();
+    let boundary_nodes = positions.len();
     for (index, points) in constraints {
         let mut handles = Vec::with_capacity(points.len());
         for (k, p) in points.iter().enumerate() {
@@ -193,8 +201,7 @@ pub(crate) fn mesh_face(
             let handle = cdt
                 .insert(point2(uv))
                 .map_err(|e| failed(format!("a poly_line point cannot be triangulated: {e:?}")))?;
-            if handle.index() == keys.len() {
-                keys.push(FacePoint::Interior(*p));
+            if handle.index() == positions.len() {
                 positions.push(*p);
             } else if handles.last() != Some(&handle.index())
                 && !(tip && handle.index() < boundary_nodes)
@@ -237,7 +244,7 @@ pub(crate) fn mesh_face(
     // triangles, `Coarse`) and dropped with the rest of the outside.
     let framed = !polyline_segments.is_empty() && matches!(face.surface, Surface::Plane { .. });
     if framed {
-        insert_frame(&mut cdt, &chart, &uv_loops, &mut keys, &mut positions).map_err(failed)?;
+        insert_frame(&mut cdt, &chart, &uv_loops, &mut positions).map_err(failed)?;
     }
     let fixed = cdt.num_vertices();
 
@@ -420,9 +427,10 @@ pub(crate) fn mesh_face(
             }
         }
         unchecked = cdt.num_vertices();
-        lift_new_vertices(&cdt, &chart, &mut keys, &mut positions).map_err(failed)?;
+        lift_new_vertices(&cdt, &chart, &mut positions).map_err(failed)?;
         for (edge, v, s, node) in kept {
-            keys[v] = FacePoint::Edge { edge, s };
+            // Node indices fit in 32 bits (`MAX_FACE_VERTICES`).
+            kept_keys.push((v as u32, FacePoint::Edge { edge, s }));
             if let Some(node) = node {
                 positions[v] = node;
             }
@@ -494,12 +502,21 @@ pub(crate) fn mesh_face(
         .collect();
     // Kept until every face is meshed: without the room to spare the pass
     // buffers had.
-    drop((positions, cdt));
+    drop(cdt);
     let mut triangles = inner;
     triangles.shrink_to_fit();
-    keys.shrink_to_fit();
+    positions.shrink_to_fit();
+    let mut on_edges: Vec<(u32, FacePoint)> = (0u32..).zip(keys).chain(kept_keys).collect();
+    // A later key for the same node replaces an earlier one (stable sort,
+    // then the last of each run is kept).
+    on_edges.sort_by_key(|&(i, _)| i);
+    on_edges.reverse();
+    on_edges.dedup_by_key(|&mut (i, _)| i);
+    on_edges.reverse();
+    on_edges.shrink_to_fit();
     Ok(Outcome::Meshed(FaceMesh {
-        points: keys,
+        positions,
+        on_edges,
         triangles,
         polylines,
         added,
@@ -624,7 +641,6 @@ fn insert_frame(
     cdt: &mut Cdt,
     chart: &Chart,
     uv_loops: &[Vec<[f64; 2]>],
-    keys: &mut Vec<FacePoint>,
     positions: &mut Vec<Point3>,
 ) -> Result<(), String> {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -647,10 +663,9 @@ fn insert_frame(
         let p = chart
             .lift(corner)
             .ok_or("the outside frame does not lift onto the face's plane")?;
-        if handle.index() != keys.len() {
+        if handle.index() != positions.len() {
             return Err("the outside frame meets the face".into());
         }
-        keys.push(FacePoint::Interior(p));
         positions.push(p);
     }
     Ok(())
@@ -881,12 +896,7 @@ fn polyline_chain(cdt: &Cdt, fixed: usize, handles: &[usize]) -> Vec<usize> {
 
 /// Lifts the vertices the triangulation has beyond `positions` onto the
 /// surface, as interior nodes.
-fn lift_new_vertices(
-    cdt: &Cdt,
-    chart: &Chart,
-    keys: &mut Vec<FacePoint>,
-    positions: &mut Vec<Point3>,
-) -> Result<(), String> {
+fn lift_new_vertices(cdt: &Cdt, chart: &Chart, positions: &mut Vec<Point3>) -> Result<(), String> {
     for v in positions.len()..cdt.num_vertices() {
         let uv = cdt
             .vertex(spade::handles::FixedVertexHandle::from_index(v))
@@ -897,7 +907,6 @@ fn lift_new_vertices(
                 uv.x, uv.y
             )
         })?;
-        keys.push(FacePoint::Interior(p));
         positions.push(p);
     }
     Ok(())

@@ -450,12 +450,7 @@ fn assemble(
     let interior: usize = face_meshes
         .iter()
         .flatten()
-        .map(|m| {
-            m.points
-                .iter()
-                .filter(|p| matches!(p, FacePoint::Interior(_)))
-                .count()
-        })
+        .map(|m| m.positions.len() - m.on_edges.len())
         .sum();
     let on_edges: usize = edge_nodes
         .iter()
@@ -502,27 +497,35 @@ fn assemble(
     for (face, mesh) in model.faces.iter().zip(face_meshes) {
         let mut triangles = Vec::new();
         if let Some(mesh) = mesh {
-            triangles.reserve_exact(mesh.triangles.len());
-            let mut ids: Vec<Option<u32>> = vec![None; mesh.points.len()];
-            for t in &mesh.triangles {
-                let mut tri = [0u32; 3];
-                for (slot, &i) in tri.iter_mut().zip(t) {
-                    let i = i as usize;
-                    let id = match (&mesh.points[i], ids[i]) {
-                        (_, Some(id)) => id,
-                        (FacePoint::Vertex(v), None) => *v,
-                        (FacePoint::Edge { edge, s }, None) => edge_ids
-                            .get(*edge)
-                            .zip(edge_nodes.get(*edge))
-                            .and_then(|(ids, disc)| ids.get(disc.index_of(*s)))
-                            .copied()
-                            .unwrap_or(0),
-                        (FacePoint::Interior(p), None) => push(&mut nodes, p),
+            let mut ids: Vec<Option<u32>> = vec![None; mesh.positions.len()];
+            for (i, key) in &mesh.on_edges {
+                let id = match key {
+                    FacePoint::Vertex(v) => *v,
+                    FacePoint::Edge { edge, s } => edge_ids
+                        .get(*edge)
+                        .zip(edge_nodes.get(*edge))
+                        .and_then(|(ids, disc)| ids.get(disc.index_of(*s)))
+                        .copied()
+                        .unwrap_or(0),
+                };
+                if let Some(slot) = ids.get_mut(*i as usize) {
+                    *slot = Some(id);
+                }
+            }
+            // Interior nodes are numbered in the order the triangles first
+            // use them. The face's triangles become the mesh's in place:
+            // the face meshes and the assembled triangles are never both held.
+            triangles = mesh.triangles;
+            for t in &mut triangles {
+                for slot in t.iter_mut() {
+                    let i = *slot as usize;
+                    let id = match ids[i] {
+                        Some(id) => id,
+                        None => push(&mut nodes, &mesh.positions[i]),
                     };
                     ids[i] = Some(id);
                     *slot = id;
                 }
-                triangles.push(tri);
             }
             for (index, chain) in &mesh.polylines {
                 let nodes = chain.iter().filter_map(|&i| ids.get(i).copied().flatten());
