@@ -47,6 +47,13 @@ pub(super) struct Refined {
     pub outside: Vec<bool>,
     /// False when the vertex budget ran out first.
     pub complete: bool,
+    /// The vertices put on segments (ascending): the only new vertices on
+    /// the boundary. `None` when not known (spade's `refine`).
+    pub on_segments: Option<Vec<usize>>,
+    /// Every triangle was checked against the angle and area bounds when
+    /// it was made (false after a flood fill: adding constraints there may
+    /// flip edges away from the new point, out of its star).
+    pub all_checked: bool,
 }
 
 struct Refiner<'a> {
@@ -74,6 +81,8 @@ struct Refiner<'a> {
     pass: u32,
     cavity: Vec<FixedFaceHandle<InnerTag>>,
     encroached: Vec<(FixedVertexHandle, FixedVertexHandle)>,
+    on_segments: Vec<usize>,
+    reflooded: bool,
     /// A bad triangle was left as it is (its point could be neither
     /// inserted nor made room for).
     gave_up: bool,
@@ -109,6 +118,8 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
         pass: 0,
         cavity: Vec::new(),
         encroached: Vec::new(),
+        on_segments: Vec::new(),
+        reflooded: false,
         gave_up: false,
     };
     let segments: Vec<_> = r
@@ -145,19 +156,24 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
         let index = face.index();
         // Gone since it was queued (its slot now holds another triangle,
         // queued on its own when it was made).
-        if index >= r.cdt.num_all_faces()
-            || r.cdt.face(face).vertices().map(|v| v.fix().index()) != corners
-            || r.outside[index]
-        {
+        if index >= r.cdt.num_all_faces() || r.outside[index] {
             continue;
         }
-        if let Some(point) = r.bad_triangle_point(face) {
+        // One lookup of the corners serves the check and the positions
+        // (face lookups are a sixth of the time at 1.5 M triangles).
+        let vertices = r.cdt.face(face).vertices();
+        if vertices.map(|v| v.fix().index()) != corners {
+            continue;
+        }
+        if let Some(point) = r.bad_triangle_point(vertices.map(|v| v.position())) {
             r.split_triangle(face, point);
         }
     }
     Refined {
         complete: complete && !r.gave_up,
         outside: r.outside,
+        on_segments: Some(r.on_segments),
+        all_checked: !r.reflooded,
     }
 }
 
@@ -194,10 +210,9 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
 impl Refiner<'_> {
     /// Queues the triangle when it is bad.
     fn push_triangle(&mut self, f: FixedFaceHandle<InnerTag>) {
-        let face = self.cdt.face(f);
-        let p = face.positions();
-        if let Some(shortest) = self.badness(p) {
-            let corners = face.vertices().map(|v| v.fix().index());
+        let vertices = self.cdt.face(f).vertices();
+        if let Some(shortest) = self.badness(vertices.map(|v| v.position())) {
+            let corners = vertices.map(|v| v.fix().index());
             self.triangles.push(shortest, (f, corners));
         }
     }
@@ -248,8 +263,7 @@ impl Refiner<'_> {
 
     /// The point to insert for a triangle below the angle or above the area
     /// limit (its off-centre or circumcentre), or `None` when it is fine.
-    fn bad_triangle_point(&self, face: FixedFaceHandle<InnerTag>) -> Option<Point2<f64>> {
-        let p = self.cdt.face(face).positions();
+    fn bad_triangle_point(&self, p: [Point2<f64>; 3]) -> Option<Point2<f64>> {
         self.badness(p)?;
         // The shortest edge k runs from p[k] to p[k + 1]; its opposite
         // corner holds the smallest angle.
@@ -402,6 +416,7 @@ impl Refiner<'_> {
                 return false;
             }
         };
+        self.on_segments.push(v.index());
         let clean = self.cdt.get_edge_from_neighbors(a, v).is_some()
             && self.cdt.get_edge_from_neighbors(v, b).is_some();
         if !(self.cdt.can_add_constraint(a, v) && self.cdt.can_add_constraint(v, b)) {
@@ -437,6 +452,7 @@ impl Refiner<'_> {
 
     /// Recomputes which faces are outside from scratch.
     fn reflood(&mut self) {
+        self.reflooded = true;
         self.outside = super::face::outside_faces(self.cdt, &[]);
     }
 
