@@ -39,32 +39,54 @@ fn vertex(cdt: &Cdt, v: usize) -> Point2<f64> {
     cdt.vertex(FixedVertexHandle::from_index(v)).position()
 }
 
-fn constraint_neighbours(cdt: &Cdt, v: usize) -> Vec<usize> {
-    cdt.vertex(FixedVertexHandle::from_index(v))
+/// The vertices joined to `v` by constraint edges: the first two, and how
+/// many there are (no allocation: this runs for every new vertex of a
+/// face, hundreds of thousands under an area limit).
+fn constraint_neighbours(cdt: &Cdt, v: usize) -> ([usize; 2], usize) {
+    let mut found = [usize::MAX; 2];
+    let mut count = 0;
+    for e in cdt
+        .vertex(FixedVertexHandle::from_index(v))
         .out_edges()
         .filter(|e| e.is_constraint_edge())
-        .map(|e| e.to().fix().index())
-        .collect()
+    {
+        if let Some(slot) = found.get_mut(count) {
+            *slot = e.to().fix().index();
+        }
+        count += 1;
+    }
+    (found, count)
 }
 
 /// The chains of vertices from index `first` on that refinement put on
 /// boundary segments (`segments` holds every boundary segment between
-/// vertices below `first`).
+/// vertices below `first`). `candidates`, when given, are the only new
+/// vertices that can be on a segment (ascending; geomc's own refinement
+/// records the ones it put there), so the others need no look.
 pub(super) fn chains(
     cdt: &Cdt,
     first: usize,
+    candidates: Option<&[usize]>,
     segments: &Segments,
     polyline_segments: &[(usize, usize)],
 ) -> Result<Vec<Chain>, String> {
     const AWAY: &str = "refinement put a node on its boundary away from every edge";
     let mut seen: HashSet<usize> = HashSet::new();
     let mut chains = Vec::new();
-    for w in first..cdt.num_vertices() {
-        if seen.contains(&w) {
+    let all: Vec<usize>;
+    let candidates = match candidates {
+        Some(c) => c,
+        None => {
+            all = (first..cdt.num_vertices()).collect();
+            &all
+        }
+    };
+    for &w in candidates {
+        if w < first || seen.contains(&w) {
             continue;
         }
-        let around = constraint_neighbours(cdt, w);
-        if around.is_empty() {
+        let (around, count) = constraint_neighbours(cdt, w);
+        if count == 0 {
             continue;
         }
         let p = vertex(cdt, w);
@@ -74,7 +96,10 @@ pub(super) fn chains(
         {
             continue;
         }
-        let [left, right] = <[usize; 2]>::try_from(around).map_err(|_| AWAY.to_string())?;
+        if count != 2 {
+            return Err(AWAY.to_string());
+        }
+        let [left, right] = around;
         // Walk each way to the first checked vertex.
         let walk = |start: usize| -> Result<(Vec<usize>, usize), String> {
             let (mut prev, mut cur, mut path) = (w, start, Vec::new());
@@ -83,9 +108,9 @@ pub(super) fn chains(
                     return Err(AWAY.to_string());
                 }
                 path.push(cur);
-                let next = match constraint_neighbours(cdt, cur)[..] {
-                    [a, b] if a == prev => b,
-                    [a, b] if b == prev => a,
+                let next = match constraint_neighbours(cdt, cur) {
+                    ([a, b], 2) if a == prev => b,
+                    ([a, b], 2) if b == prev => a,
                     _ => return Err(AWAY.to_string()),
                 };
                 (prev, cur) = (cur, next);
@@ -158,7 +183,7 @@ pub(super) fn move_onto_curve(
     // A point that fell on another constraint split it: not a chain.
     handles[1..handles.len() - 1]
         .iter()
-        .all(|&v| constraint_neighbours(cdt, v).len() == 2)
+        .all(|&v| constraint_neighbours(cdt, v).1 == 2)
         .then_some(())
 }
 

@@ -135,14 +135,35 @@ pub(crate) fn mesh_face(
         &uv_loops,
         settings.max_area.min(guide_area(&uv_loops, &face.surface)),
     );
-    let mut cdt = Cdt::with_capacity(expected, 3 * expected, 2 * expected);
+    let bulk = bulk_load_loops(&uv_loops);
+    let bulk_loaded = bulk.is_some();
+    let mut cdt = bulk.unwrap_or_else(|| Cdt::with_capacity(expected, 3 * expected, 2 * expected));
     // Keys of the loops' nodes, which come first; later nodes are interior
     // unless a plane face keeps a boundary split (`kept_keys`).
     let mut keys: Vec<FacePoint> = Vec::new();
     let mut kept_keys: Vec<(u32, FacePoint)> = Vec::new();
     let mut positions: Vec<Point3> = Vec::with_capacity(expected);
     let mut segments = Segments::new();
-    for (lp, uv) in loops.iter().zip(&uv_loops) {
+    if bulk_loaded {
+        // Vertex i is loop point i (loops in order): the keys, positions
+        // and segments follow from the loops alone.
+        let mut first = 0;
+        for lp in &loops {
+            for (i, point) in lp.iter().enumerate() {
+                keys.push(point.key.clone());
+                positions.push(point.point);
+                let (a, b) = (first + i, first + (i + 1) % lp.len());
+                let entry = if a < b {
+                    (point.edge, point.s, point.s_next)
+                } else {
+                    (point.edge, point.s_next, point.s)
+                };
+                segments.insert((a.min(b), a.max(b)), entry);
+            }
+            first += lp.len();
+        }
+    }
+    for (lp, uv) in loops.iter().zip(&uv_loops).filter(|_| !bulk_loaded) {
         let mut handles = Vec::with_capacity(lp.len());
         for (point, uv) in lp.iter().zip(uv) {
             let handle = cdt
@@ -340,6 +361,8 @@ pub(crate) fn mesh_face(
             refine::Refined {
                 outside,
                 complete: result.refinement_complete,
+                on_segments: None,
+                all_checked: false,
             }
         };
         if settings.keep_boundary && !polyline_segments.is_empty() {
@@ -374,8 +397,14 @@ pub(crate) fn mesh_face(
         let mut moved = false;
         if !settings.keep_boundary {
             // Only the vertices added since the last check.
-            let mut chains = boundary_chain::chains(&cdt, unchecked, &segments, &polyline_segments)
-                .map_err(failed)?;
+            let mut chains = boundary_chain::chains(
+                &cdt,
+                unchecked,
+                result.on_segments.as_deref(),
+                &segments,
+                &polyline_segments,
+            )
+            .map_err(failed)?;
             let plane = matches!(face.surface, Surface::Plane { .. });
             let straight = |edge: usize| {
                 matches!(
@@ -446,6 +475,16 @@ pub(crate) fn mesh_face(
         } else {
             excluded = outside_faces(&cdt, &polyline_segments);
         }
+        // geomc's refinement, when complete, left every triangle within the
+        // area limit; on a plane with no edge-length limit nothing else can
+        // make one coarse, and the check (a second lookup of every
+        // triangle) is skipped.
+        let cannot_be_coarse = own
+            && result.complete
+            && result.all_checked
+            && matches!(deviation, Deviation::Plane)
+            && settings.sizing.is_uniform()
+            && settings.sizing.at(&Point3::origin()) == f64::INFINITY;
         fine.resize(cdt.num_all_faces(), NOT_FINE);
         inner.clear();
         let mut bad = Vec::new();
@@ -458,7 +497,7 @@ pub(crate) fn mesh_face(
             // Node indices fit in 32 bits (`MAX_FACE_VERTICES`).
             inner.push([a as u32, b as u32, c as u32]);
             let key = triangle_key(a, b, c);
-            if key.is_some_and(|k| fine[slot] == k) {
+            if cannot_be_coarse || key.is_some_and(|k| fine[slot] == k) {
                 continue;
             }
             if coarse.is(f, &positions) {
@@ -758,6 +797,48 @@ fn expected_vertices(uv_loops: &[Vec<[f64; 2]>], max_area: f64) -> usize {
         0
     };
     (boundary + interior).min(MAX_FACE_VERTICES)
+}
+
+/// Boundaries from this many points on are bulk loaded (`bulk_load_loops`).
+const BULK_LOAD_POINTS: usize = 4096;
+
+/// The loops of a large boundary as one constrained triangulation, bulk
+/// loaded, with vertex i the i-th loop point (loops in order). Inserting a
+/// long loop point by point put every point outside the hull of the ones
+/// before it: on a 10,000-point polygon that took longer than the whole
+/// refinement. `None` (insert one by one, which also reports the errors)
+/// for small boundaries, repeated points, crossing loops, or a loop
+/// segment through another point.
+fn bulk_load_loops(uv_loops: &[Vec<[f64; 2]>]) -> Option<Cdt> {
+    let count: usize = uv_loops.iter().map(Vec::len).sum();
+    if count < BULK_LOAD_POINTS {
+        return None;
+    }
+    let mut points = Vec::with_capacity(count);
+    let mut segments = Vec::with_capacity(count);
+    for lp in uv_loops {
+        let first = points.len();
+        if lp.len() < 3 {
+            return None;
+        }
+        for (i, uv) in lp.iter().enumerate() {
+            points.push(point2(*uv));
+            segments.push([first + i, first + (i + 1) % lp.len()]);
+        }
+    }
+    let mut conflict = false;
+    let cdt = Cdt::try_bulk_load_cdt(points, segments.clone(), |_| conflict = true).ok()?;
+    let whole = !conflict
+        && cdt.num_vertices() == count
+        && cdt.num_constraints() == segments.len()
+        && segments.iter().all(|&[a, b]| {
+            cdt.get_edge_from_neighbors(
+                spade::handles::FixedVertexHandle::from_index(a),
+                spade::handles::FixedVertexHandle::from_index(b),
+            )
+            .is_some_and(|e| e.is_constraint_edge())
+        });
+    whole.then_some(cdt)
 }
 
 /// A first area limit for the angle refinement of a curved face, in chart
