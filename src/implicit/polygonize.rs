@@ -789,26 +789,27 @@ thread_local! {
     static EDGE_MAPS: Cell<[Vec<u32>; 2]> = const { Cell::new([Vec::new(), Vec::new()]) };
 }
 
-/// A run of slabs k0..k1: the vertices of planes k0..k1 (and of the top
-/// plane when the run is the last), and the slabs' triangles.
+/// A run of slabs k0..k1: the vertices of its inner planes k0 + 1..k1 and
+/// the slabs' triangles.
 struct RunOutput {
-    planes: Vec<PlaneVertices>,
+    inner: Vec<PlaneVertices>,
     slabs: Vec<SlabOutput>,
 }
 
-/// Contours slabs `slabs` of the field one after the other, each right after
-/// the vertices of its upper plane (its lower plane's were made for the slab
-/// before, or first).
+/// Contours slabs `slabs` (not empty) of the field one after the other,
+/// each right after the vertices of its upper plane; `bottom` and `top` are
+/// the vertices of planes k0 and k1, made once for the two runs sharing them
+/// (root finding on a plane's edges is the costly part of the whole path).
 fn contour_run(
     field: &Field,
     signs: &SignRows,
     coords: &[Vec<f64>; 3],
     slabs: std::ops::Range<usize>,
+    [bottom, top]: [&PlaneVertices; 2],
     options: &Options,
 ) -> RunOutput {
     let n1 = field.n1;
-    let last = slabs.end + 1 == n1[2] || slabs.is_empty();
-    let mut planes = Vec::with_capacity(slabs.len() + 1);
+    let mut inner = Vec::with_capacity(slabs.len());
     let mut out = Vec::with_capacity(slabs.len());
     // Edge key → vertex index within its plane, for the slab's lower and
     // upper plane; after a slab the lower plane's entries are reset and the
@@ -826,30 +827,30 @@ fn contour_run(
             map[key as usize] = if on { m as u32 } else { u32::MAX };
         }
     };
-    let mut lower = plane_vertices(field, signs, coords, slabs.start, options);
-    fill(&mut maps[0], &lower, true);
+    fill(&mut maps[0], bottom, true);
     for k in slabs.clone() {
-        let upper = plane_vertices(field, signs, coords, k + 1, options);
-        fill(&mut maps[1], &upper, true);
-        let slab = contour_slab(
-            field,
-            signs,
-            k,
-            [&lower, &upper],
-            &maps,
-            options.close_at_box,
-        );
+        if k + 1 < slabs.end {
+            inner.push(plane_vertices(field, signs, coords, k + 1, options));
+        }
+        let lower = if k == slabs.start {
+            bottom
+        } else {
+            &inner[k - slabs.start - 1]
+        };
+        let upper = if k + 1 == slabs.end {
+            top
+        } else {
+            &inner[k - slabs.start]
+        };
+        fill(&mut maps[1], upper, true);
+        let slab = contour_slab(field, signs, k, [lower, upper], &maps, options.close_at_box);
         out.push(slab);
-        fill(&mut maps[0], &lower, false);
+        fill(&mut maps[0], lower, false);
         maps.swap(0, 1);
-        planes.push(std::mem::replace(&mut lower, upper));
     }
-    fill(&mut maps[0], &lower, false);
+    fill(&mut maps[0], top, false);
     EDGE_MAPS.with(|m| m.set(maps));
-    if last {
-        planes.push(lower);
-    }
-    RunOutput { planes, slabs: out }
+    RunOutput { inner, slabs: out }
 }
 
 /// The triangles of slab k (cells k..k + 1 in z); `planes` are the vertices
@@ -899,10 +900,18 @@ fn contour_slab(
                 Block::Inside if !(close_at_box && touches_box(i, j, k)) => continue,
                 _ => {}
             }
-            let v: [f64; 8] = std::array::from_fn(|c| {
+            // Corner c's sign is bit i + (c & 1) of row c >> 1 (the rows'
+            // order above); the same `> 0` as the samples' (`signs::pack`).
+            let mut sign_case = 0usize;
+            for (r, row) in rows.iter().enumerate() {
+                let pair = (row[i / 64] >> (i % 64)) & 1
+                    | ((row[(i + 1) / 64] >> ((i + 1) % 64)) & 1) << 1;
+                sign_case |= (pair as usize) << (2 * r);
+            }
+            let cycles = table.lookup_case(sign_case, |c| {
+                let c = c as usize;
                 field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] as f64
             });
-            let cycles = table.lookup(&v);
             for c in 0..cycles.count as usize {
                 let (cycle, valid_starts) = cycles.cycle(c);
                 ids.clear();
@@ -1092,14 +1101,27 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
     // same for any thread count.
     let nz = grid.cells[2];
     let run = nz.div_ceil(RUNS).max(1);
-    let runs: Vec<RunOutput> = (0..nz.div_ceil(run).max(1))
+    // The planes where runs meet (and the bottom and top), made first.
+    let cuts: Vec<usize> = (0..nz).step_by(run).chain([nz]).collect();
+    let shared: Vec<PlaneVertices> = cuts
+        .par_iter()
+        .map(|&k| plane_vertices(field, &signs, &coords, k, options))
+        .collect();
+    let runs: Vec<RunOutput> = (0..cuts.len() - 1)
         .into_par_iter()
         .map(|r| {
-            let slabs = r * run..((r + 1) * run).min(nz);
-            contour_run(field, &signs, &coords, slabs, options)
+            let ends = [&shared[r], &shared[r + 1]];
+            contour_run(field, &signs, &coords, cuts[r]..cuts[r + 1], ends, options)
         })
         .collect();
-    let planes: Vec<&PlaneVertices> = runs.iter().flat_map(|r| &r.planes).collect();
+    // Planes in order: each run's first plane, its inner planes, and last
+    // the top plane.
+    let planes: Vec<&PlaneVertices> = runs
+        .iter()
+        .zip(&shared)
+        .flat_map(|(r, first)| std::iter::once(first).chain(&r.inner))
+        .chain(shared.last())
+        .collect();
     let slabs: Vec<&SlabOutput> = runs.iter().flat_map(|r| &r.slabs).collect();
     let mut offsets = Vec::with_capacity(planes.len());
     let mut total = 0u32;
