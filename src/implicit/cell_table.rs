@@ -97,8 +97,8 @@ impl CellTable {
         self.lookup_case(sign_case, |c| v[c as usize])
     }
 
-    /// [`CellTable::lookup`] from the sign case (bit c: corner c's value
-    /// > 0), reading corner values (`value(c)`) only for the decider on
+    /// [`CellTable::lookup`] from the sign case (bit c set: corner c is
+    /// inside), reading corner values (`value(c)`) only for the decider on
     /// ambiguous faces: most crossed cells need none, and the contouring
     /// knows the signs from its packed bits without loading the samples.
     #[inline]
