@@ -94,12 +94,20 @@ impl CellTable {
         for (c, &x) in v.iter().enumerate() {
             sign_case |= usize::from(x > 0.0) << c;
         }
+        self.lookup_case(sign_case, |c| v[c as usize])
+    }
+
+    /// [`CellTable::lookup`] from the sign case (bit c set: corner c is
+    /// inside), reading corner values (`value(c)`) only for the decider on
+    /// ambiguous faces: most crossed cells need none, and the contouring
+    /// knows the signs from its packed bits without loading the samples.
+    #[inline]
+    pub fn lookup_case(&self, sign_case: usize, value: impl Fn(u8) -> f64) -> &CaseCycles {
         let case = &self.cases[sign_case];
         let mut answers = 0usize;
         for (b, p) in case.saddles[..case.count as usize].iter().enumerate() {
-            let val = |c: u8| v[c as usize];
             // The asymptotic decider, as in `polygonize::cell_links`.
-            answers |= usize::from(val(p[0]) * val(p[2]) > val(p[1]) * val(p[3])) << b;
+            answers |= usize::from(value(p[0]) * value(p[2]) > value(p[1]) * value(p[3])) << b;
         }
         &self.entries[case.first as usize + answers]
     }

@@ -30,6 +30,7 @@ use super::signs::{self, SignRows};
 use super::tape::{AxisTape, BATCH, Ssa, Tape, Workspace};
 use super::weld;
 use rayon::prelude::*;
+use std::cell::Cell;
 use std::sync::Arc;
 
 /// The sampling grid: `cells` cells per axis over the box.
@@ -311,7 +312,8 @@ struct PlaneVertices {
     /// (j · nx1 + i) · 3 + axis, ascending.
     keys: Vec<u32>,
     positions: Vec<[f64; 3]>,
-    /// The grid sample each vertex sits on, or `weld::NONE`.
+    /// The grid sample each vertex sits on, or `weld::NONE`; empty when
+    /// no vertex of the plane sits on a sample (the usual case).
     at_sample: Vec<u64>,
 }
 
@@ -413,8 +415,10 @@ fn plane_vertices(
     // Crossings within weld::SNAP of a sample sit exactly on it (and are
     // merged into one node by `weld`).
     let plane = n1[0] * n1[1];
+    let snapped = t.iter().any(|&t| t <= weld::SNAP || t >= 1.0 - weld::SNAP);
     let at_sample = keys
         .iter()
+        .take(if snapped { keys.len() } else { 0 })
         .zip(&t)
         .map(|(&key, &t)| {
             let base = (key / 3) as usize;
@@ -771,8 +775,163 @@ pub(super) fn cycles_of(next: &[u8; 12]) -> Cycles {
 /// every slab's count is known.
 const CENTRE: u32 = 1 << 31;
 
-/// One slab's triangles and its cycle-centre vertices.
+/// One slab's triangles and its cycle-centre vertices. A triangle's
+/// vertex ids count from the first vertex of the slab's lower plane (its
+/// upper plane's follow), or are `CENTRE`-marked indices into the centres.
 type SlabOutput = (Vec<[u32; 3]>, Vec<[f64; 3]>);
+
+/// Slab runs per grid (a fixed count, so the split does not depend on the
+/// thread count; enough runs to balance the threads' loads).
+const RUNS: usize = 32;
+
+thread_local! {
+    /// `contour_run`'s edge maps, every entry `u32::MAX` while stored.
+    static EDGE_MAPS: Cell<[Vec<u32>; 2]> = const { Cell::new([Vec::new(), Vec::new()]) };
+}
+
+/// A run of slabs k0..k1: the vertices of its inner planes k0 + 1..k1 and
+/// the slabs' triangles.
+struct RunOutput {
+    inner: Vec<PlaneVertices>,
+    slabs: Vec<SlabOutput>,
+}
+
+/// Contours slabs `slabs` (not empty) of the field one after the other,
+/// each right after the vertices of its upper plane; `bottom` and `top` are
+/// the vertices of planes k0 and k1, made once for the two runs sharing them
+/// (root finding on a plane's edges is the costly part of the whole path).
+fn contour_run(
+    field: &Field,
+    signs: &SignRows,
+    coords: &[Vec<f64>; 3],
+    slabs: std::ops::Range<usize>,
+    [bottom, top]: [&PlaneVertices; 2],
+    options: &Options,
+) -> RunOutput {
+    let n1 = field.n1;
+    let mut inner = Vec::with_capacity(slabs.len());
+    let mut out = Vec::with_capacity(slabs.len());
+    // Edge key → vertex index within its plane, for the slab's lower and
+    // upper plane; after a slab the lower plane's entries are reset and the
+    // maps swap (only the entries set are touched). The maps are kept per
+    // thread between runs and calls, all unset (a fresh 0.8 MB map per run
+    // cost more in page faults than the contouring of its slabs).
+    let mut maps = EDGE_MAPS.with(Cell::take);
+    for map in &mut maps {
+        if map.len() < n1[0] * n1[1] * 3 {
+            map.resize(n1[0] * n1[1] * 3, u32::MAX);
+        }
+    }
+    let fill = |map: &mut [u32], p: &PlaneVertices, on: bool| {
+        for (m, &key) in p.keys.iter().enumerate() {
+            map[key as usize] = if on { m as u32 } else { u32::MAX };
+        }
+    };
+    fill(&mut maps[0], bottom, true);
+    for k in slabs.clone() {
+        if k + 1 < slabs.end {
+            inner.push(plane_vertices(field, signs, coords, k + 1, options));
+        }
+        let lower = if k == slabs.start {
+            bottom
+        } else {
+            &inner[k - slabs.start - 1]
+        };
+        let upper = if k + 1 == slabs.end {
+            top
+        } else {
+            &inner[k - slabs.start]
+        };
+        fill(&mut maps[1], upper, true);
+        let slab = contour_slab(field, signs, k, [lower, upper], &maps, options.close_at_box);
+        out.push(slab);
+        fill(&mut maps[0], lower, false);
+        maps.swap(0, 1);
+    }
+    fill(&mut maps[0], top, false);
+    EDGE_MAPS.with(|m| m.set(maps));
+    RunOutput { inner, slabs: out }
+}
+
+/// The triangles of slab k (cells k..k + 1 in z); `planes` are the vertices
+/// of planes k and k + 1 and `maps` their edge key → index maps.
+fn contour_slab(
+    field: &Field,
+    signs: &SignRows,
+    k: usize,
+    planes: [&PlaneVertices; 2],
+    maps: &[Vec<u32>; 2],
+    close_at_box: bool,
+) -> SlabOutput {
+    let n1 = field.n1;
+    let cells = [n1[0] - 1, n1[1] - 1];
+    let base = [0, planes[0].keys.len() as u32];
+    let position = |id: u32| {
+        let dz = usize::from(id >= base[1]);
+        planes[dz].positions[(id - base[dz]) as usize]
+    };
+    let touches_box = |i: usize, j: usize, k: usize| {
+        let b = [i / BS, j / BS, k / BS];
+        (0..3).any(|a| b[a] == 0 || (b[a] * BS + BS) >= n1[a] - 1)
+    };
+    let table = CellTable::get();
+    // About two triangles per crossed edge (growing the vector by doubling
+    // cost copies and page faults).
+    let crossed = planes[0].keys.len() + planes[1].keys.len();
+    let mut tris = Vec::with_capacity(crossed + crossed / 4);
+    let mut centres = Vec::new();
+    let mut ids = Vec::with_capacity(12);
+    for j in 0..cells[1] {
+        let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)].map(|(j, k)| signs.row(j, k));
+        // Cells whose eight corners do not all share one sign: some corner
+        // inside (OR) and not all inside (AND).
+        let mixed = (0..signs.words).map(|w| {
+            let (mut all, mut any) = (u64::MAX, 0u64);
+            for r in rows {
+                let (a, b) = (r[w], signs::shifted(r, w));
+                all &= a & b;
+                any |= a | b;
+            }
+            (any & !all & signs::low_bits(cells[0], w), w)
+        });
+        for i in mixed.flat_map(|(m, w)| signs::bits(m, w)) {
+            match field.block(i, j, k) {
+                Block::Outside => continue,
+                Block::Inside if !(close_at_box && touches_box(i, j, k)) => continue,
+                _ => {}
+            }
+            // Corner c's sign is bit i + (c & 1) of row c >> 1 (the rows'
+            // order above); the same `> 0` as the samples' (`signs::pack`).
+            let mut sign_case = 0usize;
+            for (r, row) in rows.iter().enumerate() {
+                let pair = (row[i / 64] >> (i % 64)) & 1
+                    | ((row[(i + 1) / 64] >> ((i + 1) % 64)) & 1) << 1;
+                sign_case |= (pair as usize) << (2 * r);
+            }
+            let cycles = table.lookup_case(sign_case, |c| {
+                let c = c as usize;
+                field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] as f64
+            });
+            for c in 0..cycles.count as usize {
+                let (cycle, valid_starts) = cycles.cycle(c);
+                ids.clear();
+                for &e in cycle {
+                    let (a, b) = EDGES[e as usize];
+                    let axis = (a ^ b).trailing_zeros() as usize;
+                    let (a, dz) = (a as usize, (a as usize >> 2) & 1);
+                    let key = ((j + (a >> 1 & 1)) * n1[0] + i + (a & 1)) * 3 + axis;
+                    let m = maps[dz][key];
+                    ids.push(if m == u32::MAX { m } else { base[dz] + m });
+                }
+                if ids.contains(&u32::MAX) {
+                    continue;
+                }
+                triangulate(valid_starts, &ids, position, &mut tris, &mut centres);
+            }
+        }
+    }
+    (tris, centres)
+}
 
 /// Triangulates one cycle of vertex ids as a fan whose diagonals never join
 /// two crossings on one cell face (the neighbour cell might join the same
@@ -784,7 +943,7 @@ type SlabOutput = (Vec<[u32; 3]>, Vec<[f64; 3]>);
 fn triangulate(
     valid_starts: u16,
     ids: &[u32],
-    positions: &[[f64; 3]],
+    position: impl Fn(u32) -> [f64; 3],
     out: &mut Vec<[u32; 3]>,
     centres: &mut Vec<[f64; 3]>,
 ) {
@@ -795,7 +954,7 @@ fn triangulate(
     let valid = |s: usize| valid_starts >> s & 1 == 1;
     let start = if n == 4 {
         let len = |a: usize, b: usize| {
-            let (p, q) = (positions[ids[a] as usize], positions[ids[b] as usize]);
+            let (p, q) = (position(ids[a]), position(ids[b]));
             (0..3).map(|k| (p[k] - q[k]).powi(2)).sum::<f64>()
         };
         match (valid(0), valid(1)) {
@@ -816,8 +975,9 @@ fn triangulate(
         None => {
             let mut c = [0.0; 3];
             for &id in ids {
+                let p = position(id);
                 for (k, ck) in c.iter_mut().enumerate() {
-                    *ck += positions[id as usize][k] / n as f64;
+                    *ck += p[k] / n as f64;
                 }
             }
             let centre = CENTRE | centres.len() as u32;
@@ -831,9 +991,14 @@ fn triangulate(
 
 /// The parts one after the other, each item mapped by `map(part, item)`,
 /// copied in parallel: the order is the parts' order for any thread count.
-fn concat<T: Copy + Sync, U: Send>(parts: &[&[T]], map: impl Fn(usize, T) -> U + Sync) -> Vec<U> {
+/// `spare` more items fit without growing the vector.
+fn concat<T: Copy + Sync, U: Send>(
+    parts: &[&[T]],
+    spare: usize,
+    map: impl Fn(usize, T) -> U + Sync,
+) -> Vec<U> {
     let total = parts.iter().map(|p| p.len()).sum();
-    let mut out: Vec<U> = Vec::with_capacity(total);
+    let mut out: Vec<U> = Vec::with_capacity(total + spare);
     let mut rest = &mut out.spare_capacity_mut()[..total];
     let mut slots = Vec::with_capacity(parts.len());
     for part in parts {
@@ -928,103 +1093,74 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
     let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
     let n1 = field.n1;
     let signs = SignRows::new(&field.values, n1);
-    let planes: Vec<PlaneVertices> = (0..n1[2])
-        .into_par_iter()
-        .map(|k| plane_vertices(field, &signs, &coords, k, options))
+    // Runs of consecutive slabs, each contoured by one thread right after
+    // its planes' vertices, so the samples of planes k and k + 1 are still
+    // in cache when slab k reads them (two passes over all planes read the
+    // 68 MB grid twice from memory). The runs only split the work: every
+    // plane and slab gives the same result in any run, so the output is the
+    // same for any thread count.
+    let nz = grid.cells[2];
+    let run = nz.div_ceil(RUNS).max(1);
+    // The planes where runs meet (and the bottom and top), made first.
+    let cuts: Vec<usize> = (0..nz).step_by(run).chain([nz]).collect();
+    let shared: Vec<PlaneVertices> = cuts
+        .par_iter()
+        .map(|&k| plane_vertices(field, &signs, &coords, k, options))
         .collect();
+    let runs: Vec<RunOutput> = (0..cuts.len() - 1)
+        .into_par_iter()
+        .map(|r| {
+            let ends = [&shared[r], &shared[r + 1]];
+            contour_run(field, &signs, &coords, cuts[r]..cuts[r + 1], ends, options)
+        })
+        .collect();
+    // Planes in order: each run's first plane, its inner planes, and last
+    // the top plane.
+    let planes: Vec<&PlaneVertices> = runs
+        .iter()
+        .zip(&shared)
+        .flat_map(|(r, first)| std::iter::once(first).chain(&r.inner))
+        .chain(shared.last())
+        .collect();
+    let slabs: Vec<&SlabOutput> = runs.iter().flat_map(|r| &r.slabs).collect();
     let mut offsets = Vec::with_capacity(planes.len());
     let mut total = 0u32;
     for p in &planes {
         offsets.push(total);
         total += p.keys.len() as u32;
     }
-    let at_sample: Vec<u64> = concat(
-        &planes.iter().map(|p| &p.at_sample[..]).collect::<Vec<_>>(),
-        |_, s| s,
-    );
-    let positions: Vec<[f64; 3]> = concat(
+    // Empty when no vertex sits on a sample (then `weld` has nothing to do).
+    let at_sample: Vec<u64> = if planes.iter().all(|p| p.at_sample.is_empty()) {
+        Vec::new()
+    } else {
+        let none: Vec<Vec<u64>> = planes
+            .iter()
+            .map(|p| match p.at_sample.is_empty() {
+                true => vec![weld::NONE; p.keys.len()],
+                false => Vec::new(),
+            })
+            .collect();
+        let parts: Vec<&[u64]> = planes
+            .iter()
+            .zip(&none)
+            .map(|(p, n)| {
+                if p.at_sample.is_empty() {
+                    &n[..]
+                } else {
+                    &p.at_sample[..]
+                }
+            })
+            .collect();
+        concat(&parts, 0, |_, s| s)
+    };
+    // The cycle centres are appended below: room for them from the start
+    // (growing a vector of 700k vertices copies it).
+    let centres: usize = slabs.iter().map(|s| s.1.len()).sum();
+    let mut positions: Vec<[f64; 3]> = concat(
         &planes.iter().map(|p| &p.positions[..]).collect::<Vec<_>>(),
+        centres,
         |_, p| p,
     );
-    // Edge key → vertex id for one plane, in a buffer reused per thread
-    // (only the entries set are cleared afterwards).
-    let fill = |map: &mut Vec<u32>, k: usize, on: bool| {
-        if map.is_empty() {
-            map.resize(n1[0] * n1[1] * 3, u32::MAX);
-        }
-        for (m, &key) in planes[k].keys.iter().enumerate() {
-            map[key as usize] = if on { offsets[k] + m as u32 } else { u32::MAX };
-        }
-    };
-    let touches_box = |i: usize, j: usize, k: usize| {
-        let b = [i / BS, j / BS, k / BS];
-        (0..3).any(|a| b[a] == 0 || (b[a] * BS + BS) >= n1[a] - 1)
-    };
-    let table = CellTable::get();
-    let slabs: Vec<SlabOutput> = (0..grid.cells[2])
-        .into_par_iter()
-        .map_init(
-            || [Vec::new(), Vec::new()],
-            |maps, k| {
-                fill(&mut maps[0], k, true);
-                fill(&mut maps[1], k + 1, true);
-                // About two triangles per crossed edge (growing the vector
-                // by doubling cost copies and page faults).
-                let crossed = planes[k].keys.len() + planes[k + 1].keys.len();
-                let mut tris = Vec::with_capacity(crossed + crossed / 4);
-                let mut centres = Vec::new();
-                let mut ids = Vec::with_capacity(12);
-                for j in 0..grid.cells[1] {
-                    let rows = [(j, k), (j + 1, k), (j, k + 1), (j + 1, k + 1)]
-                        .map(|(j, k)| signs.row(j, k));
-                    // Cells whose eight corners do not all share one sign:
-                    // some corner inside (OR) and not all inside (AND).
-                    let mixed = (0..signs.words).map(|w| {
-                        let (mut all, mut any) = (u64::MAX, 0u64);
-                        for r in rows {
-                            let (a, b) = (r[w], signs::shifted(r, w));
-                            all &= a & b;
-                            any |= a | b;
-                        }
-                        (any & !all & signs::low_bits(grid.cells[0], w), w)
-                    });
-                    for i in mixed.flat_map(|(m, w)| signs::bits(m, w)) {
-                        match field.block(i, j, k) {
-                            Block::Outside => continue,
-                            Block::Inside if !(options.close_at_box && touches_box(i, j, k)) => {
-                                continue;
-                            }
-                            _ => {}
-                        }
-                        let v: [f64; 8] = std::array::from_fn(|c| {
-                            field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))]
-                                as f64
-                        });
-                        let cycles = table.lookup(&v);
-                        for c in 0..cycles.count as usize {
-                            let (cycle, valid_starts) = cycles.cycle(c);
-                            ids.clear();
-                            for &e in cycle {
-                                let (a, b) = EDGES[e as usize];
-                                let axis = (a ^ b).trailing_zeros() as usize;
-                                let (a, dz) = (a as usize, (a as usize >> 2) & 1);
-                                let key = ((j + (a >> 1 & 1)) * n1[0] + i + (a & 1)) * 3 + axis;
-                                ids.push(maps[dz][key]);
-                            }
-                            if ids.contains(&u32::MAX) {
-                                continue;
-                            }
-                            triangulate(valid_starts, &ids, &positions, &mut tris, &mut centres);
-                        }
-                    }
-                }
-                fill(&mut maps[0], k, false);
-                fill(&mut maps[1], k + 1, false);
-                (tris, centres)
-            },
-        )
-        .collect();
-    let mut positions = positions;
     // Each slab's centres follow the edge vertices, slab after slab.
     let mut bases = Vec::with_capacity(slabs.len());
     for (_, centres) in &slabs {
@@ -1033,12 +1169,15 @@ fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
     }
     let triangles = concat(
         &slabs.iter().map(|s| &s.0[..]).collect::<Vec<_>>(),
+        0,
         |slab, t| {
             t.map(|id| {
                 if id & CENTRE != 0 {
                     bases[slab] + (id & !CENTRE)
                 } else {
-                    id
+                    // Slab k's vertices are planes k and k + 1's, which
+                    // follow each other in the global numbering.
+                    offsets[slab] + id
                 }
             })
         },
