@@ -234,7 +234,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             refuse_collapsed(&mesh, tolerance)?;
             let first_trimmed = mesh.faces.len();
             trimmed::append(full, &mut mesh, tolerance, min_angle, max_edge)?;
-            trimmed_shell::join(model, &mut mesh, first_trimmed)?;
+            trimmed_shell::join(model, full, &mut mesh, first_trimmed)?;
             let origins = crack::open(model, &mut mesh);
             if options.order == 2 {
                 quadratic::elevate(model, &edge_nodes, &origins, &mut mesh);

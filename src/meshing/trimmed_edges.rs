@@ -209,7 +209,10 @@ fn cut(model: &Model, edge: &crate::ir::Edge, rings: &[Ring]) -> Option<Vec<u32>
             .map(|w| (w[1] - w[0]).norm())
             .fold(0.0, f64::max)
     };
-    let distance = 4.0 * model.tolerance + 0.1 * longest(&line).max(longest(points));
+    // A guard against a wrong ring or way round, not a precision check: the
+    // model traces at its own tolerance, the mesh at the mesh's, so the two
+    // polylines differ by up to about a chord.
+    let distance = 4.0 * model.tolerance + 0.5 * longest(&line).max(longest(points));
     // Up to 64 of the edge's points, evenly spread, checked.
     let stride = points.len().div_ceil(64).max(1);
     let near = points
