@@ -82,10 +82,11 @@ fn the_bezier_hole_mesh_has_the_irs_four_sides_and_trim_as_its_boundary() {
     for (v, mv) in model.vertices.iter().zip(&mesh.vertices) {
         let p = mesh.nodes[mv.node as usize];
         let d = (v.position - nalgebra::Point3::new(p[0], p[1], p[2])).norm();
-        let closed_trim = model
-            .edges
-            .iter()
-            .any(|e| e.name.contains(".trim[") && e.begin == e.end && e.begin.index() == v_index(&model, &v.name));
+        let closed_trim = model.edges.iter().any(|e| {
+            e.name.contains(".trim[")
+                && e.begin == e.end
+                && e.begin.index() == v_index(&model, &v.name)
+        });
         if !closed_trim {
             assert!(d < 1e-9, "{}: node {d} from the vertex", v.name);
         }
@@ -136,7 +137,11 @@ fn a_hole_rim_on_a_model_edge_is_one_mesh_edge_used_by_both_faces() {
         .position(|e| e.name == "post.top_rim")
         .expect("rim") as u32;
     assert!(!mesh.edges.iter().any(|e| e.name.starts_with("plate.trim")));
-    let plate = mesh.faces.iter().position(|f| f.name == "plate").expect("plate");
+    let plate = mesh
+        .faces
+        .iter()
+        .position(|f| f.name == "plate")
+        .expect("plate");
     assert!(mesh.faces[plate].boundary.iter().any(|&(e, _)| e == rim));
     // The plate's free boundary is its four sides and the rim, node for node.
     let edges: BTreeSet<(u32, u32)> = mesh.faces[plate]

@@ -15,8 +15,7 @@ use crate::diag::{Code, Diagnostics};
 use crate::geom::{Curve, Point3, Surface};
 use crate::ir::SourceMap;
 use crate::ir::{
-    Edge, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex,
-    VertexId,
+    Edge, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex, VertexId,
 };
 use crate::trimmed::boundary::{U_MAX, U_MIN, V_MAX, V_MIN};
 use crate::trimmed::shared::{bbox, distance_to_polyline, nearest_point};

@@ -131,7 +131,10 @@ pub(super) fn append(
 
 /// The closed edges of `mesh` (first node repeated last) that `keep` keeps,
 /// as chains a trim loop may take.
-fn closed_edges(mesh: &Mesh, keep: impl Fn(usize, &str) -> bool) -> Vec<(ChainSource, Vec<Point3>)> {
+fn closed_edges(
+    mesh: &Mesh,
+    keep: impl Fn(usize, &str) -> bool,
+) -> Vec<(ChainSource, Vec<Point3>)> {
     let point = |n: u32| {
         let p = mesh.nodes.get(n as usize).copied().unwrap_or([f64::NAN; 3]);
         Point3::new(p[0], p[1], p[2])
@@ -139,7 +142,9 @@ fn closed_edges(mesh: &Mesh, keep: impl Fn(usize, &str) -> bool) -> Vec<(ChainSo
     mesh.edges
         .iter()
         .enumerate()
-        .filter(|(i, e)| e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last() && keep(*i, &e.name))
+        .filter(|(i, e)| {
+            e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last() && keep(*i, &e.name)
+        })
         .map(|(i, e)| {
             (
                 ChainSource::Edge(i),
@@ -271,7 +276,9 @@ pub(super) fn reports(
     };
     // With the topology IR, the trimmed edges are those from its start on.
     let first_trimmed_edge = model.trimmed_start.map_or(usize::MAX, |s| s[1]);
-    let edges = closed_edges(mesh, |i, name| i < first_trimmed_edge && !trimmed_chain(name));
+    let edges = closed_edges(mesh, |i, name| {
+        i < first_trimmed_edge && !trimmed_chain(name)
+    });
     if share(model, &edges, &mut meshes, tolerance, &mesh_one).is_err() {
         return Vec::new();
     }

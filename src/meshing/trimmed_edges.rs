@@ -219,6 +219,5 @@ fn cut(model: &Model, edge: &crate::ir::Edge, rings: &[Ring]) -> Option<Vec<u32>
         .iter()
         .step_by(stride)
         .all(|p| distance_to_polyline(&line, p) <= distance);
-    (path.len() >= 2 && near)
-        .then(|| path.iter().map(|&i| ring.nodes[i]).collect())
+    (path.len() >= 2 && near).then(|| path.iter().map(|&i| ring.nodes[i]).collect())
 }

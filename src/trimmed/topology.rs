@@ -124,7 +124,11 @@ fn material_on_left(s: &TrimmedSurface, points: &[[f64; 2]], lp: &[usize]) -> bo
     let w = |sign: f64| {
         let p = [m[0] - sign * 1e-3 * d[1], m[1] + sign * 1e-3 * d[0]];
         let inside = p[0] >= u0 && p[0] <= u1 && p[1] >= v0 && p[1] <= v1;
-        if inside { s.material(p[0], p[1]) } else { f64::NEG_INFINITY }
+        if inside {
+            s.material(p[0], p[1])
+        } else {
+            f64::NEG_INFINITY
+        }
     };
     w(1.0) >= w(-1.0)
 }
