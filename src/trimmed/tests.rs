@@ -655,6 +655,9 @@ fn paper_patch_at_25_degrees_has_no_smaller_angle() {
     let m = mesh_trimmed(&s, settings).expect("meshable");
     let q = m.quality(&s);
     let below: usize = q.histogram[..5].iter().sum();
-    assert!(q.min_angle >= 25.0 - 1e-9, "{below} triangles below 25°: {q:?}");
+    assert!(
+        q.min_angle >= 25.0 - 1e-9,
+        "{below} triangles below 25°: {q:?}"
+    );
     assert!(q.max_centroid_distance <= settings.tolerance, "{q:?}");
 }

@@ -167,6 +167,8 @@ fn join_across_seams(loops: &mut [Vec<Piece>], distance: f64) {
         let tail = loops[l2][j].points[1..].to_vec();
         loops[l][i].points.extend(tail);
         loops[l2].remove(j);
+        // Removing an earlier piece of the same loop shifts this one back.
+        let i = if l2 == l && j < i { i - 1 } else { i };
         let p = &mut loops[l][i];
         let (a, b) = ends(p);
         if (a - b).norm() <= distance {
