@@ -181,7 +181,8 @@ fn run(
     }
     if lowered.model.dimension == crate::ir::Dimension::Three {
         // Trimmed surfaces become faces, edges and vertices (issue 9).
-        lower::trimmed_topology::add(&mut lowered.model);
+        let (model, map) = (&mut lowered.model, &lowered.source_map);
+        lower::trimmed_topology::add(model, map, diags);
     }
     if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
         // 2D R-function regions become model entities (issue 6).

@@ -373,6 +373,11 @@ codes! {
         "The buffers of a glTF or GLB (its binary chunk, data URIs and buffer files) together hold more bytes than --max-file-size allows, so geomc stops before reading more. Raise the limit with --max-file-size BYTES if the file is trusted.";
     GltfTooManyElements = "E805", Error, "glTF accessors decode too many elements",
         "The primitives of a glTF or GLB make the reader decode more accessor elements than --max-mesh-elements allows (an accessor shared by many primitives counts each time it is used), which would take memory out of proportion to the file. Raise the limit with --max-mesh-elements N if the file is trusted.";
+    // ---- trimmed parametric surfaces on other faces (issue 9, branch trim) ----
+    TrimmedPartlyShared = "E743", Error, "a trim curve runs along another face's edge without being that edge",
+        "A trim curve of a parametric surface runs along an edge of another face for part of its length, or is an open piece (ending on the patch's sides) along it. Only a whole closed trim loop that coincides with a whole closed edge (a hole's rim on a circular edge) is shared node for node; anything less would leave the two faces without common nodes and the shell open. Make the trim loop coincide with the whole edge (same circle, within twice the tolerance), or move it clear of the edge.";
+    TrimmedSideOnEdge = "E744", Error, "a patch side lies on another face's edge",
+        "A side of a parametric surface's parameter rectangle lies along an edge of another face. Patch sides keep their own nodes (only closed trim loops take a neighbour's), so the two faces would not share nodes there and the shell would not close. Trim the surface so that its boundary there is a closed trim loop on the whole edge, or extend the rectangle past the edge and trim it back with <trim>.";
 }
 
 impl Code {

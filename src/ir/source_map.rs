@@ -121,6 +121,8 @@ pub struct SourceMap {
     pub faces: IdMap<FaceId, Origin>,
     pub subdomains: IdMap<SubdomainId, Origin>,
     pub solids: IdMap<SolidId, Origin>,
+    /// The element of each trimmed surface (`Model::trimmed` order).
+    pub trimmed: Vec<Span>,
 }
 
 impl SourceMap {

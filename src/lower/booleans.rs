@@ -863,6 +863,11 @@ pub(super) fn orient_shell(model: &Model, faces: &[FaceId]) -> Vec<OrientedFace>
 /// fanned from a point on the surface (n along the loop orientation).
 fn face_volume(model: &Model, face_id: FaceId) -> f64 {
     let face = model.face(face_id);
+    if let crate::geom::Surface::Parametric(s) = &face.surface {
+        // Its loops run counter-clockwise about R_u × R_v.
+        let share = crate::trimmed::volume_share(s);
+        return if face.reversed { -share } else { share };
+    }
     let mut total = 0.0;
     for l in &face.loops {
         let mut points = Vec::new();

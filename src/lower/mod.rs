@@ -279,7 +279,10 @@ fn lower_free(
         Geometry::PointCurve(curve) => model
             .polylines
             .push(point_calculus::standalone(name, curve)),
-        Geometry::Trimmed(surface) => model.trimmed.push((**surface).clone()),
+        Geometry::Trimmed(surface) => {
+            model.trimmed.push((**surface).clone());
+            source_map.trimmed.push(span);
+        }
         Geometry::Solid(shape) => {
             let id = lower_solid(model, source_map, welder, name, shape, span);
             entities

@@ -11,16 +11,20 @@
 //! are appended after every other (`Model::trimmed_start`), so the chart
 //! mesher can leave them out.
 
+use crate::diag::{Code, Diagnostics};
 use crate::geom::{Curve, Point3, Surface};
+use crate::ir::SourceMap;
 use crate::ir::{
-    Edge, EdgeId, Face, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex, VertexId,
+    Edge, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex, VertexId,
 };
 use crate::trimmed::boundary::{U_MAX, U_MIN, V_MAX, V_MIN};
 use crate::trimmed::shared::{bbox, distance_to_polyline, nearest_point};
 use crate::trimmed::topology::{Piece, pieces};
 
-/// Appends the vertices, edges and faces of `model.trimmed` (3D models).
-pub fn add(model: &mut Model) {
+/// Appends the vertices, edges and faces of `model.trimmed` (3D models),
+/// refusing pieces that lie along another face's edge without sharing it
+/// (E743, E744), and sets the trimmed faces' outward flags.
+pub fn add(model: &mut Model, source_map: &SourceMap, diags: &mut Diagnostics) {
     if model.trimmed.is_empty() || model.trimmed_start.is_some() {
         return;
     }
@@ -29,7 +33,9 @@ pub fn add(model: &mut Model) {
     let tol = 2.0 * model.tolerance;
     let surfaces = model.trimmed.clone();
     let mut faces = Vec::with_capacity(surfaces.len());
-    for s in &surfaces {
+    for (j, s) in surfaces.iter().enumerate() {
+        let span = source_map.trimmed.get(j).copied();
+        let own_edges = model.edges.len();
         let loops = pieces(s, model.tolerance).unwrap_or_default();
         let mut counts = [0usize; 5];
         let mut vertex_count = 0usize;
@@ -54,8 +60,12 @@ pub fn add(model: &mut Model) {
                 };
                 let slot = side_slot(piece.side);
                 counts[slot] += 1;
+                let name = format!("{}.{}[{}]", s.name, SIDE_NAMES[slot], counts[slot]);
+                if let Some((other, share)) = along_other_edge(model, own_edges, piece, tol) {
+                    refuse(model, diags, span, s, &name, piece.side, other, share);
+                }
                 model.edges.push(Edge {
-                    name: format!("{}.{}[{}]", s.name, SIDE_NAMES[slot], counts[slot]),
+                    name,
                     curve: Curve::Chain {
                         points: piece.points.clone(),
                     },
@@ -78,17 +88,120 @@ pub fn add(model: &mut Model) {
     }
     let first_face = model.faces.len();
     model.faces.extend(faces);
-    for sub in &mut model.subdomains {
-        if let SubdomainCells::Volume { boundary } = &mut sub.cells {
-            for &k in &sub.trimmed {
-                boundary.push(OrientedFace {
-                    face: crate::ir::FaceId((first_face + k) as u32),
-                    outward: true,
-                });
-            }
+    // The outward flags as for any face list: propagated across shared
+    // edges from the shell's faces, the sign fixed by the enclosed volume.
+    for k in 0..model.subdomains.len() {
+        let sub = &model.subdomains[k];
+        let SubdomainCells::Volume { boundary } = &sub.cells else {
+            continue;
+        };
+        if sub.trimmed.is_empty() {
+            continue;
+        }
+        let mut ids: Vec<FaceId> = boundary.iter().map(|of| of.face).collect();
+        ids.extend(sub.trimmed.iter().map(|&t| FaceId((first_face + t) as u32)));
+        let oriented: Vec<OrientedFace> = super::booleans::orient_shell(model, &ids);
+        if let SubdomainCells::Volume { boundary } = &mut model.subdomains[k].cells {
+            *boundary = oriented;
         }
     }
     model.trimmed_start = Some(start);
+}
+
+/// A piece of a trimmed surface's boundary that runs along an edge it does
+/// not share, for part of the piece's length (a crossing is no run): the
+/// edge and the length of the run against the piece's length.
+fn along_other_edge(
+    model: &Model,
+    own_edges: usize,
+    piece: &Piece,
+    tol: f64,
+) -> Option<(EdgeId, (f64, f64))> {
+    let own = &piece.points;
+    let length: f64 = own.windows(2).map(|w| (w[1] - w[0]).norm()).sum();
+    let longest = |l: &[Point3]| {
+        l.windows(2)
+            .map(|w| (w[1] - w[0]).norm())
+            .fold(0.0, f64::max)
+    };
+    let (lo, hi) = bbox(own);
+    for (i, e) in model.edges.iter().enumerate().take(own_edges) {
+        let line = match &e.curve {
+            Curve::Chain { points } => points.clone(),
+            c => c.samples(1024),
+        };
+        let d = tol + 0.05 * longest(&line).max(longest(own));
+        let (a, b) = bbox(&line);
+        if (0..3).any(|k| a[k] > hi[k] + d || b[k] < lo[k] - d) {
+            continue;
+        }
+        // The longest run of consecutive piece points near the edge.
+        let (mut best, mut run, mut count, mut best_count) = (0.0f64, 0.0, 0usize, 0usize);
+        for (k, p) in own.iter().enumerate() {
+            if distance_to_polyline(&line, p) <= d {
+                if count > 0 {
+                    run += (own[k] - own[k - 1]).norm();
+                }
+                count += 1;
+                if run > best {
+                    (best, best_count) = (run, count);
+                }
+            } else {
+                (run, count) = (0.0, 0);
+            }
+        }
+        if best_count >= 3 && best > (20.0 * d).max(0.02 * length) {
+            return Some((EdgeId(i as u32), (best, length)));
+        }
+    }
+    None
+}
+
+/// Reports a piece along another face's edge (E743 for a trim curve, E744
+/// for a patch side).
+#[allow(clippy::too_many_arguments)]
+fn refuse(
+    model: &Model,
+    diags: &mut Diagnostics,
+    span: Option<crate::span::Span>,
+    s: &crate::trimmed::TrimmedSurface,
+    piece: &str,
+    side: u8,
+    other: EdgeId,
+    (run, length): (f64, f64),
+) {
+    let edge = &model.edges[other.index()];
+    let faces: Vec<String> = model
+        .faces
+        .iter()
+        .filter(|f| f.loops.iter().flatten().any(|oe| oe.edge == other))
+        .map(|f| format!("`{}`", f.name))
+        .collect();
+    let of_faces = match faces.as_slice() {
+        [] => String::new(),
+        [f] => format!(" of face {f}"),
+        fs => format!(" of faces {}", fs.join(" and ")),
+    };
+    let share = format!("{:.0}%", 100.0 * run / length.max(f64::MIN_POSITIVE));
+    if side == 0 {
+        diags.error(
+            Code::TrimmedPartlyShared,
+            span,
+            format!(
+                "the trim curve `{piece}` of surface `{}` runs along edge `{}`{of_faces} for {share} of its length without being that edge; only a whole closed trim loop on a whole closed edge is shared: make the trim loop coincide with the whole edge within twice the tolerance, or move it clear of the edge",
+                s.name, edge.name
+            ),
+        );
+    } else {
+        diags.error(
+            Code::TrimmedSideOnEdge,
+            span,
+            format!(
+                "the patch side `{piece}` of surface `{}` lies along edge `{}`{of_faces} ({share} of the side); patch sides keep their own nodes, so the faces would not meet: extend the parameter rectangle past the edge and trim it back with a <trim> whose loop is the whole edge",
+                s.name, edge.name
+            ),
+        );
+    }
 }
 
 const SIDE_NAMES: [&str; 5] = ["trim", "u_min", "u_max", "v_min", "v_max"];

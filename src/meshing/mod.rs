@@ -39,6 +39,7 @@ mod report;
 mod schedule;
 mod size;
 mod trimmed;
+mod trimmed_edges;
 mod trimmed_shell;
 pub use trimmed::TrimmedReport;
 
@@ -138,6 +139,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         )));
     }
     // Trimmed surfaces' faces are meshed by `trimmed::append`, not by charts.
+    let full = model;
     let stripped;
     let model = match model.trimmed_start {
         Some(_) => {
@@ -231,8 +233,8 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             crate::allocator::release_freed_memory();
             refuse_collapsed(&mesh, tolerance)?;
             let first_trimmed = mesh.faces.len();
-            trimmed::append(model, &mut mesh, tolerance, min_angle, max_edge)?;
-            trimmed_shell::join(model, &mut mesh, first_trimmed)?;
+            trimmed::append(full, &mut mesh, tolerance, min_angle, max_edge)?;
+            trimmed_shell::join(model, full, &mut mesh, first_trimmed)?;
             let origins = crack::open(model, &mut mesh);
             if options.order == 2 {
                 quadratic::elevate(model, &edge_nodes, &origins, &mut mesh);

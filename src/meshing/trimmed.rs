@@ -42,7 +42,7 @@ pub(super) fn append(
         .par_iter()
         .map(|s| mesh_one(s, &[]))
         .collect::<Result<Vec<_>, MeshError>>()?;
-    let edges = closed_edges(mesh, |_| true);
+    let edges = closed_edges(mesh, |_, _| true);
     let sources = share(model, &edges, &mut meshes, tolerance, &mesh_one)?;
     // Global node ids: each surface's own nodes in model order, then the
     // shared ones from the chain they were taken from.
@@ -81,6 +81,7 @@ pub(super) fn append(
             break;
         }
     }
+    let mut chains = Vec::with_capacity(meshes.len());
     for (j, (s, m)) in model.trimmed.iter().zip(&meshes).enumerate() {
         let id = |i: &u32| ids[j][*i as usize];
         if m.triangles.iter().flatten().any(|i| id(i) == u32::MAX) {
@@ -89,18 +90,40 @@ pub(super) fn append(
                 message: "a shared trim node has no node".into(),
             });
         }
-        let mut boundary = Vec::with_capacity(m.boundary.len());
-        for (k, chain) in m.boundary.iter().enumerate() {
-            boundary.push((mesh.edges.len() as u32, true));
-            mesh.edges.push(MeshEdge {
-                name: format!("{}.boundary[{}]", s.name, k + 1),
-                nodes: chain.iter().map(id).collect(),
-            });
-        }
+        chains.push(
+            m.boundary
+                .iter()
+                .map(|chain| chain.iter().map(id).collect::<Vec<u32>>())
+                .collect::<Vec<_>>(),
+        );
+    }
+    // The IR's trimmed edges and vertices cut out of those chains; a
+    // model without them (a surface meshed on its own) keeps whole chains.
+    let boundaries = match model.trimmed_start {
+        Some(_) => super::trimmed_edges::write(model, mesh, &chains)?,
+        None => chains
+            .iter()
+            .zip(&model.trimmed)
+            .map(|(own, s)| {
+                own.iter()
+                    .enumerate()
+                    .map(|(k, nodes)| {
+                        mesh.edges.push(MeshEdge {
+                            name: format!("{}.boundary[{}]", s.name, k + 1),
+                            nodes: nodes.clone(),
+                        });
+                        ((mesh.edges.len() - 1) as u32, true)
+                    })
+                    .collect()
+            })
+            .collect(),
+    };
+    for (j, (s, m)) in model.trimmed.iter().zip(&meshes).enumerate() {
+        let id = |i: &u32| ids[j][*i as usize];
         mesh.faces.push(MeshFace {
             name: s.name.clone(),
             triangles: m.triangles.iter().map(|t| t.map(|i| id(&i))).collect(),
-            boundary,
+            boundary: boundaries[j].clone(),
         });
     }
     Ok(())
@@ -108,7 +131,10 @@ pub(super) fn append(
 
 /// The closed edges of `mesh` (first node repeated last) that `keep` keeps,
 /// as chains a trim loop may take.
-fn closed_edges(mesh: &Mesh, keep: impl Fn(&str) -> bool) -> Vec<(ChainSource, Vec<Point3>)> {
+fn closed_edges(
+    mesh: &Mesh,
+    keep: impl Fn(usize, &str) -> bool,
+) -> Vec<(ChainSource, Vec<Point3>)> {
     let point = |n: u32| {
         let p = mesh.nodes.get(n as usize).copied().unwrap_or([f64::NAN; 3]);
         Point3::new(p[0], p[1], p[2])
@@ -116,7 +142,9 @@ fn closed_edges(mesh: &Mesh, keep: impl Fn(&str) -> bool) -> Vec<(ChainSource, V
     mesh.edges
         .iter()
         .enumerate()
-        .filter(|(_, e)| e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last() && keep(&e.name))
+        .filter(|(i, e)| {
+            e.nodes.len() >= 4 && e.nodes.first() == e.nodes.last() && keep(*i, &e.name)
+        })
         .map(|(i, e)| {
             (
                 ChainSource::Edge(i),
@@ -246,7 +274,11 @@ pub(super) fn reports(
                 .is_some_and(|r| r.starts_with(".boundary["))
         })
     };
-    let edges = closed_edges(mesh, |name| !trimmed_chain(name));
+    // With the topology IR, the trimmed edges are those from its start on.
+    let first_trimmed_edge = model.trimmed_start.map_or(usize::MAX, |s| s[1]);
+    let edges = closed_edges(mesh, |i, name| {
+        i < first_trimmed_edge && !trimmed_chain(name)
+    });
     if share(model, &edges, &mut meshes, tolerance, &mesh_one).is_err() {
         return Vec::new();
     }

@@ -1,12 +1,15 @@
 //! Trimmed surfaces as faces of 3D subdomains (issue 9). A subdomain's
 //! `faces=` may name trimmed surfaces; their chains exist only on the mesh,
-//! so here, after they are appended: each one's outward side is taken from a
-//! neighbour across a shared mesh edge (a consistently oriented shell runs a
-//! shared edge both ways), starting from the model faces' own flags — or,
-//! with no model face, from the first trimmed face and then all flipped if
-//! the enclosed volume is negative. The shell must close (every mesh edge
-//! used by two of its triangles), and each trimmed face joins the fragment
-//! between its subdomains (`A|exterior`, `A|B`) as model faces do.
+//! so here, after they are appended: the outward flags are the topology
+//! IR's (`lower/trimmed_topology.rs`, as for any face list), checked on the
+//! mesh, where each one's outward side is taken from a neighbour across a
+//! shared mesh edge (a consistently oriented shell runs a shared edge both
+//! ways), starting from the model faces' own flags — or, with no model
+//! face, from the first trimmed face and then all flipped if the enclosed
+//! volume is negative. The shell must close (every mesh edge used by two of
+//! its triangles), and each trimmed face joins the fragment between its
+//! subdomains (`A|exterior`, `A|B`) as model faces do. Triangles stay
+//! counter-clockwise about R_u × R_v, the IR face's normal.
 
 use super::MeshError;
 use crate::ir::Model;
@@ -15,7 +18,12 @@ use std::collections::{BTreeMap, HashSet};
 
 /// `first` is the mesh face index of `model.trimmed[0]` (they are appended
 /// in model order).
-pub(super) fn join(model: &Model, mesh: &mut Mesh, first: usize) -> Result<(), MeshError> {
+pub(super) fn join(
+    model: &Model,
+    full: &Model,
+    mesh: &mut Mesh,
+    first: usize,
+) -> Result<(), MeshError> {
     // Which subdomains each trimmed face bounds, for the fragments.
     let mut sides: BTreeMap<usize, Vec<u32>> = BTreeMap::new();
     for (k, sub) in model.subdomains.iter().enumerate() {
@@ -24,21 +32,23 @@ pub(super) fn join(model: &Model, mesh: &mut Mesh, first: usize) -> Result<(), M
         }
         let trimmed: Vec<u32> = sub.trimmed.iter().map(|&t| (first + t) as u32).collect();
         let known = mesh.subdomains[k].faces.clone();
-        let flags = orient(mesh, &known, &trimmed, &sub.name)?;
+        let found = orient(mesh, &known, &trimmed, &sub.name)?;
         check_closed(model, mesh, &known, &trimmed, &sub.name, first)?;
+        // The IR's flags (`lower/trimmed_topology.rs`) are the faces' own;
+        // the mesh, oriented across its shared edges, must agree.
+        let flags = match ir_flags(full, k) {
+            Some(ir) if ir != found => {
+                return Err(MeshError::Internal {
+                    entity: format!("subdomain `{}`", sub.name),
+                    message: format!(
+                        "the outward sides of its trimmed faces are {ir:?} in the model but {found:?} on the mesh"
+                    ),
+                });
+            }
+            Some(ir) => ir,
+            None => found,
+        };
         for (&f, outward) in trimmed.iter().zip(flags) {
-            // A face first met inward is turned over, so the stored
-            // triangles face out of the first subdomain it bounds (writers
-            // keep faces as stored).
-            let first_use = !sides.contains_key(&(f as usize));
-            let outward = if first_use && !outward {
-                for t in &mut mesh.faces[f as usize].triangles {
-                    t.swap(1, 2);
-                }
-                true
-            } else {
-                outward
-            };
             mesh.subdomains[k].faces.push((f, outward));
             sides.entry(f as usize).or_default().push(k as u32);
         }
@@ -204,4 +214,23 @@ fn check_closed(
         });
     }
     Ok(())
+}
+
+/// The topology IR's outward flags of subdomain `k`'s trimmed faces, in
+/// `Subdomain::trimmed` order (`None` without the trimmed topology).
+fn ir_flags(full: &Model, k: usize) -> Option<Vec<bool>> {
+    let [_, _, f0] = full.trimmed_start?;
+    let sub = full.subdomains.get(k)?;
+    let crate::ir::SubdomainCells::Volume { boundary } = &sub.cells else {
+        return None;
+    };
+    sub.trimmed
+        .iter()
+        .map(|&t| {
+            boundary
+                .iter()
+                .find(|of| of.face.index() == f0 + t)
+                .map(|of| of.outward)
+        })
+        .collect()
 }

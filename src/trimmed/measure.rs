@@ -57,3 +57,29 @@ impl TrimmedMesh {
         q
     }
 }
+
+/// ∫ R · (R_u × R_v) du dv / 3 over the material part of the rectangle (a
+/// 96 × 96 midpoint rule masked by W ≥ 0): the surface's share of the
+/// volume a closed shell encloses, its normal R_u × R_v. The topology IR
+/// fixes a shell's outward side by the sign of that volume; loops fanned
+/// from a point cancel out on a tube (both rims' fans are flat disks).
+pub fn volume_share(s: &TrimmedSurface) -> f64 {
+    let [u0, u1, v0, v1] = s.rect;
+    let n = 96;
+    let (du, dv) = ((u1 - u0) / n as f64, (v1 - v0) / n as f64);
+    let mut total = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let (u, v) = (u0 + (i as f64 + 0.5) * du, v0 + (j as f64 + 0.5) * dv);
+            if s.material(u, v) < 0.0 {
+                continue;
+            }
+            let (ru, rv) = s.tangents(u, v);
+            let term = s.point(u, v).coords.dot(&ru.cross(&rv));
+            if term.is_finite() {
+                total += term;
+            }
+        }
+    }
+    total * du * dv / 3.0
+}

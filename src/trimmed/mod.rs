@@ -14,7 +14,7 @@ mod split;
 pub mod topology;
 mod triangulate;
 
-pub use measure::{TrimmedQuality, centroid_distance};
+pub use measure::{TrimmedQuality, centroid_distance, volume_share};
 pub use triangulate::{TrimSettings, TrimmedMesh, mesh_trimmed, mesh_trimmed_shared};
 
 use crate::geom::point_calculus::Patch9;

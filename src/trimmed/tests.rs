@@ -642,3 +642,22 @@ fn cylinder_in_a_local_frame_cut_by_a_global_plane() {
         assert!(((p.y - 2.0).hypot(p.z - 3.0) - 0.5).abs() < 1e-9, "{p}");
     }
 }
+
+#[test]
+fn paper_patch_at_25_degrees_has_no_smaller_angle() {
+    // The patch's corners and the smooth hole give no input angle under
+    // 25°, so every triangle must reach the threshold (issue 9's tests).
+    let s = paper_surface();
+    let settings = TrimSettings {
+        min_angle: 25.0,
+        ..SETTINGS
+    };
+    let m = mesh_trimmed(&s, settings).expect("meshable");
+    let q = m.quality(&s);
+    let below: usize = q.histogram[..5].iter().sum();
+    assert!(
+        q.min_angle >= 25.0 - 1e-9,
+        "{below} triangles below 25°: {q:?}"
+    );
+    assert!(q.max_centroid_distance <= settings.tolerance, "{q:?}");
+}

@@ -55,6 +55,16 @@ pub fn pieces(s: &TrimmedSurface, tolerance: f64) -> Result<Vec<Vec<Piece>>, Str
         if n < 2 {
             continue;
         }
+        // Material on the left in (u, v), so the loops run counter-clockwise
+        // about R_u × R_v as the face's loops must (the trace leaves the
+        // direction to the order it met the crossings).
+        let reversed: Vec<usize>;
+        let lp = if material_on_left(s, &b.points, lp) {
+            lp
+        } else {
+            reversed = lp.iter().rev().copied().collect();
+            &reversed
+        };
         // The class of segment i (lp[i] → lp[i + 1]): the side both ends lie
         // on, 0 on a trim curve.
         let class: Vec<u8> = (0..n)
@@ -94,6 +104,35 @@ pub fn pieces(s: &TrimmedSurface, tolerance: f64) -> Result<Vec<Vec<Piece>>, Str
     Ok(out)
 }
 
+/// Whether the material lies left of the loop: tested beside its longest
+/// segment, a point off the rectangle counting as no material.
+fn material_on_left(s: &TrimmedSurface, points: &[[f64; 2]], lp: &[usize]) -> bool {
+    let n = lp.len();
+    let Some(i) = (0..n).max_by(|&i, &j| {
+        let len = |k: usize| {
+            let (a, b) = (points[lp[k]], points[lp[(k + 1) % n]]);
+            (b[0] - a[0]).hypot(b[1] - a[1])
+        };
+        len(i).total_cmp(&len(j))
+    }) else {
+        return true;
+    };
+    let (a, b) = (points[lp[i]], points[lp[(i + 1) % n]]);
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let m = [0.5 * (a[0] + b[0]), 0.5 * (a[1] + b[1])];
+    let [u0, u1, v0, v1] = s.rect;
+    let w = |sign: f64| {
+        let p = [m[0] - sign * 1e-3 * d[1], m[1] + sign * 1e-3 * d[0]];
+        let inside = p[0] >= u0 && p[0] <= u1 && p[1] >= v0 && p[1] <= v1;
+        if inside {
+            s.material(p[0], p[1])
+        } else {
+            f64::NEG_INFINITY
+        }
+    };
+    w(1.0) >= w(-1.0)
+}
+
 /// Joins trim pieces that a periodic seam cut (one ends where another
 /// begins, at a point no side piece touches), so a hole across the seam is
 /// one closed trim piece, as the mesh joins its chain again.
@@ -128,6 +167,8 @@ fn join_across_seams(loops: &mut [Vec<Piece>], distance: f64) {
         let tail = loops[l2][j].points[1..].to_vec();
         loops[l][i].points.extend(tail);
         loops[l2].remove(j);
+        // Removing an earlier piece of the same loop shifts this one back.
+        let i = if l2 == l && j < i { i - 1 } else { i };
         let p = &mut loops[l][i];
         let (a, b) = ends(p);
         if (a - b).norm() <= distance {
