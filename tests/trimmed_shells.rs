@@ -158,7 +158,18 @@ fn a_trimmed_face_between_two_subdomains_is_their_fragment() {
     assert_eq!(by_name["lower|upper"], ["middle"]);
     assert_eq!(by_name["lower|exterior"], ["base", "lower_tube", "ring"]);
     assert_eq!(by_name["upper|exterior"], ["upper_tube", "roof"]);
-    // The middle disk faces out of `lower` and into `upper`.
+    // The middle disk keeps its surface's normal R_u × R_v, which points
+    // down (-y, the cans' axis): into `lower`, below it, and out of `upper`.
+    let p = |i: u32| nalgebra::Vector3::from(mesh.nodes[i as usize]);
+    let middle_normal: nalgebra::Vector3<f64> = mesh.faces[face_index(&mesh, "middle")]
+        .triangles
+        .iter()
+        .map(|t| (p(t[1]) - p(t[0])).cross(&(p(t[2]) - p(t[0]))))
+        .sum();
+    assert!(
+        middle_normal.y < 0.0 && middle_normal.y.abs() > 0.99 * middle_normal.norm(),
+        "middle normal {middle_normal:?}"
+    );
     let flag = |sub: &str| {
         let m = face_index(&mesh, "middle") as u32;
         mesh.subdomains
@@ -167,7 +178,7 @@ fn a_trimmed_face_between_two_subdomains_is_their_fragment() {
             .and_then(|s| s.faces.iter().find(|f| f.0 == m))
             .map(|f| f.1)
     };
-    assert_eq!((flag("lower"), flag("upper")), (Some(true), Some(false)));
+    assert_eq!((flag("lower"), flag("upper")), (Some(false), Some(true)));
 }
 
 #[test]
