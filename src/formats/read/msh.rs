@@ -55,11 +55,7 @@ impl NodeIndex {
         if tag < dense_limit {
             let t = tag as usize;
             if t >= self.dense.len() {
-                // Grown by doubling up to the limit (entries past the tags
-                // seen so far hold NONE, as tags never given do), not by one
-                // entry per new tag.
-                let grown = (2 * self.dense.len()).clamp(t + 1, (dense_limit as usize).max(t + 1));
-                self.dense.resize(grown, NONE);
+                self.dense.resize(t + 1, NONE);
             }
             self.dense
                 .get_mut(t)
@@ -492,20 +488,16 @@ impl<'a> Reader<'a> {
             let at = self.here();
             let n = self.size("the number of nodes in a block")?;
             let n = self.plausible(n, per_node, "nodes in a block", at)?;
-            let extra = if parametric != 0 {
-                _dim.clamp(0, 3) as usize
-            } else {
-                0
-            };
-            if self.binary && extra == 0 && self.binary_node_block(n, dense_limit)? {
-                read += n;
-                continue;
-            }
             tags.clear();
             for _ in 0..n {
                 let at = self.here();
                 tags.push((self.size("a node tag")?, at));
             }
+            let extra = if parametric != 0 {
+                _dim.clamp(0, 3) as usize
+            } else {
+                0
+            };
             if self.binary && extra == 0 && self.binary_coordinates(&tags, dense_limit)? {
                 read += n;
                 continue;
@@ -532,46 +524,6 @@ impl<'a> Reader<'a> {
             ));
         }
         Ok(())
-    }
-
-    /// A whole binary node block (`n` tags, then `n` coordinate triples)
-    /// read straight from the file's bytes when the file holds all of it
-    /// (else `false`, nothing read: the tag-by-tag path says where it ends).
-    /// Node by node, the same checks in the same order as that path: a
-    /// non-finite coordinate, then the node's tag given twice.
-    fn binary_node_block(&mut self, n: usize, dense_limit: u64) -> Result<bool, Diagnostic> {
-        let bytes = self.s.bytes;
-        let start = self.s.pos;
-        let Some(block) = n
-            .checked_mul(32)
-            .and_then(|len| bytes.get(start..)?.get(..len))
-        else {
-            return Ok(false);
-        };
-        let (tags, coordinates) = block.split_at(8 * n);
-        let coordinates_at = start + tags.len();
-        for (i, (t, record)) in tags
-            .chunks_exact(8)
-            .zip(coordinates.chunks_exact(24))
-            .enumerate()
-        {
-            let mut p = [0.0; 3];
-            for (k, (slot, c)) in p.iter_mut().zip(record.chunks_exact(8)).enumerate() {
-                let v = f64::from_le_bytes(super::array(c).unwrap_or([0; 8]));
-                if !v.is_finite() {
-                    return Err(error_at_byte(
-                        Code::MeshNonFinite,
-                        coordinates_at + 24 * i + 8 * k,
-                        format!("a node coordinate is {v}, not a finite number"),
-                    ));
-                }
-                *slot = v;
-            }
-            let tag = u64::from_le_bytes(super::array(t).unwrap_or([0; 8]));
-            self.add_node(tag, start + 8 * i, p, dense_limit)?;
-        }
-        self.s.pos = start + block.len();
-        Ok(true)
     }
 
     /// A binary block of node coordinates read at once, when the file holds
