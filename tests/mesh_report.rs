@@ -305,3 +305,49 @@ fn e500_to_e503_are_explained() {
         assert!(String::from_utf8_lossy(&out.stdout).contains(code));
     }
 }
+
+/// Paper 002's figure 5 through the CLI: per trimmed surface, the minimum
+/// angle distribution and the largest centroid-to-surface distance.
+#[test]
+fn inspect_mesh_reports_trimmed_angles_and_centroid_distance() {
+    let out = geomc(&[
+        "inspect",
+        "--mesh",
+        "--format",
+        "json",
+        "fixtures/valid/trimmed_bezier_hole.xml",
+    ]);
+    assert_eq!(out.status.code(), Some(0));
+    let json: serde_json::Value = serde_json::from_slice(&out.stdout).expect("JSON");
+    let mesh = &json["mesh"];
+    let tolerance = mesh["tolerance"].as_f64().expect("tolerance");
+    let target = mesh["min_angle_target"].as_f64().expect("target");
+    let trimmed = mesh["trimmed"].as_array().expect("trimmed surfaces");
+    assert_eq!(trimmed.len(), 1);
+    let panel = &trimmed[0];
+    assert_eq!(panel["name"], "panel");
+    // The panel is the only face: its triangles are the mesh's.
+    let triangles = panel["triangles"].as_u64().expect("count");
+    assert_eq!(triangles, mesh["triangles"].as_u64().expect("count"));
+    let bins: Vec<u64> = panel["min_angle_histogram"]
+        .as_array()
+        .expect("bins")
+        .iter()
+        .filter_map(|v| v.as_u64())
+        .collect();
+    assert_eq!(bins.len(), 12);
+    assert_eq!(bins.iter().sum::<u64>(), triangles);
+    // No input angle is small here: nothing under the 25° target, and the
+    // smallest angle lies in the first non-empty 5° bin.
+    let min_angle = panel["min_angle"].as_f64().expect("angle");
+    assert_eq!(target, 25.0);
+    assert!(min_angle >= target, "{min_angle}");
+    assert!(bins[..5].iter().all(|&n| n == 0), "{bins:?}");
+    let first = bins.iter().position(|&n| n > 0).expect("a bin") as f64;
+    assert!((5.0 * first..5.0 * first + 5.0).contains(&min_angle));
+    let distance = panel["max_centroid_distance"].as_f64().expect("distance");
+    assert!(
+        distance > 0.0 && distance <= tolerance,
+        "{distance} {tolerance}"
+    );
+}
