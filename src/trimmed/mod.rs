@@ -74,6 +74,35 @@ pub struct TrimmedSurface {
     pub trim: Option<Trim>,
 }
 
+/// R(u, v) of a carrier in its local frame (NaN when an expression fails).
+fn local_point(carrier: &Carrier, u: f64, v: f64) -> Point3 {
+    match carrier {
+        Carrier::Bezier { rows } => bezier(rows, u, v),
+        Carrier::Cone { r1, r2, length } => {
+            let r = r1 + (r2 - r1) * u / length;
+            Point3::new(r * v.cos(), u, r * v.sin())
+        }
+        Carrier::Sphere { radius } => {
+            let ring = radius * u.cos();
+            Point3::new(ring * v.cos(), radius * u.sin(), ring * v.sin())
+        }
+        Carrier::Torus { major, minor } => {
+            let ring = major + minor * u.cos();
+            Point3::new(ring * v.cos(), minor * u.sin(), ring * v.sin())
+        }
+        Carrier::Patch9(patch) => patch.point(u, v),
+        Carrier::Expressions { xyz } => {
+            let p = [u, v, 0.0];
+            Point3::new(
+                xyz[0].eval_point(p),
+                xyz[1].eval_point(p),
+                xyz[2].eval_point(p),
+            )
+        }
+        Carrier::Swapped(inner) => local_point(inner, v, u),
+    }
+}
+
 impl TrimmedSurface {
     /// R(u, v) in global coordinates (NaN when an expression fails).
     pub fn point(&self, u: f64, v: f64) -> Point3 {
@@ -93,40 +122,7 @@ impl TrimmedSurface {
             ..self.clone()
         }
     }
-}
 
-/// R(u, v) of a carrier in its local frame (NaN when an expression fails).
-fn local_point(carrier: &Carrier, u: f64, v: f64) -> Point3 {
-    {
-        match carrier {
-            Carrier::Bezier { rows } => bezier(rows, u, v),
-            Carrier::Cone { r1, r2, length } => {
-                let r = r1 + (r2 - r1) * u / length;
-                Point3::new(r * v.cos(), u, r * v.sin())
-            }
-            Carrier::Sphere { radius } => {
-                let ring = radius * u.cos();
-                Point3::new(ring * v.cos(), radius * u.sin(), ring * v.sin())
-            }
-            Carrier::Torus { major, minor } => {
-                let ring = major + minor * u.cos();
-                Point3::new(ring * v.cos(), minor * u.sin(), ring * v.sin())
-            }
-            Carrier::Patch9(patch) => patch.point(u, v),
-            Carrier::Expressions { xyz } => {
-                let p = [u, v, 0.0];
-                Point3::new(
-                    xyz[0].eval_point(p),
-                    xyz[1].eval_point(p),
-                    xyz[2].eval_point(p),
-                )
-            }
-            Carrier::Swapped(inner) => local_point(inner, v, u),
-        }
-    }
-}
-
-impl TrimmedSurface {
     /// Surface points on an (n + 1) × (n + 1) parameter grid.
     pub fn samples(&self, n: usize) -> Vec<Point3> {
         let [u0, u1, v0, v1] = self.rect;
@@ -155,25 +151,17 @@ impl TrimmedSurface {
     pub fn project(&self, p: &Point3) -> Option<(Point3, Vec3)> {
         let [u0, u1, v0, v1] = self.rect;
         let n = 16;
-        let mut best = (f64::INFINITY, [u0, v0]);
-        for i in 0..=n {
-            for j in 0..=n {
-                let uv = [
-                    u0 + (u1 - u0) * i as f64 / n as f64,
-                    v0 + (v1 - v0) * j as f64 / n as f64,
-                ];
-                let d = (self.point(uv[0], uv[1]) - p).norm_squared();
-                if d < best.0 {
-                    best = (d, uv);
-                }
-            }
-        }
-        let uv = triangulate::nearest_parameter(self, *p, best.1);
+        let k = shared::nearest_point(&self.samples(n), p);
+        let start = [
+            u0 + (u1 - u0) * (k / (n + 1)) as f64 / n as f64,
+            v0 + (v1 - v0) * (k % (n + 1)) as f64 / n as f64,
+        ];
+        let uv = triangulate::nearest_parameter(self, *p, start);
         let uv = [uv[0].clamp(u0, u1), uv[1].clamp(v0, v1)];
         let uv = if uv[0].is_finite() && uv[1].is_finite() {
             uv
         } else {
-            best.1
+            start
         };
         let q = self.point(uv[0], uv[1]);
         let (du, dv) = self.tangents(uv[0], uv[1]);

@@ -66,6 +66,27 @@ fn below(k: f64) -> Trim {
     Trim::new(&x, f, false)
 }
 
+/// A whole sphere of radius `r` about the y axis: one node per pole, the
+/// area 4πr² within 2e-3, minimum angle 20°, centroids within 0.002.
+fn check_whole_sphere(s: &TrimmedSurface, m: &TrimmedMesh, r: f64) -> TrimmedQuality {
+    let poles = m
+        .nodes
+        .iter()
+        .filter(|p| (p.y.abs() - r).abs() < 1e-9)
+        .count();
+    assert_eq!(poles, 2);
+    let q = m.quality(s);
+    let exact = 2.0 * TAU * r * r;
+    assert!(
+        (q.area - exact).abs() / exact < 2e-3,
+        "{} vs {exact}",
+        q.area
+    );
+    assert!(q.min_angle >= 20.0, "{q:?}");
+    assert!(q.max_centroid_distance <= 0.002, "{q:?}");
+    q
+}
+
 #[test]
 fn full_sphere_is_closed_with_one_vertex_per_pole() {
     let r = 1.5;
@@ -77,21 +98,7 @@ fn full_sphere_is_closed_with_one_vertex_per_pole() {
     for p in &m.nodes {
         assert!((p.coords.norm() - r).abs() < 1e-9, "{p}");
     }
-    let poles = m
-        .nodes
-        .iter()
-        .filter(|p| (p.y.abs() - r).abs() < 1e-9)
-        .count();
-    assert_eq!(poles, 2);
-    let q = m.quality(&s);
-    let exact = 2.0 * TAU * r * r;
-    assert!(
-        (q.area - exact).abs() / exact < 2e-3,
-        "{} vs {exact}",
-        q.area
-    );
-    assert!(q.min_angle >= 20.0, "{q:?}");
-    assert!(q.max_centroid_distance <= 0.002, "{q:?}");
+    let q = check_whole_sphere(&s, &m, r);
     eprintln!("full sphere: {} triangles, {q:?}", m.triangles.len());
 }
 
@@ -350,21 +357,7 @@ fn poles_on_the_v_sides_are_meshed_through_the_transpose() {
     let m = mesh_trimmed(&s, settings(0.15)).expect("meshable");
     assert_eq!(check_manifold(&m), 0, "no boundary segments");
     assert_eq!(euler(&m), 2);
-    let poles = m
-        .nodes
-        .iter()
-        .filter(|p| (p.y.abs() - r).abs() < 1e-9)
-        .count();
-    assert_eq!(poles, 2);
-    let q = m.quality(&s);
-    let exact = 2.0 * TAU * r * r;
-    assert!(
-        (q.area - exact).abs() / exact < 2e-3,
-        "{} vs {exact}",
-        q.area
-    );
-    assert!(q.min_angle >= 20.0, "{q:?}");
-    assert!(q.max_centroid_distance <= 0.002, "{q:?}");
+    check_whole_sphere(&s, &m, r);
     // The triangles turn about R_u × R_v of the surface as given, which
     // the transpose turns over: the enclosed volumes have opposite signs.
     let volume = |m: &TrimmedMesh| {
