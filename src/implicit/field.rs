@@ -226,7 +226,6 @@ fn classify_region(
     }
 }
 
-
 /// Samples `ssa` on the grid: blocks classified by interval arithmetic
 /// (`classify_region`), the samples of the mixed blocks evaluated row by row
 /// on their own programs, and of the proven-inside blocks on the box faces
@@ -274,7 +273,9 @@ pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
                     for k in lo[2]..owned[2] {
                         for j in lo[1]..owned[1] {
                             let row = &mut out[local(0, j, k)..][..len];
-                            kernel.rows.eval_row(&mut ws, coords[1][j], coords[2][k], row);
+                            kernel
+                                .rows
+                                .eval_row(&mut ws, coords[1][j], coords[2][k], row);
                         }
                     }
                 }
@@ -360,10 +361,21 @@ mod tests {
             panic!("a sampled function's field is block-sparse");
         };
         let stored = slot.iter().filter(|&&s| s != NOT_STORED).count();
-        let mixed = field.blocks.iter().filter(|b| matches!(b, Block::Mixed(_))).count();
-        let inside = field.blocks.iter().filter(|b| matches!(b, Block::Inside)).count();
+        let mixed = field
+            .blocks
+            .iter()
+            .filter(|b| matches!(b, Block::Mixed(_)))
+            .count();
+        let inside = field
+            .blocks
+            .iter()
+            .filter(|b| matches!(b, Block::Inside))
+            .count();
         assert!(mixed > 0 && inside > 0, "{mixed} mixed, {inside} inside");
-        assert!(stored > mixed && stored < field.blocks.len(), "{stored} stored");
+        assert!(
+            stored > mixed && stored < field.blocks.len(),
+            "{stored} stored"
+        );
         assert_eq!(data.len(), stored * BLOCK_LEN);
         // Every sample as a dense grid: its sign bits are the field's.
         let mut dense = Vec::with_capacity(n1.iter().product());

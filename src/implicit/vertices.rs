@@ -377,13 +377,12 @@ fn illinois(
     }
 }
 
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::implicit::field::sample_field;
     use crate::implicit::ir::{Binary, Ctx, NodeId};
     use crate::implicit::library;
-    use crate::implicit::field::sample_field;
     use crate::implicit::polygonize::Grid;
     use crate::implicit::rfs::RSystem;
     use crate::implicit::tape::Ssa;
