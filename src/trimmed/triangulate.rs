@@ -207,7 +207,10 @@ fn mesh_band(
         .with_max_additional_vertices(budget)
         .keep_constraint_edges();
     let mut inner: Vec<[usize; 3]> = Vec::new();
-    // Triangles this small are left as they are (next to small input angles).
+    // Triangles this small are left as they are, and boundary edges this
+    // short are not split: the guard that ends refinement at an input angle
+    // smaller than the threshold (Ruppert's corner cascade). A tenth of the
+    // tolerance, so no triangle of the size the tolerance asks for is left.
     let floor = (0.002 * h).min(0.1 * tol);
     let fixed = nodes.uv.len();
     // Triangles found fine stay fine while they exist (their nodes and
@@ -261,17 +264,8 @@ fn mesh_band(
                 Some(mut split) => {
                     split.corners = t;
                     if let Some(a) = choose(&cdt, &arc, &nodes, split, &constraints, t[0], floor) {
-                        if std::env::var("TRIMDBG").is_ok() && min_angle(&p) < settings.min_angle && pass > 30 {
-                            eprintln!("pass {pass} act {} ang {:.2} q={q:?} cons={}", match &a { Action::Split(..) => "split", _ => "insert" }, min_angle(&p), constraints.len());
-                        }
                         actions.push(a);
-                    } else if std::env::var("TRIMDBG").is_ok() && min_angle(&p) < settings.min_angle {
-                        eprintln!("pass {pass} NONE ang {:.2} q={q:?} cons={:?} sides={:?}", min_angle(&p), constraints, t.map(|i| nodes.sides[i]));
                     }
-                }
-                None if std::env::var("TRIMDBG").is_ok() && min_angle(&p) < settings.min_angle => {
-                    eprintln!("pass {pass} EXEMPT ang {:.2} angles={angles} q={q:?} cons={} sides={:?}", min_angle(&p), constraints.len(), t.map(|i| nodes.sides[i]));
-                    fine.insert(key);
                 }
                 None => {
                     fine.insert(key);
@@ -498,11 +492,6 @@ fn choose(
         }
     };
     for uv in candidates {
-        if std::env::var("TRIMDBG2").is_ok() {
-            let p = chart_point(arc, uv);
-            let loc = cdt.locate_with_hint(p, hint);
-            eprintln!("cand {uv:?} enc={:?} clear={} spacing={spacing} loc={:?} tri={:?}", encroached(cdt, p, hint), clear(cdt, p, hint, spacing), loc, split.triangle);
-        }
         match encroached(cdt, chart_point(arc, uv), hint) {
             Some(Some(e)) => {
                 return splittable(e).then_some(Action::Split(e.0, e.1));
