@@ -207,8 +207,11 @@ fn mesh_band(
         .with_max_additional_vertices(budget)
         .keep_constraint_edges();
     let mut inner: Vec<[usize; 3]> = Vec::new();
-    // Triangles this small are left as they are (next to small input angles).
-    let floor = (0.02 * h).min(tol);
+    // Triangles this small are left as they are, and boundary edges this
+    // short are not split: the guard that ends refinement at an input angle
+    // smaller than the threshold (Ruppert's corner cascade). A tenth of the
+    // tolerance, so no triangle of the size the tolerance asks for is left.
+    let floor = (0.002 * h).min(0.1 * tol);
     let fixed = nodes.uv.len();
     // Triangles found fine stay fine while they exist (their nodes and
     // the criteria do not change): they are not measured again.
@@ -258,7 +261,8 @@ fn mesh_band(
             let on_seam = |&&(a, b): &&(usize, usize)| nodes.sides[a] & nodes.sides[b] & seams != 0;
             let angles = constraints.iter().filter(|e| !on_seam(e)).count() < 2;
             match needs_split(s, &p, &q, &settings, floor, angles) {
-                Some(split) => {
+                Some(mut split) => {
+                    split.corners = t;
                     if let Some(a) = choose(&cdt, &arc, &nodes, split, &constraints, t[0], floor) {
                         actions.push(a);
                     }
@@ -349,6 +353,8 @@ struct Split {
     circumcentre: Option<[f64; 2]>,
     centroid: [f64; 2],
     triangle: [[f64; 2]; 3],
+    /// The triangle's vertices.
+    corners: [usize; 3],
 }
 
 /// What one refinement step does.
@@ -421,6 +427,7 @@ fn needs_split(
         circumcentre,
         centroid: centroid_uv,
         triangle: *q,
+        corners: [0; 3],
     })
 }
 
@@ -468,6 +475,19 @@ fn choose(
             if let Some(e) = longest_constraint() {
                 return Some(Action::Split(e.0, e.1));
             }
+            // The circumcentre lies beyond the boundary at a corner of the
+            // triangle: Ruppert splits the boundary edge there.
+            if let Some(e) = corner_constraints(cdt, &split.corners)
+                .into_iter()
+                .filter(|&e| splittable(e))
+                .max_by(|a, b| {
+                    let la = (nodes.xyz[a.0] - nodes.xyz[a.1]).norm();
+                    let lb = (nodes.xyz[b.0] - nodes.xyz[b.1]).norm();
+                    la.total_cmp(&lb)
+                })
+            {
+                return Some(Action::Split(e.0, e.1));
+            }
             vec![split.centroid]
         }
     };
@@ -476,13 +496,32 @@ fn choose(
             Some(Some(e)) => {
                 return splittable(e).then_some(Action::Split(e.0, e.1));
             }
-            Some(None) => {
+            // The 3D circumcentre may land next to a vertex the chart's
+            // Delaunay triangle does not see: then the next candidate.
+            Some(None) if clear(cdt, chart_point(arc, uv), hint, spacing) => {
                 return Some(Action::Insert { uv, hint, spacing });
             }
-            None => continue,
+            _ => continue,
         }
     }
     None
+}
+
+/// The constraint edges at the corners of a triangle (each once).
+fn corner_constraints(cdt: &Cdt, corners: &[usize; 3]) -> Vec<(usize, usize)> {
+    let mut out: Vec<(usize, usize)> = Vec::new();
+    for &c in corners {
+        let v = cdt.vertex(spade::handles::FixedVertexHandle::from_index(c));
+        for e in v.out_edges() {
+            if cdt.is_constraint_edge(e.as_undirected().fix()) {
+                let (a, b) = (e.from().fix().index(), e.to().fix().index());
+                if !out.contains(&(a, b)) && !out.contains(&(b, a)) {
+                    out.push((a, b));
+                }
+            }
+        }
+    }
+    out
 }
 
 fn chart_point(arc: &ArcChart, uv: [f64; 2]) -> Point2<f64> {
