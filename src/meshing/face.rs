@@ -47,6 +47,9 @@ const MAX_PASSES: usize = 60;
 /// boundary (another meshing round); at 6–8 a sphere face takes 2–3 passes
 /// instead of 9–10, with 8% more triangles at the same tolerance.
 const GUIDE_FACTOR: f64 = 8.0;
+/// Room reserved for a curved face's nodes, in multiples of what its area
+/// limit asks for (`expected_vertices`).
+const CURVED_ROOM: usize = 2;
 /// Nodes one face may have.
 const MAX_FACE_VERTICES: usize = 2_000_000;
 
@@ -131,10 +134,21 @@ pub(crate) fn mesh_face(
 
     // Sized up front for the nodes the area limit will ask for: growing
     // spade's tables by doubling copied them and touched twice the memory.
-    let expected = expected_vertices(
-        &uv_loops,
-        settings.max_area.min(guide_area(&uv_loops, &face.surface)),
-    );
+    // A curved face's chordal passes add about as many nodes again where
+    // the chart shrinks the surface (a stereographic hemisphere's pole):
+    // room for them is reserved too, which costs address space only, where
+    // growing the tables copied them (page faults, mostly from that copying,
+    // were 5% of meshing the seven balls).
+    let curved = if matches!(face.surface, Surface::Plane { .. }) {
+        1
+    } else {
+        CURVED_ROOM
+    };
+    let expected = curved
+        * expected_vertices(
+            &uv_loops,
+            settings.max_area.min(guide_area(&uv_loops, &face.surface)),
+        );
     let bulk = bulk_load_loops(&uv_loops);
     let bulk_loaded = bulk.is_some();
     let mut cdt = bulk.unwrap_or_else(|| Cdt::with_capacity(expected, 3 * expected, 2 * expected));
@@ -319,6 +333,11 @@ pub(crate) fn mesh_face(
     };
     // Vertices from this index on have not been checked for boundary splits.
     let mut unchecked = fixed;
+    // Constraint segments at the last check: refinement puts a vertex on a
+    // boundary segment only by splitting it, which adds one, so while the
+    // count stands no new vertex needs looking at (the look walks every new
+    // vertex's edges: 3% of meshing a sphere).
+    let mut checked_constraints = usize::MAX;
     let mut added = Vec::new();
     // A plane face without poly_lines or small input angles is refined by
     // geomc's own off-centre refinement (`refine`): spade's inserts
@@ -397,14 +416,18 @@ pub(crate) fn mesh_face(
         let mut moved = false;
         if !settings.keep_boundary {
             // Only the vertices added since the last check.
-            let mut chains = boundary_chain::chains(
-                &cdt,
-                unchecked,
-                result.on_segments.as_deref(),
-                &segments,
-                &polyline_segments,
-            )
-            .map_err(failed)?;
+            let mut chains = if cdt.num_constraints() == checked_constraints {
+                Vec::new()
+            } else {
+                boundary_chain::chains(
+                    &cdt,
+                    unchecked,
+                    result.on_segments.as_deref(),
+                    &segments,
+                    &polyline_segments,
+                )
+                .map_err(failed)?
+            };
             let plane = matches!(face.surface, Surface::Plane { .. });
             let straight = |edge: usize| {
                 matches!(
@@ -456,6 +479,7 @@ pub(crate) fn mesh_face(
             }
         }
         unchecked = cdt.num_vertices();
+        checked_constraints = cdt.num_constraints();
         lift_new_vertices(&cdt, &chart, &mut positions).map_err(failed)?;
         for (edge, v, s, node) in kept {
             // Node indices fit in 32 bits (`MAX_FACE_VERTICES`).
