@@ -47,9 +47,6 @@ const MAX_PASSES: usize = 60;
 /// boundary (another meshing round); at 6–8 a sphere face takes 2–3 passes
 /// instead of 9–10, with 8% more triangles at the same tolerance.
 const GUIDE_FACTOR: f64 = 8.0;
-/// Room reserved for a curved face's nodes, in multiples of what its area
-/// limit asks for (`expected_vertices`).
-const CURVED_ROOM: usize = 2;
 /// Nodes one face may have.
 const MAX_FACE_VERTICES: usize = 2_000_000;
 
@@ -134,21 +131,10 @@ pub(crate) fn mesh_face(
 
     // Sized up front for the nodes the area limit will ask for: growing
     // spade's tables by doubling copied them and touched twice the memory.
-    // A curved face's chordal passes add about as many nodes again where
-    // the chart shrinks the surface (a stereographic hemisphere's pole):
-    // room for them is reserved too, which costs address space only, where
-    // growing the tables copied them (page faults, mostly from that copying,
-    // were 5% of meshing the seven balls).
-    let curved = if matches!(face.surface, Surface::Plane { .. }) {
-        1
-    } else {
-        CURVED_ROOM
-    };
-    let expected = curved
-        * expected_vertices(
-            &uv_loops,
-            settings.max_area.min(guide_area(&uv_loops, &face.surface)),
-        );
+    let expected = expected_vertices(
+        &uv_loops,
+        settings.max_area.min(guide_area(&uv_loops, &face.surface)),
+    );
     let bulk = bulk_load_loops(&uv_loops);
     let bulk_loaded = bulk.is_some();
     let mut cdt = bulk.unwrap_or_else(|| Cdt::with_capacity(expected, 3 * expected, 2 * expected));
