@@ -338,9 +338,8 @@ impl<'a> Expander<'a> {
             hi: [f32::NEG_INFINITY; 3],
         };
         let include = |m: &mut Measure, node: u32| {
-            let p = mesh.nodes[node as usize];
-            for k in 0..3 {
-                let c = p[k] as f32;
+            for (k, &c) in mesh.nodes[node as usize].iter().enumerate() {
+                let c = c as f32;
                 m.lo[k] = m.lo[k].min(c);
                 m.hi[k] = m.hi[k].max(c);
             }
