@@ -12,7 +12,6 @@ use super::groups::{self, Source};
 use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
 use crate::mesh::Mesh;
 use serde_json::{Value, json};
-use std::borrow::Cow;
 use std::io::Write;
 
 pub(crate) struct Gltf {
@@ -108,39 +107,71 @@ fn percent_encode(s: &str) -> String {
 }
 
 /// One part of the binary buffer, kept where it is (the mesh's nodes and
-/// triangles, an expansion's vectors) and converted while it is written: no
-/// copy of the whole buffer is built before the output.
-enum Piece<'a> {
-    /// Vectors written as three little-endian `f32`.
-    Vec3(&'a [[f64; 3]]),
-    /// Vectors made for this output (an expansion's positions and normals),
-    /// kept as the `f32` they are written as: half the memory of `f64`.
+/// triangles, a group's faces) and converted while it is written: no copy of
+/// the whole buffer is built before the output.
+enum Piece {
+    /// Vectors made for this output, kept as the `f32` they are written as.
     Vec3F32(Vec<[f32; 3]>),
-    /// Triangle corners written as little-endian `u32`.
-    Triangles(Cow<'a, [[u32; 3]]>),
     /// Indices written as little-endian `u32`.
     Indices(Vec<u32>),
+    /// A triangle group's positions, normals and indices, one after the
+    /// other: expanded only while it is written, so one group's expansion
+    /// is alive at a time, not every group's (`groups::Expander::stream`).
+    Group {
+        faces: Vec<(u32, bool)>,
+        vertices: usize,
+        triangles: usize,
+    },
 }
 
-impl Piece<'_> {
+impl Piece {
     fn byte_len(&self) -> usize {
         match self {
-            Piece::Vec3(v) => 12 * v.len(),
             Piece::Vec3F32(v) => 12 * v.len(),
-            Piece::Triangles(t) => 12 * t.len(),
             Piece::Indices(i) => 4 * i.len(),
+            Piece::Group {
+                vertices,
+                triangles,
+                ..
+            } => 24 * vertices + 12 * triangles,
         }
     }
 
     /// Converts and writes the piece in blocks of `BLOCK` values.
-    fn write(&self, block: &mut Vec<u8>, out: &mut dyn Write) -> std::io::Result<()> {
+    fn write(
+        &self,
+        expander: &mut groups::Expander,
+        block: &mut Vec<u8>,
+        out: &mut dyn Write,
+    ) -> std::io::Result<()> {
         match self {
-            Piece::Vec3(v) => {
-                write_blocks(v.as_flattened(), block, out, |c| (c as f32).to_le_bytes())
-            }
             Piece::Vec3F32(v) => write_blocks(v.as_flattened(), block, out, f32::to_le_bytes),
-            Piece::Triangles(t) => write_blocks(t.as_flattened(), block, out, u32::to_le_bytes),
             Piece::Indices(i) => write_blocks(i, block, out, u32::to_le_bytes),
+            Piece::Group { faces, .. } => {
+                let group = expander.stream(faces);
+                let nodes = expander.mesh_nodes();
+                match &group.nodes {
+                    None => write_blocks(
+                        nodes[..group.normals.len()].as_flattened(),
+                        block,
+                        out,
+                        |c| (c as f32).to_le_bytes(),
+                    )?,
+                    Some(ids) => {
+                        for chunk in ids.chunks(BLOCK / 3) {
+                            block.clear();
+                            for &n in chunk {
+                                for c in nodes[n as usize] {
+                                    block.extend_from_slice(&(c as f32).to_le_bytes());
+                                }
+                            }
+                            out.write_all(block)?;
+                        }
+                    }
+                }
+                write_blocks(group.normals.as_flattened(), block, out, f32::to_le_bytes)?;
+                write_blocks(group.triangles.as_flattened(), block, out, u32::to_le_bytes)
+            }
         }
     }
 }
@@ -167,11 +198,12 @@ fn write_blocks<T: Copy>(
 
 /// The JSON parts and the binary buffer's pieces, built together.
 struct Document<'a> {
+    mesh: &'a Mesh,
     nodes: Vec<Value>,
     meshes: Vec<Value>,
     accessors: Vec<Value>,
     views: Vec<Value>,
-    pieces: Vec<Piece<'a>>,
+    pieces: Vec<Piece>,
     /// The buffer's length so far: the sum of the pieces' lengths.
     buffer_len: usize,
     scene: Vec<usize>,
@@ -181,6 +213,7 @@ struct Document<'a> {
 impl<'a> Document<'a> {
     fn of(mesh: &'a Mesh, format: &'static str) -> Document<'a> {
         let mut d = Document {
+            mesh,
             nodes: Vec::new(),
             meshes: Vec::new(),
             accessors: Vec::new(),
@@ -195,24 +228,24 @@ impl<'a> Document<'a> {
 
         let mut children = Vec::new();
         for g in groups::surface_groups(mesh) {
-            let ex = expander.expand(&g.faces);
-            if ex.triangles.is_empty() {
+            let m = expander.measure(&g.faces);
+            if m.triangles == 0 {
                 empty.push(g.name.to_string());
                 continue;
             }
-            let primitive = d.triangles(ex);
+            let primitive = d.triangles(g.faces, m);
             children.push(d.node(g.name, primitive, extras(mesh, g.source)));
         }
         d.parent("surfaces", children);
 
         let mut children = Vec::new();
         for g in groups::subdomain_surfaces(mesh) {
-            let ex = expander.expand(&g.faces);
-            if ex.triangles.is_empty() {
+            let m = expander.measure(&g.faces);
+            if m.triangles == 0 {
                 empty.push(g.name.to_string());
                 continue;
             }
-            let primitive = d.triangles(ex);
+            let primitive = d.triangles(g.faces, m);
             children.push(d.node(g.name, primitive, extras(mesh, g.source)));
         }
         d.parent("subdomains", children);
@@ -254,7 +287,7 @@ impl<'a> Document<'a> {
     }
 
     /// Appends a piece to the buffer as a new buffer view; returns its index.
-    fn view(&mut self, piece: Piece<'a>, target: u32) -> usize {
+    fn view(&mut self, piece: Piece, target: u32) -> usize {
         let length = piece.byte_len();
         self.views.push(json!({
             "buffer": 0,
@@ -267,13 +300,13 @@ impl<'a> Document<'a> {
         self.views.len() - 1
     }
 
-    fn vec3_accessor(&mut self, values: Cow<'a, [[f64; 3]]>, with_bounds: bool) -> usize {
+    fn vec3_accessor(&mut self, values: Vec<[f64; 3]>, with_bounds: bool) -> usize {
         let count = values.len();
         // The validator compares the bounds with the stored f32 values exactly.
         let mut lo = [f32::INFINITY; 3];
         let mut hi = [f32::NEG_INFINITY; 3];
         if with_bounds {
-            for v in values.iter() {
+            for v in &values {
                 for k in 0..3 {
                     let c = v[k] as f32;
                     lo[k] = lo[k].min(c);
@@ -281,13 +314,9 @@ impl<'a> Document<'a> {
                 }
             }
         }
-        let piece = match values {
-            Cow::Borrowed(v) => Piece::Vec3(v),
-            // Converted now (the same `as f32` the write would do) and the
-            // `f64` copy freed: the document holds every group's vectors
-            // until the buffer is written.
-            Cow::Owned(v) => Piece::Vec3F32(v.iter().map(|p| p.map(|c| c as f32)).collect()),
-        };
+        // Converted now (the same `as f32` the write would do) and the
+        // `f64` copy freed.
+        let piece = Piece::Vec3F32(values.iter().map(|p| p.map(|c| c as f32)).collect());
         let view = self.view(piece, ARRAY_BUFFER);
         let mut accessor = json!({
             "bufferView": view,
@@ -303,7 +332,7 @@ impl<'a> Document<'a> {
         self.accessors.len() - 1
     }
 
-    fn index_accessor(&mut self, piece: Piece<'a>) -> usize {
+    fn index_accessor(&mut self, piece: Piece) -> usize {
         let count = piece.byte_len() / 4;
         let view = self.view(piece, ELEMENT_ARRAY_BUFFER);
         self.accessors.push(json!({
@@ -315,10 +344,44 @@ impl<'a> Document<'a> {
         self.accessors.len() - 1
     }
 
-    fn triangles(&mut self, ex: groups::Expanded<'a>) -> Value {
-        let position = self.vec3_accessor(ex.positions, true);
-        let normal = self.vec3_accessor(Cow::Owned(ex.normals), false);
-        let indices = self.index_accessor(Piece::Triangles(ex.triangles));
+    /// A triangle group's primitive: its three buffer views follow one
+    /// another and are filled from one expansion while the buffer is written.
+    fn triangles(&mut self, faces: Vec<(u32, bool)>, m: groups::Measure) -> Value {
+        let first_view = self.views.len();
+        let lengths = [12 * m.vertices, 12 * m.vertices, 12 * m.triangles];
+        let targets = [ARRAY_BUFFER, ARRAY_BUFFER, ELEMENT_ARRAY_BUFFER];
+        let mut offset = self.buffer_len;
+        for (length, target) in lengths.into_iter().zip(targets) {
+            self.views.push(json!({
+                "buffer": 0,
+                "byteOffset": offset,
+                "byteLength": length,
+                "target": target,
+            }));
+            offset += length;
+        }
+        let piece = Piece::Group {
+            faces,
+            vertices: m.vertices,
+            triangles: m.triangles,
+        };
+        self.buffer_len += piece.byte_len();
+        self.pieces.push(piece);
+        let mut accessor = |view: usize, component: u32, count: usize, kind: &str| {
+            self.accessors.push(json!({
+                "bufferView": first_view + view,
+                "componentType": component,
+                "count": count,
+                "type": kind,
+            }));
+            self.accessors.len() - 1
+        };
+        let position = accessor(0, FLOAT, m.vertices, "VEC3");
+        let normal = accessor(1, FLOAT, m.vertices, "VEC3");
+        let indices = accessor(2, UNSIGNED_INT, 3 * m.triangles, "SCALAR");
+        // The validator compares the bounds with the stored f32 values exactly.
+        self.accessors[position]["min"] = json!(m.lo);
+        self.accessors[position]["max"] = json!(m.hi);
         json!({
             "attributes": {"POSITION": position, "NORMAL": normal},
             "indices": indices,
@@ -329,7 +392,7 @@ impl<'a> Document<'a> {
     /// A LINES (mode 1) or POINTS (mode 0) primitive over some mesh nodes.
     fn indexed(&mut self, mesh: &Mesh, nodes: &[u32], indices: Option<&[u32]>, mode: u32) -> Value {
         let points = nodes.iter().map(|&n| mesh.nodes[n as usize]).collect();
-        let position = self.vec3_accessor(Cow::Owned(points), true);
+        let position = self.vec3_accessor(points, true);
         let mut primitive = json!({"attributes": {"POSITION": position}, "mode": mode});
         if let Some(indices) = indices {
             primitive["indices"] = json!(self.index_accessor(Piece::Indices(indices.to_vec())));
@@ -382,8 +445,9 @@ impl<'a> Document<'a> {
     /// Writes the binary buffer's pieces in order.
     fn write_buffer(&self, out: &mut dyn Write) -> std::io::Result<()> {
         let mut block = Vec::with_capacity(4 * BLOCK);
+        let mut expander = groups::Expander::new(self.mesh);
         for piece in &self.pieces {
-            piece.write(&mut block, out)?;
+            piece.write(&mut expander, &mut block, out)?;
         }
         Ok(())
     }

@@ -250,7 +250,6 @@ pub(crate) fn oriented(mesh: &Mesh, face: u32, flip: bool) -> impl Iterator<Item
 /// across the edges between faces (the creases).
 #[derive(Debug, Default)]
 pub(crate) struct Expanded<'a> {
-    pub positions: Cow<'a, [[f64; 3]]>,
     pub normals: Vec<[f64; 3]>,
     /// The mesh node each vertex copies; `None` when vertex `i` is node `i`.
     nodes: Option<Vec<u32>>,
@@ -265,6 +264,29 @@ impl Expanded<'_> {
             None => vertex as u32,
         }
     }
+}
+
+/// What a group's expansion will hold, found without building it: its
+/// vertex and triangle counts and the `f32` bounds of its positions (what a
+/// glTF accessor states before its bytes are written).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Measure {
+    pub vertices: usize,
+    pub triangles: usize,
+    pub lo: [f32; 3],
+    pub hi: [f32; 3],
+}
+
+/// A group's expansion as a writer streams it: the mesh node of each vertex
+/// (positions are read from the mesh while written), unit normals as `f32`
+/// and the re-indexed triangles: 16 bytes a vertex, where positions and
+/// normals in `f64` took 52.
+#[derive(Debug, Default)]
+pub(crate) struct Streamed<'a> {
+    /// The mesh node each vertex copies; `None` when vertex `i` is node `i`.
+    pub nodes: Option<Vec<u32>>,
+    pub normals: Vec<[f32; 3]>,
+    pub triangles: Cow<'a, [[u32; 3]]>,
 }
 
 /// Expands groups of one mesh: each node's vertex in the current face sits in
@@ -295,18 +317,146 @@ impl<'a> Expander<'a> {
             let triangles = &mesh.faces[*face as usize].triangles;
             if let Some(used) = identity_prefix(triangles) {
                 return Expanded {
-                    positions: Cow::Borrowed(&mesh.nodes[..used]),
                     normals: node_normals(mesh, triangles, used),
                     nodes: None,
                     triangles: Cow::Borrowed(triangles),
                 };
             }
         }
+        self.prepare();
+        expand_into(self, faces)
+    }
+
+    /// The counts and bounds [`Expander::expand`] would give, with one
+    /// stamped pass over the corners and no vertex copied.
+    pub(crate) fn measure(&mut self, faces: &[(u32, bool)]) -> Measure {
+        let mesh = self.mesh;
+        let mut m = Measure {
+            vertices: 0,
+            triangles: 0,
+            lo: [f32::INFINITY; 3],
+            hi: [f32::NEG_INFINITY; 3],
+        };
+        let include = |m: &mut Measure, node: u32| {
+            for (k, &c) in mesh.nodes[node as usize].iter().enumerate() {
+                let c = c as f32;
+                m.lo[k] = m.lo[k].min(c);
+                m.hi[k] = m.hi[k].max(c);
+            }
+        };
+        if let [(face, false)] = faces {
+            let triangles = &mesh.faces[*face as usize].triangles;
+            if let Some(used) = identity_prefix(triangles) {
+                m.vertices = used;
+                m.triangles = triangles.len();
+                for node in 0..used as u32 {
+                    include(&mut m, node);
+                }
+                return m;
+            }
+        }
+        self.prepare();
+        for &(face, _) in faces {
+            let stamp = self.next_stamp();
+            let triangles = &mesh.faces[face as usize].triangles;
+            m.triangles += triangles.len();
+            for &node in triangles.as_flattened() {
+                let entry = &mut self.slot[node as usize];
+                if entry.0 != stamp {
+                    *entry = (stamp, 0);
+                    m.vertices += 1;
+                    include(&mut m, node);
+                }
+            }
+        }
+        m
+    }
+
+    /// The expansion [`Expander::expand`] makes, kept as it is written:
+    /// nodes instead of positions and normals already `f32` (the same
+    /// numbers: normals are summed and made unit in `f64` per face, then
+    /// converted as the writer converted them).
+    pub(crate) fn stream(&mut self, faces: &[(u32, bool)]) -> Streamed<'a> {
+        let mesh = self.mesh;
+        if let [(face, false)] = faces {
+            let triangles = &mesh.faces[*face as usize].triangles;
+            if let Some(used) = identity_prefix(triangles) {
+                let normals = node_normals(mesh, triangles, used);
+                return Streamed {
+                    nodes: None,
+                    normals: normals.iter().map(|n| n.map(|c| c as f32)).collect(),
+                    triangles: Cow::Borrowed(triangles),
+                };
+            }
+        }
+        self.prepare();
+        let triangles: usize = faces
+            .iter()
+            .map(|&(f, _)| mesh.faces[f as usize].triangles.len())
+            .sum();
+        let vertices = mesh.nodes.len().min(3 * triangles);
+        let mut out_triangles = Vec::with_capacity(triangles);
+        let mut nodes = Vec::with_capacity(vertices);
+        let mut normals: Vec<[f32; 3]> = Vec::with_capacity(vertices);
+        // One face's normal sums in f64, reused from face to face.
+        let mut sums: Vec<[f64; 3]> = Vec::new();
+        for &(face, flip) in faces {
+            let stamp = self.next_stamp();
+            let first = nodes.len();
+            sums.clear();
+            let mut total = [0.0; 3];
+            for tri in oriented(mesh, face, flip) {
+                let n = triangle_normal(mesh, tri);
+                total = add(total, n);
+                let mut t = [0u32; 3];
+                for (k, &node) in tri.iter().enumerate() {
+                    let entry = &mut self.slot[node as usize];
+                    if entry.0 != stamp {
+                        nodes.push(node);
+                        sums.push([0.0; 3]);
+                        *entry = (stamp, (nodes.len() - 1) as u32);
+                    }
+                    let index = entry.1 as usize;
+                    let s = &mut sums[index - first];
+                    *s = add(*s, n);
+                    t[k] = entry.1;
+                }
+                out_triangles.push(t);
+            }
+            let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
+            normals.extend(
+                sums.iter()
+                    .map(|s| unit(*s).unwrap_or(fallback).map(|c| c as f32)),
+            );
+        }
+        Streamed {
+            nodes: Some(nodes),
+            normals,
+            triangles: Cow::Owned(out_triangles),
+        }
+    }
+
+    /// The mesh's node positions.
+    pub(crate) fn mesh_nodes(&self) -> &'a [[f64; 3]] {
+        &self.mesh.nodes
+    }
+
+    /// The node table, made on first use (the single-face case needs none).
+    fn prepare(&mut self) {
         if self.slot.len() != self.mesh.nodes.len() {
             self.slot = vec![(u32::MAX, 0); self.mesh.nodes.len()];
             self.stamp = 0;
         }
-        expand_into(self, faces)
+    }
+
+    /// A fresh stamp for the next face (the table is cleared when they run out).
+    fn next_stamp(&mut self) -> u32 {
+        if self.stamp == u32::MAX - 1 {
+            self.slot.fill((u32::MAX, 0));
+            self.stamp = 0;
+        }
+        self.stamp += 1;
+        self.stamp
     }
 }
 
@@ -355,17 +505,11 @@ fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a>
     // (reserved at once: growing by doubling copied and touched twice the memory).
     let vertices = mesh.nodes.len().min(3 * triangles);
     let mut out_triangles = Vec::with_capacity(triangles);
-    let mut positions = Vec::with_capacity(vertices);
     let mut nodes = Vec::with_capacity(vertices);
     let mut normals: Vec<[f64; 3]> = Vec::with_capacity(vertices);
     for &(face, flip) in faces {
-        if ex.stamp == u32::MAX - 1 {
-            ex.slot.fill((u32::MAX, 0));
-            ex.stamp = 0;
-        }
-        ex.stamp += 1;
-        let stamp = ex.stamp;
-        let first = positions.len();
+        let stamp = ex.next_stamp();
+        let first = nodes.len();
         let mut total = [0.0; 3];
         for tri in oriented(mesh, face, flip) {
             let n = triangle_normal(mesh, tri);
@@ -374,12 +518,11 @@ fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a>
             for (k, &node) in tri.iter().enumerate() {
                 let entry = &mut ex.slot[node as usize];
                 if entry.0 != stamp {
-                    positions.push(mesh.nodes[node as usize]);
                     nodes.push(node);
                     // The area-weighted sum of the normals around the node,
                     // made a unit vector once the face is done.
                     normals.push([0.0; 3]);
-                    *entry = (stamp, (positions.len() - 1) as u32);
+                    *entry = (stamp, (nodes.len() - 1) as u32);
                 }
                 let index = entry.1 as usize;
                 // Area weighting: the unnormalised cross product is twice the area.
@@ -394,7 +537,6 @@ fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a>
         }
     }
     Expanded {
-        positions: Cow::Owned(positions),
         normals,
         nodes: Some(nodes),
         triangles: Cow::Owned(out_triangles),

@@ -319,6 +319,11 @@ pub(crate) fn mesh_face(
     };
     // Vertices from this index on have not been checked for boundary splits.
     let mut unchecked = fixed;
+    // Constraint segments at the last check: refinement puts a vertex on a
+    // boundary segment only by splitting it, which adds one, so while the
+    // count stands no new vertex needs looking at (the look walks every new
+    // vertex's edges: 3% of meshing a sphere).
+    let mut checked_constraints = usize::MAX;
     let mut added = Vec::new();
     // A plane face without poly_lines or small input angles is refined by
     // geomc's own off-centre refinement (`refine`): spade's inserts
@@ -397,14 +402,18 @@ pub(crate) fn mesh_face(
         let mut moved = false;
         if !settings.keep_boundary {
             // Only the vertices added since the last check.
-            let mut chains = boundary_chain::chains(
-                &cdt,
-                unchecked,
-                result.on_segments.as_deref(),
-                &segments,
-                &polyline_segments,
-            )
-            .map_err(failed)?;
+            let mut chains = if cdt.num_constraints() == checked_constraints {
+                Vec::new()
+            } else {
+                boundary_chain::chains(
+                    &cdt,
+                    unchecked,
+                    result.on_segments.as_deref(),
+                    &segments,
+                    &polyline_segments,
+                )
+                .map_err(failed)?
+            };
             let plane = matches!(face.surface, Surface::Plane { .. });
             let straight = |edge: usize| {
                 matches!(
@@ -456,6 +465,7 @@ pub(crate) fn mesh_face(
             }
         }
         unchecked = cdt.num_vertices();
+        checked_constraints = cdt.num_constraints();
         lift_new_vertices(&cdt, &chart, &mut positions).map_err(failed)?;
         for (edge, v, s, node) in kept {
             // Node indices fit in 32 bits (`MAX_FACE_VERTICES`).

@@ -322,6 +322,12 @@ fn mesh_faces(
         .filter(|&f| !model.faces[f].loops.is_empty())
         .collect();
     for round in 0..=MAX_ROUNDS {
+        // A face meshed again drops its last mesh first: a sphere's second
+        // hemisphere, re-meshed for the equator nodes its twin added, held
+        // its old mesh beside the new triangulation (a fifth of the peak).
+        for &f in &todo {
+            meshes[f] = None;
+        }
         let mut splits: BTreeMap<usize, Vec<f64>> = BTreeMap::new();
         // Faces mesh independently against the shared edge nodes: in
         // parallel, with results taken in face order (deterministic, and the
@@ -358,6 +364,7 @@ fn mesh_faces(
         // straight edges): they need no new round for that edge.
         let mut has_them: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
         let mut split_by: BTreeMap<usize, BTreeSet<usize>> = BTreeMap::new();
+        let mut resend = Vec::new();
         for (f, outcome) in outcomes {
             match outcome? {
                 Outcome::Meshed(mesh) => {
@@ -368,6 +375,8 @@ fn mesh_faces(
                     meshes[f] = Some(mesh);
                 }
                 Outcome::Split(points) => {
+                    // Meshed again in any case: it has no mesh now.
+                    resend.push(f);
                     for (edge, s) in points {
                         splits.entry(edge).or_default().push(s);
                         split_by.entry(edge).or_default().insert(f);
@@ -376,6 +385,7 @@ fn mesh_faces(
             }
         }
         todo.clear();
+        todo.extend(resend);
         for (edge, params) in splits {
             let (Some(nodes), Some(model_edge)) = (edge_nodes.get_mut(edge), model.edges.get(edge))
             else {
