@@ -342,6 +342,43 @@ fn overlapping_subdomains_are_reported() {
     assert_eq!(codes(&checked, Severity::Error), vec!["E407"]);
 }
 
+/// One-solid subdomains listed in another order than their solids: the
+/// overlap check reuses the relation check's pairs of solids, relabelled to
+/// subdomains, and must name each pair in subdomain order.
+#[test]
+fn overlaps_of_one_solid_subdomains_name_the_pairs_in_subdomain_order() {
+    let checked = check(
+        r#"<geometry version="1">
+  <sphere name="s2"><center x="3" y="3" z="3"/><radius value="0.5"/></sphere>
+  <parallelepiped name="big"><first_point x="0" y="0" z="0"/><second_point x="4" y="4" z="4"/></parallelepiped>
+  <sphere name="far"><center x="9" y="9" z="9"/><radius value="0.5"/></sphere>
+  <sphere name="s1"><center x="1" y="1" z="1"/><radius value="0.5"/></sphere>
+  <subdomain name="inner1"><solid ref="s1"/></subdomain>
+  <subdomain name="alone"><solid ref="far"/></subdomain>
+  <subdomain name="outer"><solid ref="big"/></subdomain>
+  <subdomain name="inner2"><solid ref="s2"/></subdomain>
+</geometry>"#,
+    );
+    let found: Vec<(&str, u32, &str)> = checked
+        .diagnostics
+        .items
+        .iter()
+        .map(|d| {
+            let line = (checked.source)
+                .line_col(d.span.expect("located").range().start)
+                .line;
+            (d.code.as_str(), line, d.message.as_str())
+        })
+        .collect();
+    assert_eq!(
+        found,
+        vec![
+            ("E407", 8, "subdomains 'inner1' and 'outer' overlap"),
+            ("E407", 9, "subdomains 'outer' and 'inner2' overlap"),
+        ]
+    );
+}
+
 #[test]
 fn a_two_dimensional_disk_with_a_hole() {
     let lowered = valid(

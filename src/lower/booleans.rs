@@ -125,9 +125,9 @@ pub(super) fn lower_subdomains(
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
     }
-    if !check_relations(model, source_map, &trees, diags) {
+    let Some(leaf_pairs) = check_relations(model, source_map, &trees, diags) else {
         return;
-    }
+    };
     for (id, built) in &trees {
         let cells = match model.dimension {
             Dimension::Three => SubdomainCells::Volume {
@@ -156,7 +156,7 @@ pub(super) fn lower_subdomains(
         subdomain.cells = cells;
         subdomain.solids = built.leaves.clone();
     }
-    check_overlaps(model, source_map, &trees, face_samples, diags);
+    check_overlaps(model, source_map, &trees, face_samples, leaf_pairs, diags);
 }
 
 fn build_tree(
@@ -208,21 +208,27 @@ fn build_tree(
                 return None;
             };
             let geometry = object.geometry.as_ref()?;
-            let key = match r.index {
-                Some(k) => format!("{}[{k}]", r.name),
-                None => r.name.clone(),
-            };
-            let ids: Vec<SolidId> = match (geometry, r.index) {
-                (Geometry::Group(members), None) => (1..=members.len())
-                    .flat_map(|k| {
-                        entities
-                            .solids
-                            .get(&format!("{}[{k}]", r.name))
-                            .cloned()
-                            .unwrap_or_default()
-                    })
-                    .collect(),
-                _ => entities.solids.get(&key).cloned().unwrap_or_default(),
+            // A plain reference (one per subdomain on large files) borrows its
+            // solids from the table instead of copying them under a new key.
+            let found: Vec<SolidId>;
+            let ids: &[SolidId] = match (geometry, r.index) {
+                (Geometry::Group(members), None) => {
+                    found = (1..=members.len())
+                        .flat_map(|k| {
+                            entities
+                                .solids
+                                .get(&format!("{}[{k}]", r.name))
+                                .cloned()
+                                .unwrap_or_default()
+                        })
+                        .collect();
+                    &found
+                }
+                (_, Some(k)) => {
+                    let key = format!("{}[{k}]", r.name);
+                    entities.solids.get(&key).map_or(&[], Vec::as_slice)
+                }
+                (_, None) => (entities.solids.get(r.name.as_str())).map_or(&[], Vec::as_slice),
             };
             let member_geometry = match (geometry, r.index) {
                 (Geometry::Group(members), Some(k)) => members.get(k.wrapping_sub(1)),
@@ -282,7 +288,7 @@ fn build_tree(
                 return None;
             }
             let mut members = Vec::new();
-            for id in ids {
+            for &id in ids {
                 let index = leaves.iter().position(|&l| l == id).unwrap_or_else(|| {
                     leaves.push(id);
                     leaves.len() - 1
@@ -305,7 +311,7 @@ fn check_relations(
     source_map: &SourceMap,
     trees: &[(SubdomainId, Built)],
     diags: &mut Diagnostics,
-) -> bool {
+) -> Option<LeafPairs> {
     let leaves: BTreeSet<SolidId> = trees
         .iter()
         .flat_map(|(_, b)| b.leaves.iter().copied())
@@ -315,11 +321,62 @@ fn check_relations(
         .iter()
         .map(|id| model.solids[id.index()].shape.bbox())
         .collect();
+    let pairs = candidate_pairs(&boxes, model.tolerance);
     let mut ok = true;
-    for (i, j) in candidate_pairs(&boxes, model.tolerance) {
+    for &(i, j) in &pairs {
         ok &= check_pair(model, source_map, leaves[i], leaves[j], diags);
     }
-    ok
+    ok.then_some(LeafPairs { leaves, pairs })
+}
+
+/// The candidate pairs of leaf solids (indices into `leaves`, sorted by id)
+/// that `check_relations` found. When every subdomain is one solid of its
+/// own, the overlap check's boxes are these same boxes, so it relabels these
+/// pairs instead of sorting the grid cells of the same boxes a second time.
+struct LeafPairs {
+    leaves: Vec<SolidId>,
+    pairs: Vec<(usize, usize)>,
+}
+
+impl LeafPairs {
+    /// The pairs over `members` (in member order) when each member is a tree
+    /// of exactly one leaf solid, every leaf belongs to one member, and the
+    /// member's box is its leaf's box; `None` otherwise.
+    fn relabelled(
+        &self,
+        model: &Model,
+        members: &[(SubdomainId, Member)],
+        boxes: &[crate::geom::Aabb],
+    ) -> Option<Vec<(usize, usize)>> {
+        if members.len() != self.leaves.len() {
+            return None;
+        }
+        // Members are distinct leaves when there are as many as leaves, since
+        // `leaves` is the set of all the trees' leaves.
+        let mut member_of = vec![0usize; self.leaves.len()];
+        for (m, ((_, member), bbox)) in members.iter().zip(boxes).enumerate() {
+            let Member::Tree(Built { leaves, .. }) = member else {
+                return None;
+            };
+            let [leaf] = leaves.as_slice() else {
+                return None;
+            };
+            // Equal unless a coordinate is NaN (the union with the empty box
+            // does not keep NaN): then the general pass decides.
+            if *bbox != model.solids[leaf.index()].shape.bbox() {
+                return None;
+            }
+            member_of[self.leaves.binary_search(leaf).ok()?] = m;
+        }
+        let mut pairs: Vec<(usize, usize)> = (self.pairs.iter())
+            .map(|&(i, j)| {
+                let (a, b) = (member_of[i], member_of[j]);
+                (a.min(b), a.max(b))
+            })
+            .collect();
+        pairs.sort_unstable();
+        Some(pairs)
+    }
 }
 
 /// Pairs of boxes that may overlap, found with a uniform grid whose cell is
@@ -610,6 +667,7 @@ fn check_overlaps(
     source_map: &SourceMap,
     trees: &[(SubdomainId, Built)],
     samples: &FaceSamples,
+    leaf_pairs: LeafPairs,
     diags: &mut Diagnostics,
 ) {
     let step = model.tolerance * 1000.0;
@@ -672,7 +730,12 @@ fn check_overlaps(
     };
     // Tree probes made so far, by member index (same points as made eagerly).
     let mut tree_probes: HashMap<usize, Vec<Point3>> = HashMap::new();
-    for (i, j) in candidate_pairs(&boxes, model.tolerance) {
+    // The same pairs as `candidate_pairs` over these boxes would give.
+    let pairs = leaf_pairs
+        .relabelled(model, &members, &boxes)
+        .unwrap_or_else(|| candidate_pairs(&boxes, model.tolerance));
+    drop(leaf_pairs);
+    for (i, j) in pairs {
         for k in [i, j] {
             if let (id, Member::Tree(_)) = &members[k] {
                 (tree_probes.entry(k))
