@@ -38,3 +38,42 @@ pub fn skip_purge_at_exit() {
 /// `mi_option_purge_delay` in mimalloc's `mi_option_e` (v2 and v3 alike);
 /// libmimalloc-sys names no constant for it.
 const PURGE_DELAY: libmimalloc_sys::mi_option_t = 15;
+
+/// `n` copies of `value` in a vector whose pages are first touched by
+/// writing them. A vector that is read before it is written (sums, counts)
+/// should start this way: `vec![0; n]` takes fresh pages the system zeroed,
+/// whose first touch as a read maps the shared zero page and the write after
+/// it faults again (a copy and a TLB flush on every core the process runs
+/// on): two faults per page instead of one.
+pub fn filled_vec<T: Clone>(n: usize, value: T) -> Vec<T> {
+    let mut v = Vec::with_capacity(n);
+    // Without this the compiler may fold the fill below back into a zeroed
+    // allocation (an allocation followed by zeroing is one to it).
+    std::hint::black_box(&mut v);
+    v.resize(n, value);
+    v
+}
+
+/// EXPERIMENT: transparent huge pages for one large, fully used buffer.
+pub fn huge_pages_for<T>(v: &Vec<T>) {
+    if std::env::var_os("GEOMC_EXP_THP").is_none() {
+        return;
+    }
+    static LIFTED: std::sync::Once = std::sync::Once::new();
+    LIFTED.call_once(|| unsafe {
+        libc::prctl(libc::PR_SET_THP_DISABLE, 0, 0, 0, 0);
+    });
+    let bytes = v.capacity() * std::mem::size_of::<T>();
+    const HUGE: usize = 2 << 20;
+    if bytes < 2 * HUGE {
+        return;
+    }
+    let start = v.as_ptr() as usize;
+    let from = start.div_ceil(HUGE) * HUGE;
+    let to = (start + bytes) / HUGE * HUGE;
+    if to > from {
+        unsafe {
+            libc::madvise(from as *mut libc::c_void, to - from, libc::MADV_HUGEPAGE);
+        }
+    }
+}

@@ -41,6 +41,13 @@ fn fill_and_sync<T>(
     file: File,
     fill: impl FnOnce(&mut dyn Write) -> Result<T, WriteError>,
 ) -> Result<T, WriteError> {
+    if std::env::var_os("GEOMC_EXP_DIRECT").is_some() {
+        let mut out = super::direct::DirectWriter::new(file);
+        let value = fill(&mut out)?;
+        let file = out.finish()?;
+        file.sync_all()?;
+        return Ok(value);
+    }
     // Large writes: the writers' pieces reach the kernel in few system calls.
     let mut out = BufWriter::with_capacity(1 << 20, file);
     let value = fill(&mut out)?;

@@ -114,8 +114,9 @@ enum Piece<'a> {
     /// Vectors written as three little-endian `f32`.
     Vec3(&'a [[f64; 3]]),
     /// Vectors made for this output (an expansion's positions and normals),
-    /// kept as the `f32` they are written as: half the memory of `f64`.
-    Vec3F32(Vec<[f32; 3]>),
+    /// kept as the `f32` they are written as, packed into the front of their
+    /// own `f64` storage ([`pack_f32`]): `values` of them.
+    PackedF32 { words: Vec<[f64; 3]>, values: usize },
     /// Triangle corners written as little-endian `u32`.
     Triangles(Cow<'a, [[u32; 3]]>),
     /// Indices written as little-endian `u32`.
@@ -126,7 +127,7 @@ impl Piece<'_> {
     fn byte_len(&self) -> usize {
         match self {
             Piece::Vec3(v) => 12 * v.len(),
-            Piece::Vec3F32(v) => 12 * v.len(),
+            Piece::PackedF32 { values, .. } => 4 * values,
             Piece::Triangles(t) => 12 * t.len(),
             Piece::Indices(i) => 4 * i.len(),
         }
@@ -138,7 +139,16 @@ impl Piece<'_> {
             Piece::Vec3(v) => {
                 write_blocks(v.as_flattened(), block, out, |c| (c as f32).to_le_bytes())
             }
-            Piece::Vec3F32(v) => write_blocks(v.as_flattened(), block, out, f32::to_le_bytes),
+            Piece::PackedF32 { words, values } => {
+                let words = words.as_flattened();
+                let (pairs, odd) = (values / 2, values % 2 == 1);
+                let whole = words.get(..pairs).unwrap_or_default();
+                write_blocks(whole, block, out, |w| w.to_bits().to_le_bytes())?;
+                match words.get(pairs) {
+                    Some(last) if odd => out.write_all(&last.to_bits().to_le_bytes()[..4]),
+                    _ => Ok(()),
+                }
+            }
             Piece::Triangles(t) => write_blocks(t.as_flattened(), block, out, u32::to_le_bytes),
             Piece::Indices(i) => write_blocks(i, block, out, u32::to_le_bytes),
         }
@@ -148,21 +158,38 @@ impl Piece<'_> {
 /// Values per block converted before a write (256 kB of output).
 const BLOCK: usize = 1 << 16;
 
-fn write_blocks<T: Copy>(
+fn write_blocks<T: Copy, const N: usize>(
     values: &[T],
     block: &mut Vec<u8>,
     out: &mut dyn Write,
-    bytes: impl Fn(T) -> [u8; 4],
+    bytes: impl Fn(T) -> [u8; N],
 ) -> std::io::Result<()> {
-    for chunk in values.chunks(BLOCK) {
+    for chunk in values.chunks(4 * BLOCK / N) {
         block.clear();
-        block.resize(4 * chunk.len(), 0);
-        for (slot, &v) in block.chunks_exact_mut(4).zip(chunk) {
+        block.resize(N * chunk.len(), 0);
+        for (slot, &v) in block.chunks_exact_mut(N).zip(chunk) {
             slot.copy_from_slice(&bytes(v));
         }
         out.write_all(block)?;
     }
     Ok(())
+}
+
+/// Vectors' coordinates as `f32`, packed two a word into the front of
+/// their own `f64` storage (the first of a pair in the low half): the first
+/// words' little-endian bytes are the `f32` values' bytes in order. Word `k`
+/// takes values `2k` and `2k + 1`, which no earlier word overwrote.
+fn pack_f32(mut v: Vec<[f64; 3]>) -> Piece<'static> {
+    let flat = v.as_flattened_mut();
+    let values = flat.len();
+    for k in 0..values.div_ceil(2) {
+        let c = |i: usize| flat.get(i).map_or(0, |&c| (c as f32).to_bits());
+        let word = u64::from(c(2 * k)) | (u64::from(c(2 * k + 1)) << 32);
+        if let Some(w) = flat.get_mut(k) {
+            *w = f64::from_bits(word);
+        }
+    }
+    Piece::PackedF32 { words: v, values }
 }
 
 /// The JSON parts and the binary buffer's pieces, built together.
@@ -283,10 +310,11 @@ impl<'a> Document<'a> {
         }
         let piece = match values {
             Cow::Borrowed(v) => Piece::Vec3(v),
-            // Converted now (the same `as f32` the write would do) and the
-            // `f64` copy freed: the document holds every group's vectors
-            // until the buffer is written.
-            Cow::Owned(v) => Piece::Vec3F32(v.iter().map(|p| p.map(|c| c as f32)).collect()),
+            // Converted now (the same `as f32` the write would do) into the
+            // front of the same storage: the document holds every group's
+            // vectors until the buffer is written, and a second vector for
+            // the `f32` values cost fresh pages (page faults) and a pass.
+            Cow::Owned(v) => pack_f32(v),
         };
         let view = self.view(piece, ARRAY_BUFFER);
         let mut accessor = json!({
