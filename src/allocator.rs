@@ -53,27 +53,3 @@ pub fn filled_vec<T: Clone>(n: usize, value: T) -> Vec<T> {
     v.resize(n, value);
     v
 }
-
-/// EXPERIMENT: transparent huge pages for one large, fully used buffer.
-pub fn huge_pages_for<T>(v: &Vec<T>) {
-    if std::env::var_os("GEOMC_EXP_THP").is_none() {
-        return;
-    }
-    static LIFTED: std::sync::Once = std::sync::Once::new();
-    LIFTED.call_once(|| unsafe {
-        libc::prctl(libc::PR_SET_THP_DISABLE, 0, 0, 0, 0);
-    });
-    let bytes = v.capacity() * std::mem::size_of::<T>();
-    const HUGE: usize = 2 << 20;
-    if bytes < 2 * HUGE {
-        return;
-    }
-    let start = v.as_ptr() as usize;
-    let from = start.div_ceil(HUGE) * HUGE;
-    let to = (start + bytes) / HUGE * HUGE;
-    if to > from {
-        unsafe {
-            libc::madvise(from as *mut libc::c_void, to - from, libc::MADV_HUGEPAGE);
-        }
-    }
-}

@@ -494,3 +494,31 @@ fn write_glb(json: &[u8], doc: &Document, out: &mut dyn Write) -> Result<(), Wri
     }
     Ok(())
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The packed piece writes the same bytes as converting each value.
+    #[test]
+    fn packed_f32_values_write_as_converted_ones() {
+        for count in [0usize, 1, 2, 3, 5, 70_000] {
+            let v: Vec<[f64; 3]> = (0..count)
+                .map(|i| {
+                    let x = i as f64;
+                    [x * 0.1, -x / 3.0, 1e-40 * x]
+                })
+                .collect();
+            let expected: Vec<u8> = v
+                .as_flattened()
+                .iter()
+                .flat_map(|&c| (c as f32).to_le_bytes())
+                .collect();
+            let piece = pack_f32(v);
+            assert_eq!(piece.byte_len(), expected.len());
+            let mut out = Vec::new();
+            piece.write(&mut Vec::new(), &mut out).expect("to memory");
+            assert_eq!(out, expected, "{count} vectors");
+        }
+    }
+}

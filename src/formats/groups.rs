@@ -513,3 +513,31 @@ pub(crate) fn dropped_volumes(format: &'static str, mesh: &Mesh) -> Option<super
         ),
     ))
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identity_prefix_accepts_nodes_in_first_use_order_only() {
+        assert_eq!(identity_prefix(&[[0, 1, 2], [2, 1, 3], [0, 3, 4]]), Some(5));
+        assert_eq!(identity_prefix(&[[0, 2, 1]]), None);
+        assert_eq!(identity_prefix(&[]), Some(0));
+        // A node ahead of its turn in a later run of 4,096 indices.
+        let mut long: Vec<[u32; 3]> = (0..3000).map(|i| [i, i + 1, i + 2]).collect();
+        assert_eq!(identity_prefix(&long), Some(3002));
+        long.push([0, 1, 5000]);
+        assert_eq!(identity_prefix(&long), None);
+    }
+
+    #[test]
+    fn first_non_finite_finds_the_first_bad_node_in_any_run() {
+        let mut nodes = vec![[1.0, 2.0, 3.0]; 3000];
+        assert_eq!(first_non_finite(&nodes), None);
+        nodes[2500][1] = f64::NAN;
+        nodes[2900][0] = f64::INFINITY;
+        assert_eq!(first_non_finite(&nodes), Some(2500));
+        nodes[7][2] = f64::NEG_INFINITY;
+        assert_eq!(first_non_finite(&nodes), Some(7));
+    }
+}

@@ -238,18 +238,16 @@ fn count_bucket(bucket: &mut [u32], out: &mut EdgeCounts) {
             continue;
         }
         let key = h >> 1;
-        let (mut forward, mut backward) = (0usize, 0usize);
+        // Without a branch per entry: whether an entry is this edge's is
+        // unpredictable (about every other one is).
+        let (mut uses, mut backward) = (0usize, 0usize);
         for (j, &g) in bucket.iter().enumerate().skip(i) {
-            if g >> 1 == key {
-                counted |= 1 << j;
-                if g & 1 == 0 {
-                    forward += 1;
-                } else {
-                    backward += 1;
-                }
-            }
+            let same = g >> 1 == key;
+            counted |= u32::from(same) << j;
+            uses += usize::from(same);
+            backward += usize::from(same) & (g & 1) as usize;
         }
-        tally(forward, backward, out);
+        tally(uses - backward, backward, out);
     }
 }
 

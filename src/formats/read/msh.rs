@@ -102,6 +102,7 @@ impl NodeIndex {
         }
     }
 
+    #[inline]
     fn get(&self, tag: u64) -> Option<u32> {
         if let Some((first, len)) = self.run {
             return tag
@@ -520,7 +521,6 @@ impl<'a> Reader<'a> {
         let total = self.plausible(total, per_node, "nodes", at)?;
         let dense_limit = max.min(4 * total as u64 + 1024) + 1;
         self.b.nodes.reserve(total);
-        crate::allocator::huge_pages_for(&self.b.nodes);
         let at = self.here();
         let blocks = self.plausible(blocks, 8, "node blocks", at)?;
         let mut tags: Vec<(u64, usize)> = Vec::new();
@@ -667,16 +667,15 @@ impl<'a> Reader<'a> {
         };
         let unknown = AtomicBool::new(false);
         let base = g.triangles.len();
-        g.triangles
-            .par_extend(block.par_chunks_exact(32).map(|r| {
-                match (tag(r, 8), tag(r, 16), tag(r, 24)) {
-                    (Some(a), Some(b), Some(c)) => [a, b, c],
-                    _ => {
-                        unknown.store(true, Ordering::Relaxed);
-                        [0; 3]
-                    }
+        g.triangles.par_extend(block.par_chunks_exact(32).map(|r| {
+            match (tag(r, 8), tag(r, 16), tag(r, 24)) {
+                (Some(a), Some(b), Some(c)) => [a, b, c],
+                _ => {
+                    unknown.store(true, Ordering::Relaxed);
+                    [0; 3]
                 }
-            }));
+            }
+        }));
         if unknown.load(Ordering::Relaxed) {
             g.triangles.truncate(base);
             return false;
@@ -827,7 +826,6 @@ impl<'a> Reader<'a> {
                 if let Some(g) = self.b.groups.get_mut(group) {
                     g.triangles
                         .reserve(n * if kind == Kind::Quad { 2 } else { 1 });
-                    crate::allocator::huge_pages_for(&g.triangles);
                 }
             }
             if self.binary && self.binary_elements(n, k, kind, name, group)? {
@@ -977,5 +975,46 @@ impl<'a> Reader<'a> {
             );
         }
         self.b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::NodeIndex;
+
+    #[test]
+    fn node_tags_that_run_on_need_no_table_and_a_break_moves_them_into_it() {
+        let mut index = NodeIndex::default();
+        assert_eq!(index.get(5), None);
+        for (i, tag) in [5, 6, 7].into_iter().enumerate() {
+            assert!(index.insert(tag, i as u32, 100));
+        }
+        assert!(index.dense.is_empty() && index.sparse.is_empty());
+        assert_eq!(
+            (index.get(4), index.get(5), index.get(7), index.get(8)),
+            (None, Some(0), Some(2), None)
+        );
+        // A tag before the run breaks it; the run's tags keep their nodes.
+        assert!(index.insert(2, 3, 100));
+        assert!(index.run.is_none());
+        assert_eq!(
+            (index.get(2), index.get(5), index.get(7)),
+            (Some(3), Some(0), Some(2))
+        );
+        // A tag of the run given again is a duplicate, in the vector and in the map.
+        assert!(!index.insert(6, 4, 100));
+        assert!(index.insert(1_000, 4, 100));
+        assert!(!index.insert(1_000, 5, 100));
+        assert_eq!(index.get(1_000), Some(4));
+    }
+
+    #[test]
+    fn a_repeated_first_tag_breaks_the_run_as_a_duplicate() {
+        let mut index = NodeIndex::default();
+        assert!(index.insert(u64::MAX, 0, 10));
+        // The next tag would overflow: not in the run, and not a duplicate.
+        assert!(index.insert(0, 1, 10));
+        assert!(!index.insert(u64::MAX, 2, 10));
+        assert_eq!((index.get(u64::MAX), index.get(0)), (Some(0), Some(1)));
     }
 }
