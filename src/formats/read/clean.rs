@@ -238,16 +238,18 @@ fn count_bucket(bucket: &mut [u32], out: &mut EdgeCounts) {
             continue;
         }
         let key = h >> 1;
-        // Without a branch per entry: whether an entry is this edge's is
-        // unpredictable (about every other one is).
-        let (mut uses, mut backward) = (0usize, 0usize);
+        let (mut forward, mut backward) = (0usize, 0usize);
         for (j, &g) in bucket.iter().enumerate().skip(i) {
-            let same = g >> 1 == key;
-            counted |= u32::from(same) << j;
-            uses += usize::from(same);
-            backward += usize::from(same) & (g & 1) as usize;
+            if g >> 1 == key {
+                counted |= 1 << j;
+                if g & 1 == 0 {
+                    forward += 1;
+                } else {
+                    backward += 1;
+                }
+            }
         }
-        tally(uses - backward, backward, out);
+        tally(forward, backward, out);
     }
 }
 

@@ -102,7 +102,6 @@ impl NodeIndex {
         }
     }
 
-    #[inline]
     fn get(&self, tag: u64) -> Option<u32> {
         if let Some((first, len)) = self.run {
             return tag
