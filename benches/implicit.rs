@@ -14,6 +14,13 @@
 //! evaluation alone). Without `--bench` (as under
 //! `cargo test --all-targets`) a 32-cell smoke run without peers.
 
+// The allocator of the `geomc` command, so the whole path is timed as users
+// run it (`geomc compile` of an implicit model), as in the other benches.
+// Until session 11 this bench ran on glibc's malloc: its figures in
+// docs/performance.md before then are not comparable on the allocation part.
+#[global_allocator]
+static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 use geomc::implicit::ir::{Binary, Ctx, Node, NodeId, Unary};
 use geomc::implicit::library;
 use geomc::implicit::polygonize::{self, Grid, Options};

@@ -292,6 +292,24 @@ fn output_is_the_same_for_any_thread_count() {
     assert_eq!(run(1), run(3));
 }
 
+#[test]
+fn output_is_the_same_for_any_thread_count_with_runs_of_several_slabs() {
+    // 100 cells in z: runs of 4 slabs (32 runs), whose inner planes are
+    // refined together and straddle block layers.
+    let model = compile(SEVEN_BALLS);
+    let run = |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+            .install(|| model.polygonize(Some([24, 21, 100])))
+    };
+    let one = run(1);
+    assert_eq!(check_closed_manifold(&one), (1, 2));
+    assert_eq!(one, run(2));
+    assert_eq!(one, run(3));
+}
+
 /// The faces of a cell in [`cell_links`]' corner numbering, (corner, corner) pairs
 /// for each face's edges; corner c is at (c & 1, c >> 1 & 1, c >> 2 & 1).
 fn corner(c: usize) -> [usize; 3] {

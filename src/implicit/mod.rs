@@ -7,6 +7,7 @@
 pub mod caps;
 pub mod cell_table;
 pub mod expr_ops;
+pub mod field;
 pub mod interfaces;
 pub mod interval;
 pub mod ir;
@@ -20,6 +21,7 @@ pub mod rows;
 pub mod section;
 pub mod signs;
 pub mod tape;
+pub mod vertices;
 pub mod weld;
 pub mod xml;
 

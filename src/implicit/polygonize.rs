@@ -2,11 +2,12 @@
 //!
 //! 1. The field is sampled block by block (8³ samples); interval arithmetic
 //!    proves most blocks entirely inside or outside (their samples get ±1 and
-//!    are never evaluated), and each remaining block gets its own simplified
-//!    program (`interval::simplify`).
+//!    are never evaluated nor stored), and each remaining block gets its own
+//!    simplified program (`interval::simplify`) and stores its samples
+//!    (`field.rs`).
 //! 2. Every grid edge whose end samples differ in sign gets one vertex, placed
 //!    by root finding (Illinois false position) on the edge with the owning
-//!    block's program. Vertices are numbered plane by plane, so the indexed
+//!    block's program (`vertices.rs`). Vertices are numbered plane by plane, so the indexed
 //!    mesh is the same for any thread count.
 //! 3. In each cell the surface pieces are paper 004's cycles: the crossed
 //!    edges are nodes, each cell face joins its crossings in pairs (a face
@@ -24,14 +25,14 @@
 //! solid (towards decreasing f).
 
 use super::cell_table::CellTable;
-use super::interval::{self, Interval, Sign};
+use super::field::{BS, Block, Field, sample_field};
 use super::rows::RowTape;
 use super::signs::{self, SignRows};
-use super::tape::{AxisTape, BATCH, Ssa, Tape, Workspace};
+use super::tape::Ssa;
+use super::vertices::{PlaneVertices, plane_vertices, planes_vertices};
 use super::weld;
 use rayon::prelude::*;
 use std::cell::Cell;
-use std::sync::Arc;
 
 /// The sampling grid: `cells` cells per axis over the box.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -87,42 +88,6 @@ pub struct Surface {
     pub pruned_blocks: usize,
 }
 
-const BS: usize = 8;
-
-/// What a block's samples need: the f64 tape refines crossings, the row
-/// tape samples the grid.
-struct Kernel {
-    tape: Tape,
-    /// The tape split along x, y and z for root finding on grid edges.
-    along: [AxisTape; 3],
-    rows: RowTape,
-}
-
-#[derive(Clone)]
-enum Block {
-    Inside,
-    Outside,
-    Mixed(Arc<Kernel>),
-    /// Given samples without a function: vertices by linear interpolation.
-    Sampled,
-}
-
-struct Field {
-    n1: [usize; 3],
-    values: Vec<f32>,
-    nb: [usize; 3],
-    blocks: Vec<Block>,
-}
-
-impl Field {
-    fn idx(&self, i: usize, j: usize, k: usize) -> usize {
-        (k * self.n1[1] + j) * self.n1[0] + i
-    }
-    fn block(&self, i: usize, j: usize, k: usize) -> &Block {
-        &self.blocks[((k / BS) * self.nb[1] + j / BS) * self.nb[0] + i / BS]
-    }
-}
-
 /// Samples f on every grid point, densely (no pruning), as f32, in parallel
 /// over z planes, row by row with the x terms computed once (`RowTape`).
 /// Used by the dense-throughput benchmark.
@@ -147,456 +112,6 @@ pub fn sample_grid_into(ssa: &Ssa, grid: &Grid, values: &mut [f32]) {
             }
         },
     );
-}
-
-/// A block range [lo, hi) per axis of the block grid.
-type Region = ([usize; 3], [usize; 3]);
-
-/// Classifies the blocks of `region` by interval arithmetic, recursively
-/// halving the region and simplifying the program on the way down, so a
-/// leaf block sees only the few union branches active near it (M3's
-/// 1,000-ball chain shrinks to a handful). Returns (block index, block).
-fn classify_region(
-    ssa: &Ssa,
-    region: Region,
-    coords: &[Vec<f64>; 3],
-    nb: [usize; 3],
-    out: &mut Vec<(usize, Block)>,
-) {
-    let (lo, hi) = region;
-    let n1 = [coords[0].len(), coords[1].len(), coords[2].len()];
-    let bounds = [0, 1, 2].map(|a| {
-        let top = (hi[a] * BS).min(n1[a] - 1);
-        Interval::new(coords[a][lo[a] * BS], coords[a][top])
-    });
-    let sign = interval::sign_only(ssa);
-    let iv = interval::eval(ssa, &sign, bounds);
-    let fill = |block: Block, out: &mut Vec<(usize, Block)>| {
-        for k in lo[2]..hi[2] {
-            for j in lo[1]..hi[1] {
-                for i in lo[0]..hi[0] {
-                    out.push(((k * nb[1] + j) * nb[0] + i, block.clone()));
-                }
-            }
-        }
-    };
-    match interval::classify(iv[ssa.root()]) {
-        Sign::Inside => return fill(Block::Inside, out),
-        Sign::Outside => return fill(Block::Outside, out),
-        Sign::Ambiguous => {}
-    }
-    let simpler = interval::simplify(ssa, &sign, &iv);
-    let extent = [0, 1, 2].map(|a| hi[a] - lo[a]);
-    let axis = (0..3).max_by_key(|&a| (extent[a], a)).unwrap_or(0);
-    if extent[axis] <= 1 {
-        let kernel = Kernel {
-            tape: Tape::new(&simpler),
-            along: [0, 1, 2].map(|a| AxisTape::new(&simpler, a)),
-            rows: RowTape::new(&simpler),
-        };
-        return fill(Block::Mixed(Arc::new(kernel)), out);
-    }
-    let mid = lo[axis] + extent[axis] / 2;
-    let (mut a_hi, mut b_lo) = (hi, lo);
-    a_hi[axis] = mid;
-    b_lo[axis] = mid;
-    if extent.iter().product::<usize>() >= 64 {
-        let (mut left, mut right) = (Vec::new(), Vec::new());
-        rayon::join(
-            || classify_region(&simpler, (lo, a_hi), coords, nb, &mut left),
-            || classify_region(&simpler, (b_lo, hi), coords, nb, &mut right),
-        );
-        out.extend(left);
-        out.extend(right);
-    } else {
-        classify_region(&simpler, (lo, a_hi), coords, nb, out);
-        classify_region(&simpler, (b_lo, hi), coords, nb, out);
-    }
-}
-
-fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
-    let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
-    let n1 = [coords[0].len(), coords[1].len(), coords[2].len()];
-    let nb = [n1[0].div_ceil(BS), n1[1].div_ceil(BS), n1[2].div_ceil(BS)];
-    let mut blocks = vec![Block::Outside; nb[0] * nb[1] * nb[2]];
-    if options.prune {
-        let mut found = Vec::with_capacity(blocks.len());
-        classify_region(ssa, ([0; 3], nb), &coords, nb, &mut found);
-        for (at, block) in found {
-            blocks[at] = block;
-        }
-    } else {
-        let kernel = Arc::new(Kernel {
-            tape: Tape::new(ssa),
-            along: [0, 1, 2].map(|a| AxisTape::new(ssa, a)),
-            rows: RowTape::new(ssa),
-        });
-        blocks.fill(Block::Mixed(kernel));
-    }
-    let layer = BS * n1[0] * n1[1];
-    let mut values = vec![0.0f32; n1[0] * n1[1] * n1[2]];
-    values
-        .par_chunks_mut(layer)
-        .enumerate()
-        .for_each(|(bk, chunk)| {
-            let mut row = [0.0f32; BS];
-            for bj in 0..nb[1] {
-                for bi in 0..nb[0] {
-                    let lo = [bi * BS, bj * BS, bk * BS];
-                    let owned = [0, 1, 2].map(|a| (lo[a] + BS).min(n1[a]));
-                    let len = owned[0] - lo[0];
-                    let block = &blocks[(bk * nb[1] + bj) * nb[0] + bi];
-                    let mut ws = match block {
-                        Block::Mixed(kernel) => {
-                            Some(kernel.rows.workspace(&coords[0][lo[0]..owned[0]]))
-                        }
-                        _ => None,
-                    };
-                    for k in lo[2]..owned[2] {
-                        for j in lo[1]..owned[1] {
-                            let start = ((k - lo[2]) * n1[1] + j) * n1[0] + lo[0];
-                            let dst = &mut chunk[start..start + len];
-                            match (block, ws.as_mut()) {
-                                (Block::Mixed(kernel), Some(ws)) => {
-                                    kernel.rows.eval_row(
-                                        ws,
-                                        coords[1][j],
-                                        coords[2][k],
-                                        &mut row[..len],
-                                    );
-                                    dst.copy_from_slice(&row[..len]);
-                                }
-                                (Block::Inside, _) => dst.fill(1.0),
-                                _ => dst.fill(-1.0),
-                            }
-                        }
-                    }
-                }
-            }
-        });
-    let mut field = Field {
-        n1,
-        values,
-        nb,
-        blocks,
-    };
-    close_at_box(&mut field, options);
-    field
-}
-
-/// Caps samples on the box faces at 0 (only the six faces are visited).
-fn close_at_box(field: &mut Field, options: &Options) {
-    if !options.close_at_box {
-        return;
-    }
-    let n1 = field.n1;
-    for k in 0..n1[2] {
-        let k_face = k == 0 || k == n1[2] - 1;
-        for j in 0..n1[1] {
-            let start = field.idx(0, j, k);
-            let row = &mut field.values[start..start + n1[0]];
-            if k_face || j == 0 || j == n1[1] - 1 {
-                for v in row.iter_mut() {
-                    *v = v.min(0.0);
-                }
-            } else {
-                row[0] = row[0].min(0.0);
-                row[n1[0] - 1] = row[n1[0] - 1].min(0.0);
-            }
-        }
-    }
-}
-
-/// The crossed edges whose lower end lies in one z plane, and their vertices.
-struct PlaneVertices {
-    /// (j · nx1 + i) · 3 + axis, ascending.
-    keys: Vec<u32>,
-    positions: Vec<[f64; 3]>,
-    /// The grid sample each vertex sits on, or `weld::NONE`; empty when
-    /// no vertex of the plane sits on a sample (the usual case).
-    at_sample: Vec<u64>,
-}
-
-fn plane_vertices(
-    field: &Field,
-    signs: &SignRows,
-    coords: &[Vec<f64>; 3],
-    k: usize,
-    options: &Options,
-) -> PlaneVertices {
-    let n1 = field.n1;
-    let mut keys = Vec::new();
-    let mut ends = Vec::new();
-    for j in 0..n1[1] {
-        // Crossed edges from the sign bits: x edges within the row, y and z
-        // edges against the next row and plane (bits past the row are 0).
-        let r = signs.row(j, k);
-        let ry = (j + 1 < n1[1]).then(|| signs.row(j + 1, k));
-        let rz = (k + 1 < n1[2]).then(|| signs.row(j, k + 1));
-        for w in 0..signs.words {
-            let crossed = [
-                (r[w] ^ signs::shifted(r, w)) & signs::low_bits(n1[0] - 1, w),
-                ry.map_or(0, |q| r[w] ^ q[w]),
-                rz.map_or(0, |q| r[w] ^ q[w]),
-            ];
-            for i in signs::bits(crossed[0] | crossed[1] | crossed[2], w) {
-                let v0 = field.values[field.idx(i, j, k)] as f64;
-                let bit = 1u64 << (i % 64);
-                for (axis, (ii, jj, kk)) in [(i + 1, j, k), (i, j + 1, k), (i, j, k + 1)]
-                    .into_iter()
-                    .enumerate()
-                {
-                    if crossed[axis] & bit == 0 {
-                        continue;
-                    }
-                    let v1 = field.values[field.idx(ii, jj, kk)] as f64;
-                    keys.push(((j * n1[0] + i) * 3 + axis) as u32);
-                    ends.push((
-                        [coords[0][i], coords[1][j], coords[2][k]],
-                        [coords[0][ii], coords[1][jj], coords[2][kk]],
-                        v0,
-                        v1,
-                    ));
-                }
-            }
-        }
-    }
-    // Initial guess: linear interpolation of the samples.
-    let mut t: Vec<f64> = ends
-        .iter()
-        .map(|&(_, _, v0, v1)| (v0 / (v0 - v1)).clamp(0.0, 1.0))
-        .collect();
-    // Refine with the owning block's program, grouped by block (a counting
-    // sort: a comparison sort of a plane's edges cost more than the root
-    // finding; the grouping does not change any vertex).
-    let nb = field.nb;
-    let layer = &field.blocks[(k / BS) * nb[0] * nb[1]..][..nb[0] * nb[1]];
-    let any_kernel = layer.iter().any(|b| matches!(b, Block::Mixed(_)));
-    let block_of = |e: usize| {
-        let key = keys[e] as usize / 3;
-        (key / n1[0] / BS) * nb[0] + (key % n1[0]) / BS
-    };
-    // Given samples (no kernel in this block layer): nothing to refine.
-    let groups = if any_kernel { nb[0] * nb[1] } else { 0 };
-    let mut first = vec![0u32; groups + 1];
-    for e in (0..keys.len()).filter(|_| any_kernel) {
-        first[block_of(e) + 1] += 1;
-    }
-    for b in 0..groups {
-        first[b + 1] += first[b];
-    }
-    let mut order = vec![0usize; if any_kernel { keys.len() } else { 0 }];
-    let mut next = first.clone();
-    for e in (0..keys.len()).filter(|_| any_kernel) {
-        let b = block_of(e);
-        order[next[b] as usize] = e;
-        next[b] += 1;
-    }
-    let (mut ws, mut group) = (Workspace::default(), Vec::new());
-    for b in 0..groups {
-        let (start, end) = (first[b] as usize, first[b + 1] as usize);
-        if start == end {
-            continue;
-        }
-        let (bi, bj) = (b % nb[0], b / nb[0]);
-        if let Block::Mixed(kernel) = field.block(bi * BS, bj * BS, k) {
-            refine(
-                kernel,
-                &mut ws,
-                &mut group,
-                &keys,
-                &order[start..end],
-                &ends,
-                &mut t,
-                options.iterations,
-            );
-        }
-    }
-    // Crossings within weld::SNAP of a sample sit exactly on it (and are
-    // merged into one node by `weld`).
-    let plane = n1[0] * n1[1];
-    let snapped = t.iter().any(|&t| t <= weld::SNAP || t >= 1.0 - weld::SNAP);
-    let at_sample = keys
-        .iter()
-        .take(if snapped { keys.len() } else { 0 })
-        .zip(&t)
-        .map(|(&key, &t)| {
-            let base = (key / 3) as usize;
-            let end = match key % 3 {
-                0 => base + 1,
-                1 => base + n1[0],
-                _ => base + plane,
-            };
-            if t <= weld::SNAP {
-                (k * plane + base) as u64
-            } else if t >= 1.0 - weld::SNAP {
-                (k * plane + end) as u64
-            } else {
-                weld::NONE
-            }
-        })
-        .collect();
-    let positions = ends
-        .iter()
-        .zip(&t)
-        .map(|(&(p0, p1, _, _), &t)| {
-            if t <= weld::SNAP {
-                return p0;
-            }
-            if t >= 1.0 - weld::SNAP {
-                return p1;
-            }
-            [0, 1, 2].map(|a| {
-                if p0[a] == p1[a] {
-                    p0[a]
-                } else {
-                    p0[a] + t * (p1[a] - p0[a])
-                }
-            })
-        })
-        .collect();
-    PlaneVertices {
-        keys,
-        positions,
-        at_sample,
-    }
-}
-
-/// Refines one block's crossed edges (`edges` index `keys` and `ends`).
-/// Edges are grouped by axis and evaluated on the block's axis tapes, so the
-/// terms constant along an edge are computed once per edge instead of at
-/// every step; the values, and so the vertices, are bit-identical to the
-/// plain tape's. Coordinates that `p + 0.0` would change (−0.0, NaN) or that
-/// are infinite take the plain tape.
-#[allow(clippy::too_many_arguments)] // scratch buffers reused across blocks
-fn refine(
-    kernel: &Kernel,
-    ws: &mut Workspace,
-    group: &mut Vec<usize>,
-    keys: &[u32],
-    edges: &[usize],
-    ends: &[Ends],
-    t: &mut [f64],
-    iterations: usize,
-) {
-    let plain = |c: f64| c.is_finite() && (c + 0.0).to_bits() == c.to_bits();
-    if !edges.iter().all(|&e| ends[e].0.iter().all(|&c| plain(c))) {
-        let mut ws = kernel.tape.workspace();
-        for chunk in edges.chunks(BATCH) {
-            let eval_at = |s: &[f64], out: &mut [f64]| {
-                let [xs, ys, zs] = [0, 1, 2].map(|a| {
-                    let mut c = [0.0; BATCH];
-                    for ((c, &e), &s) in c.iter_mut().zip(chunk).zip(s) {
-                        let (p0, p1, _, _) = ends[e];
-                        *c = p0[a] + s * (p1[a] - p0[a]);
-                    }
-                    c
-                });
-                let n = chunk.len();
-                kernel.tape.eval(&mut ws, &xs[..n], &ys[..n], &zs[..n], out);
-            };
-            illinois(chunk, ends, t, iterations, eval_at);
-        }
-        return;
-    }
-    for (axis, along) in kernel.along.iter().enumerate() {
-        group.clear();
-        group.extend(edges.iter().filter(|&&e| keys[e] as usize % 3 == axis));
-        if group.is_empty() {
-            continue;
-        }
-        along.prepare(ws, group.len().min(BATCH));
-        for chunk in group.chunks(BATCH) {
-            let n = chunk.len();
-            let fixed = [0, 1, 2].map(|b| {
-                let mut c = [0.0; BATCH];
-                for (c, &e) in c.iter_mut().zip(chunk) {
-                    *c = ends[e].0[b];
-                }
-                c
-            });
-            along.setup(ws, [&fixed[0][..n], &fixed[1][..n], &fixed[2][..n]]);
-            let eval_at = |s: &[f64], out: &mut [f64]| {
-                let mut coord = [0.0; BATCH];
-                for ((c, &e), &s) in coord.iter_mut().zip(chunk).zip(s) {
-                    let (p0, p1, _, _) = ends[e];
-                    *c = p0[axis] + s * (p1[axis] - p0[axis]);
-                }
-                along.eval(ws, &coord[..n], out);
-            };
-            illinois(chunk, ends, t, iterations, eval_at);
-        }
-    }
-}
-
-type Ends = ([f64; 3], [f64; 3], f64, f64);
-
-/// Illinois false position on each edge, batched: `eval_at(s, out)` gives f
-/// at parameter s[m] along edge `edges[m]`.
-fn illinois(
-    edges: &[usize],
-    ends: &[Ends],
-    t: &mut [f64],
-    iterations: usize,
-    mut eval_at: impl FnMut(&[f64], &mut [f64]),
-) {
-    // At most BATCH edges (callers chunk): working arrays on the stack.
-    let n = edges.len().min(BATCH);
-    let (mut tl, mut tr) = ([0.0; BATCH], [1.0; BATCH]);
-    let (mut fl, mut fr) = ([0.0; BATCH], [0.0; BATCH]);
-    eval_at(&tl[..n], &mut fl[..n]);
-    eval_at(&tr[..n], &mut fr[..n]);
-    // Edges whose exact end values do not bracket (a capped box sample, a
-    // pruned neighbour) keep the linear guess.
-    let mut ok = [false; BATCH];
-    for m in 0..n {
-        let (_, _, v0, v1) = ends[edges[m]];
-        ok[m] = (fl[m] > 0.0) == (v0 > 0.0)
-            && (fr[m] > 0.0) == (v1 > 0.0)
-            && (fl[m] > 0.0) != (fr[m] > 0.0);
-    }
-    let mut side = [0i8; BATCH];
-    let mut s = [0.0; BATCH];
-    for m in 0..n {
-        s[m] = t[edges[m]];
-    }
-    let mut fs = [0.0; BATCH];
-    for _ in 0..iterations {
-        for m in 0..n {
-            let d = fr[m] - fl[m];
-            let guess = (tl[m] * fr[m] - tr[m] * fl[m]) / d;
-            // A function that is NaN somewhere (sqrt of a negative, 0/0) must not
-            // poison the bracket: bisect instead, so tl and tr stay finite.
-            s[m] = if d != 0.0 && guess.is_finite() {
-                guess.max(tl[m]).min(tr[m])
-            } else {
-                0.5 * (tl[m] + tr[m])
-            };
-        }
-        eval_at(&s[..n], &mut fs[..n]);
-        for m in 0..n {
-            if (fs[m] > 0.0) == (fl[m] > 0.0) {
-                tl[m] = s[m];
-                fl[m] = fs[m];
-                if side[m] == -1 {
-                    fr[m] *= 0.5;
-                }
-                side[m] = -1;
-            } else {
-                tr[m] = s[m];
-                fr[m] = fs[m];
-                if side[m] == 1 {
-                    fl[m] *= 0.5;
-                }
-                side[m] = 1;
-            }
-        }
-    }
-    for m in 0..n {
-        if ok[m] {
-            t[edges[m]] = s[m];
-        }
-    }
 }
 
 /// Corner c of a cell is at offset (c & 1, c >> 1 & 1, c >> 2 & 1).
@@ -809,7 +324,6 @@ fn contour_run(
     options: &Options,
 ) -> RunOutput {
     let n1 = field.n1;
-    let mut inner = Vec::with_capacity(slabs.len());
     let mut out = Vec::with_capacity(slabs.len());
     // Edge key → vertex index within its plane, for the slab's lower and
     // upper plane; after a slab the lower plane's entries are reset and the
@@ -828,10 +342,10 @@ fn contour_run(
         }
     };
     fill(&mut maps[0], bottom, true);
+    // The inner planes' crossings refined together, block by block
+    // (longer batches for the f64 tape than plane by plane).
+    let inner = planes_vertices(field, signs, coords, slabs.start + 1..slabs.end, options);
     for k in slabs.clone() {
-        if k + 1 < slabs.end {
-            inner.push(plane_vertices(field, signs, coords, k + 1, options));
-        }
         let lower = if k == slabs.start {
             bottom
         } else {
@@ -910,7 +424,7 @@ fn contour_slab(
             }
             let cycles = table.lookup_case(sign_case, |c| {
                 let c = c as usize;
-                field.values[field.idx(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1))] as f64
+                field.value(i + (c & 1), j + (c >> 1 & 1), k + (c >> 2 & 1)) as f64
             });
             for c in 0..cycles.count as usize {
                 let (cycle, valid_starts) = cycles.cycle(c);
@@ -1077,22 +591,14 @@ pub fn polygonize_samples_f32_returning(
         n1[0] * n1[1] * n1[2],
         "one sample per grid point"
     );
-    let nb = n1.map(|n| n.div_ceil(BS));
-    let mut field = Field {
-        n1,
-        values,
-        nb,
-        blocks: vec![Block::Sampled; nb[0] * nb[1] * nb[2]],
-    };
-    close_at_box(&mut field, options);
+    let field = Field::dense(values, n1, options);
     let surface = mesh_field(&field, grid, options);
-    (surface, field.values)
+    (surface, field.into_dense())
 }
 
 fn mesh_field(field: &Field, grid: &Grid, options: &Options) -> Surface {
     let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
-    let n1 = field.n1;
-    let signs = SignRows::new(&field.values, n1);
+    let signs = field.signs();
     // Runs of consecutive slabs, each contoured by one thread right after
     // its planes' vertices, so the samples of planes k and k + 1 are still
     // in cache when slab k reads them (two passes over all planes read the

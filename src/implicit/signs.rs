@@ -36,6 +36,23 @@ impl SignRows {
         SignRows { words, n1, bits }
     }
 
+    /// The bits made row by row: `fill(j, k, words)` sets row (j, k)'s
+    /// words (zeroed before; bits past the row must stay 0), rows of a z
+    /// plane in order, planes in parallel.
+    pub fn from_rows(n1: [usize; 3], fill: impl Fn(usize, usize, &mut [u64]) + Sync) -> SignRows {
+        use rayon::prelude::*;
+        let words = n1[0].div_ceil(64);
+        let mut bits = vec![0u64; words * n1[1] * n1[2]];
+        bits.par_chunks_mut(words * n1[1])
+            .enumerate()
+            .for_each(|(k, plane_bits)| {
+                for (j, row_bits) in plane_bits.chunks_mut(words).enumerate() {
+                    fill(j, k, row_bits);
+                }
+            });
+        SignRows { words, n1, bits }
+    }
+
     /// The words of row (j, k).
     pub fn row(&self, j: usize, k: usize) -> &[u64] {
         let start = (k * self.n1[1] + j) * self.words;
