@@ -237,7 +237,7 @@ pub fn run(args: &Args) -> i32 {
     }
     if options.weld.is_some() || options.normals {
         // The checks again, on the mesh as written.
-        let checks = geomc::formats::read::clean::check(&loaded.mesh);
+        let checks = geomc::formats::read::clean::check_whole(&loaded.mesh);
         for d in checks.warnings() {
             eprint!(
                 "{}",
@@ -277,7 +277,7 @@ pub fn run(args: &Args) -> i32 {
     };
     let written = if check_while_writing {
         let (checks, written) = rayon::join(
-            || geomc::formats::read::clean::check(&loaded.mesh),
+            || geomc::formats::read::clean::check_whole(&loaded.mesh),
             || write(&args.output, writer, &loaded.mesh, &write_options),
         );
         report(&args.input, &checks.warnings());

@@ -20,11 +20,7 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
             mesh.nodes.len()
         ));
     }
-    if let Some(i) = mesh
-        .nodes
-        .iter()
-        .position(|p| p.iter().any(|c| !c.is_finite()))
-    {
+    if let Some(i) = first_non_finite(&mesh.nodes) {
         return bad(format!("node {i} has a coordinate that is not finite"));
     }
     let n = mesh.nodes.len();
@@ -461,24 +457,48 @@ impl<'a> Expander<'a> {
 }
 
 /// `Some(k)` when the triangles use nodes `0..k` and each first appears after
-/// all smaller ones (the order the expansion would number them in).
+/// all smaller ones (the order the expansion would number them in). Without
+/// a branch per index (a new node every few indices made the branch
+/// unpredictable): a node ahead of the next new one is remembered and
+/// looked at after each run of indices.
 fn identity_prefix(triangles: &[[u32; 3]]) -> Option<usize> {
     let mut next = 0u32;
-    for &n in triangles.as_flattened() {
-        if n == next {
-            next += 1;
-        } else if n > next {
+    for run in triangles.as_flattened().chunks(4096) {
+        let mut ahead = false;
+        for &n in run {
+            ahead |= n > next;
+            next += u32::from(n == next);
+        }
+        if ahead {
             return None;
         }
     }
     Some(next as usize)
 }
 
+/// The first node with a coordinate that is not finite. The scan has no
+/// early exit inside a run of nodes, so the compiler vectorises it.
+pub(crate) fn first_non_finite(nodes: &[[f64; 3]]) -> Option<usize> {
+    const RUN: usize = 1024;
+    for (r, run) in nodes.chunks(RUN).enumerate() {
+        let bad = run
+            .as_flattened()
+            .iter()
+            .fold(false, |bad, c| bad | !c.is_finite());
+        if bad {
+            let i = run.iter().position(|p| p.iter().any(|c| !c.is_finite()));
+            return i.map(|i| r * RUN + i);
+        }
+    }
+    None
+}
+
 /// The unit normals of nodes `0..used` over one face's triangles: the
 /// area-weighted sums, in triangle order, that [`expand_into`] forms (the
 /// same numbers, so the output does not depend on which path made it).
 fn node_normals(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> Vec<[f64; 3]> {
-    let mut normals = vec![[0.0; 3]; used];
+    // Sums read before written: zeroed by writing (see `filled_vec`).
+    let mut normals = crate::allocator::filled_vec(used, [0.0; 3]);
     let mut total = [0.0; 3];
     for &tri in triangles {
         let n = triangle_normal(mesh, tri);
@@ -634,4 +654,32 @@ pub(crate) fn dropped_volumes(format: &'static str, mesh: &Mesh) -> Option<super
             )
         ),
     ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn identity_prefix_accepts_nodes_in_first_use_order_only() {
+        assert_eq!(identity_prefix(&[[0, 1, 2], [2, 1, 3], [0, 3, 4]]), Some(5));
+        assert_eq!(identity_prefix(&[[0, 2, 1]]), None);
+        assert_eq!(identity_prefix(&[]), Some(0));
+        // A node ahead of its turn in a later run of 4,096 indices.
+        let mut long: Vec<[u32; 3]> = (0..3000).map(|i| [i, i + 1, i + 2]).collect();
+        assert_eq!(identity_prefix(&long), Some(3002));
+        long.push([0, 1, 5000]);
+        assert_eq!(identity_prefix(&long), None);
+    }
+
+    #[test]
+    fn first_non_finite_finds_the_first_bad_node_in_any_run() {
+        let mut nodes = vec![[1.0, 2.0, 3.0]; 3000];
+        assert_eq!(first_non_finite(&nodes), None);
+        nodes[2500][1] = f64::NAN;
+        nodes[2900][0] = f64::INFINITY;
+        assert_eq!(first_non_finite(&nodes), Some(2500));
+        nodes[7][2] = f64::NEG_INFINITY;
+        assert_eq!(first_non_finite(&nodes), Some(7));
+    }
 }

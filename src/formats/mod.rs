@@ -11,6 +11,7 @@
 
 mod atomic;
 mod base64;
+mod direct;
 pub mod frag;
 mod gltf;
 mod groups;

@@ -105,11 +105,7 @@ impl Builder {
                 )]);
             }
         }
-        if let Some(i) = self
-            .nodes
-            .iter()
-            .position(|p| p.iter().any(|c| !c.is_finite()))
-        {
+        if let Some(i) = crate::formats::groups::first_non_finite(&self.nodes) {
             return Err(vec![Diagnostic::new(
                 Code::MeshNonFinite,
                 None,

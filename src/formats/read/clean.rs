@@ -31,9 +31,16 @@ pub struct CleanReport {
 }
 
 impl CleanReport {
+    /// One warning per kind of problem in the whole mesh, with its count.
+    pub fn warnings(&self) -> Vec<Diagnostic> {
+        self.whole.warnings()
+    }
+}
+
+impl EdgeCounts {
     /// One warning per kind of problem, with its count.
     pub fn warnings(&self) -> Vec<Diagnostic> {
-        let c = &self.whole;
+        let c = self;
         let mut out = Vec::new();
         let mut push = |code: Code, n: usize, what: &str, help: &str| {
             if n > 0 {
@@ -71,17 +78,7 @@ impl CleanReport {
 /// The checks of a whole mesh and of each face.
 pub fn check(mesh: &Mesh) -> CleanReport {
     let scale = diagonal(mesh);
-    let whole = if let [only] = &mesh.faces[..] {
-        // One group (STL, most single-object files): no copy of its triangles.
-        counts(&mesh.nodes, &only.triangles, scale)
-    } else {
-        let all: Vec<[u32; 3]> = mesh
-            .faces
-            .iter()
-            .flat_map(|f| f.triangles.iter().copied())
-            .collect();
-        counts(&mesh.nodes, &all, scale)
-    };
+    let whole = whole_counts(mesh, scale);
     let faces = if mesh.faces.len() == 1 {
         vec![whole.clone()]
     } else {
@@ -91,6 +88,18 @@ pub fn check(mesh: &Mesh) -> CleanReport {
             .collect()
     };
     CleanReport { whole, faces }
+}
+
+/// The checks of the whole mesh only (what `convert`'s warnings say), without
+/// the per-face counts of [`check`].
+pub fn check_whole(mesh: &Mesh) -> EdgeCounts {
+    whole_counts(mesh, diagonal(mesh))
+}
+
+/// The counts over all faces' triangles together, read in place.
+fn whole_counts(mesh: &Mesh, scale: f64) -> EdgeCounts {
+    let parts: Vec<&[[u32; 3]]> = mesh.faces.iter().map(|f| f.triangles.as_slice()).collect();
+    counts_of_parts(&mesh.nodes, &parts, scale)
 }
 
 fn diagonal(mesh: &Mesh) -> f64 {
@@ -116,6 +125,11 @@ fn diagonal(mesh: &Mesh) -> f64 {
 /// 4 bytes each), then each node's few entries grouped by edge. Linear in
 /// the mesh, and the same on any thread count.
 pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCounts {
+    counts_of_parts(nodes, &[triangles], scale)
+}
+
+/// [`counts`] of the triangles of several lists together.
+fn counts_of_parts(nodes: &[[f64; 3]], parts: &[&[[u32; 3]]], scale: f64) -> EdgeCounts {
     let mut out = EdgeCounts::default();
     let area_floor = (scale * scale) * 1e-14;
     // Above this squared area the square root cannot be at or under the floor
@@ -127,25 +141,12 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
         f64::INFINITY
     };
     let n = nodes.len();
-    // The half-edges of a triangle as (lower node, higher << 1 | direction);
-    // edges of repeated or unknown nodes are skipped.
-    let halves = |t: &[u32; 3]| {
-        [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])]
-            .into_iter()
-            .filter(move |&(a, b)| a != b && (a as usize) < n && (b as usize) < n)
-            .map(|(a, b)| {
-                if a < b {
-                    (a, b << 1)
-                } else {
-                    (b, (a << 1) | 1)
-                }
-            })
-    };
     // `end[v + 1]` counts node v's half-edges, then (prefix sums) ends its
     // bucket; filling steps each end back, so `end[v + 1]` finally starts
     // bucket v and `end[v + 2]` ends it (one table, no copy for the fill).
-    let mut end = vec![0u32; n + 2];
-    for t in triangles {
+    // Counts read before written: zeroed by writing (see `filled_vec`).
+    let mut end = crate::allocator::filled_vec(n + 2, 0u32);
+    for t in parts.iter().copied().flatten() {
         if t[0] == t[1]
             || t[1] == t[2]
             || t[0] == t[2]
@@ -153,11 +154,11 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
         {
             out.degenerate += 1;
         }
-        for (lo, _) in halves(t) {
+        each_half(t, n, |lo, _| {
             if let Some(c) = end.get_mut(lo as usize + 1) {
                 *c += 1;
             }
-        }
+        });
     }
     for i in 1..end.len() {
         let before = end.get(i - 1).copied().unwrap_or(0);
@@ -166,15 +167,15 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
         }
     }
     let mut slots = vec![0u32; end.last().copied().unwrap_or(0) as usize];
-    for t in triangles {
-        for (lo, entry) in halves(t) {
+    for t in parts.iter().copied().flatten() {
+        each_half(t, n, |lo, entry| {
             if let Some(e) = end.get_mut(lo as usize + 1) {
                 *e = e.saturating_sub(1);
                 if let Some(slot) = slots.get_mut(*e as usize) {
                     *slot = entry;
                 }
             }
-        }
+        });
     }
     for w in end.get(1..).unwrap_or_default().windows(2) {
         let &[from, to] = w else {
@@ -185,6 +186,26 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
         }
     }
     out
+}
+
+/// Calls `f(lower node, higher << 1 | direction)` for each half-edge of a
+/// triangle, skipping edges of a repeated node or of a node not below `n`.
+/// Three plain calls: the iterator chain this replaced (an array, a filter,
+/// a map) kept its state on the stack in the two hottest loops.
+#[inline(always)]
+fn each_half(&[a, b, c]: &[u32; 3], n: usize, mut f: impl FnMut(u32, u32)) {
+    let mut half = |x: u32, y: u32| {
+        if x != y && (x as usize) < n && (y as usize) < n {
+            if x < y {
+                f(x, y << 1);
+            } else {
+                f(y, (x << 1) | 1);
+            }
+        }
+    };
+    half(a, b);
+    half(b, c);
+    half(c, a);
 }
 
 /// Adds the edges of one node's bucket to the counts. A bucket holds a few

@@ -15,6 +15,7 @@ use crate::diag::{Code, Diagnostic};
 use crate::mesh::CellKind;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 pub fn read(bytes: &[u8]) -> Result<(Builder, Option<bool>), Vec<Diagnostic>> {
     let mut r = Reader {
@@ -41,9 +42,17 @@ enum Version {
     V41,
 }
 
-/// Node tags to node indices: a table when tags are dense, a map otherwise.
+/// Node tags to node indices. Tags that run on from the first one, one per
+/// node in order (Gmsh and geomc number nodes 1, 2, 3, …), need no table:
+/// a node's index is its tag's distance from the first. The first tag that
+/// breaks the run moves the run into the table: a vector when tags are
+/// dense, a map otherwise.
 #[derive(Default)]
 struct NodeIndex {
+    /// While every node so far is in it: the first tag and the run's length.
+    run: Option<(u64, u32)>,
+    /// The run has been moved into the table (or never started).
+    tabled: bool,
     dense: Vec<u32>,
     sparse: FastMap<u64, u32>,
 }
@@ -52,6 +61,34 @@ const NONE: u32 = u32::MAX;
 
 impl NodeIndex {
     fn insert(&mut self, tag: u64, index: u32, dense_limit: u64) -> bool {
+        if !self.tabled {
+            match &mut self.run {
+                None if index == 0 => {
+                    self.run = Some((tag, 1));
+                    return true;
+                }
+                Some((first, len))
+                    if index == *len && first.checked_add(u64::from(*len)) == Some(tag) =>
+                {
+                    *len += 1;
+                    return true;
+                }
+                _ => self.move_run_to_table(dense_limit),
+            }
+        }
+        self.table_insert(tag, index, dense_limit)
+    }
+
+    fn move_run_to_table(&mut self, dense_limit: u64) {
+        self.tabled = true;
+        if let Some((first, len)) = self.run.take() {
+            for i in 0..len {
+                self.table_insert(first + u64::from(i), i, dense_limit);
+            }
+        }
+    }
+
+    fn table_insert(&mut self, tag: u64, index: u32, dense_limit: u64) -> bool {
         if tag < dense_limit {
             let t = tag as usize;
             if t >= self.dense.len() {
@@ -66,6 +103,12 @@ impl NodeIndex {
     }
 
     fn get(&self, tag: u64) -> Option<u32> {
+        if let Some((first, len)) = self.run {
+            return tag
+                .checked_sub(first)
+                .filter(|&i| i < u64::from(len))
+                .map(|i| i as u32);
+        }
         match self.dense.get(tag as usize) {
             Some(&i) if i != NONE => Some(i),
             _ => self.sparse.get(&tag).copied(),
@@ -488,19 +531,19 @@ impl<'a> Reader<'a> {
             let at = self.here();
             let n = self.size("the number of nodes in a block")?;
             let n = self.plausible(n, per_node, "nodes in a block", at)?;
-            tags.clear();
-            for _ in 0..n {
-                let at = self.here();
-                tags.push((self.size("a node tag")?, at));
-            }
             let extra = if parametric != 0 {
                 _dim.clamp(0, 3) as usize
             } else {
                 0
             };
-            if self.binary && extra == 0 && self.binary_coordinates(&tags, dense_limit)? {
+            if self.binary && extra == 0 && self.binary_node_block(n, dense_limit)? {
                 read += n;
                 continue;
+            }
+            tags.clear();
+            for _ in 0..n {
+                let at = self.here();
+                tags.push((self.size("a node tag")?, at));
             }
             for &(tag, at) in &tags {
                 let p = [
@@ -526,44 +569,48 @@ impl<'a> Reader<'a> {
         Ok(())
     }
 
-    /// A binary block of node coordinates read at once, when the file holds
-    /// all of it (else `false`: the value-by-value path finds the end and says
-    /// where). Errors as that path gives them.
-    fn binary_coordinates(
-        &mut self,
-        tags: &[(u64, usize)],
-        dense_limit: u64,
-    ) -> Result<bool, Diagnostic> {
+    /// A binary block of `n` nodes (their tags, then their coordinates) read
+    /// straight from the bytes when the file holds all of it, with no list of
+    /// tags (else `false`: the value-by-value path finds the end and says
+    /// where). The same checks in the same order as that path: a node's
+    /// coordinates, then its tag.
+    fn binary_node_block(&mut self, n: usize, dense_limit: u64) -> Result<bool, Diagnostic> {
         let bytes = self.s.bytes;
         let start = self.s.pos;
-        let Some(block) = tags
-            .len()
-            .checked_mul(24)
+        let Some((tags, coordinates)) = n
+            .checked_mul(32)
             .and_then(|len| bytes.get(start..)?.get(..len))
+            .and_then(|block| block.split_at_checked(8 * n))
         else {
             return Ok(false);
         };
-        for (i, (record, &(tag, tag_at))) in block.chunks_exact(24).zip(tags).enumerate() {
+        let first_coordinate = start + 8 * n;
+        for (i, (record, tag)) in coordinates
+            .chunks_exact(24)
+            .zip(tags.chunks_exact(8))
+            .enumerate()
+        {
             let mut p = [0.0; 3];
             for (k, (slot, c)) in p.iter_mut().zip(record.chunks_exact(8)).enumerate() {
                 let v = f64::from_le_bytes(super::array(c).unwrap_or([0; 8]));
                 if !v.is_finite() {
                     return Err(error_at_byte(
                         Code::MeshNonFinite,
-                        start + 24 * i + 8 * k,
+                        first_coordinate + 24 * i + 8 * k,
                         format!("a node coordinate is {v}, not a finite number"),
                     ));
                 }
                 *slot = v;
             }
-            self.add_node(tag, tag_at, p, dense_limit)?;
+            let tag = u64::from_le_bytes(super::array(tag).unwrap_or([0; 8]));
+            self.add_node(tag, start + 8 * i, p, dense_limit)?;
         }
-        self.s.pos = start + block.len();
+        self.s.pos = start + 32 * n;
         Ok(true)
     }
 
     /// A binary block of `n` elements of `k` nodes read at once, when the
-    /// file holds all of it (else `false`, as [`Self::binary_coordinates`]).
+    /// file holds all of it (else `false`, as [`Self::binary_node_block`]).
     fn binary_elements(
         &mut self,
         n: usize,
@@ -604,12 +651,12 @@ impl<'a> Reader<'a> {
         Ok(true)
     }
 
-    /// Linear triangles (most of a surface mesh) straight into their group,
-    /// their node tags looked up in parallel pieces (the same triangles in
-    /// the same order on any thread count). `false`, with nothing added,
-    /// when a tag is unknown: the general path then says which and where.
+    /// Linear triangles (most of a surface mesh) straight into their group's
+    /// reserved room, their node tags looked up in parallel pieces (the same
+    /// triangles in the same order on any thread count; no zero fill first).
+    /// `false`, with nothing added, when a tag is unknown: the general path
+    /// then says which and where.
     fn binary_triangles(&mut self, block: &[u8], group: usize) -> bool {
-        const PIECE: usize = 1 << 14;
         let nodes = &self.nodes;
         let Some(g) = self.b.groups.get_mut(group) else {
             return false;
@@ -617,29 +664,22 @@ impl<'a> Reader<'a> {
         let tag = |r: &[u8], at: usize| {
             super::bytes_at::<8>(r, at).and_then(|b| nodes.get(u64::from_le_bytes(b)))
         };
+        let unknown = AtomicBool::new(false);
         let base = g.triangles.len();
-        g.triangles.resize(base + block.len() / 32, [0; 3]);
-        let known = g
-            .triangles
-            .get_mut(base..)
-            .unwrap_or_default()
-            .par_chunks_mut(PIECE)
-            .zip(block.par_chunks(32 * PIECE))
-            .all(|(out, piece)| {
-                out.iter_mut().zip(piece.chunks_exact(32)).all(|(t, r)| {
-                    match (tag(r, 8), tag(r, 16), tag(r, 24)) {
-                        (Some(a), Some(b), Some(c)) => {
-                            *t = [a, b, c];
-                            true
-                        }
-                        _ => false,
-                    }
-                })
-            });
-        if !known {
+        g.triangles.par_extend(block.par_chunks_exact(32).map(|r| {
+            match (tag(r, 8), tag(r, 16), tag(r, 24)) {
+                (Some(a), Some(b), Some(c)) => [a, b, c],
+                _ => {
+                    unknown.store(true, Ordering::Relaxed);
+                    [0; 3]
+                }
+            }
+        }));
+        if unknown.load(Ordering::Relaxed) {
             g.triangles.truncate(base);
+            return false;
         }
-        known
+        true
     }
 
     fn nodes22(&mut self) -> Result<(), Diagnostic> {
@@ -934,5 +974,48 @@ impl<'a> Reader<'a> {
             );
         }
         self.b
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::NodeIndex;
+
+    #[test]
+    fn node_tags_that_run_on_need_no_table_and_a_break_moves_them_into_it() {
+        let mut index = NodeIndex::default();
+        assert_eq!(index.get(5), None);
+        for (i, tag) in [5, 6, 7].into_iter().enumerate() {
+            assert!(index.insert(tag, i as u32, 100));
+        }
+        assert!(index.dense.is_empty() && index.sparse.is_empty());
+        assert_eq!(
+            (index.get(4), index.get(5), index.get(7), index.get(8)),
+            (None, Some(0), Some(2), None)
+        );
+        // A tag before the run breaks it; the run's tags keep their nodes.
+        assert!(index.insert(2, 3, 100));
+        assert!(index.run.is_none());
+        assert_eq!(
+            (index.get(2), index.get(5), index.get(7)),
+            (Some(3), Some(0), Some(2))
+        );
+        // A tag of the run given again is a duplicate, in the vector and in the map.
+        assert!(!index.insert(6, 4, 100));
+        assert!(index.insert(1_000, 4, 100));
+        assert_eq!(index.get(1_000), Some(4));
+        // (After a refused duplicate the reader stops: what the table then
+        // holds for that tag does not matter.)
+        assert!(!index.insert(1_000, 5, 100));
+    }
+
+    #[test]
+    fn a_repeated_first_tag_breaks_the_run_as_a_duplicate() {
+        let mut index = NodeIndex::default();
+        assert!(index.insert(u64::MAX, 0, 10));
+        // The next tag would overflow: not in the run, and not a duplicate.
+        assert!(index.insert(0, 1, 10));
+        assert_eq!((index.get(u64::MAX), index.get(0)), (Some(0), Some(1)));
+        assert!(!index.insert(u64::MAX, 2, 10));
     }
 }
