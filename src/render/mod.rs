@@ -312,7 +312,7 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
 }
 
 fn sample_point(proj: &raster::Projected, node: u32) -> [f32; 3] {
-    let p = proj.xy(node);
+    let p = proj.xy_f[node as usize];
     [p[0], p[1], proj.snapped[node as usize].z]
 }
 
@@ -335,43 +335,27 @@ fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projecte
     let s = ss as f64;
     // Far outside the picture only the clamped bounding box matters.
     let limit = 1e6;
-    let at = |q: [f64; 3]| {
-        let p = camera.project(q);
-        let (x, y) = (
-            (p[0] * s).clamp(-limit, limit),
-            (p[1] * s).clamp(-limit, limit),
-        );
-        let z = ((p[2] - lo) / range) as f32;
-        (
-            raster::Snapped {
-                x: snap(x),
-                y: snap(y),
-                z,
-            },
-            [x as f32, y as f32],
-        )
-    };
-    if scene.slots_are_nodes && scene.light.len() == scene.points.len() {
-        let (snapped, lit): (Vec<raster::Snapped>, Vec<[f32; 4]>) = (scene.points.par_iter())
-            .zip(scene.light.par_iter())
-            .map(|(&q, l)| {
-                let (snapped, [x, y]) = at(q);
-                (snapped, [x, y, l[0], l[1]])
-            })
-            .unzip();
-        return raster::Projected {
-            snapped,
-            xy_f: Vec::new(),
-            lit,
-        };
-    }
-    let (snapped, xy_f): (Vec<raster::Snapped>, Vec<[f32; 2]>) =
-        scene.points.par_iter().map(|&q| at(q)).unzip();
-    raster::Projected {
-        snapped,
-        xy_f,
-        lit: Vec::new(),
-    }
+    let (snapped, xy_f): (Vec<raster::Snapped>, Vec<[f32; 2]>) = scene
+        .points
+        .par_iter()
+        .map(|&q| {
+            let p = camera.project(q);
+            let (x, y) = (
+                (p[0] * s).clamp(-limit, limit),
+                (p[1] * s).clamp(-limit, limit),
+            );
+            let z = ((p[2] - lo) / range) as f32;
+            (
+                raster::Snapped {
+                    x: snap(x),
+                    y: snap(y),
+                    z,
+                },
+                [x as f32, y as f32],
+            )
+        })
+        .unzip();
+    raster::Projected { snapped, xy_f }
 }
 
 /// A sample-space coordinate in 1/16 sample steps, rounded half away from

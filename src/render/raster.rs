@@ -31,24 +31,8 @@ pub struct Snapped {
 /// Node positions in sample space: snapped with depths, and unsnapped.
 pub struct Projected {
     pub snapped: Vec<Snapped>,
-    /// Unsnapped, for interpolation in shading; empty when `lit` holds them.
+    /// Unsnapped, for interpolation in shading.
     pub xy_f: Vec<[f32; 2]>,
-    /// When each node is its own light slot (smooth shading of one face, no
-    /// section): per node the unsnapped x, y beside its front and back light,
-    /// so shading a pixel gathers one 16-byte record per corner instead of
-    /// a position and a light from two arrays. Empty otherwise.
-    pub lit: Vec<[f32; 4]>,
-}
-
-impl Projected {
-    /// The unsnapped sample-space position of `node`.
-    #[inline]
-    pub fn xy(&self, node: u32) -> [f32; 2] {
-        match self.lit.get(node as usize) {
-            Some(r) if self.xy_f.is_empty() => [r[0], r[1]],
-            _ => self.xy_f[node as usize],
-        }
-    }
 }
 
 pub struct ZBuffer {
@@ -173,38 +157,12 @@ pub fn draw_band(
 ) {
     let (y0, y1) = (ys.start, ys.end);
     for chunk in bins {
-        let ids = &chunk[band];
-        for (k, &tri) in ids.iter().enumerate() {
-            if let Some(&ahead) = ids.get(k + PREFETCH_AHEAD) {
-                prefetch_corners(proj, scene.tris[ahead as usize]);
-            }
+        for &tri in &chunk[band] {
             if let Some((v, z, back)) = setup(proj, scene.tris[tri as usize]) {
                 draw(rows, width, y0, y1, v, z, tri * 2 + back);
             }
         }
     }
-}
-
-/// How many binned triangles ahead `draw_band` asks for the corners of: a
-/// band's triangles name nodes all over the 12-byte-per-node array, and
-/// most of a tiny triangle's drawing time was waiting for those loads.
-const PREFETCH_AHEAD: usize = 8;
-
-/// Asks the cache for the snapped corners of triangle `t` (a hint only: it
-/// reads nothing and changes no result).
-#[inline]
-fn prefetch_corners(proj: &Projected, t: [u32; 3]) {
-    #[cfg(target_arch = "x86_64")]
-    for n in t {
-        let at = proj.snapped.as_ptr().wrapping_add(n as usize) as *const i8;
-        // SAFETY: a prefetch is a hint; it never faults or reads into the
-        // program, whatever the address (`wrapping_add` makes no reference).
-        unsafe {
-            std::arch::x86_64::_mm_prefetch::<{ std::arch::x86_64::_MM_HINT_T0 }>(at);
-        }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = (proj, t);
 }
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
@@ -248,6 +206,23 @@ fn draw(
     if x_first > sx1 || y_first > sy1 {
         return;
     }
+    // Edge k runs from v[k] to v[k+1]; E_k(p) = (b−a)×(p−a) is positive inside.
+    let mut e_row = [0i64; 3];
+    let mut step_x = [0i64; 3];
+    let mut step_y = [0i64; 3];
+    let px = x_first * SUB + SUB / 2;
+    let py = y_first * SUB + SUB / 2;
+    for k in 0..3 {
+        let (a, b) = (v[k], v[(k + 1) % 3]);
+        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+        // Top-left rule (y down): an edge going up, or horizontal going left… in
+        // this orientation: owning samples exactly on it for exactly one of the
+        // two triangles that share it.
+        let owns = dy < 0 || (dy == 0 && dx > 0);
+        e_row[k] = dx * (py - a[1]) - dy * (px - a[0]) - if owns { 0 } else { 1 };
+        step_x[k] = -dy * SUB;
+        step_y[k] = dx * SUB;
+    }
     // Depth as a plane over sample coordinates, referenced at the triangle's
     // own first sample so bands agree exactly: one division per triangle,
     // made only once a sample is found inside (most tiny triangles of a
@@ -274,46 +249,6 @@ fn draw(
             (gy * SUB as f64) as f32,
         )
     };
-    // Most triangles of a fine mesh hold one sample centre in their box:
-    // test it alone, with the same edge values and depth the loop below
-    // would compute for it.
-    if x_first == sx1 && y_first == sy1 {
-        let (px, py) = (x_first * SUB + SUB / 2, y_first * SUB + SUB / 2);
-        for k in 0..3 {
-            let (a, b) = (v[k], v[(k + 1) % 3]);
-            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-            let owns = dy < 0 || (dy == 0 && dx > 0);
-            if dx * (py - a[1]) - dy * (px - a[0]) - if owns { 0 } else { 1 } < 0 {
-                return;
-            }
-        }
-        let (z_ref, dzdx, dzdy) = plane();
-        let zy = z_ref + dzdy * (y_first - sy0) as f32;
-        let depth = (zy + dzdx * (x_first - sx0) as f32).max(0.0);
-        let value = ((depth.to_bits() as u64) << 32) | id as u64;
-        let slot = &mut rows[(y_first as usize - y0) * width + x_first as usize];
-        if value < *slot {
-            *slot = value;
-        }
-        return;
-    }
-    // Edge k runs from v[k] to v[k+1]; E_k(p) = (b−a)×(p−a) is positive inside.
-    let mut e_row = [0i64; 3];
-    let mut step_x = [0i64; 3];
-    let mut step_y = [0i64; 3];
-    let px = x_first * SUB + SUB / 2;
-    let py = y_first * SUB + SUB / 2;
-    for k in 0..3 {
-        let (a, b) = (v[k], v[(k + 1) % 3]);
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        // Top-left rule (y down): an edge going up, or horizontal going left… in
-        // this orientation: owning samples exactly on it for exactly one of the
-        // two triangles that share it.
-        let owns = dy < 0 || (dy == 0 && dx > 0);
-        e_row[k] = dx * (py - a[1]) - dy * (px - a[0]) - if owns { 0 } else { 1 };
-        step_x[k] = -dy * SUB;
-        step_y[k] = dx * SUB;
-    }
     let mut depth_plane: Option<(f32, f32, f32)> = None;
     let id = id as u64;
     for sy in y_first..=sy1 {

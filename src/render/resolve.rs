@@ -64,21 +64,7 @@ fn shade(
         if (px + py) % 8 < 2 { 0.6 } else { 0.95 }
     } else {
         let s = scene.corner_slots[tri];
-        if !proj.lit.is_empty() {
-            // The slots are the nodes: position and light in one record.
-            let [a, b, c] = s.map(|n| proj.lit[n as usize]);
-            if s[0] == s[1] && s[1] == s[2] {
-                a[2 + back]
-            } else {
-                let (x, y) = (sx as f32 + 0.5, sy as f32 + 0.5);
-                let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-                let w1 = ((c[0] - a[0]) * (y - a[1]) - (c[1] - a[1]) * (x - a[0])) / -area;
-                let w2 = ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) / area;
-                let (w1, w2) = (w1.clamp(0.0, 1.0), w2.clamp(0.0, 1.0));
-                let w0 = (1.0 - w1 - w2).max(0.0);
-                w0 * a[2 + back] + w1 * b[2 + back] + w2 * c[2 + back]
-            }
-        } else if s[0] == s[1] && s[1] == s[2] {
+        if s[0] == s[1] && s[1] == s[2] {
             scene.light[s[0] as usize][back]
         } else {
             let t = scene.tris[tri];

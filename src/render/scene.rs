@@ -41,9 +41,6 @@ pub struct Scene<'a> {
     pub corner_slots: Cow<'a, [[u32; 3]]>,
     /// Light intensity in [0, 1] seen on the front and on the back side.
     pub light: Vec<[f32; 2]>,
-    /// Whether each corner's light slot is its node (`corner_slots` are the
-    /// triangles and `light` runs over the points).
-    pub slots_are_nodes: bool,
     pub groups: Vec<Group>,
 }
 
@@ -331,7 +328,6 @@ fn shade(scene: &mut Scene, shading: Shading, camera: &Camera, spans: Option<&[(
                 smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, spans, |n| {
                     intensity(n, light)
                 });
-            scene.slots_are_nodes = slots.is_none();
             scene.corner_slots = match slots {
                 Some(slots) => Cow::Owned(slots),
                 None => scene.tris.clone(),
@@ -349,8 +345,6 @@ fn cut(scene: &mut Scene<'_>, section: Section) {
     let old_tris = std::mem::take(&mut scene.tris);
     let old_faces = std::mem::take(&mut scene.tri_face);
     let old_slots = std::mem::take(&mut scene.corner_slots);
-    // Points made on the cut get slots of their own after the nodes'.
-    scene.slots_are_nodes = false;
     let mut tris = Vec::with_capacity(old_tris.len());
     let mut slots = Vec::with_capacity(old_tris.len());
     // Points made on a crossed edge, shared by the triangles on both sides of it.
