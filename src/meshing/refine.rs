@@ -684,7 +684,11 @@ impl Refiner<'_, '_> {
         left: bool,
         right: bool,
     ) -> Option<FixedVertexHandle> {
-        let undirected = self.cdt.get_edge_from_neighbors(a, b)?.fix().as_undirected();
+        let undirected = self
+            .cdt
+            .get_edge_from_neighbors(a, b)?
+            .fix()
+            .as_undirected();
         self.cdt.remove_constraint_edge(undirected);
         let before = self.cdt.num_vertices();
         let v = match self.cdt.insert_with_hint(x, a) {
@@ -695,7 +699,11 @@ impl Refiner<'_, '_> {
             }
         };
         let (pa, pb) = (self.cdt.vertex(a).position(), self.cdt.vertex(b).position());
-        let crossed = self.cdt.vertex(v).out_edges().any(|e| e.is_constraint_edge())
+        let crossed = self
+            .cdt
+            .vertex(v)
+            .out_edges()
+            .any(|e| e.is_constraint_edge())
             || !(self.cdt.can_add_constraint(a, v) && self.cdt.can_add_constraint(v, b));
         if crossed {
             // Back as it was: x out (with the segment it fell on, put back
@@ -815,13 +823,14 @@ impl Refiner<'_, '_> {
         // faces from v→b on are left of the path a → v → b, from v→a on
         // right of it (the chord may be off the path: a point on a curve).
         let mut left_of_path = match side {
-            Side::Split { a, b, .. } => self
-                .cdt
-                .vertex(v)
-                .out_edges()
-                .map(|e| e.to().fix())
-                .find(|&w| w == a || w == b)
-                == Some(a),
+            Side::Split { a, b, .. } => {
+                self.cdt
+                    .vertex(v)
+                    .out_edges()
+                    .map(|e| e.to().fix())
+                    .find(|&w| w == a || w == b)
+                    == Some(a)
+            }
             _ => false,
         };
         for e in self.cdt.vertex(v).out_edges() {
