@@ -62,11 +62,14 @@ fn constraint_neighbours(cdt: &Cdt, v: usize) -> ([usize; 2], usize) {
 /// boundary segments (`segments` holds every boundary segment between
 /// vertices below `first`). `candidates`, when given, are the only new
 /// vertices that can be on a segment (ascending; geomc's own refinement
-/// records the ones it put there), so the others need no look.
+/// records the ones it put there), so the others need no look. `known`
+/// (ascending) are new vertices already in `segments` (put on a curve by
+/// the refinement): chains end at them as at checked ones.
 pub(super) fn chains(
     cdt: &Cdt,
     first: usize,
     candidates: Option<&[usize]>,
+    known: &[usize],
     segments: &Segments,
     polyline_segments: &[(usize, usize)],
 ) -> Result<Vec<Chain>, String> {
@@ -82,7 +85,7 @@ pub(super) fn chains(
         }
     };
     for &w in candidates {
-        if w < first || seen.contains(&w) {
+        if w < first || seen.contains(&w) || known.binary_search(&w).is_ok() {
             continue;
         }
         let (around, count) = constraint_neighbours(cdt, w);
@@ -103,7 +106,7 @@ pub(super) fn chains(
         // Walk each way to the first checked vertex.
         let walk = |start: usize| -> Result<(Vec<usize>, usize), String> {
             let (mut prev, mut cur, mut path) = (w, start, Vec::new());
-            while cur >= first {
+            while cur >= first && known.binary_search(&cur).is_err() {
                 if path.len() > cdt.num_vertices() {
                     return Err(AWAY.to_string());
                 }

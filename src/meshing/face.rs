@@ -339,9 +339,22 @@ pub(crate) fn mesh_face(
         settings,
         small_angle,
     );
+    // Refinement splits a segment on a curved edge at the curve's point
+    // (`refine::Curves`): in the chart, and on the curve for the node.
+    let curve_point = |edge: usize, s: f64| -> Option<(Point2<f64>, Point3)> {
+        let curve = &model.edges.get(edge)?.curve;
+        if matches!(curve, crate::geom::Curve::Segment { .. }) {
+            return None;
+        }
+        let p = curve.point(s);
+        let uv = chart.to_param(&p)?;
+        Some((point2(uv), p))
+    };
     for pass in 0..MAX_PASSES {
         let result = if own {
-            let outside = if peel {
+            // After the first pass a point put on a concave curve may have
+            // left part of the hull outside even without peeling.
+            let outside = if peel || pass > 0 {
                 outside_faces(&cdt, &[])
             } else {
                 vec![false; cdt.num_all_faces()]
@@ -353,6 +366,10 @@ pub(crate) fn mesh_face(
                     max_area: settings.max_area.min(guide),
                     max_additional_vertices: budget,
                     outside,
+                    curves: Some(refine::Curves {
+                        segments: &mut segments,
+                        point: &curve_point,
+                    }),
                 },
             )
         } else {
@@ -367,6 +384,7 @@ pub(crate) fn mesh_face(
                 outside,
                 complete: result.refinement_complete,
                 on_segments: None,
+                curved: Vec::new(),
                 all_checked: false,
             }
         };
@@ -402,6 +420,7 @@ pub(crate) fn mesh_face(
         let mut moved = false;
         if !settings.keep_boundary {
             // Only the vertices added since the last check.
+            let known: Vec<usize> = result.curved.iter().map(|c| c.1).collect();
             let mut chains = if cdt.num_constraints() == checked_constraints {
                 Vec::new()
             } else {
@@ -409,6 +428,7 @@ pub(crate) fn mesh_face(
                     &cdt,
                     unchecked,
                     result.on_segments.as_deref(),
+                    &known,
                     &segments,
                     &polyline_segments,
                 )
@@ -426,6 +446,7 @@ pub(crate) fn mesh_face(
                     chains
                         .iter()
                         .flat_map(|c| c.inner.iter().map(|i| (c.edge, i.1)))
+                        .chain(result.curved.iter().map(|c| (c.0, c.2)))
                         .collect(),
                 )
             };
@@ -441,7 +462,12 @@ pub(crate) fn mesh_face(
                 if straight(chain.edge) {
                     continue;
                 }
+                // A move removes vertices, which renumbers the last ones:
+                // with points already put on curves (numbered in
+                // `segments`), the splits go back instead (rare: the curve
+                // point was refused only when its segments crossed another).
                 if pass + 1 == MAX_PASSES
+                    || !result.curved.is_empty()
                     || boundary_chain::move_onto_curve(&mut cdt, &chart, model, chain).is_none()
                 {
                     return Ok(sent_back(&chains));
@@ -462,6 +488,9 @@ pub(crate) fn mesh_face(
                 for (&v, &(_, s, node)) in indices.iter().zip(&chain.inner) {
                     kept.push((chain.edge, v, s, node));
                 }
+            }
+            for &(edge, v, s, node) in &result.curved {
+                kept.push((edge, v, s, Some(node)));
             }
         }
         unchecked = cdt.num_vertices();
@@ -744,25 +773,41 @@ fn loop_is_hull(cdt: &Cdt, uv_loops: &[Vec<[f64; 2]>]) -> bool {
 }
 
 /// True when two constraint segments (loop or poly_line) meet at a vertex at
-/// an angle below `min_angle` degrees.
+/// an angle below `min_angle` degrees. Runs over every vertex of a face:
+/// directions go to a small array (a `Vec` per vertex was 4% of a
+/// 10,000-vertex polygon's meshing time); a vertex with more constraint
+/// edges than fit is checked through a `Vec`.
 fn has_small_input_angle(cdt: &Cdt, min_angle: f64) -> bool {
     let limit = min_angle.to_radians();
-    cdt.vertices().any(|v| {
-        let p = v.position();
-        let directions: Vec<f64> = v
-            .out_edges()
-            .filter(|e| e.is_constraint_edge())
-            .map(|e| {
-                let q = e.to().position();
-                (q.y - p.y).atan2(q.x - p.x)
-            })
-            .collect();
+    let small = |directions: &[f64]| {
         directions.iter().enumerate().any(|(i, a)| {
             directions[i + 1..].iter().any(|b| {
                 let gap = (a - b).abs();
                 gap.min(std::f64::consts::TAU - gap) < limit
             })
         })
+    };
+    cdt.vertices().any(|v| {
+        let p = v.position();
+        let direction = |e: spade::handles::DirectedEdgeHandle<'_, _, _, _, _>| {
+            let q: Point2<f64> = e.to().position();
+            (q.y - p.y).atan2(q.x - p.x)
+        };
+        let mut few = [0.0f64; 8];
+        let mut count = 0;
+        for e in v.out_edges().filter(|e| e.is_constraint_edge()) {
+            if count == few.len() {
+                let all: Vec<f64> = v
+                    .out_edges()
+                    .filter(|e| e.is_constraint_edge())
+                    .map(direction)
+                    .collect();
+                return small(&all);
+            }
+            few[count] = direction(e);
+            count += 1;
+        }
+        small(&few[..count])
     })
 }
 

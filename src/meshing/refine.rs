@@ -22,17 +22,23 @@
 //!   in FIFO order, then bad triangles by shortest edge and discovery): the
 //!   same input gives the same mesh, whatever the thread count.
 //!
+//! - A segment on a curved edge is split at the curve's point at the
+//!   middle parameter (not the chord's middle) when spade can take it there
+//!   (the new segments cross nothing): the boundary stays on the curve and
+//!   no second refinement pass has to move chord points onto it.
+//!
 //! # Limitations
 //! - For plane faces without poly_lines, small input angles or a kept
 //!   boundary: the other cases stay with spade's `refine` (face.rs).
 
-use super::face::Cdt;
+use super::face::{Cdt, Segments};
+use crate::geom::Point3;
 use robust::{Coord, incircle, orient2d};
 use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{Point2, Triangulation};
 use std::collections::VecDeque;
 
-pub(super) struct Params {
+pub(super) struct Params<'a> {
     pub min_angle_degrees: f64,
     /// Largest triangle area (infinite: none).
     pub max_area: f64,
@@ -40,6 +46,18 @@ pub(super) struct Params {
     /// Faces outside the loops at the start (by face index); they are never
     /// refined, and the faces that replace them stay outside.
     pub outside: Vec<bool>,
+    /// The boundary's curves, when splits on curved edges should go onto
+    /// them.
+    pub curves: Option<Curves<'a>>,
+}
+
+/// The boundary segments' edges and curve parameters, kept up to date as
+/// segments on curves are split, and where a curved edge's point lies.
+pub(super) struct Curves<'a> {
+    pub segments: &'a mut Segments,
+    /// A curved edge's point at a curve parameter: in the chart and on the
+    /// curve; `None` for straight edges (their chord point is on them).
+    pub point: &'a dyn Fn(usize, f64) -> Option<(Point2<f64>, Point3)>,
 }
 
 pub(super) struct Refined {
@@ -48,16 +66,22 @@ pub(super) struct Refined {
     /// False when the vertex budget ran out first.
     pub complete: bool,
     /// The vertices put on segments (ascending): the only new vertices on
-    /// the boundary. `None` when not known (spade's `refine`).
+    /// the boundary. `None` when not known (spade's `refine`). Splits
+    /// put on a curve are not among them but in `curved`.
     pub on_segments: Option<Vec<usize>>,
+    /// Vertices put on curved edges, at the curve's point (ascending):
+    /// (edge, vertex, curve parameter, point on the curve).
+    pub curved: Vec<(usize, usize, f64, Point3)>,
     /// Every triangle was checked against the angle and area bounds when
     /// it was made (false after a flood fill: adding constraints there may
     /// flip edges away from the new point, out of its star).
     pub all_checked: bool,
 }
 
-struct Refiner<'a> {
+struct Refiner<'a, 'c> {
     cdt: &'a mut Cdt,
+    curves: Option<Curves<'c>>,
+    curved: Vec<(usize, usize, f64, Point3)>,
     outside: Vec<bool>,
     /// Bad triangles, shortest edge first (Triangle's order: fewer points
     /// than first-come), then in the order they were found.
@@ -65,6 +89,8 @@ struct Refiner<'a> {
     /// Reused per insertion: the faces around the new vertex.
     around: Vec<(FixedFaceHandle<InnerTag>, bool)>,
     opposite: Vec<(FixedVertexHandle, FixedVertexHandle)>,
+    /// Reused per insertion: the faces around a new vertex.
+    star: Vec<FixedFaceHandle<InnerTag>>,
     segments: VecDeque<(FixedVertexHandle, FixedVertexHandle)>,
     /// Input vertices (below this index) where two segments meet at an acute
     /// angle: splits next to them go on power-of-two shells.
@@ -92,7 +118,7 @@ struct Refiner<'a> {
     gave_up: bool,
 }
 
-pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
+pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
     let alpha = params.min_angle_degrees.to_radians();
     let cos_alpha = alpha.cos();
     let inputs = cdt.num_vertices();
@@ -103,10 +129,13 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
     let generation = vec![0; cdt.num_all_faces()];
     let mut r = Refiner {
         cdt,
+        curves: params.curves,
+        curved: Vec::new(),
         outside,
         triangles: BucketQueue::new(),
         around: Vec::new(),
         opposite: Vec::new(),
+        star: Vec::new(),
         segments: VecDeque::new(),
         acute,
         cos_limit: (params.min_angle_degrees + 1e-6).to_radians().cos(),
@@ -175,6 +204,7 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params) -> Refined {
         complete: complete && !r.gave_up,
         outside: r.outside,
         on_segments: Some(r.on_segments),
+        curved: r.curved,
         all_checked: !r.reflooded,
     }
 }
@@ -209,7 +239,7 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
         .collect()
 }
 
-impl Refiner<'_> {
+impl Refiner<'_, '_> {
     /// Queues the triangle when it is bad.
     fn push_triangle(&mut self, f: FixedFaceHandle<InnerTag>) {
         if let Some(shortest) = self.badness(self.cdt.face(f).positions()) {
@@ -293,7 +323,149 @@ impl Refiner<'_> {
     /// Inserts `x` for the bad triangle `face`, unless it encroaches a
     /// segment or lies beyond one: then those segments are split and the
     /// triangle is tried again later.
+    ///
+    /// Triangle's way: `x` is inserted, and taken out again when its star
+    /// has an encroached segment opposite it, does not hold `face` (a
+    /// segment lies between them), or lies outside. Finding the cavity
+    /// first (`split_triangle_by_cavity`) and then letting spade insert
+    /// found it twice: a third of the refinement's time on a
+    /// 10,000-vertex polygon.
     fn split_triangle(&mut self, face: FixedFaceHandle<InnerTag>, x: Point2<f64>) {
+        let faces_before = self.cdt.num_all_faces();
+        let before = self.cdt.num_vertices();
+        let corners = self.cdt.face(face).vertices().map(|v| v.fix());
+        let v = match self.cdt.insert_with_hint(x, corners[0]) {
+            Ok(v) if v.index() >= before => v,
+            _ => {
+                self.gave_up = true;
+                return;
+            }
+        };
+        let n = self.cdt.num_all_faces();
+        if self.outside.len() < n {
+            self.outside.resize(n, true);
+        }
+        if self.generation.len() < n {
+            self.generation.resize(n, 0);
+        }
+        let mut star = std::mem::take(&mut self.star);
+        star.clear();
+        self.encroached.clear();
+        // The star holds `face`'s slot when `face` was destroyed (x is
+        // visible from it); slots it reuses were all in x's region.
+        let (mut holds_face, mut outside, mut on_hull, mut on_segment) =
+            (false, false, false, false);
+        for e in self.cdt.vertex(v).out_edges() {
+            on_segment |= e.is_constraint_edge();
+            let Some(f) = e.face().as_inner() else {
+                on_hull = true;
+                continue;
+            };
+            let slot = f.fix().index();
+            holds_face |= slot == face.index();
+            outside |= slot < faces_before && self.outside[slot];
+            star.push(f.fix());
+            let next = e.next();
+            if next.is_constraint_edge() {
+                let (a, b) = (next.from(), next.to());
+                if self.encroaches(a.position(), b.position(), x) {
+                    self.encroached.push((a.fix(), b.fix()));
+                }
+            }
+        }
+        if holds_face && !outside && !on_hull && !on_segment && self.encroached.is_empty() {
+            self.star = star;
+            self.after_insertion(v, Side::Inside);
+            return;
+        }
+        // Take x out again: removing the last vertex moves no vertex, and
+        // the face slots it frees or moves are all in its star (the two
+        // slots the insertion added are the last ones).
+        let segment_ends = on_segment.then(|| {
+            let vertex = self.cdt.vertex(v);
+            let mut ends = vertex
+                .out_edges()
+                .filter(|e| e.is_constraint_edge())
+                .map(|e| e.to().fix());
+            (ends.next(), ends.next())
+        });
+        self.cdt.remove(v);
+        let n = self.cdt.num_all_faces();
+        for f in &star {
+            self.generation[f.index()] = self.generation[f.index()].wrapping_add(1);
+        }
+        if on_hull || on_segment || (holds_face && outside) {
+            // x fell outside the hull or on a segment (whose constraint the
+            // removal took), or its star mixed sides: rare, so the sides
+            // are found afresh and the cavity walk decides.
+            if let Some((Some(a), Some(b))) = segment_ends {
+                self.cdt.add_constraint(a, b);
+            }
+            self.star = star;
+            self.reflood();
+            // The flood queued every inside triangle again: the bad one is
+            // taken off (by its slot's generation) and the walk decides.
+            if let Some(f) = self.find_face(corners) {
+                self.generation[f.index()] = self.generation[f.index()].wrapping_add(1);
+                self.split_triangle_by_cavity(f, x);
+            }
+            return;
+        }
+        for f in &star {
+            if f.index() < n {
+                self.outside[f.index()] = outside;
+            }
+        }
+        if !holds_face {
+            // A segment lies between the triangle and x: the cavity walk
+            // finds it (`face` was not in the star, so it is untouched; the
+            // star's triangles are back as they were, queued again).
+            if !outside {
+                self.push_star(&star, n);
+            }
+            self.star = star;
+            self.split_triangle_by_cavity(face, x);
+            return;
+        }
+        let segments = std::mem::take(&mut self.encroached);
+        let mut split = false;
+        for &(a, b) in &segments {
+            split |= self.split_segment(a, b);
+        }
+        self.encroached = segments;
+        self.push_star(&star, n);
+        self.star = star;
+        if !split {
+            // Nothing could be split: the triangle stays as it is.
+            self.gave_up = true;
+            if let Some(f) = self.find_face(corners) {
+                self.generation[f.index()] = self.generation[f.index()].wrapping_add(1);
+            }
+        }
+    }
+
+    /// Queues the faces now in the slots of a removed vertex's star (below
+    /// `n`, the face count after the removal; later splits may have put
+    /// other faces there, queued twice then, which is harmless).
+    fn push_star(&mut self, star: &[FixedFaceHandle<InnerTag>], n: usize) {
+        for &f in star {
+            if f.index() < n && f.index() < self.cdt.num_all_faces() {
+                self.push_triangle(f);
+            }
+        }
+    }
+
+    /// The inner face with these corners (counter-clockwise), if it exists.
+    fn find_face(&self, [a, b, c]: [FixedVertexHandle; 3]) -> Option<FixedFaceHandle<InnerTag>> {
+        let edge = self.cdt.get_edge_from_neighbors(a, b)?;
+        let face = edge.face().as_inner()?;
+        (edge.next().to().fix() == c).then(|| face.fix())
+    }
+
+    /// [`Self::split_triangle`] through the cavity walk: the faces whose
+    /// circumcircle holds `x`, from `face`, not across segments; used when
+    /// a segment lies between the triangle and `x`.
+    fn split_triangle_by_cavity(&mut self, face: FixedFaceHandle<InnerTag>, x: Point2<f64>) {
         self.pass = self.pass.wrapping_add(1);
         if self.stamp.len() < self.cdt.num_all_faces() {
             self.stamp.resize(self.cdt.num_all_faces(), 0);
@@ -411,6 +583,36 @@ impl Refiner<'_> {
                 t = 1.0 - t;
             }
         }
+        if let Some((edge, s, uv, node)) = self.curve_point(a, b, t)
+            && let Some(v) = self.split_on_curve(a, b, uv, left, right)
+        {
+            let key = |x: FixedVertexHandle, y: FixedVertexHandle| {
+                (x.index().min(y.index()), x.index().max(y.index()))
+            };
+            if let Some(curves) = self.curves.as_mut() {
+                let (a_s, b_s) = match curves.segments.remove(&key(a, b)) {
+                    Some((_, lo, hi)) if a.index() < b.index() => (lo, hi),
+                    Some((_, lo, hi)) => (hi, lo),
+                    None => (s, s),
+                };
+                let entry = |x: FixedVertexHandle, sx: f64, y: FixedVertexHandle, sy: f64| {
+                    if x.index() < y.index() {
+                        (edge, sx, sy)
+                    } else {
+                        (edge, sy, sx)
+                    }
+                };
+                curves.segments.insert(key(a, v), entry(a, a_s, v, s));
+                curves.segments.insert(key(v, b), entry(v, s, b, b_s));
+            }
+            self.curved.push((edge, v.index(), s, node));
+            self.segments.push_back((a, v));
+            self.segments.push_back((v, b));
+            return true;
+        }
+        let Some(edge) = self.cdt.get_edge_from_neighbors(a, b) else {
+            return false;
+        };
         let m = Point2::new(pa.x + t * (pb.x - pa.x), pa.y + t * (pb.y - pa.y));
         let undirected = edge.fix().as_undirected();
         self.cdt.remove_constraint_edge(undirected);
@@ -441,19 +643,147 @@ impl Refiner<'_> {
             self.reflood();
             self.after_insertion(v, Side::Flooded);
         } else {
-            self.after_insertion(
-                v,
-                Side::Split {
-                    a: pa,
-                    b: pb,
-                    left,
-                    right,
-                },
-            );
+            self.after_insertion(v, Side::Split { a, b, left, right });
         }
         self.segments.push_back((a, v));
         self.segments.push_back((v, b));
         true
+    }
+
+    /// The point of segment a–b's curve at fraction `t` of its parameter
+    /// range: (edge, parameter, chart point, point on the curve), when the
+    /// segment lies on a curved edge.
+    fn curve_point(
+        &self,
+        a: FixedVertexHandle,
+        b: FixedVertexHandle,
+        t: f64,
+    ) -> Option<(usize, f64, Point2<f64>, Point3)> {
+        let curves = self.curves.as_ref()?;
+        let key = (a.index().min(b.index()), a.index().max(b.index()));
+        let &(edge, lo, hi) = curves.segments.get(&key)?;
+        let (sa, sb) = if a.index() < b.index() {
+            (lo, hi)
+        } else {
+            (hi, lo)
+        };
+        let s = sa + t * (sb - sa);
+        let (uv, node) = (curves.point)(edge, s)?;
+        Some((edge, s, uv, node))
+    }
+
+    /// Splits segment a–b at `x` off its chord (a point on its curve):
+    /// the new vertex, or `None` (the triangulation as it was, up to
+    /// face numbering) when the segments a–x–b would cross another one or
+    /// x falls on a vertex or segment.
+    fn split_on_curve(
+        &mut self,
+        a: FixedVertexHandle,
+        b: FixedVertexHandle,
+        x: Point2<f64>,
+        left: bool,
+        right: bool,
+    ) -> Option<FixedVertexHandle> {
+        let undirected = self
+            .cdt
+            .get_edge_from_neighbors(a, b)?
+            .fix()
+            .as_undirected();
+        self.cdt.remove_constraint_edge(undirected);
+        let before = self.cdt.num_vertices();
+        let v = match self.cdt.insert_with_hint(x, a) {
+            Ok(v) if v.index() >= before => v,
+            _ => {
+                self.cdt.add_constraint(a, b);
+                return None;
+            }
+        };
+        let (pa, pb) = (self.cdt.vertex(a).position(), self.cdt.vertex(b).position());
+        let crossed = self
+            .cdt
+            .vertex(v)
+            .out_edges()
+            .any(|e| e.is_constraint_edge())
+            || !(self.cdt.can_add_constraint(a, v) && self.cdt.can_add_constraint(v, b));
+        if crossed {
+            // Back as it was: x out (with the segment it fell on, put back
+            // whole), a–b constrained again, the sides found afresh.
+            let ends: Vec<FixedVertexHandle> = self
+                .cdt
+                .vertex(v)
+                .out_edges()
+                .filter(|e| e.is_constraint_edge())
+                .map(|e| e.to().fix())
+                .collect();
+            self.cdt.remove(v);
+            if let [c, d] = ends[..] {
+                self.cdt.add_constraint(c, d);
+            }
+            self.cdt.add_constraint(a, b);
+            self.reflood();
+            return None;
+        }
+        let clean = self.cdt.get_edge_from_neighbors(a, v).is_some()
+            && self.cdt.get_edge_from_neighbors(v, b).is_some();
+        self.cdt.add_constraint(a, v);
+        self.cdt.add_constraint(v, b);
+        self.sides_after_curve_split(a, b, v, pa, pb, clean, left, right);
+        Some(v)
+    }
+
+    /// Gives the faces around a vertex v just put on a curve between a and
+    /// b their sides: by the path a → v → b when every face that changes
+    /// side touches v (the constraints went in without flips, and no vertex
+    /// lies between the chord and the path), else by a new flood fill.
+    #[allow(clippy::too_many_arguments)]
+    fn sides_after_curve_split(
+        &mut self,
+        a: FixedVertexHandle,
+        b: FixedVertexHandle,
+        v: FixedVertexHandle,
+        pa: Point2<f64>,
+        pb: Point2<f64>,
+        clean: bool,
+        left: bool,
+        right: bool,
+    ) {
+        let pv = self.cdt.vertex(v).position();
+        let bulge = orient2d(coord(pa), coord(pb), coord(pv));
+        // Going counter-clockwise from v→a to v→b sweeps the right of the
+        // path; the chord lies there when v bulges to the left.
+        let (from, to) = if bulge > 0.0 { (a, b) } else { (b, a) };
+        let mut inside_sector = false;
+        let mut stray = false;
+        // Two turns: the sector may wrap past the first edge.
+        let edges: Vec<(FixedVertexHandle, Point2<f64>)> = self
+            .cdt
+            .vertex(v)
+            .out_edges()
+            .map(|e| (e.to().fix(), e.to().position()))
+            .collect();
+        for &(w, pw) in edges.iter().chain(edges.iter()) {
+            if w == from {
+                inside_sector = true;
+                continue;
+            }
+            if w == to {
+                if inside_sector {
+                    break;
+                }
+                continue;
+            }
+            if inside_sector {
+                // w must lie beyond the chord, on the side away from v.
+                let side = orient2d(coord(pa), coord(pb), coord(pw));
+                stray |= bulge != 0.0 && side * bulge >= 0.0;
+            }
+        }
+        if clean && !stray {
+            self.after_insertion(v, Side::Split { a, b, left, right });
+        } else {
+            self.reflood();
+            self.after_insertion(v, Side::Flooded);
+        }
     }
 
     /// Recomputes which faces are outside from scratch.
@@ -489,15 +819,35 @@ impl Refiner<'_> {
         let mut opposite = std::mem::take(&mut self.opposite);
         faces.clear();
         opposite.clear();
+        // For a split segment a–b: going counter-clockwise around v, the
+        // faces from v→b on are left of the path a → v → b, from v→a on
+        // right of it (the chord may be off the path: a point on a curve).
+        let mut left_of_path = match side {
+            Side::Split { a, b, .. } => {
+                self.cdt
+                    .vertex(v)
+                    .out_edges()
+                    .map(|e| e.to().fix())
+                    .find(|&w| w == a || w == b)
+                    == Some(a)
+            }
+            _ => false,
+        };
         for e in self.cdt.vertex(v).out_edges() {
+            if let Side::Split { a, b, .. } = side {
+                let to = e.to().fix();
+                if to == b {
+                    left_of_path = true;
+                } else if to == a {
+                    left_of_path = false;
+                }
+            }
             if let Some(f) = e.face().as_inner() {
                 let status = match side {
                     Side::Inside => false,
                     Side::Flooded => self.outside[f.fix().index()],
-                    Side::Split { a, b, left, right } => {
-                        let [p, q, r] = f.positions();
-                        let c = Point2::new((p.x + q.x + r.x) / 3.0, (p.y + q.y + r.y) / 3.0);
-                        if orient2d(coord(a), coord(b), coord(c)) > 0.0 {
+                    Side::Split { left, right, .. } => {
+                        if left_of_path {
                             left
                         } else {
                             right
@@ -529,10 +879,11 @@ impl Refiner<'_> {
 enum Side {
     /// A point inserted inside the loops.
     Inside,
-    /// A split segment a–b: whether its left and right sides are outside.
+    /// A split segment a–b (its ends, joined to the new vertex by
+    /// segments): whether its left and right sides are outside.
     Split {
-        a: Point2<f64>,
-        b: Point2<f64>,
+        a: FixedVertexHandle,
+        b: FixedVertexHandle,
         left: bool,
         right: bool,
     },
