@@ -543,6 +543,17 @@ fn check_pair(
 /// The faces of the subdomain's boundary, with `outward` set.
 fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<OrientedFace> {
     let mut result: BTreeMap<FaceId, bool> = BTreeMap::new();
+    // Each leaf's faces sorted once: a linear search per face and leaf was
+    // quadratic in a solid's face count.
+    let sides: Vec<Vec<(FaceId, bool)>> = built
+        .leaves
+        .iter()
+        .map(|leaf| {
+            let faces = &model.solids[leaf.index()].faces;
+            sorted_sides(faces.iter().map(|g| (g.face, g.outward)))
+        })
+        .collect();
+    let sides = &sides;
     for &leaf in &built.leaves {
         for of in &model.solids[leaf.index()].faces {
             if result.contains_key(&of.face) {
@@ -555,10 +566,9 @@ fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<Or
             // normal points away from ("behind") and the side it points to.
             let side = |behind: bool| {
                 move |i: usize| -> bool {
-                    let solid = &model.solids[built.leaves[i].index()];
-                    match solid.faces.iter().find(|g| g.face == of.face) {
-                        Some(g) => g.outward == behind,
-                        None => solid.shape.value(sample) > 0.0,
+                    match first_side(&sides[i], of.face) {
+                        Some(outward) => outward == behind,
+                        None => model.solids[built.leaves[i].index()].shape.value(sample) > 0.0,
                     }
                 }
             };
@@ -575,9 +585,34 @@ fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<Or
         .collect()
 }
 
+/// (key, flag) pairs sorted by key; a stable sort keeps a repeated key's
+/// first flag first, as a linear search would find it.
+fn sorted_sides<K: Ord + Copy>(pairs: impl Iterator<Item = (K, bool)>) -> Vec<(K, bool)> {
+    let mut v: Vec<(K, bool)> = pairs.collect();
+    v.sort_by_key(|p| p.0);
+    v
+}
+
+/// The flag of the first pair with this key in a [`sorted_sides`] list.
+fn first_side<K: Ord + Copy>(sorted: &[(K, bool)], key: K) -> Option<bool> {
+    let at = sorted.partition_point(|p| p.0 < key);
+    sorted.get(at).filter(|p| p.0 == key).map(|p| p.1)
+}
+
 /// The boundary edges of a 2D subdomain, `forward` with the region on the left.
 fn classify_edges(model: &Model, built: &Built) -> Vec<OrientedEdge> {
     let mut result: BTreeMap<EdgeId, bool> = BTreeMap::new();
+    // Each leaf's edges sorted once: a linear search per edge and leaf was
+    // quadratic in a polygon's vertex count.
+    let sides: Vec<Vec<(EdgeId, bool)>> = built
+        .leaves
+        .iter()
+        .map(|leaf| {
+            let edges = &model.solids[leaf.index()].boundary_edges;
+            sorted_sides(edges.iter().map(|g| (g.edge, g.forward)))
+        })
+        .collect();
+    let sides = &sides;
     for &leaf in &built.leaves {
         for oe in &model.solids[leaf.index()].boundary_edges {
             if result.contains_key(&oe.edge) {
@@ -587,10 +622,9 @@ fn classify_edges(model: &Model, built: &Built) -> Vec<OrientedEdge> {
             // "left" = the side on the left of the edge's own direction.
             let side = |left: bool| {
                 move |i: usize| -> bool {
-                    let solid = &model.solids[built.leaves[i].index()];
-                    match solid.boundary_edges.iter().find(|g| g.edge == oe.edge) {
-                        Some(g) => g.forward == left,
-                        None => solid.shape.value(&sample) > 0.0,
+                    match first_side(&sides[i], oe.edge) {
+                        Some(forward) => forward == left,
+                        None => model.solids[built.leaves[i].index()].shape.value(&sample) > 0.0,
                     }
                 }
             };
