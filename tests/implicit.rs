@@ -281,14 +281,7 @@ fn pruning_does_not_change_the_mesh_topology_or_volume_much() {
 
 #[test]
 fn output_is_the_same_for_any_thread_count() {
-    let model = compile(SEVEN_BALLS);
-    let run = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool")
-            .install(|| model.polygonize(Some([33, 30, 27])))
-    };
+    let run = on_threads(compile(SEVEN_BALLS), [33, 30, 27]);
     assert_eq!(run(1), run(3));
 }
 
@@ -296,18 +289,22 @@ fn output_is_the_same_for_any_thread_count() {
 fn output_is_the_same_for_any_thread_count_with_runs_of_several_slabs() {
     // 100 cells in z: runs of 4 slabs (32 runs), whose inner planes are
     // refined together and straddle block layers.
-    let model = compile(SEVEN_BALLS);
-    let run = |threads| {
-        rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool")
-            .install(|| model.polygonize(Some([24, 21, 100])))
-    };
+    let run = on_threads(compile(SEVEN_BALLS), [24, 21, 100]);
     let one = run(1);
     assert_eq!(check_closed_manifold(&one), (1, 2));
     assert_eq!(one, run(2));
     assert_eq!(one, run(3));
+}
+
+/// Polygonizes `model` on a grid of `cells` in a pool of the given thread count.
+fn on_threads(model: ImplicitModel, cells: [usize; 3]) -> impl Fn(usize) -> Surface {
+    move |threads| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("pool")
+            .install(|| model.polygonize(Some(cells)))
+    }
 }
 
 /// The faces of a cell in [`cell_links`]' corner numbering, (corner, corner) pairs

@@ -386,49 +386,11 @@ impl<'a> Expander<'a> {
             }
         }
         self.prepare();
-        let triangles: usize = faces
-            .iter()
-            .map(|&(f, _)| mesh.faces[f as usize].triangles.len())
-            .sum();
-        let vertices = mesh.nodes.len().min(3 * triangles);
-        let mut out_triangles = Vec::with_capacity(triangles);
-        let mut nodes = Vec::with_capacity(vertices);
-        let mut normals: Vec<[f32; 3]> = Vec::with_capacity(vertices);
-        // One face's normal sums in f64, reused from face to face.
-        let mut sums: Vec<[f64; 3]> = Vec::new();
-        for &(face, flip) in faces {
-            let stamp = self.next_stamp();
-            let first = nodes.len();
-            sums.clear();
-            let mut total = [0.0; 3];
-            for tri in oriented(mesh, face, flip) {
-                let n = triangle_normal(mesh, tri);
-                total = add(total, n);
-                let mut t = [0u32; 3];
-                for (k, &node) in tri.iter().enumerate() {
-                    let entry = &mut self.slot[node as usize];
-                    if entry.0 != stamp {
-                        nodes.push(node);
-                        sums.push([0.0; 3]);
-                        *entry = (stamp, (nodes.len() - 1) as u32);
-                    }
-                    let index = entry.1 as usize;
-                    let s = &mut sums[index - first];
-                    *s = add(*s, n);
-                    t[k] = entry.1;
-                }
-                out_triangles.push(t);
-            }
-            let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
-            normals.extend(
-                sums.iter()
-                    .map(|s| unit(*s).unwrap_or(fallback).map(|c| c as f32)),
-            );
-        }
+        let (nodes, normals, triangles) = expand_faces(self, faces, |n| n.map(|c| c as f32));
         Streamed {
             nodes: Some(nodes),
             normals,
-            triangles: Cow::Owned(out_triangles),
+            triangles: Cow::Owned(triangles),
         }
     }
 
@@ -516,6 +478,24 @@ fn node_normals(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> Vec<[f64; 3
 }
 
 fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a> {
+    let (nodes, normals, triangles) = expand_faces(ex, faces, |n| n);
+    Expanded {
+        normals,
+        nodes: Some(nodes),
+        triangles: Cow::Owned(triangles),
+    }
+}
+
+/// The faces' nodes (each once per face, in first-use order), their unit
+/// normals as `convert` makes them, and the triangles renumbered onto them.
+/// A node's normal is the area-weighted sum of its triangles' normals in the
+/// face, summed and made unit in `f64` whatever `N` is, so every writer gets
+/// the same numbers.
+fn expand_faces<N>(
+    ex: &mut Expander<'_>,
+    faces: &[(u32, bool)],
+    convert: impl Fn([f64; 3]) -> N,
+) -> (Vec<u32>, Vec<N>, Vec<[u32; 3]>) {
     let mesh = ex.mesh;
     let triangles: usize = faces
         .iter()
@@ -526,12 +506,16 @@ fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a>
     let vertices = mesh.nodes.len().min(3 * triangles);
     let mut out_triangles = Vec::with_capacity(triangles);
     let mut nodes = Vec::with_capacity(vertices);
-    let mut normals: Vec<[f64; 3]> = Vec::with_capacity(vertices);
+    let mut normals = Vec::with_capacity(vertices);
+    // One face's normal sums, reused from face to face.
+    let mut sums: Vec<[f64; 3]> = Vec::new();
     for &(face, flip) in faces {
         let stamp = ex.next_stamp();
         let first = nodes.len();
+        sums.clear();
         let mut total = [0.0; 3];
         for tri in oriented(mesh, face, flip) {
+            // Area weighting: the unnormalised cross product is twice the area.
             let n = triangle_normal(mesh, tri);
             total = add(total, n);
             let mut t = [0u32; 3];
@@ -539,28 +523,20 @@ fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a>
                 let entry = &mut ex.slot[node as usize];
                 if entry.0 != stamp {
                     nodes.push(node);
-                    // The area-weighted sum of the normals around the node,
-                    // made a unit vector once the face is done.
-                    normals.push([0.0; 3]);
+                    sums.push([0.0; 3]);
                     *entry = (stamp, (nodes.len() - 1) as u32);
                 }
                 let index = entry.1 as usize;
-                // Area weighting: the unnormalised cross product is twice the area.
-                normals[index] = add(normals[index], n);
+                let s = &mut sums[index - first];
+                *s = add(*s, n);
                 t[k] = entry.1;
             }
             out_triangles.push(t);
         }
         let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
-        for s in &mut normals[first..] {
-            *s = unit(*s).unwrap_or(fallback);
-        }
+        normals.extend(sums.iter().map(|s| convert(unit(*s).unwrap_or(fallback))));
     }
-    Expanded {
-        normals,
-        nodes: Some(nodes),
-        triangles: Cow::Owned(out_triangles),
-    }
+    (nodes, normals, out_triangles)
 }
 
 /// Twice the area times the unit normal, by the right-hand rule.
