@@ -207,4 +207,6 @@ mod tests;
 #[cfg(test)]
 mod tests_patch9;
 #[cfg(test)]
+mod tests_seam_cut;
+#[cfg(test)]
 mod tests_seams;

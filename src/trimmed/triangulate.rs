@@ -700,8 +700,11 @@ fn assemble(
 }
 
 /// `None` when `p` falls on a vertex or edge or outside; else the
-/// constraint edge of the triangle holding it whose diametral circle holds
-/// it, if any (a point there would make a sliver against the boundary).
+/// constraint edge whose diametral circle holds `p` (a point there would
+/// make a sliver against the boundary), if any, among those of the triangle
+/// holding it and of that triangle's neighbours: the circumcentre of a
+/// right or obtuse triangle lies on or beyond its longest edge, in the
+/// neighbour, while the edge it encroaches is one of its own triangle's.
 fn encroached(
     cdt: &Cdt,
     p: Point2<f64>,
@@ -711,21 +714,24 @@ fn encroached(
     let OnFace(face) = cdt.locate_with_hint(p, hint) else {
         return None;
     };
-    Some(
-        cdt.face(face)
-            .adjacent_edges()
-            .iter()
-            .find(|e| {
-                if !cdt.is_constraint_edge(e.as_undirected().fix()) {
-                    return false;
-                }
-                let [a, b] = e.positions();
-                let m = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
-                let r2 = 0.25 * ((a.x - b.x).powi(2) + (a.y - b.y).powi(2));
-                (p.x - m.x).powi(2) + (p.y - m.y).powi(2) < r2
-            })
-            .map(|e| (e.from().fix().index(), e.to().fix().index())),
-    )
+    let face = cdt.face(face);
+    let neighbours = face.adjacent_edges().map(|e| e.rev().face().as_inner());
+    let faces = std::iter::once(face).chain(neighbours.into_iter().flatten());
+    for f in faces {
+        let hit = f.adjacent_edges().into_iter().find(|e| {
+            if !cdt.is_constraint_edge(e.as_undirected().fix()) {
+                return false;
+            }
+            let [a, b] = e.positions();
+            let m = Point2::new(0.5 * (a.x + b.x), 0.5 * (a.y + b.y));
+            let r2 = 0.25 * ((a.x - b.x).powi(2) + (a.y - b.y).powi(2));
+            (p.x - m.x).powi(2) + (p.y - m.y).powi(2) < r2
+        });
+        if let Some(e) = hit {
+            return Some(Some((e.from().fix().index(), e.to().fix().index())));
+        }
+    }
+    Some(None)
 }
 
 /// True when `p` lies in a triangle, off its constraint edges' diametral
