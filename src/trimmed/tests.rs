@@ -197,17 +197,7 @@ fn paper_bezier_patch_with_round_hole() {
 
 #[test]
 fn untrimmed_full_cone_closes_its_seam() {
-    let s = TrimmedSurface {
-        name: "cone".into(),
-        carrier: Carrier::Cone {
-            r1: 2.0,
-            r2: 1.5,
-            length: 3.0,
-        },
-        frame: Frame::identity(),
-        rect: [0.0, 3.0, 0.0, std::f64::consts::TAU],
-        trim: None,
-    };
+    let s = interstage_cone(None);
     let m = mesh_trimmed(
         &s,
         TrimSettings {
@@ -702,4 +692,20 @@ fn paper_patch_at_25_degrees_has_no_smaller_angle() {
         "{below} triangles below 25°: {q:?}"
     );
     assert!(q.max_centroid_distance <= settings.tolerance, "{q:?}");
+}
+
+/// The interstage's full cone (radius 2 to 1.5 over a length of 3), a full
+/// turn in v, with an optional trim.
+pub(super) fn interstage_cone(trim: Option<Trim>) -> TrimmedSurface {
+    TrimmedSurface {
+        name: "cone".into(),
+        carrier: Carrier::Cone {
+            r1: 2.0,
+            r2: 1.5,
+            length: 3.0,
+        },
+        frame: Frame::identity(),
+        rect: [0.0, 3.0, 0.0, std::f64::consts::TAU],
+        trim,
+    }
 }

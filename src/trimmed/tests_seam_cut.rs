@@ -2,10 +2,9 @@
 //! interstage fixture's bottom edge at y = 0.65, issue 9): no input angle
 //! there, so no triangle may stay below the threshold.
 
-use super::tests::{below_threshold, check_manifold};
+use super::tests::{below_threshold, check_manifold, interstage_cone};
 use super::*;
 use crate::implicit::ir::{Binary, Ctx};
-use std::f64::consts::TAU;
 
 /// The interstage cone with one rectangular cut-out |z| < 0.3,
 /// |y − 1| < 0.35 on the side x > 0, centred on the seam v = 0: material
@@ -23,17 +22,7 @@ fn cone_with_seam_cut_out() -> TrimmedSurface {
     let along = c.sub(h, dy2);
     let rect = c.binary(Binary::Min, across, along);
     let f = c.binary(Binary::Min, rect, x);
-    TrimmedSurface {
-        name: "cone".into(),
-        carrier: Carrier::Cone {
-            r1: 2.0,
-            r2: 1.5,
-            length: 3.0,
-        },
-        frame: Frame::identity(),
-        rect: [0.0, 3.0, 0.0, TAU],
-        trim: Some(Trim::new(&c, f, true)),
-    }
+    interstage_cone(Some(Trim::new(&c, f, true)))
 }
 
 #[test]
