@@ -457,34 +457,25 @@ fn choose(
         nodes.sides[x] & nodes.sides[y] & nodes.fixed == 0
             && (nodes.xyz[x] - nodes.xyz[y]).norm() > 2.0 * floor
     };
-    let longest_constraint = || {
-        constraints
-            .iter()
-            .copied()
-            .filter(|&e| splittable(e))
-            .max_by(|a, b| {
-                let la = (nodes.xyz[a.0] - nodes.xyz[a.1]).norm();
-                let lb = (nodes.xyz[b.0] - nodes.xyz[b.1]).norm();
-                la.total_cmp(&lb)
-            })
+    // The longest of some boundary edges that may be split.
+    let longest_splittable = |edges: &mut dyn Iterator<Item = (usize, usize)>| {
+        edges.filter(|&e| splittable(e)).max_by(|a, b| {
+            let la = (nodes.xyz[a.0] - nodes.xyz[a.1]).norm();
+            let lb = (nodes.xyz[b.0] - nodes.xyz[b.1]).norm();
+            la.total_cmp(&lb)
+        })
     };
     let hint = spade::handles::FixedVertexHandle::from_index(corner);
     let candidates = match split.circumcentre {
         Some(c) => vec![c, split.centroid],
         None => {
-            if let Some(e) = longest_constraint() {
+            if let Some(e) = longest_splittable(&mut constraints.iter().copied()) {
                 return Some(Action::Split(e.0, e.1));
             }
             // The circumcentre lies beyond the boundary at a corner of the
             // triangle: Ruppert splits the boundary edge there.
-            if let Some(e) = corner_constraints(cdt, &split.corners)
-                .into_iter()
-                .filter(|&e| splittable(e))
-                .max_by(|a, b| {
-                    let la = (nodes.xyz[a.0] - nodes.xyz[a.1]).norm();
-                    let lb = (nodes.xyz[b.0] - nodes.xyz[b.1]).norm();
-                    la.total_cmp(&lb)
-                })
+            if let Some(e) =
+                longest_splittable(&mut corner_constraints(cdt, &split.corners).into_iter())
             {
                 return Some(Action::Split(e.0, e.1));
             }
