@@ -4,9 +4,8 @@
 //! removes the temporary file so nothing partial is left behind.
 
 use super::WriteError;
-use super::direct::DirectWriter;
 use std::fs::{File, OpenOptions};
-use std::io::Write;
+use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
@@ -42,11 +41,10 @@ fn fill_and_sync<T>(
     file: File,
     fill: impl FnOnce(&mut dyn Write) -> Result<T, WriteError>,
 ) -> Result<T, WriteError> {
-    // Large writes in whole blocks, past the page cache (`direct.rs`): the
-    // file is synced before it is renamed anyway.
-    let mut out = DirectWriter::new(file);
+    // Large writes: the writers' pieces reach the kernel in few system calls.
+    let mut out = BufWriter::with_capacity(1 << 20, file);
     let value = fill(&mut out)?;
-    let file = out.finish()?;
+    let file = out.into_inner().map_err(|e| e.into_error())?;
     file.sync_all()?;
     Ok(value)
 }

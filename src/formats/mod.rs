@@ -11,7 +11,6 @@
 
 mod atomic;
 mod base64;
-mod direct;
 pub mod frag;
 mod gltf;
 mod groups;
