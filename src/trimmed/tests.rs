@@ -240,7 +240,20 @@ fn interstage_cone_with_cut_outs_at_25_degrees() {
     check_interstage(25.0);
 }
 
+/// Before the fix one interior triangle of 16.5° stayed near the cut-out
+/// tilted at 2π/3: its circumcentre, across its long edge, was judged far
+/// from it by a (u, v) distance (a cone's u is a length, v an angle), so it
+/// got no split.
+#[test]
+fn interstage_at_tolerance_0_002_and_25_degrees_has_no_skinny_triangle() {
+    check_interstage_at(0.002, 25.0);
+}
+
 fn check_interstage(min_angle: f64) {
+    check_interstage_at(0.005, min_angle);
+}
+
+fn check_interstage_at(tolerance: f64, min_angle: f64) {
     let source = crate::span::SourceFile::new(
         "trimmed_interstage.xml",
         include_str!("../../fixtures/valid/trimmed_interstage.xml"),
@@ -251,7 +264,7 @@ fn check_interstage(min_angle: f64) {
     assert_eq!(model.trimmed.len(), 1);
     let s = &model.trimmed[0];
     let settings = TrimSettings {
-        tolerance: 0.005,
+        tolerance,
         min_angle,
         max_edge: f64::INFINITY,
     };

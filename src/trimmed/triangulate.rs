@@ -260,7 +260,7 @@ fn mesh_band(
             // edges make no input angle.
             let on_seam = |&&(a, b): &&(usize, usize)| nodes.sides[a] & nodes.sides[b] & seams != 0;
             let angles = constraints.iter().filter(|e| !on_seam(e)).count() < 2;
-            match needs_split(s, &p, &q, &settings, floor, angles) {
+            match needs_split(s, &arc, &p, &q, &settings, floor, angles) {
                 Some(mut split) => {
                     split.corners = t;
                     if let Some(a) = choose(&cdt, &arc, &nodes, split, &constraints, t[0], floor) {
@@ -373,6 +373,7 @@ enum Action {
 /// the surface, and with its angles above the threshold.
 fn needs_split(
     s: &TrimmedSurface,
+    arc: &ArcChart,
     p: &[Point3; 3],
     q: &[[f64; 2]; 3],
     settings: &TrimSettings,
@@ -414,14 +415,22 @@ fn needs_split(
         let [u0, u1, v0, v1] = s.rect;
         uv[0] > u0 && uv[0] < u1 && uv[1] > v0 && uv[1] < v1 && s.material(uv[0], uv[1]) >= 0.0
     };
-    // Far from the triangle (beyond twice its parameter size) or out of the
-    // material, the circumcentre is not usable.
+    // Far from the triangle (beyond twice its size) or out of the material,
+    // the circumcentre is not usable. Distances are measured in the chart,
+    // not in (u, v): u and v may have different units (a cone's height and
+    // angle), and a (u, v) measure called an obtuse triangle's circumcentre
+    // across its long edge far when its long edge ran along the shorter unit
+    // (it then got no split at all, issue 9's 16.5° interstage triangle).
+    let chart_distance = |a: [f64; 2], b: [f64; 2]| {
+        let (x, y) = (arc.to_chart(a), arc.to_chart(b));
+        (x[0] - y[0]).hypot(x[1] - y[1])
+    };
     let size = (0..3)
-        .map(|k| (q[k][0] - centroid_uv[0]).hypot(q[k][1] - centroid_uv[1]))
+        .map(|k| chart_distance(q[k], centroid_uv))
         .fold(0.0, f64::max);
     let circumcentre = circle
         .map(|c| nearest_parameter(s, c, centroid_uv))
-        .filter(|uv| (uv[0] - centroid_uv[0]).hypot(uv[1] - centroid_uv[1]) <= 2.0 * size)
+        .filter(|&uv| chart_distance(uv, centroid_uv) <= 2.0 * size)
         .filter(|&uv| inside(uv));
     Some(Split {
         circumcentre,
