@@ -249,6 +249,35 @@ fn interstage_at_tolerance_0_002_and_25_degrees_has_no_skinny_triangle() {
     check_interstage_at(0.002, 25.0);
 }
 
+/// Before the fix one triangle of 23.7° stayed in the patch's 90° corner at
+/// (0, −1, −1): its two boundary edges excused it from the angle test as if
+/// they met at an input angle smaller than the threshold.
+#[test]
+fn bezier_hole_at_tolerance_0_003_and_25_degrees_has_no_skinny_triangle() {
+    let source = crate::span::SourceFile::new(
+        "trimmed_bezier_hole.xml",
+        include_str!("../../fixtures/valid/trimmed_bezier_hole.xml"),
+    );
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    assert!(checked.is_valid(), "{:?}", checked.diagnostics);
+    let model = &checked.lowered.as_ref().expect("lowered").model;
+    assert_eq!(model.trimmed.len(), 1);
+    let s = &model.trimmed[0];
+    let settings = TrimSettings {
+        tolerance: 0.003,
+        min_angle: 25.0,
+        max_edge: f64::INFINITY,
+    };
+    let m = mesh_trimmed(s, settings).expect("meshable");
+    check_manifold(&m);
+    // The patch's corners are 90° and the hole is smooth: no input angle is
+    // below 25°, so no triangle is exempt either.
+    assert_eq!(below_threshold(&m, 25.0), (0, 0));
+    let q = m.quality(s);
+    assert!(q.min_angle >= 25.0, "{q:?}");
+    assert!(q.max_centroid_distance <= 0.003, "{q:?}");
+}
+
 fn check_interstage(min_angle: f64) {
     check_interstage_at(0.005, min_angle);
 }

@@ -255,11 +255,14 @@ fn mesh_band(
                 .filter(|e| cdt.is_constraint_edge(e.as_undirected().fix()))
                 .map(|e| (e.from().fix().index(), e.to().fix().index()))
                 .collect();
-            // Two constraint edges meet at an input angle: the angle test
-            // cannot be met there. A seam is no boundary on the surface: its
-            // edges make no input angle.
-            let on_seam = |&&(a, b): &&(usize, usize)| nodes.sides[a] & nodes.sides[b] & seams != 0;
-            let angles = constraints.iter().filter(|e| !on_seam(e)).count() < 2;
+            // A seam is no boundary on the surface: its edges make no angle.
+            let on_seam = |&(a, b): &(usize, usize)| nodes.sides[a] & nodes.sides[b] & seams != 0;
+            let walls: Vec<(usize, usize)> = constraints
+                .iter()
+                .copied()
+                .filter(|e| !on_seam(e))
+                .collect();
+            let angles = !input_corner(&walls, &t, &p, &nodes, settings.min_angle);
             match needs_split(s, &arc, &p, &q, &settings, floor, angles) {
                 Some(mut split) => {
                     split.corners = t;
@@ -505,6 +508,34 @@ fn choose(
         }
     }
     None
+}
+
+/// True when two of the triangle's boundary edges (`walls`, seams left
+/// out) meet at an input angle the angle test cannot be met at: one smaller
+/// than the threshold, where refinement would cascade into the corner (the
+/// triangle's angle there is the boundary's own, measured on the surface),
+/// or one between edges that are never split (a pole cap's ring, another
+/// face's chain). Two boundary edges meeting at a wider angle (a patch's
+/// 90° corner) are no excuse: the triangle is refined like any other, and
+/// Ruppert's choice splits a boundary edge there (issue 9's 23.7° triangle
+/// at the Bezier patch's corner).
+fn input_corner(
+    walls: &[(usize, usize)],
+    t: &[usize; 3],
+    p: &[Point3; 3],
+    nodes: &Nodes,
+    threshold: f64,
+) -> bool {
+    let fixed = |&(a, b): &(usize, usize)| nodes.sides[a] & nodes.sides[b] & nodes.fixed != 0;
+    (0..3).any(|k| {
+        let at = |&&(a, b): &&(usize, usize)| a == t[k] || b == t[k];
+        let meeting: Vec<&(usize, usize)> = walls.iter().filter(at).collect();
+        if meeting.len() < 2 {
+            return false;
+        }
+        let (a, b) = (p[(k + 1) % 3] - p[k], p[(k + 2) % 3] - p[k]);
+        a.angle(&b).to_degrees() < threshold || meeting.iter().any(|e| fixed(e))
+    })
 }
 
 /// The constraint edges at the corners of a triangle (each once).
