@@ -11,8 +11,14 @@ pub fn check(root: &Element, rule: &'static Rule, diags: &mut Diagnostics) {
     let mut stack = vec![(root, rule)];
     while let Some((element, rule)) = stack.pop() {
         let known = check_element(element, rule, diags);
+        // Listed once per element, not once per child (a list is made each time).
+        let rules = if known.is_empty() {
+            Vec::new()
+        } else {
+            rule.child_rules()
+        };
         for child in known.into_iter().rev() {
-            if let Some(child_rule) = rule.child_rule(child.name) {
+            if let Some(&child_rule) = rules.iter().find(|r| r.name == child.name) {
                 stack.push((child, child_rule));
             }
         }
