@@ -158,12 +158,11 @@ fn run(
             return None;
         }
     }
-    let document = read_document(source, &parsed, root, options, diags);
+    let (mut document, extracted) = read_document(source, &parsed, root, options, diags);
     // Each stage's input is dropped as soon as the next no longer needs it,
     // which keeps the peak memory of large files down.
     drop(parsed);
     release(options);
-    let (mut document, extracted) = document;
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     // Everything later reads the resolved objects, not the document's: on large
     // files they are a fifth of the peak memory while the model is lowered.
