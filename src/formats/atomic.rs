@@ -203,3 +203,27 @@ fn sync_folder(path: &Path) {
         let _ = dir.sync_all();
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Writes of odd sizes across many buffers and past several background
+    /// syncs give the file back byte for byte.
+    #[test]
+    fn large_output_in_odd_pieces_is_written_whole() {
+        let dir = tempfile::tempdir().expect("temporary folder");
+        let path = dir.path().join("big.bin");
+        let data: Vec<u8> = (0..(3 * SYNC_STEP as usize + 12_345))
+            .map(|i| (i * 7 + i / 4099) as u8)
+            .collect();
+        write_atomic(&path, |out| {
+            for piece in data.chunks(777_777) {
+                out.write_all(piece)?;
+            }
+            Ok(())
+        })
+        .expect("written");
+        assert_eq!(std::fs::read(&path).expect("read back"), data);
+    }
+}
