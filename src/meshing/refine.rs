@@ -88,7 +88,7 @@ struct Refiner<'a, 'c> {
     triangles: BucketQueue,
     /// Reused per insertion: the faces around the new vertex.
     /// with their corners (counter-clockwise) and side.
-    around: Vec<(FixedFaceHandle<InnerTag>, Corners, bool)>,
+    around: Vec<(FixedFaceHandle<InnerTag>, [Point2<f64>; 3], bool)>,
     opposite: Vec<(FixedVertexHandle, FixedVertexHandle)>,
     /// Reused per insertion: the faces around a new vertex.
     star: Vec<FixedFaceHandle<InnerTag>>,
@@ -186,7 +186,7 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
             }
             continue;
         }
-        let Some((face, generation, corners)) = r.triangles.pop() else {
+        let Some((face, generation)) = r.triangles.pop() else {
             break;
         };
         let index = face.index();
@@ -197,9 +197,8 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
         if r.generation.get(index) != Some(&generation) || r.outside[index] {
             continue;
         }
-        // Unchanged since it was queued: its corners as they were then.
-        if let Some(point) = r.bad_triangle_point(corners.points) {
-            r.split_triangle(face, point, corners);
+        if let Some(point) = r.bad_triangle_point(r.cdt.face(face).positions()) {
+            r.split_triangle(face, point);
         }
     }
     Refined {
@@ -244,20 +243,15 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
 impl Refiner<'_, '_> {
     /// Queues the triangle when it is bad.
     fn push_triangle(&mut self, f: FixedFaceHandle<InnerTag>) {
-        let vertices = self.cdt.face(f).vertices();
-        let corners = Corners {
-            handles: vertices.map(|v| v.fix()),
-            points: vertices.map(|v| v.position()),
-        };
-        self.push_triangle_at(f, corners);
+        self.push_triangle_at(f, self.cdt.face(f).positions());
     }
 
-    /// Queues the triangle with these corners when it is bad (the corners
-    /// already at hand: no face lookup, now or when it is taken off).
-    fn push_triangle_at(&mut self, f: FixedFaceHandle<InnerTag>, corners: Corners) {
-        if let Some(shortest) = self.badness(corners.points) {
+    /// Queues the triangle with corners `p` when it is bad (the corners
+    /// already at hand: no face lookup).
+    fn push_triangle_at(&mut self, f: FixedFaceHandle<InnerTag>, p: [Point2<f64>; 3]) {
+        if let Some(shortest) = self.badness(p) {
             self.triangles
-                .push(shortest, (f, self.generation[f.index()], corners));
+                .push(shortest, (f, self.generation[f.index()]));
         }
     }
 
@@ -343,17 +337,11 @@ impl Refiner<'_, '_> {
     /// first (`split_triangle_by_cavity`) and then letting spade insert
     /// found it twice: a third of the refinement's time on a
     /// 10,000-vertex polygon.
-    fn split_triangle(&mut self, face: FixedFaceHandle<InnerTag>, x: Point2<f64>, queued: Corners) {
+    fn split_triangle(&mut self, face: FixedFaceHandle<InnerTag>, x: Point2<f64>) {
         let faces_before = self.cdt.num_all_faces();
         let before = self.cdt.num_vertices();
-        let corners = queued.handles;
-        // Spade walks from the hint to the vertex nearest x first: start it
-        // at the nearest corner.
-        let distance = |p: Point2<f64>| (p.x - x.x).powi(2) + (p.y - x.y).powi(2);
-        let nearest = (0..3)
-            .min_by(|&i, &j| distance(queued.points[i]).total_cmp(&distance(queued.points[j])))
-            .unwrap_or(0);
-        let v = match self.cdt.insert_with_hint(x, corners[nearest]) {
+        let corners = self.cdt.face(face).vertices().map(|v| v.fix());
+        let v = match self.cdt.insert_with_hint(x, corners[0]) {
             Ok(v) if v.index() >= before => v,
             _ => {
                 self.gave_up = true;
@@ -878,11 +866,7 @@ impl Refiner<'_, '_> {
                 // The face left of v → w runs v, w, then next's end
                 // (counter-clockwise): its corners without a face lookup.
                 let next = e.next();
-                let (w, u) = (e.to(), next.to());
-                let corners = Corners {
-                    handles: [v, w.fix(), u.fix()],
-                    points: [pv, w.position(), u.position()],
-                };
+                let corners = [pv, e.to().position(), next.to().position()];
                 faces.push((f.fix(), corners, status));
                 if next.is_constraint_edge() {
                     opposite.push((next.from().fix(), next.to().fix()));
@@ -923,16 +907,8 @@ enum Side {
     Flooded,
 }
 
-/// A triangle's corners, counter-clockwise, and their positions.
-#[derive(Clone, Copy)]
-struct Corners {
-    handles: [FixedVertexHandle; 3],
-    points: [Point2<f64>; 3],
-}
-
-/// A queued bad triangle: its face, the slot's generation when queued, and
-/// its corners then (the same while the generation stands).
-type Queued = (FixedFaceHandle<InnerTag>, u32, Corners);
+/// A queued bad triangle: its face and the slot's generation when queued.
+type Queued = (FixedFaceHandle<InnerTag>, u32);
 
 /// Triangle's bad-triangle queue: 4,096 FIFO buckets by the shortest edge's
 /// squared length in factors of √2, shortest first. Push and pop take
