@@ -7,6 +7,7 @@
 
 use super::scene::{HIDDEN, Scene};
 use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 pub const EMPTY: u64 = u64::MAX;
 /// Sub-sample steps per sample of the snapped coordinates.
@@ -110,12 +111,15 @@ fn row_range(v: &[[i64; 2]; 3], width: usize, height: usize) -> Option<(usize, u
 
 /// For each chunk of triangles, the ids each band of `band_rows` sample rows
 /// must draw (front-facing visible sides only, rows clamped to the image).
+/// When `drawn` is given, the nodes of every binned triangle are marked in it:
+/// shading reads the light of no other node.
 pub fn bin(
     scene: &Scene,
     proj: &Projected,
     width: usize,
     height: usize,
     band_rows: usize,
+    drawn: Option<&[AtomicBool]>,
 ) -> Vec<Vec<Vec<u32>>> {
     let n_bands = height.div_ceil(band_rows);
     (0..scene.tris.len().div_ceil(CHUNK))
@@ -131,6 +135,12 @@ pub fn bin(
                     continue;
                 }
                 if let Some((first, last)) = row_range(&v, width, height) {
+                    if let Some(drawn) = drawn {
+                        // Relaxed stores of `true`: the marks end the same in any order.
+                        for n in scene.tris[tri] {
+                            drawn[n as usize].store(true, Ordering::Relaxed);
+                        }
+                    }
                     for band in bands
                         .iter_mut()
                         .take(last / band_rows + 1)
@@ -166,7 +176,7 @@ pub fn draw_band(
 }
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
-    let bins = bin(scene, proj, width, height, BAND);
+    let bins = bin(scene, proj, width, height, BAND, None);
     let mut data = vec![EMPTY; width * height];
     data.par_chunks_mut(width * BAND)
         .enumerate()
@@ -224,10 +234,10 @@ fn draw(
         step_y[k] = dx * SUB;
     }
     // Depth as a plane over sample coordinates, referenced at the triangle's
-    // own first sample so bands agree exactly: one division per triangle,
-    // made only once a sample is found inside (most tiny triangles of a
-    // large mesh cover none).
-    let plane = || {
+    // own first sample so bands agree exactly: one division per triangle.
+    // Binning dropped the triangles whose box holds no sample centre, so
+    // nearly every triangle here covers a sample and needs it.
+    let (z_ref, dzdx, dzdy) = {
         let area = ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
             - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0])) as f64;
         let (x1, y1_, x2, y2) = (
@@ -249,22 +259,19 @@ fn draw(
             (gy * SUB as f64) as f32,
         )
     };
-    let mut depth_plane: Option<(f32, f32, f32)> = None;
     let id = id as u64;
     for sy in y_first..=sy1 {
-        let row = &mut rows[(sy as usize - y0) * width..][..width];
+        let row = &mut rows[(sy as usize - y0) * width..][x_first as usize..=sx1 as usize];
+        let zy = z_ref + dzdy * (sy - sy0) as f32;
         let mut e = e_row;
-        for sx in x_first..=sx1 {
-            if (e[0] | e[1] | e[2]) >= 0 {
-                let (z_ref, dzdx, dzdy) = *depth_plane.get_or_insert_with(plane);
-                let zy = z_ref + dzdy * (sy - sy0) as f32;
-                let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
-                let value = ((depth.to_bits() as u64) << 32) | id;
-                let slot = &mut row[sx as usize];
-                if value < *slot {
-                    *slot = value;
-                }
-            }
+        // Without branches: a tiny triangle's inside tests are a coin toss
+        // for the branch predictor. Outside samples offer `EMPTY`, which
+        // never wins the minimum.
+        for (sx, slot) in (x_first..).zip(row.iter_mut()) {
+            let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
+            let value = ((depth.to_bits() as u64) << 32) | id;
+            let inside = (e[0] | e[1] | e[2]) >= 0;
+            *slot = (*slot).min(if inside { value } else { EMPTY });
             e[0] += step_x[0];
             e[1] += step_x[1];
             e[2] += step_x[2];
