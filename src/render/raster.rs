@@ -234,10 +234,10 @@ fn draw(
         step_y[k] = dx * SUB;
     }
     // Depth as a plane over sample coordinates, referenced at the triangle's
-    // own first sample so bands agree exactly: one division per triangle.
-    // Binning dropped the triangles whose box holds no sample centre, so
-    // nearly every triangle here covers a sample and needs it.
-    let (z_ref, dzdx, dzdy) = {
+    // own first sample so bands agree exactly: one division per triangle,
+    // made only once a sample is found inside (most tiny triangles of a
+    // large mesh cover none).
+    let plane = || {
         let area = ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
             - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0])) as f64;
         let (x1, y1_, x2, y2) = (
@@ -259,19 +259,22 @@ fn draw(
             (gy * SUB as f64) as f32,
         )
     };
+    let mut depth_plane: Option<(f32, f32, f32)> = None;
     let id = id as u64;
     for sy in y_first..=sy1 {
-        let row = &mut rows[(sy as usize - y0) * width..][x_first as usize..=sx1 as usize];
-        let zy = z_ref + dzdy * (sy - sy0) as f32;
+        let row = &mut rows[(sy as usize - y0) * width..][..width];
         let mut e = e_row;
-        // Without branches: a tiny triangle's inside tests are a coin toss
-        // for the branch predictor. Outside samples offer `EMPTY`, which
-        // never wins the minimum.
-        for (sx, slot) in (x_first..).zip(row.iter_mut()) {
-            let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
-            let value = ((depth.to_bits() as u64) << 32) | id;
-            let inside = (e[0] | e[1] | e[2]) >= 0;
-            *slot = (*slot).min(if inside { value } else { EMPTY });
+        for sx in x_first..=sx1 {
+            if (e[0] | e[1] | e[2]) >= 0 {
+                let (z_ref, dzdx, dzdy) = *depth_plane.get_or_insert_with(plane);
+                let zy = z_ref + dzdy * (sy - sy0) as f32;
+                let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
+                let value = ((depth.to_bits() as u64) << 32) | id;
+                let slot = &mut row[sx as usize];
+                if value < *slot {
+                    *slot = value;
+                }
+            }
             e[0] += step_x[0];
             e[1] += step_x[1];
             e[2] += step_x[2];
