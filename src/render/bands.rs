@@ -10,30 +10,14 @@ use super::raster::{self, EMPTY, Projected};
 use super::resolve::{Image, Samples, resolve_rows};
 use super::scene::Scene;
 use rayon::prelude::*;
-use std::sync::atomic::AtomicBool;
 
 /// Pixel rows per band (the unit of parallel work).
 const BAND_PIXELS: usize = 16;
 
-/// The triangles each band draws (see [`raster::bin`]), marking the nodes
-/// of those drawn in `drawn` when it is given.
-pub fn bin(
-    scene: &Scene,
-    proj: &Projected,
-    width: usize,
-    height: usize,
-    ss: usize,
-    drawn: Option<&[AtomicBool]>,
-) -> Vec<Vec<Vec<u32>>> {
-    raster::bin(scene, proj, width * ss, height * ss, BAND_PIXELS * ss, drawn)
-}
-
-/// The picture of `width`×`height` pixels at `ss`×`ss` samples each, from
-/// the bins [`bin`] made.
+/// The picture of `width`×`height` pixels at `ss`×`ss` samples each.
 pub fn render(
     scene: &Scene,
     proj: &Projected,
-    bins: &[Vec<Vec<u32>>],
     width: usize,
     height: usize,
     ss: usize,
@@ -41,6 +25,7 @@ pub fn render(
 ) -> Image {
     let (sw, sh) = (width * ss, height * ss);
     let band_rows = BAND_PIXELS * ss;
+    let bins = raster::bin(scene, proj, sw, sh, band_rows);
     let mut rgba = vec![0u8; width * height * 4];
     rgba.par_chunks_mut(width * 4 * BAND_PIXELS)
         .enumerate()
@@ -49,7 +34,7 @@ pub fn render(
             let y1 = (y0 + band_rows).min(sh);
             buf.clear();
             buf.resize(sw * (y1 - y0), EMPTY);
-            raster::draw_band(scene, proj, bins, band, buf, sw, y0..y1);
+            raster::draw_band(scene, proj, &bins, band, buf, sw, y0..y1);
             let samples = Samples {
                 data: buf,
                 width: sw,

@@ -26,7 +26,6 @@ pub use svg::SvgDrawing;
 
 use crate::diag::Code;
 use crate::mesh::Mesh;
-use std::sync::atomic::AtomicBool;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
 pub enum Shading {
@@ -254,32 +253,14 @@ fn section_warning(scene: &scene::Scene, options: &RenderOptions) -> Option<Rend
 pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, RenderError> {
     check(mesh, options)?;
     let camera = camera_for(mesh, options);
-    let ss = options.antialias as usize;
-    let (w, h) = (options.width as usize, options.height as usize);
-    // Smooth light for the nodes of the drawn triangles only, when binning
-    // can tell them before shading (no section: its cut needs every light).
-    let lit_after_binning = options.edges == Edges::None
-        && options.section.is_none()
-        && options.shading == Shading::Smooth;
-    let (scene, proj, bins) = if lit_after_binning {
-        let mut scene = scene::unlit(mesh, options);
-        let proj = project(&scene, &camera, ss);
-        let drawn: Vec<AtomicBool> = (0..scene.points.len())
-            .map(|_| AtomicBool::new(false))
-            .collect();
-        let bins = bands::bin(&scene, &proj, w, h, ss, Some(&drawn));
-        scene::light(&mut scene, options.shading, &camera, Some(&drawn));
-        (scene, proj, Some(bins))
-    } else {
-        let scene = scene::build(mesh, options, &camera);
-        let proj = project(&scene, &camera, ss);
-        (scene, proj, None)
-    };
+    let scene = scene::build(mesh, options, &camera);
     let mut warnings: Vec<RenderWarning> = section_warning(&scene, options).into_iter().collect();
-    let (sw, sh) = (w * ss, h * ss);
+    let ss = options.antialias as usize;
+    let proj = project(&scene, &camera, ss);
+    let (sw, sh) = (options.width as usize * ss, options.height as usize * ss);
     let mut image = if options.edges == Edges::None {
-        let bins = bins.unwrap_or_else(|| bands::bin(&scene, &proj, w, h, ss, None));
-        bands::render(&scene, &proj, &bins, w, h, ss, options.background)
+        let (w, h) = (options.width as usize, options.height as usize);
+        bands::render(&scene, &proj, w, h, ss, options.background)
     } else {
         let zbuf = raster::rasterize(&scene, &proj, sw, sh);
         let mut mask = vec![false; sw * sh];

@@ -7,7 +7,6 @@
 
 use super::scene::{HIDDEN, Scene};
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, Ordering};
 
 pub const EMPTY: u64 = u64::MAX;
 /// Sub-sample steps per sample of the snapped coordinates.
@@ -111,15 +110,12 @@ fn row_range(v: &[[i64; 2]; 3], width: usize, height: usize) -> Option<(usize, u
 
 /// For each chunk of triangles, the ids each band of `band_rows` sample rows
 /// must draw (front-facing visible sides only, rows clamped to the image).
-/// When `drawn` is given, the nodes of every binned triangle are marked in it:
-/// shading reads the light of no other node.
 pub fn bin(
     scene: &Scene,
     proj: &Projected,
     width: usize,
     height: usize,
     band_rows: usize,
-    drawn: Option<&[AtomicBool]>,
 ) -> Vec<Vec<Vec<u32>>> {
     let n_bands = height.div_ceil(band_rows);
     (0..scene.tris.len().div_ceil(CHUNK))
@@ -135,12 +131,6 @@ pub fn bin(
                     continue;
                 }
                 if let Some((first, last)) = row_range(&v, width, height) {
-                    if let Some(drawn) = drawn {
-                        // Relaxed stores of `true`: the marks end the same in any order.
-                        for n in scene.tris[tri] {
-                            drawn[n as usize].store(true, Ordering::Relaxed);
-                        }
-                    }
                     for band in bands
                         .iter_mut()
                         .take(last / band_rows + 1)
@@ -176,7 +166,7 @@ pub fn draw_band(
 }
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
-    let bins = bin(scene, proj, width, height, BAND, None);
+    let bins = bin(scene, proj, width, height, BAND);
     let mut data = vec![EMPTY; width * height];
     data.par_chunks_mut(width * BAND)
         .enumerate()

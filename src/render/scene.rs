@@ -9,7 +9,6 @@ use super::{ColorBy, RenderOptions, Section, Shading};
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 use std::borrow::Cow;
-use std::sync::atomic::AtomicBool;
 
 /// A side that is never seen (inside a closed subdomain, no section).
 pub const HIDDEN: u32 = u32::MAX;
@@ -43,9 +42,6 @@ pub struct Scene<'a> {
     /// Light intensity in [0, 1] seen on the front and on the back side.
     pub light: Vec<[f32; 2]>,
     pub groups: Vec<Group>,
-    /// The node spans of a one-face mesh's triangle chunks, kept from the
-    /// validity check until [`light`] sums the normals over them.
-    spans: Option<Vec<(usize, usize)>>,
 }
 
 /// Colours of the groups, cycled with a change of brightness past the end.
@@ -108,18 +104,6 @@ fn effective_color_by(mesh: &Mesh, wanted: ColorBy) -> ColorBy {
 }
 
 pub fn build<'a>(mesh: &'a Mesh, options: &RenderOptions, camera: &Camera) -> Scene<'a> {
-    let mut scene = unlit(mesh, options);
-    light(&mut scene, options.shading, camera, None);
-    if let Some(section) = options.section {
-        cut(&mut scene, section);
-    }
-    scene
-}
-
-/// The scene without its light: [`light`] must follow before shading
-/// (the picture's path lights it once binning knows the nodes drawn). No
-/// section cut.
-pub fn unlit<'a>(mesh: &'a Mesh, options: &RenderOptions) -> Scene<'a> {
     let n_faces = mesh.faces.len();
     let color_by = effective_color_by(mesh, options.color_by);
     // The subdomain on each side: `outward` means the normal leaves it, so it
@@ -245,7 +229,7 @@ pub fn unlit<'a>(mesh: &'a Mesh, options: &RenderOptions) -> Scene<'a> {
         .copied()
         .filter(|first| face_sides.iter().all(|s| s == first));
     let (tris, tri_face, one_face, spans) = triangles(mesh);
-    Scene {
+    let mut scene = Scene {
         same_sides,
         points: Cow::Borrowed(&mesh.nodes),
         tris,
@@ -253,9 +237,13 @@ pub fn unlit<'a>(mesh: &'a Mesh, options: &RenderOptions) -> Scene<'a> {
         one_face,
         face_sides,
         groups,
-        spans,
         ..Scene::default()
+    };
+    shade(&mut scene, options.shading, camera, spans.as_deref());
+    if let Some(section) = options.section {
+        cut(&mut scene, section);
     }
+    scene
 }
 
 /// The light comes from the eye's side, a little from above and the left.
@@ -319,12 +307,8 @@ fn triangles(mesh: &Mesh) -> Borrowed<'_> {
 
 /// Light per corner: flat gives each triangle one slot; smooth averages the
 /// area-weighted normals of a node within one face (creases between faces
-/// stay sharp). With `drawn` (smooth shading), only the slots of the marked
-/// nodes get their light (the rest are left at zero, never read): the
-/// triangles touching no marked node are not summed.
-pub fn light(scene: &mut Scene, shading: Shading, camera: &Camera, drawn: Option<&[AtomicBool]>) {
-    let spans = scene.spans.take();
-    let spans = spans.as_deref();
+/// stay sharp).
+fn shade(scene: &mut Scene, shading: Shading, camera: &Camera, spans: Option<&[(usize, usize)]>) {
     let light = light_direction(camera);
     match shading {
         Shading::Flat => {
@@ -341,7 +325,7 @@ pub fn light(scene: &mut Scene, shading: Shading, camera: &Camera, drawn: Option
         }
         Shading::Smooth => {
             let (slots, light) =
-                smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, spans, drawn, |n| {
+                smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, spans, |n| {
                     intensity(n, light)
                 });
             scene.corner_slots = match slots {

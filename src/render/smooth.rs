@@ -7,7 +7,7 @@
 
 use super::camera::cross;
 use rayon::prelude::*;
-use std::sync::atomic::{AtomicBool, AtomicU32, Ordering};
+use std::sync::atomic::{AtomicU32, Ordering};
 
 /// Triangles per chunk of partial sums.
 pub const CHUNK: usize = 1 << 14;
@@ -39,23 +39,14 @@ fn add(sum: &mut [f64; 3], n: [f64; 3]) {
 /// `tri_face` must be non-decreasing (triangles grouped by face in face order).
 /// `spans`, when given for a one-face mesh, are [`node_spans`] of `tris`
 /// (the caller's validity check made them; they are not made twice).
-/// `drawn`, when given, marks the nodes whose slots are wanted: a triangle
-/// naming none of them is skipped (it adds to no wanted slot, so a wanted
-/// slot's sum is the same, added in the same order), and the slots of
-/// unmarked nodes are left at `T::default()`.
 pub fn per_slot<T: Copy + Default + Send + Sync>(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     tri_face: &[u32],
     spans: Option<&[(usize, usize)]>,
-    drawn: Option<&[AtomicBool]>,
     finish: impl Fn([f64; 3]) -> T + Sync,
 ) -> (Option<Vec<[u32; 3]>>, Vec<T>) {
     let n = points.len();
-    let wanted = |t: &[u32; 3]| {
-        drawn.is_none_or(|d| t.iter().any(|&k| d[k as usize].load(Ordering::Relaxed)))
-    };
-    let wanted_node = |k: usize| drawn.is_none_or(|d| d[k].load(Ordering::Relaxed));
     let (own_slots, extra) = if tri_face.first() == tri_face.last() {
         (None, Vec::new())
     } else {
@@ -81,9 +72,6 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
     if !local {
         let mut sums = vec![[0.0; 3]; n + extra.len()];
         for (t, s) in tris.iter().zip(corner_slots) {
-            if !wanted(t) {
-                continue;
-            }
             let normal = tri_normal(points, *t);
             for &k in s {
                 add(&mut sums[k as usize], normal);
@@ -102,9 +90,6 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
             let mut part = vec![[0.0; 3]; hi.saturating_sub(lo)];
             let mut later = Vec::new();
             for (t, s) in ts.iter().zip(ss) {
-                if !wanted(t) {
-                    continue;
-                }
                 let normal = tri_normal(points, *t);
                 for &k in s {
                     if (k as usize) < n {
@@ -131,10 +116,8 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
                     add(&mut sums[node - b0], part[node - lo]);
                 }
             }
-            for (k, (o, &v)) in block.iter_mut().zip(sums.iter()).enumerate() {
-                if wanted_node(b0 + k) {
-                    *o = finish(v);
-                }
+            for (o, &v) in block.iter_mut().zip(sums.iter()) {
+                *o = finish(v);
             }
         },
     );
@@ -255,7 +238,7 @@ mod tests {
     }
 
     fn check(points: &[[f64; 3]], tris: &[[u32; 3]], tri_face: &[u32], (nx, ny): (usize, usize)) {
-        let (slots, sums) = per_slot(points, tris, tri_face, None, None, |v| v);
+        let (slots, sums) = per_slot(points, tris, tri_face, None, |v| v);
         let one_face = tri_face.iter().all(|&f| f == 0);
         assert_eq!(slots.is_none(), one_face);
         let slots = slots.unwrap_or_else(|| tris.to_vec());
