@@ -183,7 +183,7 @@ const AHEAD: usize = 8;
 
 /// Asks for the cache line of `value` without waiting for it.
 #[inline(always)]
-fn prefetch<T>(value: &T) {
+pub(super) fn prefetch<T>(value: &T) {
     #[cfg(target_arch = "x86_64")]
     {
         use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
