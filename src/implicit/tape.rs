@@ -279,6 +279,9 @@ pub struct AxisTape {
     axis: usize,
     setup: Vec<Instr>,
     step: Vec<Instr>,
+    /// The slots set up per segment that the step reads (what `compact`
+    /// moves when segments drop out).
+    carried: Vec<u32>,
     consts: Vec<(u32, f64)>,
     vars: [Option<u32>; 3],
     slots: usize,
@@ -306,6 +309,7 @@ impl AxisTape {
             axis,
             setup: Vec::new(),
             step: Vec::new(),
+            carried: Vec::new(),
             consts: Vec::new(),
             vars: [None; 3],
             slots: 0,
@@ -354,6 +358,26 @@ impl AxisTape {
         }
         tape.slots = slots as usize;
         tape.out = slot_of[n - 1];
+        // Fixed slots are never reused, so a step input that no step
+        // instruction writes, and that is neither the axis coordinate nor a
+        // constant, holds a per-segment value from `setup`.
+        let written: Vec<u32> = tape.step.iter().map(|i| i.out).collect();
+        let skip = |s: u32| {
+            written.contains(&s)
+                || tape.vars[axis] == Some(s)
+                || tape.consts.iter().any(|&(c, _)| c == s)
+        };
+        for ins in &tape.step {
+            for s in [ins.a, ins.b] {
+                if !skip(s) && !tape.carried.contains(&s) {
+                    tape.carried.push(s);
+                }
+            }
+        }
+        if !varies[n - 1] {
+            // A root constant along the axis: `eval` reads the set-up output.
+            tape.carried.push(tape.out);
+        }
         tape
     }
 
@@ -393,6 +417,18 @@ impl AxisTape {
             }
         }
         run(&self.setup, &mut ws.buf, len);
+    }
+
+    /// Keeps only the set-up segments at lanes `keep` (ascending), moved to
+    /// lanes 0, 1, …: root finding drops the edges that have converged
+    /// without setting the others up again.
+    pub fn compact(&self, ws: &mut Workspace, keep: &[usize]) {
+        for &s in &self.carried {
+            let slot = &mut ws.buf[s as usize * BATCH..][..BATCH];
+            for (q, &k) in keep.iter().enumerate() {
+                slot[q] = slot[k];
+            }
+        }
     }
 
     /// f at the set-up segments' points with coordinate `along[m]` on the
@@ -464,6 +500,8 @@ fn unary(u: Unary, o: &mut [f64], a: &[f64]) {
         Unary::Square => each!(|x: f64| x * x),
         Unary::Sqrt => each!(f64::sqrt),
         Unary::Abs => each!(f64::abs),
+        Unary::Sin => super::trig::sin_lanes(o, a),
+        Unary::Cos => super::trig::cos_lanes(o, a),
         _ => each!(|x| u.apply(x)),
     }
 }
