@@ -69,8 +69,6 @@ pub(super) struct Field {
     pub nb: [usize; 3],
     pub blocks: Vec<Block>,
     samples: Samples,
-    /// Samples on the box faces were capped at 0 (`close_at_box`).
-    capped: bool,
 }
 
 impl Field {
@@ -86,7 +84,6 @@ impl Field {
             nb,
             blocks: vec![Block::Sampled; nb[0] * nb[1] * nb[2]],
             samples: Samples::Dense(values),
-            capped: options.close_at_box,
         }
     }
 
@@ -119,20 +116,6 @@ impl Field {
                 }
             }
         }
-    }
-
-    /// Whether the sample at (i, j, k) is f there as evaluated by its block's
-    /// program (rounded to f32): false for the ±1 of proven blocks, samples
-    /// capped on the box faces and given samples. Root finding starts its
-    /// brackets from such samples instead of evaluating f at the edge ends.
-    #[inline]
-    pub fn evaluated(&self, i: usize, j: usize, k: usize) -> bool {
-        let Samples::Blocks { slot, .. } = &self.samples else {
-            return false;
-        };
-        let b = self.block_index(i, j, k);
-        let on_box = [i, j, k].iter().zip(self.n1).any(|(&c, n)| c == 0 || c == n - 1);
-        slot[b] != NOT_STORED && matches!(self.blocks[b], Block::Mixed(_)) && !(self.capped && on_box)
     }
 
     /// The inside/outside bits of every sample.
@@ -318,7 +301,6 @@ pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
         nb,
         blocks,
         samples: Samples::Blocks { slot, data },
-        capped: options.close_at_box,
     }
 }
 

@@ -28,15 +28,8 @@ pub(super) struct PlaneVertices {
     pub at_sample: Vec<u64>,
 }
 
-/// A crossed edge: its end points, the samples there, and whether each
-/// sample is f as evaluated (`Field::evaluated`: not a proven block's ±1
-/// nor a value capped on the box).
-#[derive(Debug, Clone, Copy)]
-struct Ends {
-    p: [[f64; 3]; 2],
-    v: [f64; 2],
-    evaluated: [bool; 2],
-}
+/// An edge's end points and the samples there.
+type Ends = ([f64; 3], [f64; 3], f64, f64);
 
 /// The vertices of plane k.
 pub(super) fn plane_vertices(
@@ -76,7 +69,7 @@ pub(super) fn planes_vertices(
     // Initial guess: linear interpolation of the samples.
     let mut t: Vec<f64> = ends
         .iter()
-        .map(|e| (e.v[0] / (e.v[0] - e.v[1])).clamp(0.0, 1.0))
+        .map(|&(_, _, v0, v1)| (v0 / (v0 - v1)).clamp(0.0, 1.0))
         .collect();
     refine_by_block(field, &ks, &first, &keys, &ends, &mut t, options);
     ks.enumerate()
@@ -121,14 +114,12 @@ fn crossed_edges(
                     }
                     let v1 = field.value(ii, jj, kk) as f64;
                     keys.push(((j * n1[0] + i) * 3 + axis) as u32);
-                    ends.push(Ends {
-                        p: [
-                            [coords[0][i], coords[1][j], coords[2][k]],
-                            [coords[0][ii], coords[1][jj], coords[2][kk]],
-                        ],
-                        v: [v0, v1],
-                        evaluated: [field.evaluated(i, j, k), field.evaluated(ii, jj, kk)],
-                    });
+                    ends.push((
+                        [coords[0][i], coords[1][j], coords[2][k]],
+                        [coords[0][ii], coords[1][jj], coords[2][kk]],
+                        v0,
+                        v1,
+                    ));
                 }
             }
         }
@@ -228,7 +219,7 @@ fn finish(n1: [usize; 3], k: usize, keys: &[u32], ends: &[Ends], t: &[f64]) -> P
     let positions = ends
         .iter()
         .zip(t)
-        .map(|(&Ends { p: [p0, p1], .. }, &t)| {
+        .map(|(&(p0, p1, _, _), &t)| {
             if t <= weld::SNAP {
                 return p0;
             }
@@ -254,9 +245,9 @@ fn finish(n1: [usize; 3], k: usize, keys: &[u32], ends: &[Ends], t: &[f64]) -> P
 /// Refines one block's crossed edges (`edges` index `keys` and `ends`).
 /// Edges are grouped by axis and evaluated on the block's axis tapes, so the
 /// terms constant along an edge are computed once per edge instead of at
-/// every step; the values are bit-identical to the plain tape's.
-/// Coordinates that `p + 0.0` would change (−0.0, NaN) or that are infinite
-/// take the plain tape.
+/// every step; the values, and so the vertices, are bit-identical to the
+/// plain tape's. Coordinates that `p + 0.0` would change (−0.0, NaN) or that
+/// are infinite take the plain tape.
 #[allow(clippy::too_many_arguments)] // scratch buffers reused across blocks
 fn refine(
     kernel: &Kernel,
@@ -269,22 +260,22 @@ fn refine(
     iterations: usize,
 ) {
     let plain = |c: f64| c.is_finite() && (c + 0.0).to_bits() == c.to_bits();
-    if !edges.iter().all(|&e| ends[e].p[0].iter().all(|&c| plain(c))) {
+    if !edges.iter().all(|&e| ends[e].0.iter().all(|&c| plain(c))) {
         let mut ws = kernel.tape.workspace();
         for chunk in edges.chunks(BATCH) {
-            let eval_at = |lanes: &[usize], s: &[f64], out: &mut [f64]| {
+            let eval_at = |s: &[f64], out: &mut [f64]| {
                 let [xs, ys, zs] = [0, 1, 2].map(|a| {
                     let mut c = [0.0; BATCH];
-                    for ((c, &m), &s) in c.iter_mut().zip(lanes).zip(s) {
-                        let [p0, p1] = ends[chunk[m]].p;
+                    for ((c, &e), &s) in c.iter_mut().zip(chunk).zip(s) {
+                        let (p0, p1, _, _) = ends[e];
                         *c = p0[a] + s * (p1[a] - p0[a]);
                     }
                     c
                 });
-                let n = lanes.len();
+                let n = chunk.len();
                 kernel.tape.eval(&mut ws, &xs[..n], &ys[..n], &zs[..n], out);
             };
-            illinois(chunk, ends, t, iterations, eval_at, |_| {});
+            illinois(chunk, ends, t, iterations, eval_at);
         }
         return;
     }
@@ -302,168 +293,81 @@ fn refine(
             let n = chunk.len();
             for (b, fixed) in fixed.iter_mut().enumerate() {
                 for (c, &e) in fixed.iter_mut().zip(chunk) {
-                    *c = ends[e].p[0][b];
+                    *c = ends[e].0[b];
                 }
             }
             along.setup(ws, [&fixed[0][..n], &fixed[1][..n], &fixed[2][..n]]);
-            // The tape's lanes and the closures below share `ws`.
-            let ws = std::cell::RefCell::new(&mut *ws);
-            let eval_at = |lanes: &[usize], s: &[f64], out: &mut [f64]| {
-                for ((c, &m), &s) in coord.iter_mut().zip(lanes).zip(s) {
-                    let [p0, p1] = ends[chunk[m]].p;
+            let eval_at = |s: &[f64], out: &mut [f64]| {
+                for ((c, &e), &s) in coord.iter_mut().zip(chunk).zip(s) {
+                    let (p0, p1, _, _) = ends[e];
                     *c = p0[axis] + s * (p1[axis] - p0[axis]);
                 }
-                along.eval(&mut ws.borrow_mut(), &coord[..lanes.len()], out);
+                along.eval(ws, &coord[..n], out);
             };
-            let compact = |keep: &[usize]| along.compact(&mut ws.borrow_mut(), keep);
-            illinois(chunk, ends, t, iterations, eval_at, compact);
+            illinois(chunk, ends, t, iterations, eval_at);
         }
     }
 }
 
-/// Root finding stops on an edge once its next step would move less than
-/// this (in units of the edge, 1.9e-10 ≈ 1.5e-12 of the box at 256 cells), or
-/// its bracket is this short: the secant steps converge superlinearly, so
-/// the error left is far below the step.
-const STEP: f64 = 1.0 / (1u64 << 32) as f64;
-
-/// Finds a crossing on each edge, batched: `eval_at(lanes, s, out)` gives f
-/// at parameter s[q] along edge `edges[lanes[q]]` on tape lane q.
-///
-/// The bracket starts from the edge's samples where they are f as
-/// evaluated (only the first guess depends on their f32 rounding; every
-/// later step is weighed by f64 values), else from f evaluated at the ends;
-/// an edge whose exact end values do not bracket keeps the linear guess.
-/// Each step is the secant through the last two points when it falls
-/// inside the bracket, else false position on the bracket with the
-/// Illinois halving of an end kept twice (which bounds the steps on curved
-/// or nearly tangent crossings). An edge takes at most `iterations + 2`
-/// evaluations (the Illinois iteration this replaced evaluated both ends
-/// and then `iterations` points) and stops earlier once a step would move
-/// less than [`STEP`] or f is exactly 0; `compact(keep)` then moves the
-/// tape lanes `keep` to lanes 0, 1, …. Each edge's steps depend only on its
-/// own values, so the result does not depend on which edges share a batch.
+/// Illinois false position on each edge, batched: `eval_at(s, out)` gives f
+/// at parameter s[m] along edge `edges[m]`.
 fn illinois(
     edges: &[usize],
     ends: &[Ends],
     t: &mut [f64],
     iterations: usize,
-    mut eval_at: impl FnMut(&[usize], &[f64], &mut [f64]),
-    mut compact: impl FnMut(&[usize]),
+    mut eval_at: impl FnMut(&[f64], &mut [f64]),
 ) {
-    if iterations == 0 {
-        return;
-    }
     // At most BATCH edges (callers chunk): working arrays on the stack.
     let n = edges.len().min(BATCH);
-    let mut lanes = [0usize; BATCH];
-    for (q, l) in lanes.iter_mut().enumerate() {
-        *l = q;
-    }
-    // Bracket [tl, tr] with its values, and the last two points evaluated
-    // (p older, q newer) for the secant.
     let (mut tl, mut tr) = ([0.0; BATCH], [1.0; BATCH]);
     let (mut fl, mut fr) = ([0.0; BATCH], [0.0; BATCH]);
+    eval_at(&tl[..n], &mut fl[..n]);
+    eval_at(&tr[..n], &mut fr[..n]);
+    // Edges whose exact end values do not bracket (a capped box sample, a
+    // pruned neighbour) keep the linear guess.
+    let mut ok = [false; BATCH];
     for m in 0..n {
-        [fl[m], fr[m]] = ends[edges[m]].v;
+        let (_, _, v0, v1) = ends[edges[m]];
+        ok[m] = (fl[m] > 0.0) == (v0 > 0.0)
+            && (fr[m] > 0.0) == (v1 > 0.0)
+            && (fl[m] > 0.0) != (fr[m] > 0.0);
     }
-    // Ends whose samples are not f (a capped box sample, a proven block's
-    // ±1) are evaluated; that counts against the edge's evaluations.
-    let mut ok = [true; BATCH];
-    let mut exact = [0.0; BATCH];
-    let mut budget = iterations + 2;
-    for (end, f) in [(0, &mut fl), (1, &mut fr)] {
-        if edges[..n].iter().all(|&e| ends[e].evaluated[end]) {
-            continue;
-        }
-        let at = [end as f64; BATCH];
-        eval_at(&lanes[..n], &at[..n], &mut exact[..n]);
-        budget -= 1;
-        for m in 0..n {
-            let e = &ends[edges[m]];
-            if !e.evaluated[end] {
-                ok[m] &= (exact[m] > 0.0) == (e.v[end] > 0.0);
-                f[m] = exact[m];
-            }
-        }
-    }
-    for m in 0..n {
-        ok[m] &= (fl[m] > 0.0) != (fr[m] > 0.0);
-    }
-    let (mut tp, mut tq) = (tl, tr);
-    let (mut fp, mut fq) = (fl, fr);
     let mut side = [0i8; BATCH];
     let mut s = [0.0; BATCH];
     for m in 0..n {
         s[m] = t[edges[m]];
     }
-    let (mut sq, mut fs, mut keep) = ([0.0; BATCH], [0.0; BATCH], [0usize; BATCH]);
-    let mut active = n;
-    for step in 0..budget {
-        // Next points; an edge whose step is below STEP is done.
-        let mut kept = 0;
-        for q in 0..active {
-            let m = lanes[q];
-            let d = fq[m] - fp[m];
-            let secant = (tp[m] * fq[m] - tq[m] * fp[m]) / d;
-            let next = if step > 0 && d != 0.0 && secant > tl[m] && secant < tr[m] {
-                secant
+    let mut fs = [0.0; BATCH];
+    for _ in 0..iterations {
+        for m in 0..n {
+            let d = fr[m] - fl[m];
+            let guess = (tl[m] * fr[m] - tr[m] * fl[m]) / d;
+            // A function that is NaN somewhere (sqrt of a negative, 0/0) must not
+            // poison the bracket: bisect instead, so tl and tr stay finite.
+            s[m] = if d != 0.0 && guess.is_finite() {
+                guess.max(tl[m]).min(tr[m])
             } else {
-                let d = fr[m] - fl[m];
-                let guess = (tl[m] * fr[m] - tr[m] * fl[m]) / d;
-                // A function that is NaN somewhere (sqrt of a negative, 0/0)
-                // must not poison the bracket: bisect instead.
-                if d != 0.0 && guess.is_finite() {
-                    guess.max(tl[m]).min(tr[m])
-                } else {
-                    0.5 * (tl[m] + tr[m])
-                }
+                0.5 * (tl[m] + tr[m])
             };
-            let done = step > 0 && (next - tq[m]).abs() <= STEP;
-            s[m] = next;
-            if !done {
-                keep[kept] = q;
-                lanes[kept] = m;
-                sq[kept] = next;
-                kept += 1;
-            }
         }
-        if kept < active {
-            compact(&keep[..kept]);
-            active = kept;
-        }
-        if active == 0 {
-            break;
-        }
-        eval_at(&lanes[..active], &sq[..active], &mut fs[..active]);
-        let mut kept = 0;
-        for q in 0..active {
-            let (m, f) = (lanes[q], fs[q]);
-            if (f > 0.0) == (fl[m] > 0.0) {
+        eval_at(&s[..n], &mut fs[..n]);
+        for m in 0..n {
+            if (fs[m] > 0.0) == (fl[m] > 0.0) {
                 tl[m] = s[m];
-                fl[m] = f;
+                fl[m] = fs[m];
                 if side[m] == -1 {
                     fr[m] *= 0.5;
                 }
                 side[m] = -1;
             } else {
                 tr[m] = s[m];
-                fr[m] = f;
+                fr[m] = fs[m];
                 if side[m] == 1 {
                     fl[m] *= 0.5;
                 }
                 side[m] = 1;
             }
-            (tp[m], fp[m], tq[m], fq[m]) = (tq[m], fq[m], s[m], f);
-            if f != 0.0 && tr[m] - tl[m] > STEP {
-                keep[kept] = q;
-                lanes[kept] = m;
-                kept += 1;
-            }
-        }
-        if kept < active {
-            compact(&keep[..kept]);
-            active = kept;
         }
     }
     for m in 0..n {
