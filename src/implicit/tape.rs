@@ -594,8 +594,8 @@ mod tests {
         let ssa = Ssa::from_ctx(&ctx, root);
         let tape = Tape::new(&ssa);
         let n = 2000;
-        let p: [Vec<f64>; 3] = [0.37, 0.11, 0.73]
-            .map(|w| (0..n).map(|i| (i as f64 * w).sin() * 1.05).collect());
+        let p: [Vec<f64>; 3] =
+            [0.37, 0.11, 0.73].map(|w| (0..n).map(|i| (i as f64 * w).sin() * 1.05).collect());
         let mut got = vec![0.0; n];
         tape.eval(&mut tape.workspace(), &p[0], &p[1], &p[2], &mut got);
         let mut worst: f64 = 0.0;
