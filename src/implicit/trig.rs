@@ -82,15 +82,21 @@ fn lanes_generic(o: &mut [f64], a: &[f64], quarter: u64) {
     let mut far = false;
     for (o, &x) in o.iter_mut().zip(a) {
         *o = kernel(x, quarter);
-        far |= !(x.abs() <= LIMIT);
+        far |= !reduced(x);
     }
     if far {
         for (o, &x) in o.iter_mut().zip(a) {
-            if !(x.abs() <= LIMIT) {
+            if !reduced(x) {
                 *o = if quarter == 0 { x.sin() } else { x.cos() };
             }
         }
     }
+}
+
+/// Whether `kernel` serves x (false for NaN and ±∞ too).
+#[inline(always)]
+fn reduced(x: f64) -> bool {
+    x.abs() <= LIMIT
 }
 
 /// sin(x + quarter · π/2) for |x| ≤ `LIMIT`.
