@@ -332,7 +332,14 @@ pub(crate) fn mesh_face(
     // chordal passes (95% of meshing), where ours checks the surface on each
     // new triangle in the same loop.
     let plane = matches!(face.surface, Surface::Plane { .. });
-    let own = !framed && !small_angle && !settings.keep_boundary && polyline_segments.is_empty();
+    // Periodic charts (a torus) stay with spade: their seam segments, split
+    // by our loop, fell between the unwrapped copies of an edge (E502).
+    let periodic = chart.periods().iter().any(Option::is_some);
+    let own = !framed
+        && !small_angle
+        && !settings.keep_boundary
+        && polyline_segments.is_empty()
+        && (plane || !periodic);
     let budget = vertex_budget(
         &uv_loops,
         settings.max_area.min(guide),
