@@ -403,7 +403,7 @@ pub(crate) fn mesh_face(
                         segments: &mut segments,
                         point: &curve_point,
                     }),
-                    surface: (!plane).then(|| refine::SurfaceCheck {
+                    surface: (!plane).then_some(refine::SurfaceCheck {
                         positions: &mut positions,
                         lift: &lift,
                         coarse: &surface_coarse,
