@@ -49,6 +49,23 @@ pub(super) struct Params<'a> {
     /// The boundary's curves, when splits on curved edges should go onto
     /// them.
     pub curves: Option<Curves<'a>>,
+    /// The surface criteria (chordal deviation, edge length) of a curved
+    /// face, checked on each new triangle with its corners lifted.
+    pub surface: Option<SurfaceCheck<'a>>,
+}
+
+/// A curved face's surface criteria inside the refinement loop: each new
+/// vertex is lifted once (into `positions`, indexed like the vertices), and
+/// a triangle the surface finds too coarse is refined like one too large,
+/// so one loop meets the angle bound and the tolerance together instead of
+/// alternating spade's whole-face refinement with whole-face chordal scans.
+pub(super) struct SurfaceCheck<'a> {
+    /// Every vertex's point on the surface; grown as vertices are added.
+    pub positions: &'a mut Vec<Point3>,
+    /// A chart point's point on the surface.
+    pub lift: &'a dyn Fn(Point2<f64>) -> Option<Point3>,
+    /// Whether a triangle (corners on the surface) is too coarse.
+    pub coarse: &'a dyn Fn([&Point3; 3]) -> bool,
 }
 
 /// The boundary segments' edges and curve parameters, kept up to date as
@@ -81,6 +98,15 @@ pub(super) struct Refined {
 struct Refiner<'a, 'c> {
     cdt: &'a mut Cdt,
     curves: Option<Curves<'c>>,
+    surface: Option<SurfaceCheck<'c>>,
+    /// The curve point of the segment split being made: the position of the
+    /// vertex it adds (the chart's lift of it may be off the curve by the
+    /// chart's rounding).
+    next_node: Option<Point3>,
+    /// A vertex did not lift onto the surface: the lifted positions stop
+    /// before it, and triangles with corners beyond them are not checked
+    /// against the surface (the caller reports the vertex).
+    lift_failed: bool,
     curved: Vec<(usize, usize, f64, Point3)>,
     outside: Vec<bool>,
     /// Bad triangles, shortest edge first (Triangle's order: fewer points
@@ -131,6 +157,9 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
     let mut r = Refiner {
         cdt,
         curves: params.curves,
+        surface: params.surface,
+        next_node: None,
+        lift_failed: false,
         curved: Vec::new(),
         outside,
         triangles: BucketQueue::new(),
@@ -197,6 +226,9 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
         if r.generation.get(index) != Some(&generation) || r.outside[index] {
             continue;
         }
+        // Unchanged since it was found bad (same slot generation): its
+        // point is computed without checking it again (the surface check
+        // is the costly half of that).
         if let Some(point) = r.bad_triangle_point(r.cdt.face(face).positions()) {
             r.split_triangle(face, point);
         }
@@ -247,24 +279,73 @@ impl Refiner<'_, '_> {
     }
 
     /// Queues the triangle with corners `p` when it is bad (the corners
-    /// already at hand: no face lookup).
+    /// already at hand: no face lookup unless a surface check needs the
+    /// vertices).
     fn push_triangle_at(&mut self, f: FixedFaceHandle<InnerTag>, p: [Point2<f64>; 3]) {
-        if let Some(shortest) = self.badness(p) {
+        self.lift_new_vertices();
+        let (lengths, k) = shortest_edge(p);
+        let bad = self.badness(p, lengths, k)
+            || (self.surface.is_some() && {
+                let corners = self.cdt.face(f).vertices().map(|v| v.fix().index());
+                self.too_coarse(corners)
+            });
+        if bad {
             self.triangles
-                .push(shortest, (f, self.generation[f.index()]));
+                .push(lengths[k], (f, self.generation[f.index()]));
         }
     }
 
-    /// The squared length of the triangle's shortest edge when it is below
-    /// the angle bound or above the area limit.
-    fn badness(&self, p: [Point2<f64>; 3]) -> Option<f64> {
-        let (lengths, k) = shortest_edge(p);
+    /// Whether the triangle is below the angle bound or above the area
+    /// limit (`lengths`, `k`: its squared edge lengths and the shortest).
+    fn badness(&self, p: [Point2<f64>; 3], lengths: [f64; 3], k: usize) -> bool {
         let (o, q, r) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
         let (u, v) = ([o.x - r.x, o.y - r.y], [q.x - r.x, q.y - r.y]);
         let cross = (q.x - o.x) * (r.y - o.y) - (q.y - o.y) * (r.x - o.x);
         let skinny = (u[0] * v[0] + u[1] * v[1])
             > self.cos_limit * (lengths[(k + 1) % 3] * lengths[(k + 2) % 3]).sqrt();
-        (skinny || 0.5 * cross > self.max_area).then_some(lengths[k])
+        skinny || 0.5 * cross > self.max_area
+    }
+
+    /// Whether the surface finds the triangle with these corners too coarse
+    /// (never without a surface check, or before its corners are lifted).
+    fn too_coarse(&self, [a, b, c]: [usize; 3]) -> bool {
+        let Some(surface) = &self.surface else {
+            return false;
+        };
+        let positions = &surface.positions;
+        match (positions.get(a), positions.get(b), positions.get(c)) {
+            (Some(pa), Some(pb), Some(pc)) => (surface.coarse)([pa, pb, pc]),
+            _ => false,
+        }
+    }
+
+    /// Lifts the vertices added since the last call onto the surface (the
+    /// split being made puts its vertex at its curve point instead).
+    fn lift_new_vertices(&mut self) {
+        let Some(surface) = self.surface.as_mut() else {
+            return;
+        };
+        let n = self.cdt.num_vertices();
+        while !self.lift_failed && surface.positions.len() < n {
+            let v = surface.positions.len();
+            let point = match self.next_node {
+                Some(node) if v + 1 == n => Some(node),
+                _ => (surface.lift)(self.cdt.vertex(FixedVertexHandle::from_index(v)).position()),
+            };
+            match point {
+                Some(p) => surface.positions.push(p),
+                None => self.lift_failed = true,
+            }
+        }
+    }
+
+    /// After the last vertex was taken out again: its lifted position goes
+    /// too (the next vertex takes its index).
+    fn forget_removed(&mut self) {
+        let n = self.cdt.num_vertices();
+        if let Some(surface) = self.surface.as_mut() {
+            surface.positions.truncate(n);
+        }
     }
 
     /// Whether the apex of an inside triangle next to segment a–b lies in
@@ -299,10 +380,9 @@ impl Refiner<'_, '_> {
                 >= self.lens_cos2 * (u[0] * u[0] + u[1] * u[1]) * (v[0] * v[0] + v[1] * v[1])
     }
 
-    /// The point to insert for a triangle below the angle or above the area
-    /// limit (its off-centre or circumcentre), or `None` when it is fine.
+    /// The point to insert for a bad triangle (its off-centre or
+    /// circumcentre), or `None` when it is degenerate.
     fn bad_triangle_point(&self, p: [Point2<f64>; 3]) -> Option<Point2<f64>> {
-        self.badness(p)?;
         // The shortest edge k runs from p[k] to p[k + 1]; its opposite
         // corner holds the smallest angle.
         let (_, k) = shortest_edge(p);
@@ -398,6 +478,7 @@ impl Refiner<'_, '_> {
             (ends.next(), ends.next())
         });
         self.cdt.remove(v);
+        self.forget_removed();
         let n = self.cdt.num_all_faces();
         for f in &star {
             self.generation[f.index()] = self.generation[f.index()].wrapping_add(1);
@@ -591,9 +672,11 @@ impl Refiner<'_, '_> {
                 t = 1.0 - t;
             }
         }
-        if let Some((edge, s, uv, node)) = self.curve_point(a, b, t)
-            && let Some(v) = self.split_on_curve(a, b, uv, left, right)
-        {
+        let on_curve = self.curve_point(a, b, t);
+        self.next_node = on_curve.map(|c| c.3);
+        let split = on_curve.and_then(|(_, _, uv, _)| self.split_on_curve(a, b, uv, left, right));
+        self.next_node = None;
+        if let (Some((edge, s, _, node)), Some(v)) = (on_curve, split) {
             let key = |x: FixedVertexHandle, y: FixedVertexHandle| {
                 (x.index().min(y.index()), x.index().max(y.index()))
             };
@@ -724,6 +807,7 @@ impl Refiner<'_, '_> {
                 .map(|e| e.to().fix())
                 .collect();
             self.cdt.remove(v);
+            self.forget_removed();
             if let [c, d] = ends[..] {
                 self.cdt.add_constraint(c, d);
             }
