@@ -120,13 +120,14 @@ fn run(
     diags: &mut Diagnostics,
     implicit: &mut Vec<ImplicitSubdomain>,
 ) -> Option<Lowered> {
-    let mut root = match syntax::parse(source, &options.limits) {
-        Ok(root) => root,
+    let parsed = match syntax::parse_document(source, &options.limits) {
+        Ok(parsed) => parsed,
         Err(d) => {
             diags.push(d);
             return None;
         }
     };
+    let root = parsed.root();
     if root.name != grammar::GEOMETRY.name {
         diags.push(
             Diagnostic::new(
@@ -157,13 +158,10 @@ fn run(
             return None;
         }
     }
-    doc::structure::check(&root, &grammar::GEOMETRY, diags);
-    // Implicit solids and the subdomains using them take their own path.
-    let extracted = crate::implicit::xml::extract(&mut root);
-    let mut document = doc::build_with(source, &root, diags, &options.expressions);
+    let (mut document, extracted) = read_document(source, &parsed, root, options, diags);
     // Each stage's input is dropped as soon as the next no longer needs it,
     // which keeps the peak memory of large files down.
-    drop(root);
+    drop(parsed);
     release(options);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     // Everything later reads the resolved objects, not the document's: on large
@@ -206,6 +204,37 @@ fn run(
         diags.items.retain(|d| d.code != Code::Dangling);
     }
     Some(lowered)
+}
+
+/// Checks the structure of the parsed file and builds its typed document, one
+/// top-level element at a time: each element is built from the parser's
+/// document, checked, and dropped once its part of the typed document is made,
+/// so no whole element tree is ever alive. `root` is the root with its child
+/// elements as shells. Implicit solids and the subdomains using them are taken
+/// out for their own path.
+fn read_document<'s>(
+    source: &SourceFile,
+    parsed: &syntax::Document<'s>,
+    mut root: syntax::Element<'s>,
+    options: &Options,
+    diags: &mut Diagnostics,
+) -> (doc::Document, crate::implicit::xml::Extracted<'s>) {
+    doc::structure::check_element(&root, &grammar::GEOMETRY, diags);
+    let extractor = crate::implicit::xml::Extractor::new(&root);
+    let mut builder = doc::DocumentBuilder::new(source, &root, &options.expressions);
+    root.children = Vec::new();
+    let rules = grammar::GEOMETRY.child_rules();
+    let mut extracted = crate::implicit::xml::Extracted::default();
+    for element in parsed.top_level() {
+        // The root's check reported unknown elements; only known ones go deeper.
+        if let Some(rule) = rules.iter().find(|r| r.name == element.name) {
+            doc::structure::check(&element, rule, diags);
+        }
+        if let Some(element) = extractor.take(element, &mut extracted) {
+            builder.add(&element, diags);
+        }
+    }
+    (builder.finish(), extracted)
 }
 
 fn release(options: &Options) {

@@ -163,3 +163,45 @@ fn a_triangle_on_an_unknown_node_names_its_byte() {
         )
     );
 }
+
+/// Blocks whose tags run on from the block before are read whole (in
+/// parallel pieces); a block that skips a tag, or repeats one from an
+/// earlier block, is read node by node with the same numbering and errors.
+#[test]
+fn blocks_that_run_on_then_skip_or_repeat_a_tag() {
+    let three: [[f64; 3]; 2] = [[2.0, 0.0, 0.0], [0.0, 3.0, 0.0]];
+    let bytes = msh(
+        &[
+            (&[1, 2], &[C[0], C[1]]),
+            (&[3, 4], &[C[2], C[3]]),
+            (&[6, 7], &three),
+        ],
+        &[[1, 2, 3], [3, 4, 6], [7, 6, 4]],
+    );
+    let loaded = load_bytes(ReadFormat::Msh, &bytes, Path::new(".")).expect("valid MSH");
+    let mesh = &loaded.mesh;
+    assert_eq!(mesh.nodes.len(), 6);
+    assert_eq!(mesh.nodes[3], C[3]);
+    assert_eq!(mesh.nodes[5], [0.0, 3.0, 0.0]);
+    assert_eq!(
+        mesh.faces[0].triangles,
+        vec![[0, 1, 2], [2, 3, 4], [5, 4, 3]]
+    );
+    // The third block's first tag repeats the second block's last: its
+    // tags start at byte 267 (header 79, two blocks of 20 + 64 bytes, 20).
+    let repeated = msh(
+        &[
+            (&[1, 2], &[C[0], C[1]]),
+            (&[3, 4], &[C[2], C[3]]),
+            (&[4, 5], &three),
+        ],
+        &[[1, 2, 3]],
+    );
+    assert_eq!(
+        error(&repeated),
+        (
+            Code::MeshCountMismatch,
+            "at byte 267: node tag 4 is given twice".to_string()
+        )
+    );
+}

@@ -21,28 +21,58 @@ pub fn build_with(
     diags: &mut Diagnostics,
     limits: &ExprLimits,
 ) -> Document {
-    let mut b = Builder {
-        source,
-        diags,
-        limits: *limits,
-    };
-    let mut doc = Document {
-        dimension: match root.attribute("dimension").map(|a| a.value.trim()) {
-            Some("2") => 2,
-            _ => 3,
-        },
-        title: root.attribute("name").map(|a| a.value.to_string()),
-        ..Document::default()
-    };
-    // One object or subdomain per top-level element in large files: sized once
-    // instead of grown by doubling (each growth copies and touches fresh pages).
-    let subdomains = root.children_named("subdomain").count();
-    doc.subdomains.reserve(subdomains);
-    doc.objects.reserve(root.children.len() - subdomains);
+    let mut builder = DocumentBuilder::new(source, root, limits);
     for element in &root.children {
-        b.top_level(element, &mut doc);
+        builder.add(element, diags);
     }
-    doc
+    builder.finish()
+}
+
+/// Builds the typed document one top-level element at a time, so a caller can
+/// drop each element as soon as its part of the document is made.
+pub struct DocumentBuilder<'a> {
+    source: &'a SourceFile,
+    limits: ExprLimits,
+    doc: Document,
+}
+
+impl<'a> DocumentBuilder<'a> {
+    /// Starts a document from the root's attributes; its children (shells are
+    /// enough) only size the object and subdomain lists.
+    pub fn new(source: &'a SourceFile, root: &Element, limits: &ExprLimits) -> Self {
+        let mut doc = Document {
+            dimension: match root.attribute("dimension").map(|a| a.value.trim()) {
+                Some("2") => 2,
+                _ => 3,
+            },
+            title: root.attribute("name").map(|a| a.value.to_string()),
+            ..Document::default()
+        };
+        // One object or subdomain per top-level element in large files: sized once
+        // instead of grown by doubling (each growth copies and touches fresh pages).
+        let subdomains = root.children_named("subdomain").count();
+        doc.subdomains.reserve(subdomains);
+        doc.objects.reserve(root.children.len() - subdomains);
+        DocumentBuilder {
+            source,
+            limits: *limits,
+            doc,
+        }
+    }
+
+    /// Adds what one top-level element defines.
+    pub fn add(&mut self, element: &Element, diags: &mut Diagnostics) {
+        Builder {
+            source: self.source,
+            diags,
+            limits: self.limits,
+        }
+        .top_level(element, &mut self.doc);
+    }
+
+    pub fn finish(self) -> Document {
+        self.doc
+    }
 }
 
 /// Parses one attribute's expression with spans in the source, reporting

@@ -7,5 +7,5 @@ pub mod grammar;
 pub mod model;
 pub mod structure;
 
-pub use build::{build, build_with, parse_attribute_expr, parse_ref};
+pub use build::{DocumentBuilder, build, build_with, parse_attribute_expr, parse_ref};
 pub use model::*;

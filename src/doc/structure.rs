@@ -10,28 +10,46 @@ use crate::syntax::Element;
 pub fn check(root: &Element, rule: &'static Rule, diags: &mut Diagnostics) {
     let mut stack = vec![(root, rule)];
     while let Some((element, rule)) = stack.pop() {
-        check_attributes(element, rule, diags);
-        for (text, span) in &element.text {
-            diags.push(
-                Diagnostic::new(
-                    Code::UnexpectedText,
-                    *span,
-                    format!(
-                        "unexpected text '{}' inside <{}>",
-                        abbreviate(text),
-                        element.name
-                    ),
-                )
-                .with_help("put data in attributes; use an XML comment <!-- … --> for notes"),
-            );
-        }
-        let known: Vec<&Element> = check_children(element, rule, diags);
+        let known = check_element(element, rule, diags);
+        // Listed once per element, not once per child (a list is made each time).
+        let rules = if known.is_empty() {
+            Vec::new()
+        } else {
+            rule.child_rules()
+        };
         for child in known.into_iter().rev() {
-            if let Some(child_rule) = rule.child_rule(child.name) {
+            if let Some(&child_rule) = rules.iter().find(|r| r.name == child.name) {
                 stack.push((child, child_rule));
             }
         }
     }
+}
+
+/// Checks `element` itself against `rule`: its attributes, its text, and the
+/// names, counts and order of its children, but nothing inside them (the
+/// driver checks a large file's root this way, then each child as it is built).
+/// Returns the children whose rules are known.
+pub fn check_element<'e>(
+    element: &'e Element,
+    rule: &'static Rule,
+    diags: &mut Diagnostics,
+) -> Vec<&'e Element<'e>> {
+    check_attributes(element, rule, diags);
+    for (text, span) in &element.text {
+        diags.push(
+            Diagnostic::new(
+                Code::UnexpectedText,
+                *span,
+                format!(
+                    "unexpected text '{}' inside <{}>",
+                    abbreviate(text),
+                    element.name
+                ),
+            )
+            .with_help("put data in attributes; use an XML comment <!-- … --> for notes"),
+        );
+    }
+    check_children(element, rule, diags)
 }
 
 fn abbreviate(text: &str) -> String {

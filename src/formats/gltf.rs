@@ -8,7 +8,7 @@
 //! edges; each node's `extras` say what it is and, for a fragment, its
 //! subdomain pair. Floats are `f32`, as glTF requires.
 
-use super::groups::{self, Source};
+use super::groups::{self, Source, StreamedNormals};
 use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
 use crate::mesh::Mesh;
 use serde_json::{Value, json};
@@ -119,8 +119,7 @@ enum Piece {
     /// is alive at a time, not every group's (`groups::Expander::stream`).
     Group {
         faces: Vec<(u32, bool)>,
-        vertices: usize,
-        triangles: usize,
+        measured: groups::Measure,
     },
 }
 
@@ -129,15 +128,11 @@ impl Piece {
         match self {
             Piece::Vec3F32(v) => 12 * v.len(),
             Piece::Indices(i) => 4 * i.len(),
-            Piece::Group {
-                vertices,
-                triangles,
-                ..
-            } => 24 * vertices + 12 * triangles,
+            Piece::Group { measured, .. } => 24 * measured.vertices + 12 * measured.triangles,
         }
     }
 
-    /// Converts and writes the piece in blocks of `BLOCK` values.
+    /// Converts and writes the piece in blocks of about [`BLOCK`] bytes.
     fn write(
         &self,
         expander: &mut groups::Expander,
@@ -147,48 +142,58 @@ impl Piece {
         match self {
             Piece::Vec3F32(v) => write_blocks(v.as_flattened(), block, out, f32::to_le_bytes),
             Piece::Indices(i) => write_blocks(i, block, out, u32::to_le_bytes),
-            Piece::Group { faces, .. } => {
-                let group = expander.stream(faces);
+            Piece::Group { faces, measured } => {
+                let group = expander.stream(faces, measured);
                 let nodes = expander.mesh_nodes();
+                let position = |p: [f64; 3]| f32x3_bytes(p.map(|c| c as f32));
                 match &group.nodes {
-                    None => write_blocks(
-                        nodes[..group.normals.len()].as_flattened(),
-                        block,
-                        out,
-                        |c| (c as f32).to_le_bytes(),
-                    )?,
+                    None => write_blocks(&nodes[..group.normals.len()], block, out, position)?,
                     Some(ids) => {
-                        for chunk in ids.chunks(BLOCK / 3) {
-                            block.clear();
-                            for &n in chunk {
-                                for c in nodes[n as usize] {
-                                    block.extend_from_slice(&(c as f32).to_le_bytes());
-                                }
-                            }
-                            out.write_all(block)?;
-                        }
+                        write_blocks(ids, block, out, |n| position(nodes[n as usize]))?;
                     }
                 }
-                write_blocks(group.normals.as_flattened(), block, out, f32::to_le_bytes)?;
+                match &group.normals {
+                    StreamedNormals::Unit(v) => {
+                        write_blocks(v.as_flattened(), block, out, f32::to_le_bytes)?;
+                    }
+                    StreamedNormals::Sums { sums, fallback } => {
+                        write_blocks(sums, block, out, |s| {
+                            f32x3_bytes(StreamedNormals::unit_f32(s, *fallback))
+                        })?;
+                    }
+                }
                 write_blocks(group.triangles.as_flattened(), block, out, u32::to_le_bytes)
             }
         }
     }
 }
 
-/// Values per block converted before a write (256 kB of output).
-const BLOCK: usize = 1 << 16;
+/// Bytes per block converted before a write (256 kB). Blocks go through
+/// `write_atomic`'s buffer: writing them straight to the file from wherever
+/// they lie made the kernel's copy into the page cache up to three times
+/// slower for some offsets of the file against the memory (measured).
+const BLOCK: usize = 1 << 18;
 
-fn write_blocks<T: Copy>(
+/// Three `f32` as 12 little-endian bytes.
+fn f32x3_bytes(v: [f32; 3]) -> [u8; 12] {
+    let mut b = [0u8; 12];
+    for (slot, c) in b.chunks_exact_mut(4).zip(v) {
+        slot.copy_from_slice(&c.to_le_bytes());
+    }
+    b
+}
+
+/// Writes `values` converted to `N` bytes each, a block at a time.
+fn write_blocks<T: Copy, const N: usize>(
     values: &[T],
     block: &mut Vec<u8>,
     out: &mut dyn Write,
-    bytes: impl Fn(T) -> [u8; 4],
+    bytes: impl Fn(T) -> [u8; N],
 ) -> std::io::Result<()> {
-    for chunk in values.chunks(BLOCK) {
-        block.clear();
-        block.resize(4 * chunk.len(), 0);
-        for (slot, &v) in block.chunks_exact_mut(4).zip(chunk) {
+    for chunk in values.chunks(BLOCK.div_ceil(N)) {
+        // Every byte is written below: resizing fills only when it grows.
+        block.resize(N * chunk.len(), 0);
+        for (slot, &v) in block.chunks_exact_mut(N).zip(chunk) {
             slot.copy_from_slice(&bytes(v));
         }
         out.write_all(block)?;
@@ -360,11 +365,7 @@ impl<'a> Document<'a> {
             }));
             offset += length;
         }
-        let piece = Piece::Group {
-            faces,
-            vertices: m.vertices,
-            triangles: m.triangles,
-        };
+        let piece = Piece::Group { faces, measured: m };
         self.buffer_len += piece.byte_len();
         self.pieces.push(piece);
         let mut accessor = |view: usize, component: u32, count: usize, kind: &str| {
@@ -444,7 +445,7 @@ impl<'a> Document<'a> {
 
     /// Writes the binary buffer's pieces in order.
     fn write_buffer(&self, out: &mut dyn Write) -> std::io::Result<()> {
-        let mut block = Vec::with_capacity(4 * BLOCK);
+        let mut block = Vec::with_capacity(BLOCK + 12);
         let mut expander = groups::Expander::new(self.mesh);
         for piece in &self.pieces {
             piece.write(&mut expander, &mut block, out)?;

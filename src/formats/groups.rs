@@ -5,6 +5,7 @@
 
 use super::WriteError;
 use crate::mesh::Mesh;
+use rayon::prelude::*;
 use std::borrow::Cow;
 
 /// Rejects a mesh whose indices leave their tables or whose coordinates are
@@ -39,8 +40,7 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
         }
     }
     for f in &mesh.faces {
-        // The largest index, in a loop the compiler vectorises.
-        let largest = f.triangles.as_flattened().iter().fold(0, |m, &v| m.max(v));
+        let largest = largest_index(&f.triangles);
         if !f.triangles.is_empty() && !node_ok(&largest) {
             return bad(format!("face `{}` refers to a node out of range", f.name));
         }
@@ -271,18 +271,49 @@ pub(crate) struct Measure {
     pub triangles: usize,
     pub lo: [f32; 3],
     pub hi: [f32; 3],
+    /// `Some(k)`: one face as it is whose nodes are `0..k` in first-use
+    /// order (the expansion copies nothing), found once for [`Expander::stream`].
+    pub identity: Option<usize>,
 }
 
 /// A group's expansion as a writer streams it: the mesh node of each vertex
-/// (positions are read from the mesh while written), unit normals as `f32`
-/// and the re-indexed triangles: 16 bytes a vertex, where positions and
-/// normals in `f64` took 52.
-#[derive(Debug, Default)]
+/// (positions are read from the mesh while written), its normals and the
+/// re-indexed triangles.
+#[derive(Debug)]
 pub(crate) struct Streamed<'a> {
     /// The mesh node each vertex copies; `None` when vertex `i` is node `i`.
     pub nodes: Option<Vec<u32>>,
-    pub normals: Vec<[f32; 3]>,
+    pub normals: StreamedNormals,
     pub triangles: Cow<'a, [[u32; 3]]>,
+}
+
+/// A streamed group's vertex normals.
+#[derive(Debug)]
+pub(crate) enum StreamedNormals {
+    /// Unit normals as `f32` (an expansion: 12 bytes a vertex).
+    Unit(Vec<[f32; 3]>),
+    /// The area-weighted sums of one face as it is, made unit (`fallback` for
+    /// a zero sum) and converted by [`StreamedNormals::unit_f32`] while they
+    /// are written: no second vector, no pass of its own.
+    Sums {
+        sums: Vec<[f64; 3]>,
+        fallback: [f64; 3],
+    },
+}
+
+impl StreamedNormals {
+    /// The number of vertices.
+    pub(crate) fn len(&self) -> usize {
+        match self {
+            StreamedNormals::Unit(v) => v.len(),
+            StreamedNormals::Sums { sums, .. } => sums.len(),
+        }
+    }
+
+    /// A sum made unit as [`node_normals`] makes it, then `f32`.
+    pub(crate) fn unit_f32(sum: [f64; 3], fallback: [f64; 3]) -> [f32; 3] {
+        unit(sum).unwrap_or(fallback).map(|c| c as f32)
+    }
 }
 
 /// Expands groups of one mesh: each node's vertex in the current face sits in
@@ -332,6 +363,7 @@ impl<'a> Expander<'a> {
             triangles: 0,
             lo: [f32::INFINITY; 3],
             hi: [f32::NEG_INFINITY; 3],
+            identity: None,
         };
         let include = |m: &mut Measure, node: u32| {
             for (k, &c) in mesh.nodes[node as usize].iter().enumerate() {
@@ -343,10 +375,23 @@ impl<'a> Expander<'a> {
         if let [(face, false)] = faces {
             let triangles = &mesh.faces[*face as usize].triangles;
             if let Some(used) = identity_prefix(triangles) {
+                m.identity = Some(used);
                 m.vertices = used;
                 m.triangles = triangles.len();
-                for node in 0..used as u32 {
-                    include(&mut m, node);
+                // Bounds in `f64`, converted once: rounding to `f32` never
+                // changes the order of two values, so the converted bounds
+                // are the bounds of the converted values.
+                let mut lo = [f64::INFINITY; 3];
+                let mut hi = [f64::NEG_INFINITY; 3];
+                for p in &mesh.nodes[..used] {
+                    for k in 0..3 {
+                        lo[k] = lo[k].min(p[k]);
+                        hi[k] = hi[k].max(p[k]);
+                    }
+                }
+                if used > 0 {
+                    m.lo = lo.map(|c| c as f32);
+                    m.hi = hi.map(|c| c as f32);
                 }
                 return m;
             }
@@ -369,27 +414,26 @@ impl<'a> Expander<'a> {
     }
 
     /// The expansion [`Expander::expand`] makes, kept as it is written:
-    /// nodes instead of positions and normals already `f32` (the same
-    /// numbers: normals are summed and made unit in `f64` per face, then
-    /// converted as the writer converted them).
-    pub(crate) fn stream(&mut self, faces: &[(u32, bool)]) -> Streamed<'a> {
+    /// nodes instead of positions, normals as `f32` or as sums made unit
+    /// while written (the same numbers: normals are summed and made unit in
+    /// `f64` per face, then converted as the writer converted them).
+    /// `measured` is what [`Expander::measure`] gave for these faces.
+    pub(crate) fn stream(&mut self, faces: &[(u32, bool)], measured: &Measure) -> Streamed<'a> {
         let mesh = self.mesh;
-        if let [(face, false)] = faces {
+        if let ([(face, false)], Some(used)) = (faces, measured.identity) {
             let triangles = &mesh.faces[*face as usize].triangles;
-            if let Some(used) = identity_prefix(triangles) {
-                let normals = node_normals(mesh, triangles, used);
-                return Streamed {
-                    nodes: None,
-                    normals: normals.iter().map(|n| n.map(|c| c as f32)).collect(),
-                    triangles: Cow::Borrowed(triangles),
-                };
-            }
+            let (sums, fallback) = node_sums(mesh, triangles, used);
+            return Streamed {
+                nodes: None,
+                normals: StreamedNormals::Sums { sums, fallback },
+                triangles: Cow::Borrowed(triangles),
+            };
         }
         self.prepare();
         let (nodes, normals, triangles) = expand_faces(self, faces, |n| n.map(|c| c as f32));
         Streamed {
             nodes: Some(nodes),
-            normals,
+            normals: StreamedNormals::Unit(normals),
             triangles: Cow::Owned(triangles),
         }
     }
@@ -438,43 +482,62 @@ fn identity_prefix(triangles: &[[u32; 3]]) -> Option<usize> {
     Some(next as usize)
 }
 
-/// The first node with a coordinate that is not finite. The scan has no
-/// early exit inside a run of nodes, so the compiler vectorises it.
+/// The first node with a coordinate that is not finite. Runs of nodes are
+/// scanned in parallel, each with no early exit inside, so the compiler
+/// vectorises it.
 pub(crate) fn first_non_finite(nodes: &[[f64; 3]]) -> Option<usize> {
     const RUN: usize = 1024;
-    for (r, run) in nodes.chunks(RUN).enumerate() {
-        let bad = run
-            .as_flattened()
-            .iter()
-            .fold(false, |bad, c| bad | !c.is_finite());
-        if bad {
-            let i = run.iter().position(|p| p.iter().any(|c| !c.is_finite()));
-            return i.map(|i| r * RUN + i);
-        }
-    }
-    None
+    let r = nodes
+        .par_chunks(RUN)
+        .with_min_len(64)
+        .position_first(|run| {
+            run.as_flattened()
+                .iter()
+                .fold(false, |bad, c| bad | !c.is_finite())
+        })?;
+    let run = nodes.get(r * RUN..)?;
+    let i = run.iter().position(|p| p.iter().any(|c| !c.is_finite()));
+    i.map(|i| r * RUN + i)
+}
+
+/// The largest node index of some triangles (0 when there are none), from
+/// parallel pieces, each a loop the compiler vectorises (a short-circuiting
+/// `any` is a branch per index).
+pub(crate) fn largest_index(triangles: &[[u32; 3]]) -> u32 {
+    triangles
+        .as_flattened()
+        .par_chunks(1 << 16)
+        .map(|piece| piece.iter().fold(0, |m, &v| m.max(v)))
+        .max()
+        .unwrap_or(0)
 }
 
 /// The unit normals of nodes `0..used` over one face's triangles: the
 /// area-weighted sums, in triangle order, that [`expand_into`] forms (the
 /// same numbers, so the output does not depend on which path made it).
 fn node_normals(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> Vec<[f64; 3]> {
+    let (mut normals, fallback) = node_sums(mesh, triangles, used);
+    for s in &mut normals {
+        *s = unit(*s).unwrap_or(fallback);
+    }
+    normals
+}
+
+/// [`node_normals`] before they are made unit: the sums, and the normal of a
+/// node whose sum is zero (the face's total direction).
+fn node_sums(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> (Vec<[f64; 3]>, [f64; 3]) {
     // Sums read before written: zeroed by writing (see `filled_vec`).
-    let mut normals = crate::allocator::filled_vec(used, [0.0; 3]);
+    let mut sums = crate::allocator::filled_vec(used, [0.0; 3]);
     let mut total = [0.0; 3];
     for &tri in triangles {
         let n = triangle_normal(mesh, tri);
         total = add(total, n);
         for v in tri {
-            let s = &mut normals[v as usize];
+            let s = &mut sums[v as usize];
             *s = add(*s, n);
         }
     }
-    let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
-    for s in &mut normals {
-        *s = unit(*s).unwrap_or(fallback);
-    }
-    normals
+    (sums, unit(total).unwrap_or([0.0, 0.0, 1.0]))
 }
 
 fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a> {

@@ -21,6 +21,7 @@ pub mod rows;
 pub mod section;
 pub mod signs;
 pub mod tape;
+pub mod trig;
 pub mod vertices;
 pub mod weld;
 pub mod xml;

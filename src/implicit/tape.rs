@@ -464,6 +464,8 @@ fn unary(u: Unary, o: &mut [f64], a: &[f64]) {
         Unary::Square => each!(|x: f64| x * x),
         Unary::Sqrt => each!(f64::sqrt),
         Unary::Abs => each!(f64::abs),
+        Unary::Sin => super::trig::sin_lanes(o, a),
+        Unary::Cos => super::trig::cos_lanes(o, a),
         _ => each!(|x| u.apply(x)),
     }
 }
@@ -554,6 +556,70 @@ mod tests {
                 along.eval(&mut ws, &moved, &mut got);
                 let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
                 assert_eq!(bits(&got), bits(&want), "axis {axis} shift {shift}");
+            }
+        }
+    }
+
+    /// PERF-ANCHORS.md's M2: min(0.04 − g², 0.81 − |p|²), g the gyroid.
+    fn gyroid_in_ball() -> (Ctx, NodeId) {
+        let mut ctx = Ctx::new();
+        let v = [ctx.var(0), ctx.var(1), ctx.var(2)];
+        let six = ctx.constant(6.0);
+        let s: Vec<NodeId> = v.iter().map(|&a| ctx.mul(six, a)).collect();
+        let mut g = ctx.constant(0.0);
+        for k in 0..3 {
+            let sn = ctx.unary(Unary::Sin, s[k]);
+            let cs = ctx.unary(Unary::Cos, s[(k + 1) % 3]);
+            let t = ctx.mul(sn, cs);
+            g = ctx.add(g, t);
+        }
+        let gg = ctx.square(g);
+        let c = ctx.constant(0.04);
+        let shell = ctx.sub(c, gg);
+        let rr: Vec<NodeId> = v.iter().map(|&a| ctx.square(a)).collect();
+        let r2 = ctx.add(rr[0], rr[1]);
+        let r2 = ctx.add(r2, rr[2]);
+        let big = ctx.constant(0.81);
+        let ball = ctx.sub(big, r2);
+        let root = ctx.binary(Binary::Min, shell, ball);
+        (ctx, root)
+    }
+
+    #[test]
+    fn sin_and_cos_lanes_give_the_scalar_values_on_the_gyroid() {
+        // The tapes take sin and cos from `trig` (vectorised), the scalar
+        // evaluation from libm: within 1e-12 of the function's scale (its
+        // terms are of order 1), on a grid's points and between them.
+        let (ctx, root) = gyroid_in_ball();
+        let ssa = Ssa::from_ctx(&ctx, root);
+        let tape = Tape::new(&ssa);
+        let n = 2000;
+        let p: [Vec<f64>; 3] =
+            [0.37, 0.11, 0.73].map(|w| (0..n).map(|i| (i as f64 * w).sin() * 1.05).collect());
+        let mut got = vec![0.0; n];
+        tape.eval(&mut tape.workspace(), &p[0], &p[1], &p[2], &mut got);
+        let mut worst: f64 = 0.0;
+        for i in 0..n {
+            let want = ssa.eval_point([p[0][i], p[1][i], p[2][i]]);
+            worst = worst.max((got[i] - want).abs() / want.abs().max(1.0));
+        }
+        assert!(worst <= 1e-12, "tape: {worst:e} relative");
+        for axis in 0..3 {
+            let along = AxisTape::new(&ssa, axis);
+            let mut ws = along.workspace();
+            let m = 100;
+            along.setup(&mut ws, [&p[0][..m], &p[1][..m], &p[2][..m]]);
+            for step in [0.0, 0.3, 1.0] {
+                let moved: Vec<f64> = p[axis][..m].iter().map(|v| v + step / 128.0).collect();
+                let mut out = vec![0.0; m];
+                along.eval(&mut ws, &moved, &mut out);
+                for i in 0..m {
+                    let mut q = [p[0][i], p[1][i], p[2][i]];
+                    q[axis] = moved[i];
+                    let want = ssa.eval_point(q);
+                    let rel = (out[i] - want).abs() / want.abs().max(1.0);
+                    assert!(rel <= 1e-12, "axis {axis}, point {i}: {} vs {want}", out[i]);
+                }
             }
         }
     }

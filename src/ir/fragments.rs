@@ -59,28 +59,40 @@ pub fn derive_fragments(model: &Model) -> Vec<Fragment> {
             .map_or_else(|| format!("#{}", id.0), |s| s.name.clone())
     };
 
-    let mut groups: BTreeMap<(SubdomainId, Side, String), Vec<u32>> = BTreeMap::new();
+    // Grouped first by the user's name, or none for the default name: a
+    // name string per face (edge) was most of this on a 10,000-edge polygon.
+    let mut by_pair: BTreeMap<(SubdomainId, Side, Option<&str>), Vec<u32>> = BTreeMap::new();
     for (id, subdomains) in sides {
-        let mut it = subdomains.iter().copied();
-        let (k, other) = match (it.next(), it.next(), it.next()) {
-            (Some(k), None, None) => (k, Side::Exterior),
-            (Some(k), Some(k2), None) => (k, Side::Subdomain(k2)),
+        let (k, other) = match subdomains[..] {
+            [k] => (k, Side::Exterior),
+            [k, k2] => (k, Side::Subdomain(k2)),
             _ => continue,
         };
-        let name = match names.get(&id) {
-            Some(name) => (*name).to_string(),
+        let name = names.get(&id).copied();
+        by_pair.entry((k, other, name)).or_default().push(id);
+    }
+    let mut groups: BTreeMap<(SubdomainId, Side, String), Vec<u32>> = BTreeMap::new();
+    for ((k, other, name), ids) in by_pair {
+        let name = match name {
+            Some(name) => name.to_string(),
             None => match other {
                 Side::Exterior => format!("{}|exterior", subdomain_name(k)),
                 Side::Subdomain(k2) => format!("{}|{}", subdomain_name(k), subdomain_name(k2)),
             },
         };
-        groups.entry((k, other, name)).or_default().push(id);
+        // A user name equal to a default one is one group, as before.
+        let group = groups.entry((k, other, name)).or_default();
+        let merged = !group.is_empty();
+        group.extend(ids);
+        if merged {
+            group.sort_unstable();
+        }
     }
 
     groups
         .into_iter()
         .map(|((subdomain, other, name), ids)| {
-            // BTreeMap iteration gives ids ascending already.
+            // Ascending: BTreeMap iteration, or sorted when merged.
             let (faces, edges) = match model.dimension {
                 Dimension::Three => (ids.into_iter().map(FaceId).collect(), Vec::new()),
                 Dimension::Two => (Vec::new(), ids.into_iter().map(EdgeId).collect()),
@@ -96,30 +108,36 @@ pub fn derive_fragments(model: &Model) -> Vec<Fragment> {
         .collect()
 }
 
-/// For every face, the subdomains whose Volume boundary lists it.
-fn face_sides(model: &Model) -> BTreeMap<u32, BTreeSet<SubdomainId>> {
-    let mut sides: BTreeMap<u32, BTreeSet<SubdomainId>> = BTreeMap::new();
+/// Adds subdomain k to a face's (edge's) sides: subdomains come in
+/// ascending order, so the list stays sorted and without repeats (a `Vec`
+/// rather than a set: one allocation fewer per face or edge).
+fn push_side(sides: &mut Vec<SubdomainId>, k: SubdomainId) {
+    if sides.last() != Some(&k) {
+        sides.push(k);
+    }
+}
+
+/// For every face, the subdomains whose Volume boundary lists it (sorted).
+fn face_sides(model: &Model) -> BTreeMap<u32, Vec<SubdomainId>> {
+    let mut sides: BTreeMap<u32, Vec<SubdomainId>> = BTreeMap::new();
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         if let SubdomainCells::Volume { boundary } = &subdomain.cells {
             for of in boundary
                 .iter()
                 .filter(|of| of.face.index() < model.faces.len())
             {
-                sides
-                    .entry(of.face.0)
-                    .or_default()
-                    .insert(SubdomainId(k as u32));
+                push_side(sides.entry(of.face.0).or_default(), SubdomainId(k as u32));
             }
         }
     }
     sides
 }
 
-/// For every edge, the region subdomains it bounds. An edge lies on region
+/// For every edge, the region subdomains it bounds (sorted). An edge lies on region
 /// k's boundary when exactly one face of k uses it; one shared by two faces
 /// of k is inside k and bounds nothing.
-fn edge_sides(model: &Model) -> BTreeMap<u32, BTreeSet<SubdomainId>> {
-    let mut sides: BTreeMap<u32, BTreeSet<SubdomainId>> = BTreeMap::new();
+fn edge_sides(model: &Model) -> BTreeMap<u32, Vec<SubdomainId>> {
+    let mut sides: BTreeMap<u32, Vec<SubdomainId>> = BTreeMap::new();
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         let SubdomainCells::Region { faces } = &subdomain.cells else {
             continue;
@@ -140,7 +158,7 @@ fn edge_sides(model: &Model) -> BTreeMap<u32, BTreeSet<SubdomainId>> {
         }
         for (e, n) in uses {
             if n == 1 {
-                sides.entry(e).or_default().insert(SubdomainId(k as u32));
+                push_side(sides.entry(e).or_default(), SubdomainId(k as u32));
             }
         }
     }

@@ -243,7 +243,13 @@ pub(crate) fn no_area_width(
     b: &nalgebra::Vector3<f64>,
     c: &nalgebra::Vector3<f64>,
 ) -> Option<f64> {
-    let longest = (b - a).norm().max((c - b).norm()).max((a - c).norm());
-    let twice = (b - a).cross(&(c - a)).norm();
-    (twice <= 1e-14 * longest * longest).then(|| twice / longest.max(f64::MIN_POSITIVE))
+    // Compared squared (no square root for the triangles that pass: this
+    // runs over every triangle of a mesh).
+    let longest2 = (b - a)
+        .norm_squared()
+        .max((c - b).norm_squared())
+        .max((a - c).norm_squared());
+    let twice2 = (b - a).cross(&(c - a)).norm_squared();
+    (twice2 <= 1e-28 * longest2 * longest2)
+        .then(|| twice2.sqrt() / longest2.sqrt().max(f64::MIN_POSITIVE))
 }

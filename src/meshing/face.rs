@@ -325,20 +325,46 @@ pub(crate) fn mesh_face(
     // vertex's edges: 3% of meshing a sphere).
     let mut checked_constraints = usize::MAX;
     let mut added = Vec::new();
-    // A plane face without poly_lines or small input angles is refined by
-    // geomc's own off-centre refinement (`refine`): spade's inserts
-    // circumcentres (a third more triangles than Triangle on a long polygon).
-    let own = matches!(face.surface, Surface::Plane { .. })
-        && !framed
+    // A face without poly_lines or small input angles is refined by geomc's
+    // own off-centre refinement (`refine`): spade's inserts circumcentres (a
+    // third more triangles than Triangle on a long polygon), and on a curved
+    // face it rescanned the whole face on each of its 2–3 calls between the
+    // chordal passes (95% of meshing), where ours checks the surface on each
+    // new triangle in the same loop.
+    let plane = matches!(face.surface, Surface::Plane { .. });
+    // Periodic charts (a torus) stay with spade: their seam segments, split
+    // by our loop, fell between the unwrapped copies of an edge (E502).
+    let periodic = chart.periods().iter().any(Option::is_some);
+    let own = !framed
         && !small_angle
         && !settings.keep_boundary
-        && polyline_segments.is_empty();
+        && polyline_segments.is_empty()
+        && (plane || !periodic);
     let budget = vertex_budget(
         &uv_loops,
         settings.max_area.min(guide),
         settings,
         small_angle,
     );
+    // The surface check inside the refinement (curved faces): the same
+    // criteria as the scan after it (`Coarse`), except for triangles whose
+    // longest edge is below the tolerance, which no chart of a smooth
+    // surface makes stray by the tolerance; they are left to the scan (a
+    // degenerate point of a general surface would otherwise be refined
+    // without end). `skipped` says whether any was.
+    let skipped = std::cell::Cell::new(false);
+    let lift = |uv: Point2<f64>| chart.lift([uv.x, uv.y]);
+    let surface_coarse = |[a, b, c]: [&Point3; 3]| {
+        let longest2 = (b - a)
+            .norm_squared()
+            .max((c - b).norm_squared())
+            .max((a - c).norm_squared());
+        if longest2 < settings.tolerance * settings.tolerance {
+            skipped.set(true);
+            return false;
+        }
+        too_coarse(&deviation, [a, b, c], settings)
+    };
     // Refinement splits a segment on a curved edge at the curve's point
     // (`refine::Curves`): in the chart, and on the curve for the node.
     let curve_point = |edge: usize, s: f64| -> Option<(Point2<f64>, Point3)> {
@@ -363,12 +389,24 @@ pub(crate) fn mesh_face(
                 &mut cdt,
                 refine::Params {
                     min_angle_degrees: settings.min_angle,
-                    max_area: settings.max_area.min(guide),
+                    // Curved faces: the surface check sets the size (the
+                    // guide area, a uniform chart size, only over-refined
+                    // where the chart shrinks the surface).
+                    max_area: if plane {
+                        settings.max_area.min(guide)
+                    } else {
+                        settings.max_area
+                    },
                     max_additional_vertices: budget,
                     outside,
                     curves: Some(refine::Curves {
                         segments: &mut segments,
                         point: &curve_point,
+                    }),
+                    surface: (!plane).then_some(refine::SurfaceCheck {
+                        positions: &mut positions,
+                        lift: &lift,
+                        coarse: &surface_coarse,
                     }),
                 },
             )
@@ -518,12 +556,18 @@ pub(crate) fn mesh_face(
         // area limit; on a plane with no edge-length limit nothing else can
         // make one coarse, and the check (a second lookup of every
         // triangle) is skipped.
+        // On a curved face the refinement checked every triangle it left
+        // against the surface, unless it skipped some (`skipped`).
         let cannot_be_coarse = own
             && result.complete
             && result.all_checked
-            && matches!(deviation, Deviation::Plane)
-            && settings.sizing.is_uniform()
-            && settings.sizing.at(&Point3::origin()) == f64::INFINITY;
+            && if plane {
+                matches!(deviation, Deviation::Plane)
+                    && settings.sizing.is_uniform()
+                    && settings.sizing.at(&Point3::origin()) == f64::INFINITY
+            } else {
+                !skipped.get()
+            };
         fine.resize(cdt.num_all_faces(), NOT_FINE);
         inner.clear();
         let mut bad = Vec::new();
@@ -775,15 +819,23 @@ fn loop_is_hull(cdt: &Cdt, uv_loops: &[Vec<[f64; 2]>]) -> bool {
 /// True when two constraint segments (loop or poly_line) meet at a vertex at
 /// an angle below `min_angle` degrees. Runs over every vertex of a face:
 /// directions go to a small array (a `Vec` per vertex was 4% of a
-/// 10,000-vertex polygon's meshing time); a vertex with more constraint
-/// edges than fit is checked through a `Vec`.
+/// 10,000-vertex polygon's meshing time) and are compared by their dot
+/// product (an `atan2` per direction was another 2%); a vertex with more
+/// constraint edges than fit is checked through a `Vec`.
 fn has_small_input_angle(cdt: &Cdt, min_angle: f64) -> bool {
-    let limit = min_angle.to_radians();
-    let small = |directions: &[f64]| {
-        directions.iter().enumerate().any(|(i, a)| {
-            directions[i + 1..].iter().any(|b| {
-                let gap = (a - b).abs();
-                gap.min(std::f64::consts::TAU - gap) < limit
+    // The angle between u and v is below the limit when u·v > cos(limit)·|u||v|
+    // (the limit is at most 33°, so its cosine is positive).
+    let cos_limit = min_angle.to_radians().cos();
+    let small = |directions: &[[f64; 2]]| {
+        directions.iter().enumerate().any(|(i, u)| {
+            directions[i + 1..].iter().any(|v| {
+                let dot = u[0] * v[0] + u[1] * v[1];
+                dot > 0.0
+                    && dot * dot
+                        > cos_limit
+                            * cos_limit
+                            * (u[0] * u[0] + u[1] * u[1])
+                            * (v[0] * v[0] + v[1] * v[1])
             })
         })
     };
@@ -791,13 +843,13 @@ fn has_small_input_angle(cdt: &Cdt, min_angle: f64) -> bool {
         let p = v.position();
         let direction = |e: spade::handles::DirectedEdgeHandle<'_, _, _, _, _>| {
             let q: Point2<f64> = e.to().position();
-            (q.y - p.y).atan2(q.x - p.x)
+            [q.x - p.x, q.y - p.y]
         };
-        let mut few = [0.0f64; 8];
+        let mut few = [[0.0f64; 2]; 8];
         let mut count = 0;
         for e in v.out_edges().filter(|e| e.is_constraint_edge()) {
             if count == few.len() {
-                let all: Vec<f64> = v
+                let all: Vec<[f64; 2]> = v
                     .out_edges()
                     .filter(|e| e.is_constraint_edge())
                     .map(direction)

@@ -49,6 +49,23 @@ pub(super) struct Params<'a> {
     /// The boundary's curves, when splits on curved edges should go onto
     /// them.
     pub curves: Option<Curves<'a>>,
+    /// The surface criteria (chordal deviation, edge length) of a curved
+    /// face, checked on each new triangle with its corners lifted.
+    pub surface: Option<SurfaceCheck<'a>>,
+}
+
+/// A curved face's surface criteria inside the refinement loop: each new
+/// vertex is lifted once (into `positions`, indexed like the vertices), and
+/// a triangle the surface finds too coarse is refined like one too large,
+/// so one loop meets the angle bound and the tolerance together instead of
+/// alternating spade's whole-face refinement with whole-face chordal scans.
+pub(super) struct SurfaceCheck<'a> {
+    /// Every vertex's point on the surface; grown as vertices are added.
+    pub positions: &'a mut Vec<Point3>,
+    /// A chart point's point on the surface.
+    pub lift: &'a dyn Fn(Point2<f64>) -> Option<Point3>,
+    /// Whether a triangle (corners on the surface) is too coarse.
+    pub coarse: &'a dyn Fn([&Point3; 3]) -> bool,
 }
 
 /// The boundary segments' edges and curve parameters, kept up to date as
@@ -81,13 +98,23 @@ pub(super) struct Refined {
 struct Refiner<'a, 'c> {
     cdt: &'a mut Cdt,
     curves: Option<Curves<'c>>,
+    surface: Option<SurfaceCheck<'c>>,
+    /// The curve point of the segment split being made: the position of the
+    /// vertex it adds (the chart's lift of it may be off the curve by the
+    /// chart's rounding).
+    next_node: Option<Point3>,
+    /// A vertex did not lift onto the surface: the lifted positions stop
+    /// before it, and triangles with corners beyond them are not checked
+    /// against the surface (the caller reports the vertex).
+    lift_failed: bool,
     curved: Vec<(usize, usize, f64, Point3)>,
     outside: Vec<bool>,
     /// Bad triangles, shortest edge first (Triangle's order: fewer points
     /// than first-come), then in the order they were found.
     triangles: BucketQueue,
     /// Reused per insertion: the faces around the new vertex.
-    around: Vec<(FixedFaceHandle<InnerTag>, bool)>,
+    /// with their corners (counter-clockwise) and side.
+    around: Vec<(FixedFaceHandle<InnerTag>, [Point2<f64>; 3], bool)>,
     opposite: Vec<(FixedVertexHandle, FixedVertexHandle)>,
     /// Reused per insertion: the faces around a new vertex.
     star: Vec<FixedFaceHandle<InnerTag>>,
@@ -130,6 +157,9 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
     let mut r = Refiner {
         cdt,
         curves: params.curves,
+        surface: params.surface,
+        next_node: None,
+        lift_failed: false,
         curved: Vec::new(),
         outside,
         triangles: BucketQueue::new(),
@@ -196,6 +226,9 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
         if r.generation.get(index) != Some(&generation) || r.outside[index] {
             continue;
         }
+        // Unchanged since it was found bad (same slot generation): its
+        // point is computed without checking it again (the surface check
+        // is the costly half of that).
         if let Some(point) = r.bad_triangle_point(r.cdt.face(face).positions()) {
             r.split_triangle(face, point);
         }
@@ -242,22 +275,77 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
 impl Refiner<'_, '_> {
     /// Queues the triangle when it is bad.
     fn push_triangle(&mut self, f: FixedFaceHandle<InnerTag>) {
-        if let Some(shortest) = self.badness(self.cdt.face(f).positions()) {
+        self.push_triangle_at(f, self.cdt.face(f).positions());
+    }
+
+    /// Queues the triangle with corners `p` when it is bad (the corners
+    /// already at hand: no face lookup unless a surface check needs the
+    /// vertices).
+    fn push_triangle_at(&mut self, f: FixedFaceHandle<InnerTag>, p: [Point2<f64>; 3]) {
+        self.lift_new_vertices();
+        let (lengths, k) = shortest_edge(p);
+        let bad = self.badness(p, lengths, k)
+            || (self.surface.is_some() && {
+                let corners = self.cdt.face(f).vertices().map(|v| v.fix().index());
+                self.too_coarse(corners)
+            });
+        if bad {
             self.triangles
-                .push(shortest, (f, self.generation[f.index()]));
+                .push(lengths[k], (f, self.generation[f.index()]));
         }
     }
 
-    /// The squared length of the triangle's shortest edge when it is below
-    /// the angle bound or above the area limit.
-    fn badness(&self, p: [Point2<f64>; 3]) -> Option<f64> {
-        let (lengths, k) = shortest_edge(p);
+    /// Whether the triangle is below the angle bound or above the area
+    /// limit (`lengths`, `k`: its squared edge lengths and the shortest).
+    fn badness(&self, p: [Point2<f64>; 3], lengths: [f64; 3], k: usize) -> bool {
         let (o, q, r) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
         let (u, v) = ([o.x - r.x, o.y - r.y], [q.x - r.x, q.y - r.y]);
         let cross = (q.x - o.x) * (r.y - o.y) - (q.y - o.y) * (r.x - o.x);
         let skinny = (u[0] * v[0] + u[1] * v[1])
             > self.cos_limit * (lengths[(k + 1) % 3] * lengths[(k + 2) % 3]).sqrt();
-        (skinny || 0.5 * cross > self.max_area).then_some(lengths[k])
+        skinny || 0.5 * cross > self.max_area
+    }
+
+    /// Whether the surface finds the triangle with these corners too coarse
+    /// (never without a surface check, or before its corners are lifted).
+    fn too_coarse(&self, [a, b, c]: [usize; 3]) -> bool {
+        let Some(surface) = &self.surface else {
+            return false;
+        };
+        let positions = &surface.positions;
+        match (positions.get(a), positions.get(b), positions.get(c)) {
+            (Some(pa), Some(pb), Some(pc)) => (surface.coarse)([pa, pb, pc]),
+            _ => false,
+        }
+    }
+
+    /// Lifts the vertices added since the last call onto the surface (the
+    /// split being made puts its vertex at its curve point instead).
+    fn lift_new_vertices(&mut self) {
+        let Some(surface) = self.surface.as_mut() else {
+            return;
+        };
+        let n = self.cdt.num_vertices();
+        while !self.lift_failed && surface.positions.len() < n {
+            let v = surface.positions.len();
+            let point = match self.next_node {
+                Some(node) if v + 1 == n => Some(node),
+                _ => (surface.lift)(self.cdt.vertex(FixedVertexHandle::from_index(v)).position()),
+            };
+            match point {
+                Some(p) => surface.positions.push(p),
+                None => self.lift_failed = true,
+            }
+        }
+    }
+
+    /// After the last vertex was taken out again: its lifted position goes
+    /// too (the next vertex takes its index).
+    fn forget_removed(&mut self) {
+        let n = self.cdt.num_vertices();
+        if let Some(surface) = self.surface.as_mut() {
+            surface.positions.truncate(n);
+        }
     }
 
     /// Whether the apex of an inside triangle next to segment a–b lies in
@@ -292,10 +380,9 @@ impl Refiner<'_, '_> {
                 >= self.lens_cos2 * (u[0] * u[0] + u[1] * u[1]) * (v[0] * v[0] + v[1] * v[1])
     }
 
-    /// The point to insert for a triangle below the angle or above the area
-    /// limit (its off-centre or circumcentre), or `None` when it is fine.
+    /// The point to insert for a bad triangle (its off-centre or
+    /// circumcentre), or `None` when it is degenerate.
     fn bad_triangle_point(&self, p: [Point2<f64>; 3]) -> Option<Point2<f64>> {
-        self.badness(p)?;
         // The shortest edge k runs from p[k] to p[k + 1]; its opposite
         // corner holds the smallest angle.
         let (_, k) = shortest_edge(p);
@@ -375,7 +462,8 @@ impl Refiner<'_, '_> {
         }
         if holds_face && !outside && !on_hull && !on_segment && self.encroached.is_empty() {
             self.star = star;
-            self.after_insertion(v, Side::Inside);
+            // The segments opposite x were just checked against it.
+            self.after_insertion(v, Side::Inside { checked: true });
             return;
         }
         // Take x out again: removing the last vertex moves no vertex, and
@@ -390,6 +478,7 @@ impl Refiner<'_, '_> {
             (ends.next(), ends.next())
         });
         self.cdt.remove(v);
+        self.forget_removed();
         let n = self.cdt.num_all_faces();
         for f in &star {
             self.generation[f.index()] = self.generation[f.index()].wrapping_add(1);
@@ -547,7 +636,7 @@ impl Refiner<'_, '_> {
                 return;
             }
         };
-        self.after_insertion(v, Side::Inside);
+        self.after_insertion(v, Side::Inside { checked: false });
     }
 
     /// Splits segment a–b at its middle, or on a power-of-two shell around
@@ -583,9 +672,11 @@ impl Refiner<'_, '_> {
                 t = 1.0 - t;
             }
         }
-        if let Some((edge, s, uv, node)) = self.curve_point(a, b, t)
-            && let Some(v) = self.split_on_curve(a, b, uv, left, right)
-        {
+        let on_curve = self.curve_point(a, b, t);
+        self.next_node = on_curve.map(|c| c.3);
+        let split = on_curve.and_then(|(_, _, uv, _)| self.split_on_curve(a, b, uv, left, right));
+        self.next_node = None;
+        if let (Some((edge, s, _, node)), Some(v)) = (on_curve, split) {
             let key = |x: FixedVertexHandle, y: FixedVertexHandle| {
                 (x.index().min(y.index()), x.index().max(y.index()))
             };
@@ -716,6 +807,7 @@ impl Refiner<'_, '_> {
                 .map(|e| e.to().fix())
                 .collect();
             self.cdt.remove(v);
+            self.forget_removed();
             if let [c, d] = ends[..] {
                 self.cdt.add_constraint(c, d);
             }
@@ -833,6 +925,7 @@ impl Refiner<'_, '_> {
             }
             _ => false,
         };
+        let pv = self.cdt.vertex(v).position();
         for e in self.cdt.vertex(v).out_edges() {
             if let Side::Split { a, b, .. } = side {
                 let to = e.to().fix();
@@ -844,7 +937,7 @@ impl Refiner<'_, '_> {
             }
             if let Some(f) = e.face().as_inner() {
                 let status = match side {
-                    Side::Inside => false,
+                    Side::Inside { .. } => false,
                     Side::Flooded => self.outside[f.fix().index()],
                     Side::Split { left, right, .. } => {
                         if left_of_path {
@@ -854,21 +947,26 @@ impl Refiner<'_, '_> {
                         }
                     }
                 };
-                faces.push((f.fix(), status));
+                // The face left of v → w runs v, w, then next's end
+                // (counter-clockwise): its corners without a face lookup.
                 let next = e.next();
+                let corners = [pv, e.to().position(), next.to().position()];
+                faces.push((f.fix(), corners, status));
                 if next.is_constraint_edge() {
                     opposite.push((next.from().fix(), next.to().fix()));
                 }
             }
         }
-        for &(f, status) in &faces {
+        for &(f, corners, status) in &faces {
             self.outside[f.index()] = status;
             self.generation[f.index()] = self.generation[f.index()].wrapping_add(1);
             if !status {
-                self.push_triangle(f);
+                self.push_triangle_at(f, corners);
             }
         }
-        self.segments.extend(opposite.iter().copied());
+        if !matches!(side, Side::Inside { checked: true }) {
+            self.segments.extend(opposite.iter().copied());
+        }
         self.around = faces;
         self.opposite = opposite;
     }
@@ -877,8 +975,10 @@ impl Refiner<'_, '_> {
 /// Which side of the boundary the faces around a new vertex are on.
 #[derive(Clone, Copy)]
 enum Side {
-    /// A point inserted inside the loops.
-    Inside,
+    /// A point inserted inside the loops; `checked` when the segments
+    /// opposite it are known not to be encroached by it (nothing else
+    /// around them changed, so they need no second look).
+    Inside { checked: bool },
     /// A split segment a–b (its ends, joined to the new vertex by
     /// segments): whether its left and right sides are outside.
     Split {
@@ -919,12 +1019,7 @@ impl BucketQueue {
     fn push(&mut self, shortest_squared: f64, item: Queued) {
         // 2·log2 of the squared length, from about −2,100 to 2,050 for
         // finite positive doubles, shifted into 0..4,096.
-        let bucket = if shortest_squared > 0.0 {
-            let k = (2.0 * shortest_squared.log2()).floor() + 2048.0;
-            k.clamp(0.0, (BUCKETS - 1) as f64) as usize
-        } else {
-            0
-        };
+        let bucket = bucket_of(shortest_squared);
         self.buckets[bucket].push_back(item);
         self.lowest = self.lowest.min(bucket);
         self.len += 1;
@@ -945,6 +1040,26 @@ impl BucketQueue {
     }
 }
 
+/// The bucket of a squared length x: ⌊2·log2 x⌋ + 2,048, clamped to the
+/// buckets. Read off the bits of a normal x (x = 2^e·m, m in [1, 2):
+/// ⌊2·log2 x⌋ = 2e, plus 1 when m ≥ √2) instead of calling `log2` and
+/// `floor`, which were 2–3% of the refinement; subnormals and the rest
+/// take the slow way.
+fn bucket_of(x: f64) -> usize {
+    if x.is_nan() || x <= 0.0 {
+        return 0;
+    }
+    let bits = x.to_bits();
+    let biased = ((bits >> 52) & 0x7ff) as i64;
+    let k = if biased == 0 || biased == 0x7ff {
+        (2.0 * x.log2()).floor()
+    } else {
+        let mantissa = f64::from_bits((bits & ((1u64 << 52) - 1)) | (1023u64 << 52));
+        (2 * (biased - 1023) + i64::from(mantissa >= std::f64::consts::SQRT_2)) as f64
+    };
+    (k + 2048.0).clamp(0.0, (BUCKETS - 1) as f64) as usize
+}
+
 /// The squared edge lengths of a triangle (edge i from corner i to i + 1)
 /// and the index of the shortest.
 fn shortest_edge(p: [Point2<f64>; 3]) -> ([f64; 3], usize) {
@@ -957,4 +1072,31 @@ fn shortest_edge(p: [Point2<f64>; 3]) -> ([f64; 3], usize) {
         .min_by(|&i, &j| lengths[i].total_cmp(&lengths[j]))
         .unwrap_or(0);
     (lengths, k)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// The bucket from the bits is the bucket from `log2`: powers of two,
+    /// the √2 step between them, and lengths from 1e-300 to 1e300.
+    #[test]
+    fn bucket_from_bits_matches_log2() {
+        let slow = |x: f64| ((2.0 * x.log2()).floor() + 2048.0).clamp(0.0, 4095.0) as usize;
+        let mut x = 1e-300;
+        while x < 1e300 {
+            assert_eq!(bucket_of(x), slow(x), "{x:e}");
+            x *= 1.0137;
+        }
+        assert_eq!(bucket_of(1.0), 2048);
+        assert_eq!(bucket_of(2.0), 2050);
+        assert_eq!(bucket_of(0.5), 2046);
+        assert_eq!(bucket_of(std::f64::consts::SQRT_2), 2049);
+        let below_sqrt2 = f64::from_bits(std::f64::consts::SQRT_2.to_bits() - 1);
+        assert_eq!(bucket_of(below_sqrt2), 2048);
+        assert_eq!(bucket_of(0.0), 0);
+        assert_eq!(bucket_of(f64::NAN), 0);
+        assert_eq!(bucket_of(5e-324), 0);
+        assert_eq!(bucket_of(f64::INFINITY), 4095);
+    }
 }

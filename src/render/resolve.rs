@@ -3,7 +3,10 @@
 //! (as multisampling does, so anti-aliasing costs coverage tests, not shading),
 //! and the samples of a pixel are averaged with straight alpha.
 
-use super::raster::{EMPTY, Projected, ZBuffer};
+use super::raster::{EMPTY, Projected, ZBuffer, prefetch};
+
+/// Pixels ahead whose triangle's corners are fetched while one is shaded.
+const AHEAD: usize = 8;
 use super::scene::Scene;
 use rayon::prelude::*;
 
@@ -198,9 +201,33 @@ pub fn resolve_rows(
     out: &mut [u8],
 ) {
     let width = samples.width / ss;
+    // The triangle shown at a pixel's first sample, when there is one.
+    let first_tri = |px: usize, py: usize| {
+        let value = samples.value(px * ss, py * ss);
+        (value != EMPTY).then_some(((value & 0xffff_ffff) >> 1) as usize)
+    };
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
         for px in 0..width {
+            // Shading gathers a triangle, then its corners' positions and
+            // light: fetch the triangle of the pixel 16 ahead and the
+            // corners of the one 8 ahead, so the loads overlap.
+            if let Some(tri) = (px + 2 * AHEAD < width)
+                .then(|| first_tri(px + 2 * AHEAD, py))
+                .flatten()
+            {
+                prefetch(&scene.tris[tri]);
+                prefetch(&scene.corner_slots[tri]);
+            }
+            if let Some(tri) = (px + AHEAD < width)
+                .then(|| first_tri(px + AHEAD, py))
+                .flatten()
+            {
+                for (n, slot) in scene.tris[tri].into_iter().zip(scene.corner_slots[tri]) {
+                    prefetch(&proj.xy_f[n as usize]);
+                    prefetch(&scene.light[slot as usize]);
+                }
+            }
             if let Some(color) = uniform(scene, proj, samples, ss, px, py) {
                 row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
                 continue;

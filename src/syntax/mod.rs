@@ -1,6 +1,7 @@
-//! XML syntax: the only module that touches the XML parser. It turns text into an
-//! owned element tree with byte spans on every name and value, refusing DTDs,
-//! over-deep nesting and oversized input before any later stage sees them.
+//! XML syntax: the only module that touches the XML parser. It turns text into
+//! element trees with byte spans on every name and value (the whole tree, or one
+//! top-level element at a time), refusing DTDs, over-deep nesting and oversized
+//! input before any later stage sees them.
 
 // User-controlled bytes and values: no panicking index (docs/reliability.md).
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
@@ -35,6 +36,40 @@ impl Default for Limits {
 
 /// Parses `source` into an owned tree, or says why it cannot.
 pub fn parse<'s>(source: &'s SourceFile, limits: &Limits) -> Result<Element<'s>, Diagnostic> {
+    let document = parse_document(source, limits)?;
+    Ok(tree::build(document.xml.root_element()))
+}
+
+/// A parsed document whose elements become [`Element`]s one top-level child at
+/// a time: a large file never holds the parser's document and a whole element
+/// tree together (they were the first of the front end's memory peaks).
+pub struct Document<'s> {
+    xml: roxmltree::Document<'s>,
+}
+
+impl<'s> Document<'s> {
+    /// The root element with its attributes and text; each child element is a
+    /// shell with its name, spans and attributes but without content.
+    pub fn root(&self) -> Element<'s> {
+        tree::shallow(self.xml.root_element())
+    }
+
+    /// The root's child elements, each built whole when the iterator reaches it.
+    pub fn top_level(&self) -> impl Iterator<Item = Element<'s>> + '_ {
+        self.xml
+            .root_element()
+            .children()
+            .filter(|c| c.is_element())
+            .map(tree::build)
+    }
+}
+
+/// Parses `source`, refusing what [`Limits`] and the format forbid (size, DTDs,
+/// node count, nesting), or says why it cannot.
+pub fn parse_document<'s>(
+    source: &'s SourceFile,
+    limits: &Limits,
+) -> Result<Document<'s>, Diagnostic> {
     let text = source.text.as_str();
     if text.len() > limits.max_file_size {
         return Err(Diagnostic::new(
@@ -64,9 +99,8 @@ pub fn parse<'s>(source: &'s SourceFile, limits: &Limits) -> Result<Element<'s>,
     };
     let document = roxmltree::Document::parse_with_options(text, options)
         .map_err(|error| xml_error(source, &error, limits))?;
-    let root = document.root_element();
-    check_depth(root, limits)?;
-    Ok(tree::build(root))
+    check_depth(document.root_element(), limits)?;
+    Ok(Document { xml: document })
 }
 
 /// The first "<!DOCTYPE", in any case. "<!" has no case variants, so only

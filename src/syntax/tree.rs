@@ -52,14 +52,7 @@ pub(super) fn build<'s>(root: roxmltree::Node<'_, 's>) -> Element<'s> {
         };
         match children.next() {
             Some(child) if child.is_element() => stack.push((child.children(), shell(child))),
-            Some(child) if child.is_text() => {
-                let text = child.text().unwrap_or("");
-                if !text.trim().is_empty() {
-                    element
-                        .text
-                        .push((text.trim().to_string(), Span::from_range(child.range())));
-                }
-            }
+            Some(child) if child.is_text() => push_text(element, child),
             Some(_) => {}
             None => {
                 let Some((_, finished)) = stack.pop() else {
@@ -74,7 +67,36 @@ pub(super) fn build<'s>(root: roxmltree::Node<'_, 's>) -> Element<'s> {
     }
 }
 
+/// The element with its attributes and non-whitespace text, and its child
+/// elements as [`shell`]s without capacity for children of their own.
+pub(super) fn shallow<'s>(node: roxmltree::Node<'_, 's>) -> Element<'s> {
+    let mut element = shell(node);
+    for child in node.children() {
+        if child.is_element() {
+            element.children.push(shell_with(child, 0));
+        } else if child.is_text() {
+            push_text(&mut element, child);
+        }
+    }
+    element
+}
+
+fn push_text(element: &mut Element, node: roxmltree::Node) {
+    let text = node.text().unwrap_or("");
+    if !text.trim().is_empty() {
+        element
+            .text
+            .push((text.trim().to_string(), Span::from_range(node.range())));
+    }
+}
+
 fn shell<'s>(node: roxmltree::Node<'_, 's>) -> Element<'s> {
+    // Sized exactly: no growth by doubling (the root of a large file has
+    // hundreds of thousands of children).
+    shell_with(node, node.children().filter(|c| c.is_element()).count())
+}
+
+fn shell_with<'s>(node: roxmltree::Node<'_, 's>, children: usize) -> Element<'s> {
     let range = node.range();
     let name = node.tag_name().name();
     let name_start = range.start + 1;
@@ -97,9 +119,7 @@ fn shell<'s>(node: roxmltree::Node<'_, 's>) -> Element<'s> {
                 value_span: Span::from_range(a.range_value()),
             })
             .collect(),
-        // Sized exactly: no growth by doubling (the root of a large file has
-        // hundreds of thousands of children).
-        children: Vec::with_capacity(node.children().filter(|c| c.is_element()).count()),
+        children: Vec::with_capacity(children),
         text: Vec::new(),
     }
 }

@@ -90,9 +90,7 @@ impl Builder {
     pub fn finish_unchecked(mut self) -> Result<Loaded, Vec<Diagnostic>> {
         let n = self.nodes.len();
         for g in &self.groups {
-            // The largest index, in a loop the compiler vectorises (a
-            // short-circuiting `any` is a branch per index).
-            let largest = g.triangles.as_flattened().iter().fold(0, |m, &v| m.max(v));
+            let largest = crate::formats::groups::largest_index(&g.triangles);
             let bad = (!g.triangles.is_empty() && largest as usize >= n)
                 || g.lines.iter().flatten().any(|&v| v as usize >= n)
                 || g.points.iter().any(|&v| v as usize >= n)

@@ -79,6 +79,42 @@ impl NodeIndex {
         self.table_insert(tag, index, dense_limit)
     }
 
+    /// Whether a block's tags (8 bytes each) continue the run for nodes
+    /// numbered from `next` on: each one more than the one before, the
+    /// first one after the run's last (or any, for the first node).
+    fn run_continues(&self, tags: &[u8], next: usize) -> bool {
+        let Some(first) = super::bytes_at::<8>(tags, 0).map(u64::from_le_bytes) else {
+            return false;
+        };
+        let n = tags.len() / 8;
+        let fits = u32::try_from(next + n).is_ok() && first.checked_add(n as u64).is_some();
+        let follows = match self.run {
+            _ if self.tabled => false,
+            None => next == 0,
+            Some((start, len)) => {
+                len as usize == next && start.checked_add(u64::from(len)) == Some(first)
+            }
+        };
+        fits && follows
+            && tags.par_chunks(8 << 12).enumerate().all(|(c, piece)| {
+                let base = first + (c as u64) * 4096;
+                // No early exit inside a piece, so the compiler vectorises it.
+                piece.chunks_exact(8).enumerate().fold(true, |ok, (i, t)| {
+                    ok & (u64::from_le_bytes(super::array(t).unwrap_or([0; 8])) == base + i as u64)
+                })
+            })
+    }
+
+    /// Adds a block's `n` nodes to the run (after [`NodeIndex::run_continues`]).
+    fn extend_run(&mut self, tags: &[u8], n: usize) {
+        let first = super::bytes_at::<8>(tags, 0).map_or(0, u64::from_le_bytes);
+        let len = n as u32;
+        self.run = match self.run {
+            None => Some((first, len)),
+            Some((start, old)) => Some((start, old + len)),
+        };
+    }
+
     fn move_run_to_table(&mut self, dense_limit: u64) {
         self.tabled = true;
         if let Some((first, len)) = self.run.take() {
@@ -585,6 +621,10 @@ impl<'a> Reader<'a> {
             return Ok(false);
         };
         let first_coordinate = start + 8 * n;
+        if self.run_on_block(tags, coordinates) {
+            self.s.pos = start + 32 * n;
+            return Ok(true);
+        }
         for (i, (record, tag)) in coordinates
             .chunks_exact(24)
             .zip(tags.chunks_exact(8))
@@ -607,6 +647,39 @@ impl<'a> Reader<'a> {
         }
         self.s.pos = start + 32 * n;
         Ok(true)
+    }
+
+    /// The common block at once: tags that run on from the nodes before
+    /// (1, 2, 3, …) and finite coordinates, copied in parallel pieces (in
+    /// order). `false`, with nothing added, for any other block: the
+    /// node-by-node loop then reads it and gives the first error.
+    fn run_on_block(&mut self, tags: &[u8], coordinates: &[u8]) -> bool {
+        let n = tags.len() / 8;
+        let next = self.b.nodes.len();
+        if n == 0 || !self.nodes.run_continues(tags, next) {
+            return false;
+        }
+        let non_finite = AtomicBool::new(false);
+        let value =
+            |r: &[u8], at: usize| f64::from_le_bytes(super::bytes_at::<8>(r, at).unwrap_or([0; 8]));
+        self.b.nodes.par_extend(
+            coordinates
+                .par_chunks_exact(24)
+                .with_min_len(4096)
+                .map(|r| {
+                    let p = [value(r, 0), value(r, 8), value(r, 16)];
+                    if !(p[0].is_finite() & p[1].is_finite() & p[2].is_finite()) {
+                        non_finite.store(true, Ordering::Relaxed);
+                    }
+                    p
+                }),
+        );
+        if non_finite.load(Ordering::Relaxed) {
+            self.b.nodes.truncate(next);
+            return false;
+        }
+        self.nodes.extend_run(tags, n);
+        true
     }
 
     /// A binary block of `n` elements of `k` nodes read at once, when the

@@ -54,40 +54,56 @@ const TRIMMED: [&str; 6] = [
     "torus_surface",
 ];
 
-/// Moves the implicit definitions, and every subdomain whose solid tree
-/// names one of them, out of `root`.
-pub fn extract<'s>(root: &mut Element<'s>) -> Extracted<'s> {
-    let names: HashSet<String> = root
-        .children
-        .iter()
-        .filter(|c| SOLIDS.contains(&c.name))
-        .filter_map(|c| c.attribute("name"))
-        .map(|a| a.value.trim().to_string())
-        .collect();
-    let mut out = Extracted::default();
-    for surface in root.children.iter().filter(|c| TRIMMED.contains(&c.name)) {
-        let name = surface
-            .attribute("name")
-            .map_or(String::new(), |a| a.value.trim().to_string());
-        for t in surface.children_named("trim") {
-            if !t.children.is_empty() {
-                out.trims.push((name.clone(), t.clone()));
+/// Decides, one top-level element at a time, which elements the implicit path
+/// takes: the implicit definitions, and every subdomain whose solid tree names
+/// one of them (so the driver can build a large file's elements one by one).
+pub struct Extractor {
+    /// The names of the implicit solids.
+    names: HashSet<String>,
+    /// Whether the file has any implicit element at all.
+    any: bool,
+}
+
+impl Extractor {
+    /// Reads the root's children (shells are enough: names and attributes).
+    pub fn new(root: &Element) -> Extractor {
+        Extractor {
+            names: root
+                .children
+                .iter()
+                .filter(|c| SOLIDS.contains(&c.name))
+                .filter_map(|c| c.attribute("name"))
+                .map(|a| a.value.trim().to_string())
+                .collect(),
+            any: root.children.iter().any(|c| ELEMENTS.contains(&c.name)),
+        }
+    }
+
+    /// Moves `child` into `out` when the implicit path owns it, else hands it
+    /// back; copies of a trimmed surface's `<trim>` trees go to `out.trims`.
+    pub fn take<'s>(&self, child: Element<'s>, out: &mut Extracted<'s>) -> Option<Element<'s>> {
+        if TRIMMED.contains(&child.name) {
+            let name = child
+                .attribute("name")
+                .map_or(String::new(), |a| a.value.trim().to_string());
+            for t in child.children_named("trim") {
+                if !t.children.is_empty() {
+                    out.trims.push((name.clone(), t.clone()));
+                }
             }
         }
-    }
-    if !root.children.iter().any(|c| ELEMENTS.contains(&c.name)) {
-        return out;
-    }
-    for child in std::mem::take(&mut root.children) {
-        if ELEMENTS.contains(&child.name) {
+        if !self.any {
+            Some(child)
+        } else if ELEMENTS.contains(&child.name) {
             out.defs.push(child);
-        } else if child.name == "subdomain" && names_any(&child, &names) {
+            None
+        } else if child.name == "subdomain" && names_any(&child, &self.names) {
             out.subdomains.push(child);
+            None
         } else {
-            root.children.push(child);
+            Some(child)
         }
     }
-    out
 }
 
 /// Whether a `<solid ref>` below `e` names one of `names`.
