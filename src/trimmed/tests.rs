@@ -249,20 +249,25 @@ fn interstage_at_tolerance_0_002_and_25_degrees_has_no_skinny_triangle() {
     check_interstage_at(0.002, 25.0);
 }
 
+/// The one trimmed surface of a valid fixture.
+fn fixture_surface(name: &str, text: &str) -> TrimmedSurface {
+    let source = crate::span::SourceFile::new(name, text);
+    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
+    assert!(checked.is_valid(), "{:?}", checked.diagnostics);
+    let model = &checked.lowered.as_ref().expect("lowered").model;
+    assert_eq!(model.trimmed.len(), 1);
+    model.trimmed[0].clone()
+}
+
 /// Before the fix one triangle of 23.7° stayed in the patch's 90° corner at
 /// (0, −1, −1): its two boundary edges excused it from the angle test as if
 /// they met at an input angle smaller than the threshold.
 #[test]
 fn bezier_hole_at_tolerance_0_003_and_25_degrees_has_no_skinny_triangle() {
-    let source = crate::span::SourceFile::new(
+    let s = &fixture_surface(
         "trimmed_bezier_hole.xml",
         include_str!("../../fixtures/valid/trimmed_bezier_hole.xml"),
     );
-    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
-    assert!(checked.is_valid(), "{:?}", checked.diagnostics);
-    let model = &checked.lowered.as_ref().expect("lowered").model;
-    assert_eq!(model.trimmed.len(), 1);
-    let s = &model.trimmed[0];
     let settings = TrimSettings {
         tolerance: 0.003,
         min_angle: 25.0,
@@ -283,15 +288,10 @@ fn check_interstage(min_angle: f64) {
 }
 
 fn check_interstage_at(tolerance: f64, min_angle: f64) {
-    let source = crate::span::SourceFile::new(
+    let s = &fixture_surface(
         "trimmed_interstage.xml",
         include_str!("../../fixtures/valid/trimmed_interstage.xml"),
     );
-    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
-    assert!(checked.is_valid(), "{:?}", checked.diagnostics);
-    let model = &checked.lowered.as_ref().expect("lowered").model;
-    assert_eq!(model.trimmed.len(), 1);
-    let s = &model.trimmed[0];
     let settings = TrimSettings {
         tolerance,
         min_angle,
@@ -364,13 +364,10 @@ fn density(triangles: usize, area: f64, size: f64) -> f64 {
 
 #[test]
 fn interstage_counts_follow_the_element_size() {
-    let source = crate::span::SourceFile::new(
+    let s = &fixture_surface(
         "trimmed_interstage.xml",
         include_str!("../../fixtures/valid/trimmed_interstage.xml"),
     );
-    let checked = crate::driver::check_source(source, &crate::driver::Options::default());
-    let model = &checked.lowered.as_ref().expect("lowered").model;
-    let s = &model.trimmed[0];
     let mut figures = Vec::new();
     for size in [0.2, 0.1, 0.05] {
         let settings = TrimSettings {
