@@ -4,11 +4,11 @@
 //! and the samples of a pixel are averaged with straight alpha.
 
 use super::raster::{EMPTY, Projected, ZBuffer, prefetch};
+use super::scene::Scene;
+use rayon::prelude::*;
 
 /// Pixels ahead whose triangle's corners are fetched while one is shaded.
 const AHEAD: usize = 8;
-use super::scene::Scene;
-use rayon::prelude::*;
 
 pub const EDGE_COLOR: [u8; 4] = [25, 25, 30, 255];
 
