@@ -149,6 +149,60 @@ fn disk_region_has_pi_area_30_degrees_and_nodes_on_the_circle() {
     assert!(triangles(&m).len() as f64 >= PI / 0.01);
 }
 
+/// An area limit far below the contour's spacing makes refinement split
+/// contour pieces: the new nodes go on the circle (f = 0), not on the chords
+/// (up to 2e-3 inside the circle here).
+#[test]
+fn contour_pieces_split_by_refinement_get_their_nodes_on_the_circle() {
+    let coarse = mesh(DISK, &at_30_degrees(Some(0.01)));
+    let m = mesh(DISK, &at_30_degrees(Some(1e-4)));
+    let (traced, refined) = (boundary_segments(&coarse), boundary_segments(&m));
+    assert!(
+        refined >= 2 * traced,
+        "{traced} -> {refined} boundary segments"
+    );
+    let nodes = boundary_nodes(&m);
+    assert_eq!(nodes.len(), refined);
+    for p in &nodes {
+        let r = p[0].hypot(p[1]);
+        assert!(
+            (r - 1.0).abs() < 1e-9,
+            "boundary node off the circle: r = {r}"
+        );
+    }
+    let angle = min_angle(&m);
+    assert!(angle >= 30.0 - 1e-9, "min angle {angle}");
+    let a = area(&m);
+    assert!((a - PI).abs() / PI < 1e-4, "area {a}");
+}
+
+/// `area=` on a region's subdomain limits its triangles' area, as on a
+/// kernel subdomain; a limit that is not positive is E300.
+#[test]
+fn area_attribute_of_a_region_subdomain_limits_its_triangles() {
+    let limited = DISK.replace(
+        r#"<subdomain name="inside" material="steel">"#,
+        r#"<subdomain name="inside" material="steel" area="2e-3">"#,
+    );
+    let m = mesh(&limited, &at_30_degrees(None));
+    let largest = triangles(&m)
+        .iter()
+        .map(|t| {
+            let [p, q, r] = t.map(|n| m.nodes[n as usize]);
+            0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
+        })
+        .fold(0.0f64, f64::max);
+    assert!(largest <= 2e-3, "largest triangle {largest}");
+    assert!(triangles(&m).len() as f64 >= PI / 2e-3);
+    let unlimited = mesh(DISK, &at_30_degrees(None));
+    assert!(triangles(&unlimited).len() < triangles(&m).len() / 2);
+    let bad = DISK.replace(
+        r#"<subdomain name="inside" material="steel">"#,
+        r#"<subdomain name="inside" material="steel" area="-1">"#,
+    );
+    assert_eq!(codes(&bad), vec![Code::NonPositiveSize]);
+}
+
 #[test]
 fn annulus_region_has_two_loops_on_their_circles() {
     let m = mesh(ANNULUS, &at_30_degrees(None));

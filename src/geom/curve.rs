@@ -5,6 +5,7 @@ use super::newton::project_onto_pair;
 use super::point_calculus::PcCurve;
 use super::trace::{polyline_at, trace};
 use super::{Point3, Surface, Vec3};
+use crate::implicit::tape::Ssa;
 use std::f64::consts::TAU;
 
 #[derive(Debug, Clone, PartialEq)]
@@ -33,6 +34,11 @@ pub enum Curve {
     /// curve or a patch side), sampled at the model tolerance; its mesh nodes
     /// come from the surface's own meshing, not from this polyline.
     Chain { points: Vec<Point3> },
+    /// A piece a → b of a 2D R-function region's contour f(x, y) = 0 (a
+    /// marching-squares segment): its points lie on the contour where it
+    /// crosses the chord's normal, so a split by refinement lands on the
+    /// true curve, not on the chord.
+    Contour { a: Point3, b: Point3, f: Box<Ssa> },
 }
 
 impl Curve {
@@ -61,6 +67,7 @@ impl Curve {
             }
             Curve::PointCalculus(c) => c.point(s),
             Curve::Chain { points } => polyline_at(points, s).0,
+            Curve::Contour { a, b, f } => contour_point(a, b, f, s),
         }
     }
 
@@ -86,7 +93,7 @@ impl Curve {
     /// The unit tangent at s, in the direction of increasing s.
     pub fn tangent(&self, s: f64) -> Vec3 {
         match self {
-            Curve::Segment { a, b } => unit(b - a),
+            Curve::Segment { a, b } | Curve::Contour { a, b, .. } => unit(b - a),
             Curve::Ellipse {
                 major,
                 minor,
@@ -117,7 +124,7 @@ impl Curve {
 
     pub fn is_closed(&self) -> bool {
         match self {
-            Curve::Segment { .. } => false,
+            Curve::Segment { .. } | Curve::Contour { .. } => false,
             Curve::Ellipse { t0, t1, .. } => (t1 - t0).abs() >= TAU * (1.0 - 1e-12),
             Curve::Intersection { a, b, .. } => same_point(a, b),
             Curve::PointCalculus(c) => same_point(&c.begin(), &c.end()),
@@ -159,7 +166,8 @@ impl Curve {
     /// The length, exact for segments and circles, by quadrature otherwise.
     pub fn length(&self) -> f64 {
         match self {
-            Curve::Segment { a, b } => (b - a).norm(),
+            // A contour piece is within half the chordal tolerance of its chord.
+            Curve::Segment { a, b } | Curve::Contour { a, b, .. } => (b - a).norm(),
             Curve::Ellipse {
                 major,
                 minor,
@@ -192,7 +200,7 @@ impl Curve {
     /// tangent there; the building block of [`super::intersect_curves`].
     pub(super) fn carrier_project(&self, p: &Point3) -> Option<(Point3, Vec3)> {
         match self {
-            Curve::Segment { a, b } => {
+            Curve::Segment { a, b } | Curve::Contour { a, b, .. } => {
                 let d = b - a;
                 let len2 = d.norm_squared();
                 if len2 <= 0.0 || !len2.is_finite() {
@@ -234,6 +242,74 @@ impl Curve {
             _ => p,
         }
     }
+}
+
+/// The point of f = 0 on the normal to the chord a → b through its point
+/// at s: the sign change nearest the chord, searched in steps doubling up to
+/// half the chord's length either side, then Illinois steps. The chord point
+/// itself when f has no sign change there (or is not finite).
+fn contour_point(a: &Point3, b: &Point3, f: &Ssa, s: f64) -> Point3 {
+    let c = a + (b - a) * s.clamp(0.0, 1.0);
+    let d = b - a;
+    let length = d.norm();
+    if s <= 0.0 || s >= 1.0 || length.is_nan() || length <= 0.0 {
+        return c;
+    }
+    let normal = Vec3::new(-d.y, d.x, 0.0) / length;
+    let g = |t: f64| {
+        let p = c + normal * t;
+        f.eval_point([p.x, p.y, p.z])
+    };
+    let g0 = g(0.0);
+    if g0 == 0.0 || !g0.is_finite() {
+        return c;
+    }
+    let mut step = 1e-3 * length;
+    while step <= 0.5 * length {
+        for t in [step, -step] {
+            let gt = g(t);
+            if gt.is_finite() && (gt > 0.0) != (g0 > 0.0) {
+                return c + normal * illinois(&g, (0.0, g0), (t, gt), 1e-14 * length);
+            }
+        }
+        step *= 2.0;
+    }
+    c
+}
+
+/// A root of g between x0 and x1, where g changes sign (Illinois variant
+/// of regula falsi: halves the stale end's value so both ends move).
+fn illinois(
+    g: &dyn Fn(f64) -> f64,
+    (mut x0, mut g0): (f64, f64),
+    (mut x1, mut g1): (f64, f64),
+    tolerance: f64,
+) -> f64 {
+    let mut side = 0;
+    for _ in 0..100 {
+        let x = (x0 * g1 - x1 * g0) / (g1 - g0);
+        if !x.is_finite() {
+            break;
+        }
+        let gx = g(x);
+        if gx == 0.0 || (x1 - x0).abs() <= tolerance {
+            return x;
+        }
+        if (gx > 0.0) == (g1 > 0.0) {
+            (x1, g1) = (x, gx);
+            if side == 1 {
+                g0 *= 0.5;
+            }
+            side = 1;
+        } else {
+            (x0, g0) = (x, gx);
+            if side == -1 {
+                g1 *= 0.5;
+            }
+            side = -1;
+        }
+    }
+    0.5 * (x0 + x1)
 }
 
 fn ellipse_point(center: &Point3, major: &Vec3, minor: &Vec3, t: f64) -> Point3 {

@@ -242,6 +242,8 @@ fn add_region(
         ));
     }
     let origin = Origin { span: sub.span };
+    // Each contour piece carries f, so splits by refinement land on f = 0.
+    let contour = f.ssa();
     let mut face_loops = Vec::with_capacity(loops.len());
     for (l, points) in loops.iter().enumerate() {
         let first = model.vertices.len();
@@ -260,9 +262,10 @@ fn add_region(
             let id = EdgeId(model.edges.len() as u32);
             model.edges.push(Edge {
                 name: format!("{}.contour[{}].e{}", sub.name, l + 1, k + 1),
-                curve: Curve::Segment {
+                curve: Curve::Contour {
                     a: model.vertices[a].position,
                     b: model.vertices[b].position,
+                    f: Box::new(contour.clone()),
                 },
                 begin: VertexId(a as u32),
                 end: VertexId(b as u32),
@@ -291,6 +294,7 @@ fn add_region(
         name: sub.name.clone(),
         material: sub.material.clone(),
         cells: SubdomainCells::Region { faces: vec![face] },
+        max_area: sub.max_area,
         ..Default::default()
     });
     source_map.subdomains.insert(id, origin);

@@ -54,7 +54,7 @@ pub(crate) fn discretise(
         .position;
     let mut n = match &edge.curve {
         _ if edge.is_closed() => 3,
-        Curve::Segment { .. } => 1,
+        Curve::Segment { .. } | Curve::Contour { .. } => 1,
         _ => 2,
     };
     if let Curve::PointCalculus(curve) = &edge.curve {
@@ -69,8 +69,9 @@ pub(crate) fn discretise(
         nodes.params = params;
         return Ok(nodes);
     }
-    if let Curve::Segment { a, b } = &edge.curve {
-        // A straight edge only needs the length limit.
+    if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = &edge.curve {
+        // A straight edge only needs the length limit (a contour piece is
+        // within the tolerance of its chord already).
         let length = (b - a).norm();
         if max_edge.is_finite() && max_edge > 0.0 {
             n = n.max((length / max_edge).ceil() as usize);

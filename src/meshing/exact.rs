@@ -172,6 +172,8 @@ fn planar(model: &Model, face: &Face, origin: &Point3, normal: &Vec3) -> Option<
 fn loop_integral(curve: &Curve) -> Option<Vec3> {
     match curve {
         Curve::Segment { a, b } => Some(a.coords.cross(&b.coords)),
+        // The chord's: the region's area is that of its traced polygon.
+        Curve::Contour { a, b, .. } => Some(a.coords.cross(&b.coords)),
         Curve::Ellipse {
             center,
             major,

@@ -54,7 +54,7 @@ fn subdomain_name(model: &Model, id: SubdomainId) -> String {
 /// only (the evaluation methods belong to the geometry kernel).
 fn curve_is_closed(curve: &Curve, tolerance: f64) -> bool {
     match curve {
-        Curve::Segment { .. } => false,
+        Curve::Segment { .. } | Curve::Contour { .. } => false,
         Curve::Ellipse { t0, t1, .. } => {
             ((t1 - t0) - std::f64::consts::TAU).abs() <= ANGLE_TOLERANCE
         }
@@ -70,6 +70,7 @@ fn curve_is_closed(curve: &Curve, tolerance: f64) -> bool {
 fn curve_description(curve: &Curve) -> String {
     match curve {
         Curve::Segment { .. } => "a straight segment".to_string(),
+        Curve::Contour { .. } => "a piece of a region's contour".to_string(),
         Curve::Ellipse { t0, t1, .. } => format!("an arc spanning {:.6} rad, not 2π", t1 - t0),
         Curve::Intersection { .. } => "an intersection curve with distinct ends".to_string(),
         Curve::PointCalculus(c) => format!("a {} with distinct ends", c.element()),

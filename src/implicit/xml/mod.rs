@@ -150,6 +150,8 @@ pub struct ImplicitSubdomain {
     pub material: Option<String>,
     pub span: Span,
     pub solid: ImplicitSolid,
+    /// 2D regions: the largest triangle area (`area=`).
+    pub max_area: Option<f64>,
 }
 
 impl ImplicitSubdomain {
@@ -250,15 +252,42 @@ pub fn lower(ex: &Extracted, env: &Env, diags: &mut Diagnostics) -> Lowered {
             Some(solid) => solid,
             None => continue,
         };
+        let max_area = area_limit(s, env, &mut out.used_parameters, diags);
         out.subdomains.push(ImplicitSubdomain {
             name: name.value.trim().to_string(),
             material: s.attribute("material").map(|a| a.value.to_string()),
             span: s.name_span,
             solid,
+            max_area,
         });
     }
     overlap::check(&out.subdomains, diags);
     out
+}
+
+/// A subdomain's `area=` (read by 2D regions): `None` when absent or bad
+/// (reported, as for kernel subdomains).
+fn area_limit(
+    s: &Element,
+    env: &Env,
+    used: &mut BTreeSet<String>,
+    diags: &mut Diagnostics,
+) -> Option<f64> {
+    let area = settings::constant(s, "area", env, used, diags)??;
+    if area > 0.0 {
+        return Some(area);
+    }
+    let name = s.attribute("name").map_or("", |a| a.value.trim());
+    let span = s.attribute("area").map_or(s.name_span, |a| a.value_span);
+    diags.push(
+        Diagnostic::new(
+            Code::NonPositiveSize,
+            span,
+            format!("the area limit of '{name}' is {area}; it must be positive"),
+        )
+        .with_help("give the area limit a value greater than zero"),
+    );
+    None
 }
 
 /// The solid of one subdomain tree: a density volume alone, or R-operations
