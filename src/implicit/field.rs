@@ -327,24 +327,12 @@ fn close_dense_at_box(values: &mut [f32], n1: [usize; 3]) {
 mod tests {
     use super::*;
     use crate::implicit::ir::Ctx;
-    use crate::implicit::library;
-    use crate::implicit::rfs::RSystem;
 
     /// A ball of radius 1.2 in the box [-1, 1]³: it leaves the box through
     /// the six faces, so proven-inside blocks lie on the box.
     fn big_ball() -> Ssa {
         let mut ctx = Ctx::new();
-        let args = [
-            ctx.var(0),
-            ctx.var(1),
-            ctx.var(2),
-            ctx.constant(1.2),
-            ctx.constant(0.05),
-            ctx.constant(0.0),
-            ctx.constant(-0.03),
-        ];
-        let lib = library::lookup("Ball").expect("Ball is in the library");
-        let f = (lib.build)(&mut ctx, RSystem::Rvachev, &args).expect("Ball builds");
+        let f = crate::implicit::vertices::tests::ball(&mut ctx, 1.2, [0.05, 0.0, -0.03]);
         Ssa::from_ctx(&ctx, f)
     }
 

@@ -378,7 +378,7 @@ fn illinois(
 }
 
 #[cfg(test)]
-mod tests {
+pub(super) mod tests {
     use super::*;
     use crate::implicit::field::sample_field;
     use crate::implicit::ir::{Binary, Ctx, NodeId};
@@ -387,7 +387,8 @@ mod tests {
     use crate::implicit::rfs::RSystem;
     use crate::implicit::tape::Ssa;
 
-    fn ball(ctx: &mut Ctx, r: f64, c: [f64; 3]) -> NodeId {
+    /// Paper 001's `Ball` of radius r about c (Rvachev's system).
+    pub(in crate::implicit) fn ball(ctx: &mut Ctx, r: f64, c: [f64; 3]) -> NodeId {
         let args = [
             ctx.var(0),
             ctx.var(1),

@@ -273,6 +273,18 @@ fn acute_vertices(cdt: &Cdt) -> Vec<bool> {
 }
 
 impl Refiner<'_, '_> {
+    /// Gives the per-face tables a slot for every face spade made (new
+    /// faces start outside, at generation 0).
+    fn grow_face_tables(&mut self) {
+        let n = self.cdt.num_all_faces();
+        if self.outside.len() < n {
+            self.outside.resize(n, true);
+        }
+        if self.generation.len() < n {
+            self.generation.resize(n, 0);
+        }
+    }
+
     /// Queues the triangle when it is bad.
     fn push_triangle(&mut self, f: FixedFaceHandle<InnerTag>) {
         self.push_triangle_at(f, self.cdt.face(f).positions());
@@ -428,13 +440,7 @@ impl Refiner<'_, '_> {
                 return;
             }
         };
-        let n = self.cdt.num_all_faces();
-        if self.outside.len() < n {
-            self.outside.resize(n, true);
-        }
-        if self.generation.len() < n {
-            self.generation.resize(n, 0);
-        }
+        self.grow_face_tables();
         let mut star = std::mem::take(&mut self.star);
         star.clear();
         self.encroached.clear();
@@ -900,13 +906,7 @@ impl Refiner<'_, '_> {
     /// for the quality check, and the segments opposite `v` for
     /// encroachment.
     fn after_insertion(&mut self, v: FixedVertexHandle, side: Side) {
-        let n = self.cdt.num_all_faces();
-        if self.outside.len() < n {
-            self.outside.resize(n, true);
-        }
-        if self.generation.len() < n {
-            self.generation.resize(n, 0);
-        }
+        self.grow_face_tables();
         let mut faces = std::mem::take(&mut self.around);
         let mut opposite = std::mem::take(&mut self.opposite);
         faces.clear();
