@@ -273,3 +273,63 @@ fn a_trimmed_face_that_does_not_meet_its_shell_is_refused() {
     );
     assert!(!out.exists());
 }
+
+/// The smallest angle of a triangle, in degrees, with corners in any
+/// dimension given as coordinates.
+fn smallest_angle<const N: usize>(p: [[f64; N]; 3]) -> f64 {
+    (0..3)
+        .map(|k| {
+            let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
+            let u: Vec<f64> = (0..N).map(|i| b[i] - a[i]).collect();
+            let v: Vec<f64> = (0..N).map(|i| c[i] - a[i]).collect();
+            let dot: f64 = u.iter().zip(&v).map(|(x, y)| x * y).sum();
+            let nu = u.iter().map(|x| x * x).sum::<f64>().sqrt();
+            let nv = v.iter().map(|x| x * x).sum::<f64>().sqrt();
+            (dot / (nu * nv)).clamp(-1.0, 1.0).acos().to_degrees()
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
+/// Issue 3 asks for 25° on planar faces: the post's top (whose rim the
+/// plate's hole takes) and bottom have it. Its side is a cylinder, refined
+/// in its conformal log-polar chart (ln R = y / r, θ): 25° holds there; on
+/// the surface a straight chart triangle spanning a third of a unit of ln R
+/// is bent, which left one triangle at 22.2° against the rim (26.2° in the
+/// chart). The rim is not held fixed: the side is meshed in one round
+/// before the plate takes the rim's nodes.
+#[test]
+fn plate_on_post_keeps_25_degrees_on_its_planes_and_in_the_side_chart() {
+    let mesh = mesh_of("fixtures/valid/trimmed_plate_on_post.xml");
+    let face_angles = |name: &str, map: &dyn Fn([f64; 3]) -> Vec<f64>| {
+        mesh.faces[face_index(&mesh, name)]
+            .triangles
+            .iter()
+            .map(|t| {
+                let c = t.map(|n| map(mesh.nodes[n as usize]));
+                smallest_angle([
+                    [c[0][0], c[0][1], c[0].get(2).copied().unwrap_or(0.0)],
+                    [c[1][0], c[1][1], c[1].get(2).copied().unwrap_or(0.0)],
+                    [c[2][0], c[2][1], c[2].get(2).copied().unwrap_or(0.0)],
+                ])
+            })
+            .fold(f64::INFINITY, f64::min)
+    };
+    let space = |p: [f64; 3]| p.to_vec();
+    for plane in ["post.top", "post.bottom"] {
+        let angle = face_angles(plane, &space);
+        assert!(angle >= 25.0, "{plane}: smallest angle {angle:.2}°");
+    }
+    let chart = |p: [f64; 3]| {
+        let scale = (p[1] / 0.4).exp();
+        let theta = p[2].atan2(p[0]);
+        vec![scale * theta.cos(), scale * theta.sin()]
+    };
+    let in_chart = face_angles("post.side", &chart);
+    assert!(in_chart >= 25.0, "post.side in its chart: {in_chart:.2}°");
+    // The chart's bend at this tolerance, not a bound the mesher promises.
+    let on_surface = face_angles("post.side", &space);
+    assert!(
+        on_surface >= 22.0,
+        "post.side on the surface: {on_surface:.2}°"
+    );
+}

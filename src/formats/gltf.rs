@@ -8,7 +8,7 @@
 //! edges; each node's `extras` say what it is and, for a fragment, its
 //! subdomain pair. Floats are `f32`, as glTF requires.
 
-use super::groups::{self, Source, StreamedNormals};
+use super::groups::{self, Source};
 use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
 use crate::mesh::Mesh;
 use serde_json::{Value, json};
@@ -115,8 +115,9 @@ enum Piece {
     /// Indices written as little-endian `u32`.
     Indices(Vec<u32>),
     /// A triangle group's positions, normals and indices, one after the
-    /// other: expanded only while it is written, so one group's expansion
-    /// is alive at a time, not every group's (`groups::Expander::stream`).
+    /// other: the expansion's vertices, normals and triangles are made
+    /// while they are written (one pass over the faces each), so none of
+    /// them is held; only one face's normal sums are.
     Group {
         faces: Vec<(u32, bool)>,
         measured: groups::Measure,
@@ -143,28 +144,73 @@ impl Piece {
             Piece::Vec3F32(v) => write_blocks(v.as_flattened(), block, out, f32::to_le_bytes),
             Piece::Indices(i) => write_blocks(i, block, out, u32::to_le_bytes),
             Piece::Group { faces, measured } => {
-                let group = expander.stream(faces, measured);
-                let nodes = expander.mesh_nodes();
-                let position = |p: [f64; 3]| f32x3_bytes(p.map(|c| c as f32));
-                match &group.nodes {
-                    None => write_blocks(&nodes[..group.normals.len()], block, out, position)?,
-                    Some(ids) => {
-                        write_blocks(ids, block, out, |n| position(nodes[n as usize]))?;
-                    }
+                let mesh = expander.mesh();
+                if let ([(face, false)], Some(used)) = (faces.as_slice(), measured.identity) {
+                    // One face as it is: its vertices are the mesh's first
+                    // nodes and its triangles the face's own.
+                    write_blocks(&mesh.nodes[..used], block, out, position)?;
+                    let (sums, fallback) = expander.identity_sums(*face, used);
+                    write_blocks(&sums, block, out, |s| {
+                        f32x3_bytes(groups::unit_f32(s, fallback))
+                    })?;
+                    let triangles = &mesh.faces[*face as usize].triangles;
+                    return write_blocks(triangles.as_flattened(), block, out, u32::to_le_bytes);
                 }
-                match &group.normals {
-                    StreamedNormals::Unit(v) => {
-                        write_blocks(v.as_flattened(), block, out, f32::to_le_bytes)?;
+                let mut blocks = Blocks::new(block, out);
+                expander.each_vertex(faces, |n| blocks.put(&position(mesh.nodes[n as usize])))?;
+                // One face's sums at a time; reserved for the whole group
+                // at once (pages only count once written).
+                let mut sums = Vec::with_capacity(measured.vertices);
+                expander.each_normal(faces, &mut sums, |n| {
+                    blocks.put(&f32x3_bytes(n.map(|c| c as f32)))
+                })?;
+                drop(sums);
+                expander.each_triangle(faces, |t| {
+                    let mut b = [0u8; 12];
+                    for (slot, i) in b.chunks_exact_mut(4).zip(t) {
+                        slot.copy_from_slice(&i.to_le_bytes());
                     }
-                    StreamedNormals::Sums { sums, fallback } => {
-                        write_blocks(sums, block, out, |s| {
-                            f32x3_bytes(StreamedNormals::unit_f32(s, *fallback))
-                        })?;
-                    }
-                }
-                write_blocks(group.triangles.as_flattened(), block, out, u32::to_le_bytes)
+                    blocks.put(&b)
+                })?;
+                blocks.finish()
             }
         }
+    }
+}
+
+/// An `f64` position as the 12 bytes of its `f32` coordinates.
+fn position(p: [f64; 3]) -> [u8; 12] {
+    f32x3_bytes(p.map(|c| c as f32))
+}
+
+/// Values made one at a time, gathered into blocks of about [`BLOCK`]
+/// bytes before each write.
+struct Blocks<'b> {
+    block: &'b mut Vec<u8>,
+    out: &'b mut dyn Write,
+}
+
+impl<'b> Blocks<'b> {
+    /// Starts empty (`write_blocks` leaves its last block in `block`).
+    fn new(block: &'b mut Vec<u8>, out: &'b mut dyn Write) -> Blocks<'b> {
+        block.clear();
+        Blocks { block, out }
+    }
+
+    fn put(&mut self, bytes: &[u8]) -> std::io::Result<()> {
+        self.block.extend_from_slice(bytes);
+        if self.block.len() >= BLOCK {
+            self.out.write_all(self.block)?;
+            self.block.clear();
+        }
+        Ok(())
+    }
+
+    /// Writes what is left.
+    fn finish(self) -> std::io::Result<()> {
+        self.out.write_all(self.block)?;
+        self.block.clear();
+        Ok(())
     }
 }
 

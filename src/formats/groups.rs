@@ -272,48 +272,14 @@ pub(crate) struct Measure {
     pub lo: [f32; 3],
     pub hi: [f32; 3],
     /// `Some(k)`: one face as it is whose nodes are `0..k` in first-use
-    /// order (the expansion copies nothing), found once for [`Expander::stream`].
+    /// order (the expansion copies nothing), found once for the writer.
     pub identity: Option<usize>,
 }
 
-/// A group's expansion as a writer streams it: the mesh node of each vertex
-/// (positions are read from the mesh while written), its normals and the
-/// re-indexed triangles.
-#[derive(Debug)]
-pub(crate) struct Streamed<'a> {
-    /// The mesh node each vertex copies; `None` when vertex `i` is node `i`.
-    pub nodes: Option<Vec<u32>>,
-    pub normals: StreamedNormals,
-    pub triangles: Cow<'a, [[u32; 3]]>,
-}
-
-/// A streamed group's vertex normals.
-#[derive(Debug)]
-pub(crate) enum StreamedNormals {
-    /// Unit normals as `f32` (an expansion: 12 bytes a vertex).
-    Unit(Vec<[f32; 3]>),
-    /// The area-weighted sums of one face as it is, made unit (`fallback` for
-    /// a zero sum) and converted by [`StreamedNormals::unit_f32`] while they
-    /// are written: no second vector, no pass of its own.
-    Sums {
-        sums: Vec<[f64; 3]>,
-        fallback: [f64; 3],
-    },
-}
-
-impl StreamedNormals {
-    /// The number of vertices.
-    pub(crate) fn len(&self) -> usize {
-        match self {
-            StreamedNormals::Unit(v) => v.len(),
-            StreamedNormals::Sums { sums, .. } => sums.len(),
-        }
-    }
-
-    /// A sum made unit as [`node_normals`] makes it, then `f32`.
-    pub(crate) fn unit_f32(sum: [f64; 3], fallback: [f64; 3]) -> [f32; 3] {
-        unit(sum).unwrap_or(fallback).map(|c| c as f32)
-    }
+/// A normal sum made unit as [`node_normals`] makes it (`fallback` for a
+/// zero sum), then `f32`: what a writer streaming the sums writes.
+pub(crate) fn unit_f32(sum: [f64; 3], fallback: [f64; 3]) -> [f32; 3] {
+    unit(sum).unwrap_or(fallback).map(|c| c as f32)
 }
 
 /// Expands groups of one mesh: each node's vertex in the current face sits in
@@ -413,34 +379,104 @@ impl<'a> Expander<'a> {
         m
     }
 
-    /// The expansion [`Expander::expand`] makes, kept as it is written:
-    /// nodes instead of positions, normals as `f32` or as sums made unit
-    /// while written (the same numbers: normals are summed and made unit in
-    /// `f64` per face, then converted as the writer converted them).
-    /// `measured` is what [`Expander::measure`] gave for these faces.
-    pub(crate) fn stream(&mut self, faces: &[(u32, bool)], measured: &Measure) -> Streamed<'a> {
-        let mesh = self.mesh;
-        if let ([(face, false)], Some(used)) = (faces, measured.identity) {
-            let triangles = &mesh.faces[*face as usize].triangles;
-            let (sums, fallback) = node_sums(mesh, triangles, used);
-            return Streamed {
-                nodes: None,
-                normals: StreamedNormals::Sums { sums, fallback },
-                triangles: Cow::Borrowed(triangles),
-            };
-        }
-        self.prepare();
-        let (nodes, normals, triangles) = expand_faces(self, faces, |n| n.map(|c| c as f32));
-        Streamed {
-            nodes: Some(nodes),
-            normals: StreamedNormals::Unit(normals),
-            triangles: Cow::Owned(triangles),
-        }
+    /// The area-weighted normal sums of one face as it is whose nodes are
+    /// `0..used` (`Measure::identity`), to be made unit while written
+    /// ([`unit_f32`]): the expansion would copy nothing but its normals.
+    /// Returns the sums and the normal of a node whose sum is zero.
+    pub(crate) fn identity_sums(&self, face: u32, used: usize) -> (Vec<[f64; 3]>, [f64; 3]) {
+        node_sums(self.mesh, &self.mesh.faces[face as usize].triangles, used)
     }
 
-    /// The mesh's node positions.
-    pub(crate) fn mesh_nodes(&self) -> &'a [[f64; 3]] {
-        &self.mesh.nodes
+    /// The vertices [`Expander::expand`] would make for these faces, in its
+    /// order, as the mesh node each copies: nothing is stored (a glTF
+    /// writer streams their positions).
+    pub(crate) fn each_vertex<E>(
+        &mut self,
+        faces: &[(u32, bool)],
+        mut vertex: impl FnMut(u32) -> Result<(), E>,
+    ) -> Result<(), E> {
+        self.prepare();
+        for &(face, flip) in faces {
+            let stamp = self.next_stamp();
+            for tri in oriented(self.mesh, face, flip) {
+                for node in tri {
+                    let entry = &mut self.slot[node as usize];
+                    if entry.0 != stamp {
+                        *entry = (stamp, 0);
+                        vertex(node)?;
+                    }
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// The unit normals [`Expander::expand`] would give these faces'
+    /// vertices, in its order (the same sums in `f64`, face by face): only
+    /// one face's sums are held, in `sums`.
+    pub(crate) fn each_normal<E>(
+        &mut self,
+        faces: &[(u32, bool)],
+        sums: &mut Vec<[f64; 3]>,
+        mut normal: impl FnMut([f64; 3]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        let mesh = self.mesh;
+        self.prepare();
+        for &(face, flip) in faces {
+            let stamp = self.next_stamp();
+            sums.clear();
+            let mut total = [0.0; 3];
+            for tri in oriented(mesh, face, flip) {
+                let n = triangle_normal(mesh, tri);
+                total = add(total, n);
+                for node in tri {
+                    let entry = &mut self.slot[node as usize];
+                    if entry.0 != stamp {
+                        *entry = (stamp, sums.len() as u32);
+                        sums.push([0.0; 3]);
+                    }
+                    let s = &mut sums[entry.1 as usize];
+                    *s = add(*s, n);
+                }
+            }
+            let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
+            for s in sums.iter() {
+                normal(unit(*s).unwrap_or(fallback))?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The triangles [`Expander::expand`] would give, renumbered onto its
+    /// vertices, in its order, without storing them.
+    pub(crate) fn each_triangle<E>(
+        &mut self,
+        faces: &[(u32, bool)],
+        mut triangle: impl FnMut([u32; 3]) -> Result<(), E>,
+    ) -> Result<(), E> {
+        self.prepare();
+        let mut count = 0u32;
+        for &(face, flip) in faces {
+            let stamp = self.next_stamp();
+            for tri in oriented(self.mesh, face, flip) {
+                let mut t = [0u32; 3];
+                for (k, node) in tri.into_iter().enumerate() {
+                    let entry = &mut self.slot[node as usize];
+                    if entry.0 != stamp {
+                        *entry = (stamp, count);
+                        count += 1;
+                    }
+                    t[k] = entry.1;
+                }
+                triangle(t)?;
+            }
+        }
+        Ok(())
+    }
+
+    /// The mesh it expands.
+    pub(crate) fn mesh(&self) -> &'a Mesh {
+        self.mesh
     }
 
     /// The node table, made on first use (the single-face case needs none).

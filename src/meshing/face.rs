@@ -134,7 +134,13 @@ pub(crate) fn mesh_face(
     let expected = expected_vertices(
         &uv_loops,
         settings.max_area.min(guide_area(&uv_loops, &face.surface)),
-    );
+    )
+    .max(curved_vertices(
+        &chart,
+        &uv_loops,
+        &face.surface,
+        settings.tolerance,
+    ));
     let bulk = bulk_load_loops(&uv_loops);
     let bulk_loaded = bulk.is_some();
     let mut cdt = bulk.unwrap_or_else(|| Cdt::with_capacity(expected, 3 * expected, 2 * expected));
@@ -304,7 +310,8 @@ pub(crate) fn mesh_face(
     if small_angle {
         parameters = parameters.with_min_required_area(settings.tolerance * settings.tolerance);
     }
-    let mut inner = Vec::new();
+    // Two triangles a node: sized with the triangulation.
+    let mut inner = Vec::with_capacity(2 * expected);
     // Triangles already found fine, by face slot: the key of the triangle
     // (its corner nodes, which never move) that was fine there. Later passes
     // only check the triangles insertions created or moved.
@@ -904,6 +911,90 @@ fn expected_vertices(uv_loops: &[Vec<[f64; 2]>], max_area: f64) -> usize {
         0
     };
     (boundary + interior).min(MAX_FACE_VERTICES)
+}
+
+/// Cells per side of the grid [`curved_vertices`] samples the chart on.
+const ESTIMATE_GRID: usize = 24;
+
+/// Triangles per unit of area × curvature / tolerance that the surface
+/// check leaves (0.70 measured on spheres of radius 0.3 and 0.7 at 2e-5).
+const TRIANGLES_PER_CURVATURE: f64 = 0.7;
+
+/// The nodes the chordal check will give a curved face, estimated from a
+/// coarse grid over its chart: each cell inside the loops contributes its
+/// area on the surface times the curvature its diagonals' midpoints show
+/// (a chord of length l at distance d from the surface: κ ≈ 8d / l²). The
+/// triangulation and node tables are sized from it once: the area-based
+/// guess was 2–5 times short on spheres, and each doubling of spade's tables
+/// left the old ones resident until the face was done (a fifth of the
+/// meshing peak of paper 001's seven balls). Only memory depends on it.
+fn curved_vertices(
+    chart: &Chart,
+    uv_loops: &[Vec<[f64; 2]>],
+    surface: &Surface,
+    tolerance: f64,
+) -> usize {
+    if matches!(surface, Surface::Plane { .. }) || !(tolerance > 0.0) {
+        return 0;
+    }
+    let deviation = Deviation::of(surface);
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in uv_loops.iter().flatten() {
+        for k in 0..2 {
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
+        }
+    }
+    let n = ESTIMATE_GRID;
+    let step = [(hi[0] - lo[0]) / n as f64, (hi[1] - lo[1]) / n as f64];
+    if !(step[0] > 0.0 && step[1] > 0.0 && step[0].is_finite() && step[1].is_finite()) {
+        return 0;
+    }
+    let at = |i: usize, j: usize| [lo[0] + i as f64 * step[0], lo[1] + j as f64 * step[1]];
+    let mut triangles = 0.0;
+    for i in 0..n {
+        for j in 0..n {
+            let centre = [
+                lo[0] + (i as f64 + 0.5) * step[0],
+                lo[1] + (j as f64 + 0.5) * step[1],
+            ];
+            if !winding_odd(uv_loops, centre) {
+                continue;
+            }
+            let corners = [at(i, j), at(i + 1, j), at(i + 1, j + 1), at(i, j + 1)];
+            let Some([a, b, c, d]) = corners
+                .map(|uv| chart.lift(uv))
+                .into_iter()
+                .collect::<Option<Vec<_>>>()
+                .and_then(|v| <[Point3; 4]>::try_from(v).ok())
+            else {
+                continue;
+            };
+            let area = 0.5 * ((b - a).cross(&(d - a)).norm() + (b - c).cross(&(d - c)).norm());
+            let curvature = [(a, c), (b, d)]
+                .iter()
+                .map(|(p, q)| {
+                    let chord2 = (q - p).norm_squared();
+                    let mid = Point3::from((p.coords + q.coords) / 2.0);
+                    let d = deviation.signed_distance(&mid).abs();
+                    if chord2 > 0.0 && d.is_finite() {
+                        8.0 * d / chord2
+                    } else {
+                        0.0
+                    }
+                })
+                .fold(0.0, f64::max);
+            triangles += TRIANGLES_PER_CURVATURE * area * curvature / tolerance;
+        }
+    }
+    // Two triangles a node, and a third to spare: a reservation a little
+    // short costs a whole doubling, one too long costs no touched memory.
+    let vertices = 0.65 * triangles;
+    if vertices.is_finite() {
+        (vertices as usize).min(MAX_FACE_VERTICES)
+    } else {
+        0
+    }
 }
 
 /// Boundaries from this many points on are bulk loaded (`bulk_load_loops`).
