@@ -937,7 +937,7 @@ fn curved_vertices(
     surface: &Surface,
     tolerance: f64,
 ) -> usize {
-    if matches!(surface, Surface::Plane { .. }) || !(tolerance > 0.0) {
+    if matches!(surface, Surface::Plane { .. }) || tolerance.is_nan() || tolerance <= 0.0 {
         return 0;
     }
     let deviation = Deviation::of(surface);
