@@ -86,7 +86,8 @@ fn carve(
         return None;
     };
     // A region that failed to trace was reported already.
-    let r = (first_region..model.subdomains.len()).find(|&r| model.subdomains[r].name == *region)?;
+    let r =
+        (first_region..model.subdomains.len()).find(|&r| model.subdomains[r].name == *region)?;
     let (fk, fr) = (face_of(model, k)?, face_of(model, r)?);
     let outline = Outline::of(model, fk);
     let touch = touch_distance(model, fr);
@@ -151,11 +152,23 @@ fn share_box_sides(
     // Carved regions' contours are in kernel faces too: not kernel edges.
     let region_edges: BTreeSet<EdgeId> = (first_region..model.subdomains.len())
         .filter_map(|k| face_of(model, k))
-        .flat_map(|f| model.faces[f.index()].loops.iter().flatten().map(|oe| oe.edge))
+        .flat_map(|f| {
+            model.faces[f.index()]
+                .loops
+                .iter()
+                .flatten()
+                .map(|oe| oe.edge)
+        })
         .collect();
     let kernel_edges: BTreeSet<EdgeId> = (0..first_region)
         .filter_map(|k| face_of(model, k))
-        .flat_map(|f| model.faces[f.index()].loops.iter().flatten().map(|oe| oe.edge))
+        .flat_map(|f| {
+            model.faces[f.index()]
+                .loops
+                .iter()
+                .flatten()
+                .map(|oe| oe.edge)
+        })
         .filter(|e| !region_edges.contains(e))
         .filter(|&e| matches!(model.edge(e).curve, Curve::Segment { .. }))
         .collect();
