@@ -463,8 +463,8 @@ fn check(
     let outlines: BTreeMap<usize, Outline> = (0..n)
         .filter_map(|k| faces[k].map(|f| (k, Outline::of(model, f))))
         .collect();
-    for r in first_region..n {
-        let (Some(fr), Some(or)) = (faces[r], outlines.get(&r)) else {
+    for (r, &face) in faces.iter().enumerate().skip(first_region) {
+        let (Some(fr), Some(or)) = (face, outlines.get(&r)) else {
             continue;
         };
         let touch = touch_distance(model, fr);

@@ -83,12 +83,15 @@ pub fn trace(f: &ImplicitModel, s: &TrimmedSurface) -> Result<(Loops, bool), Str
     Ok((loops.into_iter().map(|(points, _)| points).collect(), cut))
 }
 
-/// [`trace`], each point with its box-side flags (0 on f = 0, else the
-/// sides of the box it lies on).
+/// A closed loop of points (x, y), each with its box-side flags (0 on
+/// f = 0, else the sides of the box it lies on).
+type SidedLoop = (Vec<[f64; 2]>, Vec<u8>);
+
+/// [`trace`], each point with its box-side flags.
 fn trace_with_sides(
     f: &ImplicitModel,
     s: &TrimmedSurface,
-) -> Result<(Vec<(Vec<[f64; 2]>, Vec<u8>)>, bool), String> {
+) -> Result<(Vec<SidedLoop>, bool), String> {
     let [nx, ny] = [f.geom.cells[0], f.geom.cells[1]];
     let mut b: Boundary = boundary::trace(s, [nx, ny])?;
     let [x0, x1, y0, y1] = s.rect;
@@ -116,7 +119,7 @@ fn trace_with_sides(
         })
         // A loop without area (f ≥ 0 only on a point or a line, where f
         // touches zero from below) bounds nothing.
-        .filter(|(points, _): &(Vec<[f64; 2]>, Vec<u8>)| shoelace(points).abs() > min_area)
+        .filter(|(points, _): &SidedLoop| shoelace(points).abs() > min_area)
         .collect();
     Ok((loops, cut))
 }
