@@ -384,6 +384,37 @@ mod tests {
         Ssa::from_ctx(&ctx, f)
     }
 
+    /// Two balls apart, joined by max: the blocks around each ball simplify
+    /// to that ball alone, so many mixed blocks share few kernels, each
+    /// numbered by its place in `kernels`.
+    #[test]
+    fn mixed_blocks_with_equal_programs_share_one_kernel() {
+        let mut ctx = Ctx::new();
+        let a = crate::implicit::vertices::tests::ball(&mut ctx, 0.3, [-0.5, 0.0, 0.0]);
+        let b = crate::implicit::vertices::tests::ball(&mut ctx, 0.3, [0.5, 0.1, 0.0]);
+        let f = ctx.binary(crate::implicit::ir::Binary::Max, a, b);
+        let grid = Grid {
+            min: [-1.0; 3],
+            max: [1.0; 3],
+            cells: [64, 64, 64],
+        };
+        let field = sample_field(&Ssa::from_ctx(&ctx, f), &grid, &Options::default());
+        let ids: Vec<u32> = field
+            .blocks
+            .iter()
+            .filter_map(|b| match b {
+                Block::Mixed(k) => Some(k.id),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(field.kernels.len(), 2, "one kernel per ball");
+        assert!(ids.len() > 20, "{} mixed blocks", ids.len());
+        for (id, kernel) in field.kernels.iter().enumerate() {
+            assert_eq!(kernel.id as usize, id);
+            assert!(ids.iter().filter(|&&i| i as usize == id).count() > 8);
+        }
+    }
+
     #[test]
     fn the_sparse_field_stores_only_mixed_and_capped_blocks_and_packs_their_signs() {
         let grid = Grid {

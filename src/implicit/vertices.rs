@@ -6,10 +6,11 @@
 //! edges, 8 planes of them. Refined plane by plane, each call of the
 //! interpreted f64 tape ran over 2–4 lanes, so the per-instruction overhead
 //! (dispatch, slicing, small copies) cost more than the arithmetic. A run of
-//! planes is refined kernel by kernel across all its planes (blocks with equal programs share a kernel), so the batches
-//! are several times longer. Every lane is computed independently and with
-//! the same block program, so the vertices are bit-identical to refining
-//! each plane alone (test `refining_planes_together_gives_the_same_vertices`).
+//! planes is refined kernel by kernel across all its planes (blocks with
+//! equal programs share a kernel), so the batches are several times longer.
+//! Every lane is computed independently and with the same block program, so
+//! the vertices are bit-identical to refining each plane alone (test
+//! `refining_planes_together_gives_the_same_vertices`).
 
 use super::field::{BS, Block, Field, Kernel};
 use super::polygonize::Options;
