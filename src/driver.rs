@@ -178,6 +178,7 @@ fn run(
         set_trims(&mut lowered.model, trims);
     }
     if lowered.model.dimension == crate::ir::Dimension::Three {
+        crate::implicit::xml::warn_area_in_3d(implicit, diags);
         // Trimmed surfaces become faces, edges and vertices (issue 9).
         let (model, map) = (&mut lowered.model, &lowered.source_map);
         lower::trimmed_topology::add(model, map, diags);

@@ -217,6 +217,8 @@ pub struct ImplicitSubdomain {
     pub solid: ImplicitSolid,
     /// 2D regions: the largest triangle area (`area=`).
     pub max_area: Option<f64>,
+    /// Where `area=` is written (for W150 in a 3D model).
+    pub area_span: Option<Span>,
 }
 
 impl ImplicitSubdomain {
@@ -324,10 +326,33 @@ pub fn lower(ex: &Extracted, env: &Env, diags: &mut Diagnostics) -> Lowered {
             span: s.name_span,
             solid,
             max_area,
+            area_span: s.attribute("area").map(|a| a.value_span),
         });
     }
     overlap::check(&out.subdomains, diags);
     out
+}
+
+/// W150 for each subdomain that gives `area=` in a 3D model, where only 2D
+/// regions read it (as for kernel subdomains).
+pub fn warn_area_in_3d(subdomains: &[ImplicitSubdomain], diags: &mut Diagnostics) {
+    for sub in subdomains {
+        let Some(area) = sub.max_area else {
+            continue;
+        };
+        diags.push(
+            Diagnostic::new(
+                Code::AreaIn3d,
+                sub.area_span.unwrap_or(sub.span),
+                format!(
+                    "subdomain '{}' gives area={} in a 3D model, where it is ignored",
+                    sub.name,
+                    crate::resolve::fmt(area)
+                ),
+            )
+            .with_help("remove area=, or set dimension=\"2\" on <geometry> for a planar model"),
+        );
+    }
 }
 
 /// A subdomain's `area=` (read by 2D regions): `None` when absent or bad
