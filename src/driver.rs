@@ -178,14 +178,22 @@ fn run(
         set_trims(&mut lowered.model, trims);
     }
     if lowered.model.dimension == crate::ir::Dimension::Three {
+        crate::implicit::xml::warn_area_in_3d(implicit, diags);
         // Trimmed surfaces become faces, edges and vertices (issue 9).
         let (model, map) = (&mut lowered.model, &lowered.source_map);
         lower::trimmed_topology::add(model, map, diags);
     }
-    if lowered.model.dimension == crate::ir::Dimension::Two && !implicit.is_empty() {
-        // 2D R-function regions become model entities (issue 6).
+    if lowered.model.dimension == crate::ir::Dimension::Two
+        && (!implicit.is_empty() || !extracted.carves.is_empty())
+    {
+        // 2D R-function regions become model entities (issue 6), joined to
+        // the kernel regions they touch or are carved from.
         let (model, map) = (&mut lowered.model, &mut lowered.source_map);
+        let first_region = model.subdomains.len();
         lower::rfunction_region::add_regions(model, map, implicit, diags);
+        let region_of = whole_solids(&extracted.subdomains);
+        let carves = &extracted.carves;
+        lower::region_interfaces::join(model, map, first_region, carves, &region_of, diags);
     }
     drop(resolved);
     release(options);
@@ -204,6 +212,22 @@ fn run(
         diags.items.retain(|d| d.code != Code::Dangling);
     }
     Some(lowered)
+}
+
+/// (solid, subdomain) for each implicit subdomain whose tree is one
+/// `<solid ref>`.
+fn whole_solids(subdomains: &[crate::syntax::Element]) -> Vec<(String, String)> {
+    subdomains
+        .iter()
+        .filter_map(|s| {
+            let name = s.attribute("name")?.value.trim().to_string();
+            let [child] = s.children.as_slice() else {
+                return None;
+            };
+            let solid = child.attribute("ref").filter(|_| child.name == "solid")?;
+            Some((solid.value.trim().to_string(), name))
+        })
+        .collect()
 }
 
 /// Checks the structure of the parsed file and builds its typed document, one

@@ -302,6 +302,34 @@ fn bad_names_calls_and_settings_are_located() {
     assert!(c.implicit.is_empty());
 }
 
+/// `area=` on an implicit subdomain of a 3D model is W150 at the attribute's
+/// value, with the message kernel subdomains get; the solid is still meshed.
+#[test]
+fn area_on_an_implicit_subdomain_in_3d_is_warned_as_ignored() {
+    let c = check(&model(
+        r#"<rfunction name="part" nx="20" ny="20" nz="20"> <ball r="0.8" x0="0" y0="0" z0="0"/> </rfunction>
+<subdomain name="solid" area="0.01"> <solid ref="part"/> </subdomain>"#,
+    ));
+    assert_eq!(codes(&c), vec![("W150".to_string(), 4, 31)]);
+    let d = &c.diagnostics.items[0];
+    assert_eq!(
+        d.message,
+        "subdomain 'solid' gives area=0.01 in a 3D model, where it is ignored"
+    );
+    assert_eq!(
+        d.help.as_deref(),
+        Some("remove area=, or set dimension=\"2\" on <geometry> for a planar model")
+    );
+    let subs = valid(&c);
+    assert_eq!(subs.len(), 1);
+    assert_watertight(&subs[0].polygonize(None));
+    let plain = check(&model(
+        r#"<rfunction name="part" nx="20" ny="20" nz="20"> <ball r="0.8" x0="0" y0="0" z0="0"/> </rfunction>
+<subdomain name="solid"> <solid ref="part"/> </subdomain>"#,
+    ));
+    assert!(codes(&plain).is_empty(), "{:#?}", plain.diagnostics.items);
+}
+
 #[test]
 fn implicit_and_boundary_solids_cannot_mix_in_one_tree() {
     let c = check(&model(

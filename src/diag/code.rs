@@ -378,6 +378,13 @@ codes! {
         "A trim curve of a parametric surface runs along an edge of another face for part of its length, or is an open piece (ending on the patch's sides) along it. Only a whole closed trim loop that coincides with a whole closed edge (a hole's rim on a circular edge) is shared node for node; anything less would leave the two faces without common nodes and the shell open. Make the trim loop coincide with the whole edge (same circle, within twice the tolerance), or move it clear of the edge.";
     TrimmedSideOnEdge = "E744", Error, "a patch side lies on another face's edge",
         "A side of a parametric surface's parameter rectangle lies along an edge of another face. Patch sides keep their own nodes (only closed trim loops take a neighbour's), so the two faces would not share nodes there and the shell would not close. Trim the surface so that its boundary there is a closed trim loop on the whole edge, or extend the rectangle past the edge and trim it back with <trim>.";
+    // ---- twod: R-function regions against kernel regions (issue 6, branch twod, session 13) ----
+    RegionTouches = "E543", Error, "2D R-function region touches another region where no interface can be made",
+        "A 2D R-function region shares a conforming interface with a kernel region only where a straight side of its box (x_min..y_max) lies on a straight kernel edge, or when a kernel subdomain carves it out with <difference> (a hole or inclusion). Elsewhere its contour is not a kernel curve, so a region that touches a kernel region (closer than the contour's chordal tolerance, 0.5e-3 of its box diagonal), or another R-function region, would be meshed with hanging nodes. Move the regions apart, carve one out of the other with <difference>, or let the region's box side lie on the kernel edge.";
+    RegionCarveOutside = "E544", Error, "carved R-function region is not strictly inside its subdomain",
+        "A kernel subdomain's <difference> may subtract a 2D R-function region that lies strictly inside the subdomain's region (its contour a hole of it); this one reaches the subdomain's boundary or outside it. Enlarge the kernel region, shrink the R-function region, or make them neighbours without <difference>.";
+    RegionCarveNotSubdomain = "E545", Error, "carved R-function solid is not a subdomain",
+        "A kernel subdomain's <difference> subtracts an R-function solid whose region is no subdomain's whole solid (<subdomain><solid ref=\"NAME\"/></subdomain>): its contour is traced only for subdomains. Add that subdomain (an inclusion), or subtract a kernel solid.";
 }
 
 impl Code {

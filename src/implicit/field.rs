@@ -29,8 +29,10 @@ const BLOCK_LEN: usize = BS * BS * BS;
 const NOT_STORED: u32 = u32::MAX;
 
 /// What a block's samples need: the f64 tape refines crossings, the row
-/// tape samples the grid.
+/// tape samples the grid. Blocks whose simplified programs are equal share
+/// one kernel (`id` indexes `Field::kernels`).
 pub(super) struct Kernel {
+    pub id: u32,
     pub tape: Tape,
     /// The tape split along x, y and z for root finding on grid edges.
     pub along: [AxisTape; 3],
@@ -38,8 +40,9 @@ pub(super) struct Kernel {
 }
 
 impl Kernel {
-    fn new(ssa: &Ssa) -> Kernel {
+    fn new(ssa: &Ssa, id: u32) -> Kernel {
         Kernel {
+            id,
             tape: Tape::new(ssa),
             along: [0, 1, 2].map(|a| AxisTape::new(ssa, a)),
             rows: RowTape::new(ssa),
@@ -68,6 +71,8 @@ pub(super) struct Field {
     pub n1: [usize; 3],
     pub nb: [usize; 3],
     pub blocks: Vec<Block>,
+    /// The distinct kernels of the mixed blocks, by `Kernel::id`.
+    pub kernels: Vec<Arc<Kernel>>,
     samples: Samples,
 }
 
@@ -83,6 +88,7 @@ impl Field {
             n1,
             nb,
             blocks: vec![Block::Sampled; nb[0] * nb[1] * nb[2]],
+            kernels: Vec::new(),
             samples: Samples::Dense(values),
         }
     }
@@ -169,16 +175,23 @@ fn local(i: usize, j: usize, k: usize) -> usize {
 /// A block range [lo, hi) per axis of the block grid.
 type Region = ([usize; 3], [usize; 3]);
 
+/// A classified block: proven (`Inside`/`Outside`), or mixed with its
+/// simplified program (the kernels are built once per distinct program).
+enum Leaf {
+    Proven(Block),
+    Mixed(Ssa),
+}
+
 /// Classifies the blocks of `region` by interval arithmetic, recursively
 /// halving the region and simplifying the program on the way down, so a
 /// leaf block sees only the few union branches active near it (M3's
-/// 1,000-ball chain shrinks to a handful). Returns (block index, block).
+/// 1,000-ball chain shrinks to a handful). Returns (block index, leaf).
 fn classify_region(
     ssa: &Ssa,
     region: Region,
     coords: &[Vec<f64>; 3],
     nb: [usize; 3],
-    out: &mut Vec<(usize, Block)>,
+    out: &mut Vec<(usize, Leaf)>,
 ) {
     let (lo, hi) = region;
     let n1 = [coords[0].len(), coords[1].len(), coords[2].len()];
@@ -188,11 +201,11 @@ fn classify_region(
     });
     let sign = interval::sign_only(ssa);
     let iv = interval::eval(ssa, &sign, bounds);
-    let fill = |block: Block, out: &mut Vec<(usize, Block)>| {
+    let fill = |block: Block, out: &mut Vec<(usize, Leaf)>| {
         for k in lo[2]..hi[2] {
             for j in lo[1]..hi[1] {
                 for i in lo[0]..hi[0] {
-                    out.push(((k * nb[1] + j) * nb[0] + i, block.clone()));
+                    out.push(((k * nb[1] + j) * nb[0] + i, Leaf::Proven(block.clone())));
                 }
             }
         }
@@ -206,7 +219,8 @@ fn classify_region(
     let extent = [0, 1, 2].map(|a| hi[a] - lo[a]);
     let axis = (0..3).max_by_key(|&a| (extent[a], a)).unwrap_or(0);
     if extent[axis] <= 1 {
-        return fill(Block::Mixed(Arc::new(Kernel::new(&simpler))), out);
+        let at = (lo[2] * nb[1] + lo[1]) * nb[0] + lo[0];
+        return out.push((at, Leaf::Mixed(simpler)));
     }
     let mid = lo[axis] + extent[axis] / 2;
     let (mut a_hi, mut b_lo) = (hi, lo);
@@ -235,15 +249,15 @@ pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
     let n1 = [coords[0].len(), coords[1].len(), coords[2].len()];
     let nb = [n1[0].div_ceil(BS), n1[1].div_ceil(BS), n1[2].div_ceil(BS)];
     let mut blocks = vec![Block::Outside; nb[0] * nb[1] * nb[2]];
-    if options.prune {
+    let kernels = if options.prune {
         let mut found = Vec::with_capacity(blocks.len());
         classify_region(ssa, ([0; 3], nb), &coords, nb, &mut found);
-        for (at, block) in found {
-            blocks[at] = block;
-        }
+        share_kernels(&found, &mut blocks)
     } else {
-        blocks.fill(Block::Mixed(Arc::new(Kernel::new(ssa))));
-    }
+        let kernel = Arc::new(Kernel::new(ssa, 0));
+        blocks.fill(Block::Mixed(kernel.clone()));
+        vec![kernel]
+    };
     let on_box = |b: usize| {
         let at = [b % nb[0], b / nb[0] % nb[1], b / (nb[0] * nb[1])];
         (0..3).any(|a| at[a] == 0 || at[a] == nb[a] - 1)
@@ -300,8 +314,42 @@ pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
         n1,
         nb,
         blocks,
+        kernels,
         samples: Samples::Blocks { slot, data },
     }
+}
+
+/// Sets the classified blocks; mixed blocks with equal programs share one
+/// kernel, numbered in the order of `found` (deterministic). Why: M3's
+/// neighbouring blocks around one ball, and M2's inner blocks (all the
+/// gyroid alone), have the same program: building it once per block cost
+/// allocations and time, and one kernel per program lets root finding run
+/// their edges in one batch (`vertices::refine_by_kernel`).
+fn share_kernels(found: &[(usize, Leaf)], blocks: &mut [Block]) -> Vec<Arc<Kernel>> {
+    let mut ids: std::collections::HashMap<&Ssa, u32> = std::collections::HashMap::new();
+    let mut programs: Vec<&Ssa> = Vec::new();
+    let mut mixed: Vec<(usize, u32)> = Vec::new();
+    for (at, leaf) in found {
+        match leaf {
+            Leaf::Proven(block) => blocks[*at] = block.clone(),
+            Leaf::Mixed(ssa) => {
+                let id = *ids.entry(ssa).or_insert_with(|| {
+                    programs.push(ssa);
+                    (programs.len() - 1) as u32
+                });
+                mixed.push((*at, id));
+            }
+        }
+    }
+    let kernels: Vec<Arc<Kernel>> = programs
+        .par_iter()
+        .enumerate()
+        .map(|(id, ssa)| Arc::new(Kernel::new(ssa, id as u32)))
+        .collect();
+    for (at, id) in mixed {
+        blocks[at] = Block::Mixed(kernels[id as usize].clone());
+    }
+    kernels
 }
 
 /// Caps given samples on the box faces at 0 (only the six faces are visited).
@@ -334,6 +382,37 @@ mod tests {
         let mut ctx = Ctx::new();
         let f = crate::implicit::vertices::tests::ball(&mut ctx, 1.2, [0.05, 0.0, -0.03]);
         Ssa::from_ctx(&ctx, f)
+    }
+
+    /// Two balls apart, joined by max: the blocks around each ball simplify
+    /// to that ball alone, so many mixed blocks share few kernels, each
+    /// numbered by its place in `kernels`.
+    #[test]
+    fn mixed_blocks_with_equal_programs_share_one_kernel() {
+        let mut ctx = Ctx::new();
+        let a = crate::implicit::vertices::tests::ball(&mut ctx, 0.3, [-0.5, 0.0, 0.0]);
+        let b = crate::implicit::vertices::tests::ball(&mut ctx, 0.3, [0.5, 0.1, 0.0]);
+        let f = ctx.binary(crate::implicit::ir::Binary::Max, a, b);
+        let grid = Grid {
+            min: [-1.0; 3],
+            max: [1.0; 3],
+            cells: [64, 64, 64],
+        };
+        let field = sample_field(&Ssa::from_ctx(&ctx, f), &grid, &Options::default());
+        let ids: Vec<u32> = field
+            .blocks
+            .iter()
+            .filter_map(|b| match b {
+                Block::Mixed(k) => Some(k.id),
+                _ => None,
+            })
+            .collect();
+        assert_eq!(field.kernels.len(), 2, "one kernel per ball");
+        assert!(ids.len() > 20, "{} mixed blocks", ids.len());
+        for (id, kernel) in field.kernels.iter().enumerate() {
+            assert_eq!(kernel.id as usize, id);
+            assert!(ids.iter().filter(|&&i| i as usize == id).count() > 8);
+        }
     }
 
     #[test]

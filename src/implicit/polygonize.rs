@@ -342,7 +342,7 @@ fn contour_run(
         }
     };
     fill(&mut maps[0], bottom, true);
-    // The inner planes' crossings refined together, block by block
+    // The inner planes' crossings refined together, kernel by kernel
     // (longer batches for the f64 tape than plane by plane).
     let inner = planes_vertices(field, signs, coords, slabs.start + 1..slabs.end, options);
     for k in slabs.clone() {

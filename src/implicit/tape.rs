@@ -10,7 +10,7 @@ pub const BATCH: usize = 128;
 
 /// The reachable part of a function, renumbered densely; children refer to
 /// earlier indices; the last entry is the root.
-#[derive(Debug, Clone, PartialEq)]
+#[derive(Debug, Clone, PartialEq, Eq, Hash)]
 pub struct Ssa {
     pub ops: Vec<Node>,
 }

@@ -6,10 +6,11 @@
 //! edges, 8 planes of them. Refined plane by plane, each call of the
 //! interpreted f64 tape ran over 2–4 lanes, so the per-instruction overhead
 //! (dispatch, slicing, small copies) cost more than the arithmetic. A run of
-//! planes is refined block by block across all its planes, so the batches
-//! are several times longer. Every lane is computed independently and with
-//! the same block program, so the vertices are bit-identical to refining
-//! each plane alone (test `refining_planes_together_gives_the_same_vertices`).
+//! planes is refined kernel by kernel across all its planes (blocks with
+//! equal programs share a kernel), so the batches are several times longer.
+//! Every lane is computed independently and with the same block program, so
+//! the vertices are bit-identical to refining each plane alone (test
+//! `refining_planes_together_gives_the_same_vertices`).
 
 use super::field::{BS, Block, Field, Kernel};
 use super::polygonize::Options;
@@ -48,7 +49,7 @@ pub(super) fn plane_vertices(
 }
 
 /// The vertices of planes `ks`, one entry per plane, with the crossings of
-/// all the planes refined block by block together.
+/// all the planes refined kernel by kernel together.
 pub(super) fn planes_vertices(
     field: &Field,
     signs: &SignRows,
@@ -71,7 +72,7 @@ pub(super) fn planes_vertices(
         .iter()
         .map(|&(_, _, v0, v1)| (v0 / (v0 - v1)).clamp(0.0, 1.0))
         .collect();
-    refine_by_block(field, &ks, &first, &keys, &ends, &mut t, options);
+    refine_by_kernel(field, &ks, &first, &keys, &ends, &mut t, options);
     ks.enumerate()
         .map(|(p, k)| {
             let range = first[p]..first[p + 1];
@@ -127,9 +128,13 @@ fn crossed_edges(
 }
 
 /// Refines the crossings with their owning blocks' programs, grouped by
-/// block (a counting sort: a comparison sort of the edges cost more than
-/// the root finding; the grouping does not change any vertex).
-fn refine_by_block(
+/// kernel (a counting sort: a comparison sort of the edges cost more than
+/// the root finding). Blocks with equal programs share a kernel, so their
+/// edges run in one batch: a block alone has about 20 edges per axis, and
+/// the interpreted tape's per-call cost was then larger than the
+/// arithmetic. Every lane is independent, so the grouping does not change
+/// any vertex.
+fn refine_by_kernel(
     field: &Field,
     ks: &Range<usize>,
     first: &[usize],
@@ -139,7 +144,8 @@ fn refine_by_block(
     options: &Options,
 ) {
     let (n1, nb) = (field.n1, field.nb);
-    if ks.is_empty() {
+    if ks.is_empty() || field.kernels.is_empty() {
+        // Given samples (no kernel): nothing to refine.
         return;
     }
     let last = ks.end - 1;
@@ -147,35 +153,38 @@ fn refine_by_block(
     let layers = ks.start / BS..last / BS + 1;
     let per_layer = nb[0] * nb[1];
     let blocks = &field.blocks[layers.start * per_layer..layers.end * per_layer];
-    // Given samples (no kernel in these block layers): nothing to refine.
-    if !blocks.iter().any(|b| matches!(b, Block::Mixed(_))) {
-        return;
-    }
-    let mut block_of = Vec::with_capacity(keys.len());
+    // Each edge's kernel, `none` for edges of proven blocks (their linear
+    // guess stays).
+    let none = field.kernels.len() as u32;
+    let mut kernel_of = Vec::with_capacity(keys.len());
     for (p, k) in ks.clone().enumerate() {
         let layer = (k / BS - layers.start) * per_layer;
-        block_of.extend(keys[first[p]..first[p + 1]].iter().map(|&key| {
+        kernel_of.extend(keys[first[p]..first[p + 1]].iter().map(|&key| {
             let key = key as usize / 3;
-            (layer + (key / n1[0] / BS) * nb[0] + (key % n1[0]) / BS) as u32
+            let b = layer + (key / n1[0] / BS) * nb[0] + (key % n1[0]) / BS;
+            match &blocks[b] {
+                Block::Mixed(kernel) => kernel.id,
+                _ => none,
+            }
         }));
     }
-    let mut start = vec![0u32; blocks.len() + 1];
-    for &b in &block_of {
-        start[b as usize + 1] += 1;
+    let mut start = vec![0u32; field.kernels.len() + 2];
+    for &id in &kernel_of {
+        start[id as usize + 1] += 1;
     }
-    for b in 0..blocks.len() {
-        start[b + 1] += start[b];
+    for id in 0..=field.kernels.len() {
+        start[id + 1] += start[id];
     }
     let mut order = vec![0usize; keys.len()];
     let mut next = start.clone();
-    for (e, &b) in block_of.iter().enumerate() {
-        order[next[b as usize] as usize] = e;
-        next[b as usize] += 1;
+    for (e, &id) in kernel_of.iter().enumerate() {
+        order[next[id as usize] as usize] = e;
+        next[id as usize] += 1;
     }
     let (mut ws, mut group) = (Workspace::default(), Vec::new());
-    for (b, block) in blocks.iter().enumerate() {
-        let edges = &order[start[b] as usize..start[b + 1] as usize];
-        if let (Block::Mixed(kernel), false) = (block, edges.is_empty()) {
+    for (id, kernel) in field.kernels.iter().enumerate() {
+        let edges = &order[start[id] as usize..start[id + 1] as usize];
+        if !edges.is_empty() {
             refine(
                 kernel,
                 &mut ws,

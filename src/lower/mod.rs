@@ -9,6 +9,7 @@ mod explicit;
 mod isolation;
 mod point_calculus;
 mod prune;
+pub mod region_interfaces;
 pub mod rfunction_region;
 pub mod trimmed_topology;
 mod weld;

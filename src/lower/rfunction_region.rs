@@ -79,6 +79,19 @@ pub type Loops = Vec<Vec<[f64; 2]>>;
 /// (outer loops counter-clockwise, holes clockwise), and whether the box
 /// cuts the region.
 pub fn trace(f: &ImplicitModel, s: &TrimmedSurface) -> Result<(Loops, bool), String> {
+    let (loops, cut) = trace_with_sides(f, s)?;
+    Ok((loops.into_iter().map(|(points, _)| points).collect(), cut))
+}
+
+/// A closed loop of points (x, y), each with its box-side flags (0 on
+/// f = 0, else the sides of the box it lies on).
+type SidedLoop = (Vec<[f64; 2]>, Vec<u8>);
+
+/// [`trace`], each point with its box-side flags.
+fn trace_with_sides(
+    f: &ImplicitModel,
+    s: &TrimmedSurface,
+) -> Result<(Vec<SidedLoop>, bool), String> {
     let [nx, ny] = [f.geom.cells[0], f.geom.cells[1]];
     let mut b: Boundary = boundary::trace(s, [nx, ny])?;
     let [x0, x1, y0, y1] = s.rect;
@@ -97,15 +110,16 @@ pub fn trace(f: &ImplicitModel, s: &TrimmedSurface) -> Result<(Loops, bool), Str
         .map(|lp| {
             let mut points: Vec<[f64; 2]> = lp.iter().map(|&p| b.points[p]).collect();
             let sides: Vec<u8> = lp.iter().map(|&p| b.sides[p]).collect();
-            grade(s, &mut points, sides);
+            let mut sides = grade(s, &mut points, sides);
             if !material_on_left(s, &points) {
                 points.reverse();
+                sides.reverse();
             }
-            points
+            (points, sides)
         })
         // A loop without area (f ≥ 0 only on a point or a line, where f
         // touches zero from below) bounds nothing.
-        .filter(|points: &Vec<[f64; 2]>| shoelace(points).abs() > min_area)
+        .filter(|(points, _): &SidedLoop| shoelace(points).abs() > min_area)
         .collect();
     Ok((loops, cut))
 }
@@ -130,7 +144,7 @@ const GRADING: f64 = 1.5;
 /// shorter one anyway, and each such split costs the 2D mesher a round of
 /// re-meshing (at most 8, after which the angle bound may fail): graded
 /// contours leave it nothing to split.
-fn grade(s: &TrimmedSurface, points: &mut Vec<[f64; 2]>, mut sides: Vec<u8>) {
+fn grade(s: &TrimmedSurface, points: &mut Vec<[f64; 2]>, mut sides: Vec<u8>) -> Vec<u8> {
     let len = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]).hypot(b[1] - a[1]);
     // Each pass halves segments; 40 passes cover any ratio a grid gives.
     for _ in 0..40 {
@@ -164,6 +178,7 @@ fn grade(s: &TrimmedSurface, points: &mut Vec<[f64; 2]>, mut sides: Vec<u8>) {
             break;
         }
     }
+    sides
 }
 
 /// Whether the region lies on the left of the loop, judged across its
@@ -200,7 +215,7 @@ fn add_region(
 ) {
     let surface = region_surface(&sub.name, f);
     let (loops, cut) =
-        match trace(f, &surface) {
+        match trace_with_sides(f, &surface) {
             Ok(traced) => traced,
             Err(reason) => {
                 diags.push(
@@ -245,7 +260,7 @@ fn add_region(
     // Each contour piece carries f, so splits by refinement land on f = 0.
     let contour = f.ssa();
     let mut face_loops = Vec::with_capacity(loops.len());
-    for (l, points) in loops.iter().enumerate() {
+    for (l, (points, sides)) in loops.iter().enumerate() {
         let first = model.vertices.len();
         for (k, p) in points.iter().enumerate() {
             let id = VertexId(model.vertices.len() as u32);
@@ -260,13 +275,21 @@ fn add_region(
         for k in 0..n {
             let (a, b) = (first + k, first + (k + 1) % n);
             let id = EdgeId(model.edges.len() as u32);
+            let (pa, pb) = (model.vertices[a].position, model.vertices[b].position);
+            // A piece along a side of the box is straight: a split stays on
+            // the side (f = 0 may be near, but it is not this edge).
+            let curve = if sides[k] & sides[(k + 1) % n] != 0 {
+                Curve::Segment { a: pa, b: pb }
+            } else {
+                Curve::Contour {
+                    a: pa,
+                    b: pb,
+                    f: Box::new(contour.clone()),
+                }
+            };
             model.edges.push(Edge {
                 name: format!("{}.contour[{}].e{}", sub.name, l + 1, k + 1),
-                curve: Curve::Contour {
-                    a: model.vertices[a].position,
-                    b: model.vertices[b].position,
-                    f: Box::new(contour.clone()),
-                },
+                curve,
                 begin: VertexId(a as u32),
                 end: VertexId(b as u32),
             });

@@ -36,6 +36,19 @@ pub struct Extracted<'s> {
     /// Copies of the `<trim>` elements holding an R-function tree, with the
     /// name of their surface (issue 9); the originals stay in the tree.
     pub trims: Vec<(String, Element<'s>)>,
+    /// 2D models: implicit solids a kernel subdomain's `<difference>`
+    /// subtracts (issue 6), taken out of its tree; the R-function region
+    /// lowering makes their contours holes of that subdomain's face.
+    pub carves: Vec<Carve>,
+}
+
+/// An implicit solid subtracted from a kernel subdomain of a 2D model.
+#[derive(Debug, Clone)]
+pub struct Carve {
+    pub subdomain: String,
+    pub solid: String,
+    /// The `ref` value naming the solid.
+    pub span: Span,
 }
 
 impl Extracted<'_> {
@@ -62,6 +75,8 @@ pub struct Extractor {
     names: HashSet<String>,
     /// Whether the file has any implicit element at all.
     any: bool,
+    /// Whether the model is 2D (`dimension="2"`).
+    planar: bool,
 }
 
 impl Extractor {
@@ -76,6 +91,9 @@ impl Extractor {
                 .map(|a| a.value.trim().to_string())
                 .collect(),
             any: root.children.iter().any(|c| ELEMENTS.contains(&c.name)),
+            planar: root
+                .attribute("dimension")
+                .is_some_and(|a| a.value.trim() == "2"),
         }
     }
 
@@ -98,11 +116,58 @@ impl Extractor {
             out.defs.push(child);
             None
         } else if child.name == "subdomain" && names_any(&child, &self.names) {
-            out.subdomains.push(child);
-            None
+            self.carve(child, out)
         } else {
             Some(child)
         }
+    }
+}
+
+impl Extractor {
+    /// In a 2D model, a kernel subdomain `<difference>` whose first operand
+    /// is a kernel tree and whose other operands are kernel trees or
+    /// `<solid ref>`s of implicit solids stays on the kernel path without the
+    /// implicit operands (recorded in `out.carves`); any other subdomain
+    /// naming an implicit solid goes to the implicit path.
+    fn carve<'s>(&self, mut child: Element<'s>, out: &mut Extracted<'s>) -> Option<Element<'s>> {
+        let implicit_ref = |e: &Element| {
+            e.name == "solid"
+                && e.attribute("ref")
+                    .is_some_and(|r| self.names.contains(r.value.trim()))
+        };
+        let carvable = self.planar
+            && child.children.len() == 1
+            && child.children[0].name == "difference"
+            && child.children[0]
+                .children
+                .first()
+                .is_some_and(|first| !names_any(first, &self.names))
+            && child.children[0].children[1..]
+                .iter()
+                .all(|e| implicit_ref(e) || !names_any(e, &self.names));
+        let name = child.attribute("name").map(|a| a.value.trim().to_string());
+        let (true, Some(name)) = (carvable, name) else {
+            out.subdomains.push(child);
+            return None;
+        };
+        let difference = &mut child.children[0];
+        let operands = std::mem::take(&mut difference.children);
+        for e in operands {
+            match e.attribute("ref").filter(|_| implicit_ref(&e)) {
+                Some(r) => out.carves.push(Carve {
+                    subdomain: name.clone(),
+                    solid: r.value.trim().to_string(),
+                    span: r.value_span,
+                }),
+                None => difference.children.push(e),
+            }
+        }
+        if difference.children.len() == 1 {
+            // A difference of one operand is that operand.
+            let first = difference.children.remove(0);
+            child.children[0] = first;
+        }
+        Some(child)
     }
 }
 
@@ -152,6 +217,8 @@ pub struct ImplicitSubdomain {
     pub solid: ImplicitSolid,
     /// 2D regions: the largest triangle area (`area=`).
     pub max_area: Option<f64>,
+    /// Where `area=` is written (for W150 in a 3D model).
+    pub area_span: Option<Span>,
 }
 
 impl ImplicitSubdomain {
@@ -259,10 +326,33 @@ pub fn lower(ex: &Extracted, env: &Env, diags: &mut Diagnostics) -> Lowered {
             span: s.name_span,
             solid,
             max_area,
+            area_span: s.attribute("area").map(|a| a.value_span),
         });
     }
     overlap::check(&out.subdomains, diags);
     out
+}
+
+/// W150 for each subdomain that gives `area=` in a 3D model, where only 2D
+/// regions read it (as for kernel subdomains).
+pub fn warn_area_in_3d(subdomains: &[ImplicitSubdomain], diags: &mut Diagnostics) {
+    for sub in subdomains {
+        let Some(area) = sub.max_area else {
+            continue;
+        };
+        diags.push(
+            Diagnostic::new(
+                Code::AreaIn3d,
+                sub.area_span.unwrap_or(sub.span),
+                format!(
+                    "subdomain '{}' gives area={} in a 3D model, where it is ignored",
+                    sub.name,
+                    crate::resolve::fmt(area)
+                ),
+            )
+            .with_help("remove area=, or set dimension=\"2\" on <geometry> for a planar model"),
+        );
+    }
 }
 
 /// A subdomain's `area=` (read by 2D regions): `None` when absent or bad

@@ -1,0 +1,556 @@
+//! Interfaces of 2D R-function regions with kernel regions (issue 6). A
+//! region's contour is its own polyline, not a kernel curve, so it can share
+//! edges with a kernel region in two ways, both conforming (one model edge
+//! used by both faces, so the mesh shares its nodes and the edges form the
+//! fragment `KERNEL|REGION`):
+//!
+//! - **carving**: a kernel subdomain's `<difference>` subtracts the
+//!   R-function solid of a region subdomain lying strictly inside it; the
+//!   region's contour loops become holes of the kernel face (an inclusion);
+//! - **a box side on a straight kernel edge**: contour pieces along a side of
+//!   the region's box that lie on a straight kernel edge replace that part of
+//!   the edge, which is split around them.
+//!
+//! Anything else that touches is E543 (the interface would have hanging
+//! nodes) and an overlap is E407, as for kernel subdomains.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::geom::{Curve, Point3};
+use crate::implicit::xml::Carve;
+use crate::ir::{
+    Edge, EdgeId, FaceId, Model, OrientedEdge, SourceMap, SubdomainCells, SubdomainId, VertexId,
+};
+use std::collections::{BTreeMap, BTreeSet};
+
+/// The touch distance, as a fraction of a region's extent: the contour's
+/// chordal tolerance (`rfunction_region`'s 0.5e-3 of its box diagonal).
+const TOUCH_FRACTION: f64 = 0.5e-3;
+
+/// Joins the R-function regions (subdomains `first_region..`) to the kernel
+/// regions before them: carves, shares box sides lying on straight kernel
+/// edges, then reports what still touches (E543) or overlaps (E407).
+/// `region_of` maps an implicit solid to the subdomain whose whole solid it is.
+pub fn join(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    first_region: usize,
+    carves: &[Carve],
+    region_of: &[(String, String)],
+    diags: &mut Diagnostics,
+) {
+    // Pairs a refused carve reported already.
+    let mut reported = BTreeSet::new();
+    for c in carves {
+        if let Some(pair) = carve(model, first_region, c, region_of, diags) {
+            reported.insert(pair);
+        }
+    }
+    for r in first_region..model.subdomains.len() {
+        share_box_sides(model, source_map, first_region, r, diags);
+    }
+    check(model, source_map, first_region, &reported, diags);
+}
+
+/// The one face of a 2D subdomain.
+fn face_of(model: &Model, k: usize) -> Option<FaceId> {
+    match &model.subdomains[k].cells {
+        SubdomainCells::Region { faces } if faces.len() == 1 => Some(faces[0]),
+        _ => None,
+    }
+}
+
+fn carve(
+    model: &mut Model,
+    first_region: usize,
+    c: &Carve,
+    region_of: &[(String, String)],
+    diags: &mut Diagnostics,
+) -> Option<(usize, usize)> {
+    // A kernel subdomain that failed to lower was reported already.
+    let k = (0..first_region).find(|&k| model.subdomains[k].name == c.subdomain)?;
+    let Some((_, region)) = region_of.iter().find(|(solid, _)| *solid == c.solid) else {
+        diags.push(
+            Diagnostic::new(
+                Code::RegionCarveNotSubdomain,
+                c.span,
+                format!(
+                    "subdomain '{}' subtracts the R-function solid '{}', which is no subdomain's whole solid",
+                    c.subdomain, c.solid
+                ),
+            )
+            .with_help(format!(
+                "add <subdomain name=\"…\"><solid ref=\"{}\"/></subdomain> (an inclusion), or subtract a kernel solid",
+                c.solid
+            )),
+        );
+        return None;
+    };
+    // A region that failed to trace was reported already.
+    let r =
+        (first_region..model.subdomains.len()).find(|&r| model.subdomains[r].name == *region)?;
+    let (fk, fr) = (face_of(model, k)?, face_of(model, r)?);
+    let outline = Outline::of(model, fk);
+    let touch = touch_distance(model, fr);
+    let outside = loop_vertices(model, fr)
+        .into_iter()
+        .map(|v| model.vertex(v).position)
+        .find(|p| outline.distance(p) <= touch || !outline.contains(p));
+    if let Some(p) = outside {
+        diags.push(
+            Diagnostic::new(
+                Code::RegionCarveOutside,
+                c.span,
+                format!(
+                    "subdomain '{}' subtracts region '{}', but the region is not strictly inside it: its contour reaches ({:.6}, {:.6})",
+                    c.subdomain, region, p.x, p.y
+                ),
+            )
+            .with_help("make the region lie inside the kernel region, clear of its boundary, or make them neighbours without <difference>"),
+        );
+        return Some((k, r));
+    }
+    let holes: Vec<Vec<OrientedEdge>> = model.faces[fr.index()]
+        .loops
+        .iter()
+        .map(|l| {
+            l.iter()
+                .rev()
+                .map(|oe| OrientedEdge {
+                    edge: oe.edge,
+                    forward: !oe.forward,
+                })
+                .collect()
+        })
+        .collect();
+    model.faces[fk.index()].loops.extend(holes);
+    None
+}
+
+/// Straight contour pieces of region `r` (its box sides) lying on a straight
+/// kernel edge become part of that edge: the kernel edge is cut into the
+/// pieces between them, and every face using it walks the whole chain.
+fn share_box_sides(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    first_region: usize,
+    r: usize,
+    diags: &mut Diagnostics,
+) {
+    let Some(fr) = face_of(model, r) else {
+        return;
+    };
+    let sides: Vec<EdgeId> = model.faces[fr.index()]
+        .loops
+        .iter()
+        .flatten()
+        .map(|oe| oe.edge)
+        .filter(|&e| matches!(model.edge(e).curve, Curve::Segment { .. }))
+        .collect();
+    if sides.is_empty() {
+        return;
+    }
+    // Carved regions' contours are in kernel faces too: not kernel edges.
+    let region_edges: BTreeSet<EdgeId> = (first_region..model.subdomains.len())
+        .filter_map(|k| face_of(model, k))
+        .flat_map(|f| {
+            model.faces[f.index()]
+                .loops
+                .iter()
+                .flatten()
+                .map(|oe| oe.edge)
+        })
+        .collect();
+    let kernel_edges: BTreeSet<EdgeId> = (0..first_region)
+        .filter_map(|k| face_of(model, k))
+        .flat_map(|f| {
+            model.faces[f.index()]
+                .loops
+                .iter()
+                .flatten()
+                .map(|oe| oe.edge)
+        })
+        .filter(|e| !region_edges.contains(e))
+        .filter(|&e| matches!(model.edge(e).curve, Curve::Segment { .. }))
+        .collect();
+    let tol = 16.0 * model.tolerance;
+    for ke in kernel_edges {
+        let (a, b) = ends(model, ke);
+        let d = b - a;
+        let length2 = d.norm_squared();
+        if length2 <= tol * tol {
+            continue;
+        }
+        let at = |p: Point3| (p - a).dot(&d) / length2;
+        let off = |p: Point3| (p - a - d * at(p)).norm();
+        // (from, to, edge, runs a → b) along the kernel edge.
+        let mut on: Vec<(f64, f64, EdgeId, bool)> = sides
+            .iter()
+            .filter_map(|&e| {
+                let (p, q) = ends(model, e);
+                let inside = |p: Point3| off(p) <= tol && (-1e-9..=1.0 + 1e-9).contains(&at(p));
+                (inside(p) && inside(q)).then(|| {
+                    let (s, t) = (at(p), at(q));
+                    (s.min(t), s.max(t), e, s < t)
+                })
+            })
+            .collect();
+        if on.is_empty() {
+            continue;
+        }
+        on.sort_by(|x, y| x.0.total_cmp(&y.0));
+        let eps = tol / length2.sqrt();
+        let mut chain = Vec::with_capacity(2 * on.len() + 1);
+        let mut cur = model.edge(ke).begin;
+        let mut last = 0.0;
+        let mut failed = None;
+        for &(from, to, e, forward) in &on {
+            let edge = model.edge(e);
+            let (start, end) = if forward {
+                (edge.begin, edge.end)
+            } else {
+                (edge.end, edge.begin)
+            };
+            if from > last + eps {
+                chain.push(Piece::Gap(cur, start));
+            } else if start != cur {
+                // The piece starts on a kernel vertex or where another ends:
+                // two vertices at one point.
+                failed = Some(model.vertex(start).position);
+                break;
+            }
+            chain.push(Piece::Shared(OrientedEdge { edge: e, forward }));
+            cur = end;
+            last = to;
+        }
+        let end_vertex = model.edge(ke).end;
+        if failed.is_none() {
+            if last < 1.0 - eps {
+                chain.push(Piece::Gap(cur, end_vertex));
+            } else {
+                failed = Some(model.vertex(cur).position);
+            }
+        }
+        if let Some(p) = failed {
+            let span = source_map.subdomain(SubdomainId(r as u32));
+            diags.push(
+                Diagnostic::new(
+                    Code::RegionTouches,
+                    span,
+                    format!(
+                        "region '{}' runs along edge '{}' up to its end or to another piece at ({:.6}, {:.6}); only a box side strictly inside a straight kernel edge becomes an interface",
+                        model.subdomains[r].name, model.edge(ke).name, p.x, p.y
+                    ),
+                )
+                .with_help("move the region's box side so that it ends inside the kernel edge"),
+            );
+            continue;
+        }
+        let replacement = split_edge(model, source_map, ke, &chain);
+        for face in &mut model.faces {
+            for lp in &mut face.loops {
+                if !lp.iter().any(|oe| oe.edge == ke) {
+                    continue;
+                }
+                let mut out = Vec::with_capacity(lp.len() + replacement.len());
+                for oe in lp.iter() {
+                    if oe.edge != ke {
+                        out.push(*oe);
+                    } else if oe.forward {
+                        out.extend(replacement.iter().copied());
+                    } else {
+                        out.extend(replacement.iter().rev().map(|p| OrientedEdge {
+                            edge: p.edge,
+                            forward: !p.forward,
+                        }));
+                    }
+                }
+                *lp = out;
+            }
+        }
+    }
+}
+
+/// A part of a kernel edge after the split: a straight gap between two
+/// vertices, or a region's contour piece.
+enum Piece {
+    Gap(VertexId, VertexId),
+    Shared(OrientedEdge),
+}
+
+/// Makes the gaps of `chain` edges (the first keeps the kernel edge's id,
+/// name and boundaries; the others are `NAME.2`, `NAME.3`, … in the same
+/// boundaries) and returns the chain in the edge's direction.
+fn split_edge(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    ke: EdgeId,
+    chain: &[Piece],
+) -> Vec<OrientedEdge> {
+    let name = model.edge(ke).name.clone();
+    let origin = source_map.edges.get(&ke).copied();
+    let mut out = Vec::with_capacity(chain.len());
+    let mut added = Vec::new();
+    let mut gaps = 0;
+    for piece in chain {
+        match *piece {
+            Piece::Shared(oe) => out.push(oe),
+            Piece::Gap(from, to) => {
+                let curve = Curve::Segment {
+                    a: model.vertex(from).position,
+                    b: model.vertex(to).position,
+                };
+                gaps += 1;
+                let id = if gaps == 1 {
+                    let edge = &mut model.edges[ke.index()];
+                    (edge.curve, edge.begin, edge.end) = (curve, from, to);
+                    ke
+                } else {
+                    let id = EdgeId(model.edges.len() as u32);
+                    model.edges.push(Edge {
+                        name: format!("{name}.{gaps}"),
+                        curve,
+                        begin: from,
+                        end: to,
+                    });
+                    if let Some(o) = origin {
+                        source_map.edges.insert(id, o);
+                    }
+                    added.push(id);
+                    id
+                };
+                out.push(OrientedEdge {
+                    edge: id,
+                    forward: true,
+                });
+            }
+        }
+    }
+    for boundary in &mut model.boundaries {
+        if boundary.edges.contains(&ke) {
+            boundary.edges.extend(added.iter().copied());
+        }
+    }
+    out
+}
+
+fn ends(model: &Model, e: EdgeId) -> (Point3, Point3) {
+    let edge = model.edge(e);
+    (
+        model.vertex(edge.begin).position,
+        model.vertex(edge.end).position,
+    )
+}
+
+/// The vertices of a face's loops, each once, in loop order.
+fn loop_vertices(model: &Model, f: FaceId) -> Vec<VertexId> {
+    let mut seen = BTreeSet::new();
+    model.faces[f.index()]
+        .loops
+        .iter()
+        .flatten()
+        .flat_map(|oe| {
+            let e = model.edge(oe.edge);
+            [e.begin, e.end]
+        })
+        .filter(|v| seen.insert(*v))
+        .collect()
+}
+
+/// [`TOUCH_FRACTION`] of the diagonal of a region's contour.
+fn touch_distance(model: &Model, f: FaceId) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for v in loop_vertices(model, f) {
+        let p = model.vertex(v).position;
+        lo = [lo[0].min(p.x), lo[1].min(p.y)];
+        hi = [hi[0].max(p.x), hi[1].max(p.y)];
+    }
+    TOUCH_FRACTION * (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+}
+
+/// A face's boundary as straight pieces (curved edges sampled finely), each
+/// with its edge.
+struct Outline {
+    segments: Vec<([f64; 2], [f64; 2], EdgeId)>,
+    lo: [f64; 2],
+    hi: [f64; 2],
+}
+
+impl Outline {
+    fn of(model: &Model, f: FaceId) -> Outline {
+        let mut segments = Vec::new();
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for oe in model.faces[f.index()].loops.iter().flatten() {
+            let curve = &model.edge(oe.edge).curve;
+            let n = match curve {
+                Curve::Segment { .. } | Curve::Contour { .. } => 1,
+                _ => 256,
+            };
+            let points = curve.samples(n);
+            for w in points.windows(2) {
+                let (a, b) = ([w[0].x, w[0].y], [w[1].x, w[1].y]);
+                for p in [a, b] {
+                    lo = [lo[0].min(p[0]), lo[1].min(p[1])];
+                    hi = [hi[0].max(p[0]), hi[1].max(p[1])];
+                }
+                segments.push((a, b, oe.edge));
+            }
+        }
+        Outline { segments, lo, hi }
+    }
+
+    /// Whether the boxes of two outlines come within `gap` of each other.
+    fn near(&self, other: &Outline, gap: f64) -> bool {
+        (0..2).all(|i| self.lo[i] <= other.hi[i] + gap && other.lo[i] <= self.hi[i] + gap)
+    }
+
+    fn distance(&self, p: &Point3) -> f64 {
+        self.segments
+            .iter()
+            .map(|(a, b, _)| segment_distance([p.x, p.y], *a, *b))
+            .fold(f64::INFINITY, f64::min)
+    }
+
+    /// Even–odd: inside the outer loop and outside the holes.
+    fn contains(&self, p: &Point3) -> bool {
+        let mut inside = false;
+        for (a, b, _) in &self.segments {
+            if (a[1] > p.y) != (b[1] > p.y) {
+                let x = a[0] + (p.y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
+                if p.x < x {
+                    inside = !inside;
+                }
+            }
+        }
+        inside
+    }
+
+    /// Sample points of the outline, except on the `skip` edges.
+    fn points_off<'a>(&'a self, skip: &'a BTreeSet<EdgeId>) -> impl Iterator<Item = Point3> + 'a {
+        self.segments
+            .iter()
+            .filter(|(_, _, e)| !skip.contains(e))
+            .flat_map(|(a, b, _)| {
+                let m = [(a[0] + b[0]) / 2.0, (a[1] + b[1]) / 2.0];
+                [*a, m]
+            })
+            .map(|p| Point3::new(p[0], p[1], 0.0))
+    }
+}
+
+fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
+    let d = [b[0] - a[0], b[1] - a[1]];
+    let l2 = d[0] * d[0] + d[1] * d[1];
+    let t = if l2 > 0.0 {
+        (((p[0] - a[0]) * d[0] + (p[1] - a[1]) * d[1]) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - a[0] - t * d[0]).hypot(p[1] - a[1] - t * d[1])
+}
+
+/// Reports each region that touches a kernel region or another region
+/// outside their shared edges (E543), or overlaps a kernel region (E407;
+/// regions among themselves are checked by the implicit overlap check).
+fn check(
+    model: &Model,
+    source_map: &SourceMap,
+    first_region: usize,
+    reported: &BTreeSet<(usize, usize)>,
+    diags: &mut Diagnostics,
+) {
+    let n = model.subdomains.len();
+    let faces: Vec<Option<FaceId>> = (0..n).map(|k| face_of(model, k)).collect();
+    let outlines: BTreeMap<usize, Outline> = (0..n)
+        .filter_map(|k| faces[k].map(|f| (k, Outline::of(model, f))))
+        .collect();
+    for (r, &face) in faces.iter().enumerate().skip(first_region) {
+        let (Some(fr), Some(or)) = (face, outlines.get(&r)) else {
+            continue;
+        };
+        let touch = touch_distance(model, fr);
+        let region_edges: BTreeSet<EdgeId> = or.segments.iter().map(|s| s.2).collect();
+        for k in 0..n {
+            if k == r {
+                continue;
+            }
+            let Some(ok) = outlines.get(&k).filter(|o| o.near(or, touch)) else {
+                continue;
+            };
+            // Regions meet regions once, from the first.
+            if (k >= first_region && k < r) || reported.contains(&(k, r)) {
+                continue;
+            }
+            let shared: BTreeSet<EdgeId> = ok
+                .segments
+                .iter()
+                .map(|s| s.2)
+                .filter(|e| region_edges.contains(e))
+                .collect();
+            let exempt: BTreeSet<VertexId> = shared
+                .iter()
+                .flat_map(|&e| [model.edge(e).begin, model.edge(e).end])
+                .collect();
+            let finding = loop_vertices(model, fr)
+                .into_iter()
+                .filter(|v| !exempt.contains(v))
+                .map(|v| model.vertex(v).position)
+                .find_map(|p| {
+                    if ok.distance(&p) <= touch {
+                        Some((Code::RegionTouches, p))
+                    } else if k < first_region && ok.contains(&p) {
+                        Some((Code::SubdomainsOverlap, p))
+                    } else {
+                        None
+                    }
+                })
+                .or_else(|| {
+                    let far = |p: &Point3| or.distance(p) > touch;
+                    ok.points_off(&shared).find_map(|p| {
+                        if !far(&p) {
+                            (k >= first_region).then_some((Code::RegionTouches, p))
+                        } else if k < first_region && or.contains(&p) {
+                            Some((Code::SubdomainsOverlap, p))
+                        } else {
+                            None
+                        }
+                    })
+                });
+            if let Some((code, p)) = finding {
+                report(model, source_map, code, (k, r), p, diags);
+            }
+        }
+    }
+}
+
+fn report(
+    model: &Model,
+    source_map: &SourceMap,
+    code: Code,
+    (k, r): (usize, usize),
+    p: Point3,
+    diags: &mut Diagnostics,
+) {
+    let (kernel, region) = (&model.subdomains[k].name, &model.subdomains[r].name);
+    let span = source_map.subdomain(SubdomainId(r as u32));
+    let d = if code == Code::SubdomainsOverlap {
+        Diagnostic::new(
+            code,
+            span,
+            format!("region '{region}' and subdomain '{kernel}' overlap at ({:.6}, {:.6})", p.x, p.y),
+        )
+        .with_help(format!(
+            "carve one out of the other: <subdomain name=\"{kernel}\"><difference> … <solid ref=\"…\"/></difference></subdomain> subtracting the region's solid"
+        ))
+    } else {
+        Diagnostic::new(
+            code,
+            span,
+            format!(
+                "region '{region}' touches subdomain '{kernel}' at ({:.6}, {:.6}), where their boundaries cannot share nodes",
+                p.x, p.y
+            ),
+        )
+        .with_help("move them apart, carve the region out of a kernel subdomain with <difference>, or let a side of the region's box lie on a straight kernel edge")
+    };
+    diags.push(d);
+}
