@@ -140,7 +140,7 @@ fn apply(
         edge.end = v(edge.end).unwrap_or(edge.end);
     }
     for face in &mut model.faces {
-        for oe in face.loops.iter_mut().flatten() {
+        for oe in face.loops.edges_mut() {
             oe.edge = e(oe.edge).unwrap_or(oe.edge);
         }
     }
