@@ -207,7 +207,7 @@ mod tests {
             two.iter().collect::<Vec<_>>(),
             [&[oe(0), oe(1)][..], &[oe(5)]]
         );
-        assert_eq!(two.iter().rev().next(), Some(&[oe(5)][..]));
+        assert_eq!(two.iter().next_back(), Some(&[oe(5)][..]));
         assert_eq!(two.edges(), [oe(0), oe(1), oe(5)]);
         two[1][0] = oe(7);
         two.push(vec![oe(3)]);
