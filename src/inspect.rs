@@ -87,9 +87,10 @@ impl Report {
                                     }),
                             )
                             .collect(),
-                        SubdomainCells::Region { faces } => {
-                            faces.iter().map(|f| model.face(*f).name.clone()).collect()
-                        }
+                        SubdomainCells::Region { faces } => faces
+                            .iter()
+                            .map(|f| model.face(*f).name.to_string())
+                            .collect(),
                     },
                 })
                 .collect(),
@@ -177,9 +178,9 @@ impl Report {
         }
         if matrices {
             let m = IncidenceMatrices::of(model);
-            let vertices: Vec<String> = model.vertices.iter().map(|v| v.name.clone()).collect();
-            let edges: Vec<String> = model.edges.iter().map(|e| e.name.clone()).collect();
-            let faces: Vec<String> = model.faces.iter().map(|f| f.name.clone()).collect();
+            let vertices: Vec<String> = model.vertices.iter().map(|v| v.name.to_string()).collect();
+            let edges: Vec<String> = model.edges.iter().map(|e| e.name.to_string()).collect();
+            let faces: Vec<String> = model.faces.iter().map(|f| f.name.to_string()).collect();
             let subdomains: Vec<String> = model.subdomains.iter().map(|d| d.name.clone()).collect();
             for (title, matrix, rows, cols) in [
                 ("M_VE (vertex × edge)", &m.ve, &vertices, &edges),
@@ -220,12 +221,12 @@ fn fragment_summary(model: &Model, f: &Fragment) -> FragmentSummary {
         faces: f
             .faces
             .iter()
-            .map(|id| model.face(*id).name.clone())
+            .map(|id| model.face(*id).name.to_string())
             .collect(),
         edges: f
             .edges
             .iter()
-            .map(|id| model.edge(*id).name.clone())
+            .map(|id| model.edge(*id).name.to_string())
             .collect(),
     }
 }
@@ -250,8 +251,15 @@ fn plural(n: usize) -> &'static str {
 /// by its discriminant): standalone lines first, then edges, in model order.
 fn point_curves(model: &Model) -> Vec<String> {
     use crate::geom::Curve;
-    let lines = model.polylines.iter().map(|l| (&l.name, &l.curve, "line"));
-    let edges = model.edges.iter().map(|e| (&e.name, &e.curve, "edge"));
+    use std::fmt::Display;
+    let lines = model
+        .polylines
+        .iter()
+        .map(|l| (&l.name as &dyn Display, &l.curve, "line"));
+    let edges = model
+        .edges
+        .iter()
+        .map(|e| (&e.name as &dyn Display, &e.curve, "edge"));
     let mut out = Vec::new();
     for (name, curve, role) in lines
         .map(|(n, c, r)| (n, c.as_ref(), r))

@@ -104,7 +104,7 @@ fn hemispheres_are_told_apart() {
     let faces = geomc::meshing::exact::face_measures(&m);
     for (face, measure) in m.faces.iter().zip(&faces) {
         let measure = measure.expect("exact");
-        let expected = match face.name.as_str() {
+        let expected = match face.name.to_string().as_str() {
             "a.north" => 7.0 * PI / 3.0,
             "a.south" => -PI,
             other => panic!("unexpected face {other}"),

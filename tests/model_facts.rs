@@ -69,7 +69,7 @@ fn ball_in_a_box_gives_an_outer_and_an_interface_fragment() {
             let mut faces: Vec<String> = f
                 .faces
                 .iter()
-                .map(|id| model.face(*id).name.clone())
+                .map(|id| model.face(*id).name.to_string())
                 .collect();
             faces.sort();
             (model.subdomain(f.subdomain).name.clone(), other, faces)
@@ -104,7 +104,7 @@ fn ball_in_a_box_gives_an_outer_and_an_interface_fragment() {
     let inward: Vec<String> = boundary
         .iter()
         .filter(|f| !f.outward)
-        .map(|f| model.face(f.face).name.clone())
+        .map(|f| model.face(f.face).name.to_string())
         .collect();
     assert_eq!(
         inward,

@@ -32,10 +32,10 @@ fn segments(nodes: &[u32]) -> Vec<(u32, u32)> {
 /// Mesh edges and vertices are the IR's, in order, and no segment is in two
 /// mesh edges (no duplicate line elements).
 fn assert_edges_are_the_irs(model: &Model, mesh: &Mesh) {
-    let ir: Vec<&str> = model.edges.iter().map(|e| e.name.as_str()).collect();
+    let ir: Vec<String> = model.edges.iter().map(|e| e.name.to_string()).collect();
     let got: Vec<&str> = mesh.edges.iter().map(|e| e.name.as_str()).collect();
     assert_eq!(got, ir);
-    let ir: Vec<&str> = model.vertices.iter().map(|v| v.name.as_str()).collect();
+    let ir: Vec<String> = model.vertices.iter().map(|v| v.name.to_string()).collect();
     let got: Vec<&str> = mesh.vertices.iter().map(|v| v.name.as_str()).collect();
     assert_eq!(got, ir);
     let mut seen: BTreeMap<(u32, u32), &str> = BTreeMap::new();
@@ -83,9 +83,9 @@ fn the_bezier_hole_mesh_has_the_irs_four_sides_and_trim_as_its_boundary() {
         let p = mesh.nodes[mv.node as usize];
         let d = (v.position - nalgebra::Point3::new(p[0], p[1], p[2])).norm();
         let closed_trim = model.edges.iter().any(|e| {
-            e.name.contains(".trim[")
+            e.name.to_string().contains(".trim[")
                 && e.begin == e.end
-                && e.begin.index() == v_index(&model, &v.name)
+                && e.begin.index() == v_index(&model, &v.name.to_string())
         });
         if !closed_trim {
             assert!(d < 1e-9, "{}: node {d} from the vertex", v.name);
@@ -252,7 +252,7 @@ fn ir_flags(model: &Model, subdomain: &str) -> BTreeMap<String, bool> {
     };
     boundary
         .iter()
-        .map(|of| (model.faces[of.face.index()].name.clone(), of.outward))
+        .map(|of| (model.faces[of.face.index()].name.to_string(), of.outward))
         .collect()
 }
 

@@ -234,7 +234,7 @@ mod tests {
     use crate::ir::Dimension;
     use crate::valid::fixtures::{Builder, cube, torus};
 
-    fn names<T>(items: &[T], name: impl Fn(&T) -> &str) -> Vec<String> {
+    fn names<T, N: ToString + ?Sized>(items: &[T], name: impl Fn(&T) -> &N) -> Vec<String> {
         items.iter().map(|x| name(x).to_string()).collect()
     }
 

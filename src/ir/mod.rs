@@ -14,10 +14,14 @@
 
 mod fragments;
 mod incidence;
+mod loops;
+mod name;
 mod source_map;
 
 pub use fragments::{Fragment, Side, derive_fragments};
 pub use incidence::{Incidence, IncidenceMatrices};
+pub use loops::Loops;
+pub use name::{EntityName, LOCAL_NAMES, LocalName};
 pub use source_map::{DenseId, IdMap, Origin, SourceMap};
 
 use crate::geom::{Aabb, Curve, Point3, SolidShape, Surface};
@@ -41,13 +45,13 @@ pub enum Dimension {
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Vertex {
-    pub name: String,
+    pub name: EntityName,
     pub position: Point3,
 }
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Edge {
-    pub name: String,
+    pub name: EntityName,
     pub curve: Curve,
     pub begin: VertexId,
     pub end: VertexId,
@@ -68,11 +72,11 @@ pub struct OrientedEdge {
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Face {
-    pub name: String,
+    pub name: EntityName,
     pub surface: Surface,
     /// The face normal is −∇S when true.
     pub reversed: bool,
-    pub loops: Vec<Vec<OrientedEdge>>,
+    pub loops: Loops,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

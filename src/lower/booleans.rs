@@ -674,13 +674,13 @@ fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<
     let origin = model.vertex(model.edge(edges[0].edge).begin).position;
     let id = FaceId(model.faces.len() as u32);
     model.faces.push(Face {
-        name: name.to_string(),
+        name: name.into(),
         surface: Surface::Plane {
             origin,
             normal: Vec3::z(),
         },
         reversed: false,
-        loops,
+        loops: loops.into(),
     });
     Some(id)
 }

@@ -3,22 +3,23 @@
 //! Built in local indices; the welder merges them into the model.
 
 use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
+use crate::ir::LocalName;
 use std::f64::consts::TAU;
 
 pub struct BrepVertex {
-    pub name: std::borrow::Cow<'static, str>,
+    pub name: LocalName,
     pub position: Point3,
 }
 
 pub struct BrepEdge {
-    pub name: std::borrow::Cow<'static, str>,
+    pub name: LocalName,
     pub curve: Curve,
     pub begin: usize,
     pub end: usize,
 }
 
 pub struct BrepFace {
-    pub name: &'static str,
+    pub name: LocalName,
     pub surface: Surface,
     /// Loops of (local edge index, forward), counter-clockwise about the
     /// outward normal.
@@ -68,23 +69,66 @@ fn ellipse(frame: &Frame, center: Vec3, a: Vec3, b: Vec3) -> Curve {
     }
 }
 
-const FACE_NAMES: [[&str; 2]; 3] = [["xmin", "xmax"], ["ymin", "ymax"], ["zmin", "zmax"]];
+/// Local names are indices into `LOCAL_NAMES` (`ir/name.rs`), checked at
+/// compile time: `named` fails the build on a name the table lacks.
+const fn named(name: &str) -> LocalName {
+    LocalName::named(name)
+}
+
+const FACE_NAMES: [[LocalName; 2]; 3] = [
+    [named("xmin"), named("xmax")],
+    [named("ymin"), named("ymax")],
+    [named("zmin"), named("zmax")],
+];
 /// Edge names by axis the edge runs along, then the sides of the two other
 /// axes in ascending axis order ("xmin_ymax" runs along z).
-const EDGE_NAMES: [[[&str; 2]; 2]; 3] = [
-    [["ymin_zmin", "ymin_zmax"], ["ymax_zmin", "ymax_zmax"]],
-    [["xmin_zmin", "xmin_zmax"], ["xmax_zmin", "xmax_zmax"]],
-    [["xmin_ymin", "xmin_ymax"], ["xmax_ymin", "xmax_ymax"]],
+const EDGE_NAMES: [[[LocalName; 2]; 2]; 3] = [
+    [
+        [named("ymin_zmin"), named("ymin_zmax")],
+        [named("ymax_zmin"), named("ymax_zmax")],
+    ],
+    [
+        [named("xmin_zmin"), named("xmin_zmax")],
+        [named("xmax_zmin"), named("xmax_zmax")],
+    ],
+    [
+        [named("xmin_ymin"), named("xmin_ymax")],
+        [named("xmax_ymin"), named("xmax_ymax")],
+    ],
 ];
-const VERTEX_NAMES: [&str; 8] = [
-    "v000", "v100", "v010", "v110", "v001", "v101", "v011", "v111",
+const VERTEX_NAMES: [LocalName; 8] = [
+    named("v000"),
+    named("v100"),
+    named("v010"),
+    named("v110"),
+    named("v001"),
+    named("v101"),
+    named("v011"),
+    named("v111"),
 ];
+/// The round primitives' names (constants, so no lookup at run time).
+const BOTTOM: LocalName = named("bottom");
+const BOTTOM_RIM: LocalName = named("bottom_rim");
+const BOTTOM_SEAM: LocalName = named("bottom_seam");
+const EQUATOR: LocalName = named("equator");
+const MERIDIAN: LocalName = named("meridian");
+const NORTH: LocalName = named("north");
+const PARALLEL: LocalName = named("parallel");
+const REGION: LocalName = named("region");
+const RIM: LocalName = named("rim");
+const SEAM: LocalName = named("seam");
+const SIDE: LocalName = named("side");
+const SOUTH: LocalName = named("south");
+const SURFACE: LocalName = named("surface");
+const TOP: LocalName = named("top");
+const TOP_RIM: LocalName = named("top_rim");
+const TOP_SEAM: LocalName = named("top_seam");
 
 fn parallelepiped(frame: &Frame) -> Brep {
     let corner = |i: usize, j: usize, k: usize| i + 2 * j + 4 * k;
     let vertices = (0..8)
         .map(|n| BrepVertex {
-            name: VERTEX_NAMES[n].into(),
+            name: VERTEX_NAMES[n],
             position: frame.to_global(&Point3::new(
                 (n & 1) as f64,
                 ((n >> 1) & 1) as f64,
@@ -107,7 +151,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
                 at[axis] = 1;
                 let end = corner(at[0], at[1], at[2]);
                 edges.push(BrepEdge {
-                    name: name.into(),
+                    name,
                     curve: Curve::Segment {
                         a: vertices[begin].position,
                         b: vertices[end].position,
@@ -176,24 +220,24 @@ fn ball(frame: &Frame) -> Brep {
     let surface = Surface::Ellipsoid { frame: *frame };
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam".into(),
+            name: SEAM,
             position: seam,
         }],
         edges: vec![BrepEdge {
-            name: "equator".into(),
+            name: EQUATOR,
             curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
             begin: 0,
             end: 0,
         }],
         faces: vec![
             BrepFace {
-                name: "north",
+                name: NORTH,
                 surface: surface.clone(),
                 loops: vec![vec![(0, !flip)]],
                 sample: frame.to_global(&Point3::new(0.0, 0.0, 1.0)),
             },
             BrepFace {
-                name: "south",
+                name: SOUTH,
                 surface,
                 loops: vec![vec![(0, flip)]],
                 sample: frame.to_global(&Point3::new(0.0, 0.0, -1.0)),
@@ -210,8 +254,8 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
     let mut faces = Vec::new();
     let mut side_loops = Vec::new();
     let rims = [
-        (0.0, r0, "bottom_seam", "bottom_rim", "bottom", -1.0),
-        (1.0, r1, "top_seam", "top_rim", "top", 1.0),
+        (0.0, r0, BOTTOM_SEAM, BOTTOM_RIM, BOTTOM, -1.0),
+        (1.0, r1, TOP_SEAM, TOP_RIM, TOP, 1.0),
     ];
     for (z, r, vertex, rim, cap, up) in rims {
         if r <= 0.0 {
@@ -219,12 +263,12 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
         }
         let v = vertices.len();
         vertices.push(BrepVertex {
-            name: vertex.into(),
+            name: vertex,
             position: frame.to_global(&Point3::new(r, 0.0, z)),
         });
         let e = edges.len();
         edges.push(BrepEdge {
-            name: rim.into(),
+            name: rim,
             curve: ellipse(frame, Vec3::new(0.0, 0.0, z), Vec3::x() * r, Vec3::y() * r),
             begin: v,
             end: v,
@@ -245,7 +289,7 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
     }
     let mid_r = 0.5 * (r0 + r1);
     faces.push(BrepFace {
-        name: "side",
+        name: SIDE,
         surface: Surface::Cone {
             frame: *frame,
             r0,
@@ -274,18 +318,18 @@ fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
     }
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam".into(),
+            name: SEAM,
             position: frame.to_global(&Point3::new(outer, 0.0, 0.0)),
         }],
         edges: vec![
             BrepEdge {
-                name: "parallel".into(),
+                name: PARALLEL,
                 curve: ellipse(frame, Vec3::zeros(), Vec3::x() * outer, Vec3::y() * outer),
                 begin: 0,
                 end: 0,
             },
             BrepEdge {
-                name: "meridian".into(),
+                name: MERIDIAN,
                 curve: ellipse(
                     frame,
                     Vec3::new(major, 0.0, 0.0),
@@ -297,7 +341,7 @@ fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
             },
         ],
         faces: vec![BrepFace {
-            name: "surface",
+            name: SURFACE,
             surface: Surface::Torus {
                 frame: *frame,
                 major,
@@ -323,17 +367,17 @@ fn disk(frame: &Frame) -> Brep {
     let center = frame.origin;
     Brep {
         vertices: vec![BrepVertex {
-            name: "seam".into(),
+            name: SEAM,
             position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)),
         }],
         edges: vec![BrepEdge {
-            name: "rim".into(),
+            name: RIM,
             curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
             begin: 0,
             end: 0,
         }],
         faces: vec![BrepFace {
-            name: "region",
+            name: REGION,
             surface: Surface::Plane {
                 origin: center,
                 normal: region_normal(frame),
@@ -352,7 +396,7 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
     let n = local.len();
     let vertices: Vec<BrepVertex> = (0..n)
         .map(|i| BrepVertex {
-            name: format!("v{}", i + 1).into(),
+            name: LocalName::Vertex(i as u32 + 1),
             position: frame.to_global(&local[i]),
         })
         .collect();
@@ -360,7 +404,7 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
         .map(|i| {
             let j = (i + 1) % n;
             BrepEdge {
-                name: format!("e{}", i + 1).into(),
+                name: LocalName::Edge(i as u32 + 1),
                 curve: Curve::Segment {
                     a: vertices[i].position,
                     b: vertices[j].position,
@@ -390,7 +434,7 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
         vertices,
         edges,
         faces: vec![BrepFace {
-            name: "region",
+            name: REGION,
             surface: Surface::Plane {
                 origin: sample,
                 normal: region_normal(frame),

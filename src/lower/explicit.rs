@@ -29,7 +29,7 @@ pub(super) fn lower_topology(
         if let Some(Geometry::Vertex(p)) = &object.geometry {
             let id = VertexId(model.vertices.len() as u32);
             model.vertices.push(Vertex {
-                name: object.name.clone(),
+                name: object.name.as_str().into(),
                 position: *p,
             });
             source_map.vertices.insert(id, Origin { span: object.span });
@@ -174,10 +174,10 @@ pub(super) fn lower_topology(
         let reversed = orient_loops(model, &mut chained, &surface);
         let id = crate::ir::FaceId(model.faces.len() as u32);
         model.faces.push(Face {
-            name: object.name.clone(),
+            name: object.name.as_str().into(),
             surface,
             reversed,
-            loops: chained,
+            loops: chained.into(),
         });
         source_map.faces.insert(id, Origin { span: object.span });
         entities.faces.insert(object.name.clone(), id);
@@ -198,7 +198,7 @@ fn push_edge(
 ) {
     let id = EdgeId(model.edges.len() as u32);
     model.edges.push(Edge {
-        name: object.name.clone(),
+        name: object.name.as_str().into(),
         curve,
         begin,
         end,

@@ -19,8 +19,8 @@ use crate::diag::Diagnostics;
 use crate::doc::Document;
 use crate::geom::{Aabb, SolidShape};
 use crate::ir::{
-    Dimension, Face, Model, OrientedEdge, OrientedFace, Origin, PointSet, Polyline, Solid, SolidId,
-    SourceMap,
+    Dimension, EntityName, Face, Loops, Model, OrientedEdge, OrientedFace, Origin, PointSet,
+    Polyline, Solid, SolidId, SourceMap,
 };
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
@@ -52,10 +52,10 @@ impl Entities {
     /// ("box.xmin" → its welded face). Explicit entities keep their names: an
     /// explicit entity of the same name wins, and among solids the first does.
     fn add_solid_entities(&mut self, model: &Model) {
-        fn add<'n, T: Copy>(
+        fn add<T: Copy>(
             table: &mut HashMap<String, T>,
             solid: &str,
-            names: impl Iterator<Item = &'n str>,
+            names: impl Iterator<Item = crate::ir::LocalName>,
             ids: impl Iterator<Item = T>,
         ) {
             for (local, id) in names.zip(ids) {
@@ -73,13 +73,13 @@ impl Entities {
             add(
                 &mut self.vertices,
                 name,
-                brep.vertices.iter().map(|v| v.name.as_ref()),
+                brep.vertices.iter().map(|v| v.name),
                 solid.vertices.iter().copied(),
             );
             add(
                 &mut self.edges,
                 name,
-                brep.edges.iter().map(|e| e.name.as_ref()),
+                brep.edges.iter().map(|e| e.name),
                 solid.edges.iter().copied(),
             );
             add(
@@ -307,13 +307,15 @@ fn lower_solid(
     let origin = Origin { span };
     let brep = brep::of(shape);
     welder.begin_solid(model);
-    // Entity names are made only for new entities; the name tables for
-    // faces= and edges= lists are built later, and only when a file has such lists.
+    // The entities' names share the solid's ("{name}.{local}"); the name
+    // tables for faces= and edges= lists are built later, and only when a
+    // file has such lists.
+    let base: std::sync::Arc<Box<str>> = std::sync::Arc::new(name.into());
     let vertex_ids: Vec<_> = brep
         .vertices
         .iter()
         .map(|v| {
-            let (id, new) = welder.vertex(model, || format!("{name}.{}", v.name), v.position);
+            let (id, new) = welder.vertex(model, || EntityName::local(&base, v.name), v.position);
             if new {
                 source_map.vertices.insert(id, origin);
             }
@@ -326,7 +328,7 @@ fn lower_solid(
         .map(|e| {
             let (id, flipped, new) = welder.edge(
                 model,
-                || format!("{name}.{}", e.name),
+                || EntityName::local(&base, e.name),
                 e.curve,
                 vertex_ids[e.begin],
                 vertex_ids[e.end],
@@ -346,14 +348,14 @@ fn lower_solid(
     };
     let mut faces = Vec::with_capacity(brep.faces.len());
     for f in brep.faces {
-        let loops: Vec<Vec<OrientedEdge>> = f
+        let loops: Loops = f
             .loops
             .iter()
-            .map(|l| l.iter().copied().map(orient).collect())
+            .map(|l| l.iter().copied().map(orient).collect::<Vec<_>>())
             .collect();
         let first = loops.first().and_then(|l| l.first()).copied();
         let face = Face {
-            name: format!("{name}.{}", f.name),
+            name: EntityName::local(&base, f.name),
             surface: f.surface,
             reversed: false,
             loops,
@@ -383,8 +385,8 @@ fn lower_solid(
 
 fn same_direction(face: &Face, probe: OrientedEdge) -> bool {
     face.loops
+        .edges()
         .iter()
-        .flatten()
         .find(|e| e.edge == probe.edge)
         .is_none_or(|e| e.forward == probe.forward)
 }

@@ -41,8 +41,6 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     for b in &model.boundaries {
         b.faces.iter().for_each(|f| keep_face[f.index()] = true);
     }
-    // Map faces.
-    let face_map = compact(&keep_face);
     let mut keep_edge = vec![false; model.edges.len()];
     for (k, face) in model.faces.iter().enumerate() {
         if keep_face[k] {
@@ -72,7 +70,6 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     for b in &model.boundaries {
         b.edges.iter().for_each(|e| keep_edge[e.index()] = true);
     }
-    let edge_map = compact(&keep_edge);
     let mut keep_vertex = vec![false; model.vertices.len()];
     for (k, edge) in model.edges.iter().enumerate() {
         if keep_edge[k] {
@@ -91,13 +88,18 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
             *keep = true;
         }
     }
-    let vertex_map = compact(&keep_vertex);
     if keep_face.iter().all(|&k| k)
         && keep_edge.iter().all(|&k| k)
         && keep_vertex.iter().all(|&k| k)
     {
         return;
     }
+    // The maps only when something goes: on large files they were megabytes
+    // at the end of lowering, where the memory peaks.
+    let face_map = compact(&keep_face);
+    let edge_map = compact(&keep_edge);
+    let vertex_map = compact(&keep_vertex);
+    drop((keep_face, keep_edge, keep_vertex));
     apply(model, source_map, &face_map, &edge_map, &vertex_map);
 }
 
@@ -140,7 +142,7 @@ fn apply(
         edge.end = v(edge.end).unwrap_or(edge.end);
     }
     for face in &mut model.faces {
-        for oe in face.loops.iter_mut().flatten() {
+        for oe in face.loops.edges_mut() {
             oe.edge = e(oe.edge).unwrap_or(oe.edge);
         }
     }

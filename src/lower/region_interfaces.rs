@@ -18,7 +18,8 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::geom::{Curve, Point3};
 use crate::implicit::xml::Carve;
 use crate::ir::{
-    Edge, EdgeId, FaceId, Model, OrientedEdge, SourceMap, SubdomainCells, SubdomainId, VertexId,
+    Edge, EdgeId, FaceId, Loops, Model, OrientedEdge, SourceMap, SubdomainCells, SubdomainId,
+    VertexId,
 };
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -122,7 +123,10 @@ fn carve(
                 .collect()
         })
         .collect();
-    model.faces[fk.index()].loops.extend(holes);
+    let face = &mut model.faces[fk.index()];
+    let mut loops = face.loops.to_vecs();
+    loops.extend(holes);
+    face.loops = Loops::from(loops);
     None
 }
 
@@ -247,7 +251,11 @@ fn share_box_sides(
         }
         let replacement = split_edge(model, source_map, ke, &chain);
         for face in &mut model.faces {
-            for lp in &mut face.loops {
+            if !face.loops.edges().iter().any(|oe| oe.edge == ke) {
+                continue;
+            }
+            let mut loops = face.loops.to_vecs();
+            for lp in &mut loops {
                 if !lp.iter().any(|oe| oe.edge == ke) {
                     continue;
                 }
@@ -266,6 +274,7 @@ fn share_box_sides(
                 }
                 *lp = out;
             }
+            face.loops = Loops::from(loops);
         }
     }
 }
@@ -307,7 +316,7 @@ fn split_edge(
                 } else {
                     let id = EdgeId(model.edges.len() as u32);
                     model.edges.push(Edge {
-                        name: format!("{name}.{gaps}"),
+                        name: format!("{name}.{gaps}").into(),
                         curve,
                         begin: from,
                         end: to,

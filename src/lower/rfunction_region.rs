@@ -265,7 +265,7 @@ fn add_region(
         for (k, p) in points.iter().enumerate() {
             let id = VertexId(model.vertices.len() as u32);
             model.vertices.push(Vertex {
-                name: format!("{}.contour[{}].v{}", sub.name, l + 1, k + 1),
+                name: format!("{}.contour[{}].v{}", sub.name, l + 1, k + 1).into(),
                 position: Point3::new(p[0], p[1], 0.0),
             });
             source_map.vertices.insert(id, origin);
@@ -288,7 +288,7 @@ fn add_region(
                 }
             };
             model.edges.push(Edge {
-                name: format!("{}.contour[{}].e{}", sub.name, l + 1, k + 1),
+                name: format!("{}.contour[{}].e{}", sub.name, l + 1, k + 1).into(),
                 curve,
                 begin: VertexId(a as u32),
                 end: VertexId(b as u32),
@@ -303,13 +303,13 @@ fn add_region(
     }
     let face = FaceId(model.faces.len() as u32);
     model.faces.push(Face {
-        name: format!("{}.region", sub.name),
+        name: format!("{}.region", sub.name).into(),
         surface: Surface::Plane {
             origin: Point3::origin(),
             normal: Vec3::z(),
         },
         reversed: false,
-        loops: face_loops,
+        loops: face_loops.into(),
     });
     source_map.faces.insert(face, origin);
     let id = SubdomainId(model.subdomains.len() as u32);

@@ -65,7 +65,7 @@ pub fn add(model: &mut Model, source_map: &SourceMap, diags: &mut Diagnostics) {
                     refuse(model, diags, span, s, &name, piece.side, other, share);
                 }
                 model.edges.push(Edge {
-                    name,
+                    name: name.into(),
                     curve: Curve::Chain {
                         points: piece.points.clone(),
                     },
@@ -80,10 +80,10 @@ pub fn add(model: &mut Model, source_map: &SourceMap, diags: &mut Diagnostics) {
             }
         }
         faces.push(Face {
-            name: s.name.clone(),
+            name: s.name.as_str().into(),
             surface: Surface::Parametric(Box::new(s.clone())),
             reversed: false,
-            loops: chain_loops(&oriented),
+            loops: chain_loops(&oriented).into(),
         });
     }
     let first_face = model.faces.len();
@@ -233,7 +233,7 @@ fn vertex(
     }
     *count += 1;
     model.vertices.push(Vertex {
-        name: format!("{surface}.vertex[{count}]"),
+        name: format!("{surface}.vertex[{count}]").into(),
         position: p,
     });
     VertexId((model.vertices.len() - 1) as u32)
@@ -253,7 +253,7 @@ fn shared_edge(model: &Model, piece: &Piece) -> Option<OrientedEdge> {
             .fold(0.0, f64::max)
     };
     for (i, e) in model.edges.iter().enumerate() {
-        if e.begin != e.end || (piece.side != 0 && !e.name.contains(".trim[")) {
+        if e.begin != e.end || (piece.side != 0 && !e.name.to_string().contains(".trim[")) {
             continue;
         }
         let line = match &e.curve {

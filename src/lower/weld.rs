@@ -8,7 +8,7 @@
 
 use super::booleans::cell_hash;
 use crate::geom::{Curve, Point3};
-use crate::ir::{Edge, EdgeId, Face, FaceId, Model, OrientedEdge, Vertex, VertexId};
+use crate::ir::{Edge, EdgeId, EntityName, Face, FaceId, Model, OrientedEdge, Vertex, VertexId};
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash};
 
@@ -208,7 +208,7 @@ impl Welder {
     pub fn vertex(
         &mut self,
         model: &mut Model,
-        name: impl FnOnce() -> String,
+        name: impl FnOnce() -> EntityName,
         position: Point3,
     ) -> (VertexId, bool) {
         let key = self.key(&position);
@@ -250,7 +250,7 @@ impl Welder {
     pub fn edge(
         &mut self,
         model: &mut Model,
-        name: impl FnOnce() -> String,
+        name: impl FnOnce() -> EntityName,
         curve: Curve,
         begin: VertexId,
         end: VertexId,
@@ -331,7 +331,7 @@ impl Welder {
 /// The edges of a face's loops, sorted (the welding key).
 fn sorted_edges(face: &Face, out: &mut Vec<EdgeId>) {
     out.clear();
-    out.extend(face.loops.iter().flatten().map(|e: &OrientedEdge| e.edge));
+    out.extend(face.loops.edges().iter().map(|e: &OrientedEdge| e.edge));
     out.sort_unstable();
 }
 

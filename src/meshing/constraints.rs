@@ -76,7 +76,7 @@ pub(crate) fn assign(
         let mut home = None;
         for (face, loops) in &regions {
             let refuse = |reason: String| MeshError::Face {
-                face: model.faces[*face].name.clone(),
+                face: model.faces[*face].name.to_string(),
                 reason,
             };
             let touching = |p: &Point3| nearest_segment(loops, p).filter(|(_, d)| *d <= tolerance);
@@ -285,7 +285,7 @@ fn refuse_crossing_lines(
             if touch {
                 let name = |k: usize| model.polylines[k].name.clone();
                 return Err(MeshError::Face {
-                    face: model.faces[face].name.clone(),
+                    face: model.faces[face].name.to_string(),
                     reason: format!(
                         "poly_lines `{}` and `{}` cross or touch (within the tolerance {:e}); constraints inside one subdomain must keep apart: end one short of the other or split them where they meet",
                         name(*a),

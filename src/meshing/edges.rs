@@ -39,7 +39,7 @@ pub(crate) fn discretise(
     max_edge: f64,
 ) -> Result<EdgeNodes, MeshError> {
     let failed = |reason: &str| MeshError::Edge {
-        edge: edge.name.clone(),
+        edge: edge.name.to_string(),
         reason: reason.to_string(),
     };
     let begin = model

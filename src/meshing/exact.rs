@@ -193,10 +193,10 @@ fn loop_integral(curve: &Curve) -> Option<Vec3> {
 /// the local equator alone, and its loop runs counter-clockwise about the
 /// face normal, which decides the side.
 fn hemisphere_is_north(model: &Model, face: &Face, frame: &Frame) -> Option<bool> {
-    let [single] = face.loops.as_slice() else {
+    let (1, Some(single)) = (face.loops.len(), face.loops.first()) else {
         return None;
     };
-    let [oriented] = single.as_slice() else {
+    let [oriented] = single else {
         return None;
     };
     let Curve::Ellipse {
@@ -236,7 +236,7 @@ fn cone_side_is_whole(model: &Model, face: &Face, frame: &Frame, r0: f64, r1: f6
     let inv = frame.inverse()?;
     let mut rims = Vec::new();
     for lp in &face.loops {
-        let [oriented] = lp.as_slice() else {
+        let [oriented] = lp else {
             return None;
         };
         let Curve::Ellipse { center, t0, t1, .. } = &model.edges.get(oriented.edge.index())?.curve
@@ -268,7 +268,7 @@ fn cone_side_is_whole(model: &Model, face: &Face, frame: &Frame, r0: f64, r1: f6
 /// A torus face is whole when its one loop is the seam ring: a parallel and
 /// a meridian, each run both ways.
 fn torus_is_whole(face: &Face) -> Option<()> {
-    let [ring] = face.loops.as_slice() else {
+    let (1, Some(ring)) = (face.loops.len(), face.loops.first()) else {
         return None;
     };
     let mut edges: Vec<u32> = ring.iter().map(|oe| oe.edge.0).collect();

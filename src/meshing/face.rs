@@ -124,7 +124,7 @@ pub(crate) fn mesh_face(
     constraints: &[(usize, Vec<Point3>)],
 ) -> Result<Outcome, MeshError> {
     let failed = |reason: String| MeshError::Face {
-        face: face.name.clone(),
+        face: face.name.to_string(),
         reason,
     };
     let loops = walk_loops(model, face, edges).map_err(failed)?;

@@ -311,7 +311,7 @@ fn mesh_faces(
             })?;
             if face.loops.is_empty() {
                 return Err(MeshError::Face {
-                    face: face.name.clone(),
+                    face: face.name.to_string(),
                     reason: format!("it bounds subdomain `{}` but has no loops", sub.name),
                 });
             }
@@ -500,7 +500,7 @@ fn assemble(
             });
         }
         edges.push(MeshEdge {
-            name: edge.name.clone(),
+            name: edge.name.to_string(),
             nodes: ids,
         });
     }
@@ -546,7 +546,7 @@ fn assemble(
             }
         }
         faces.push(MeshFace {
-            name: face.name.clone(),
+            name: face.name.to_string(),
             triangles,
             boundary: face
                 .loops
@@ -613,7 +613,7 @@ fn assemble(
             .iter()
             .enumerate()
             .map(|(i, v)| MeshVertex {
-                name: v.name.clone(),
+                name: v.name.to_string(),
                 node: i as u32,
             })
             .collect(),

@@ -59,7 +59,7 @@ pub(super) fn write(
             }
             let edge = &model.edges[k];
             let path = cut(model, edge, &rings).ok_or_else(|| MeshError::Face {
-                face: face.name.clone(),
+                face: face.name.to_string(),
                 reason: format!(
                     "its boundary piece `{}` was not found on the mesh of its boundary; \
                      refine the tolerance so the trim curve is traced alike for the model \
@@ -91,7 +91,7 @@ pub(super) fn write(
             });
         };
         mesh.edges.push(MeshEdge {
-            name: edge.name.clone(),
+            name: edge.name.to_string(),
             nodes,
         });
     }
@@ -104,7 +104,7 @@ pub(super) fn write(
             });
         };
         mesh.vertices.push(MeshVertex {
-            name: vertex.name.clone(),
+            name: vertex.name.to_string(),
             node,
         });
     }

@@ -273,7 +273,7 @@ fn closed_surfaces_fixture_through_the_mesher() {
     // sides cut at its corners), the ring's hole across its seam.
     let names = |v: Vec<&str>| v.into_iter().map(String::from).collect::<Vec<_>>();
     let mesh_edges: Vec<String> = mesh.edges.iter().map(|e| e.name.clone()).collect();
-    let ir_edges: Vec<String> = model.edges.iter().map(|e| e.name.clone()).collect();
+    let ir_edges: Vec<String> = model.edges.iter().map(|e| e.name.to_string()).collect();
     assert_eq!(mesh_edges, ir_edges);
     for (face, chains) in [
         ("ball", names(vec![])),

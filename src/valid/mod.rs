@@ -83,7 +83,7 @@ pub(crate) mod fixtures {
             }
             let id = VertexId(self.model.vertices.len() as u32);
             self.model.vertices.push(Vertex {
-                name: format!("v{}", id.0),
+                name: format!("v{}", id.0).into(),
                 position,
             });
             let origin = self.origin();
@@ -118,7 +118,7 @@ pub(crate) mod fixtures {
         pub fn push_edge(&mut self, curve: Curve, begin: VertexId, end: VertexId) -> EdgeId {
             let id = EdgeId(self.model.edges.len() as u32);
             self.model.edges.push(Edge {
-                name: format!("e{}", id.0),
+                name: format!("e{}", id.0).into(),
                 curve,
                 begin,
                 end,
@@ -136,10 +136,10 @@ pub(crate) mod fixtures {
         ) -> FaceId {
             let id = FaceId(self.model.faces.len() as u32);
             self.model.faces.push(Face {
-                name: name.to_string(),
+                name: name.into(),
                 surface,
                 reversed: false,
-                loops,
+                loops: loops.into(),
             });
             self.cycles.push(Vec::new());
             let origin = self.origin();

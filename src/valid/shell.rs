@@ -26,21 +26,21 @@ fn vertex_name(model: &Model, id: VertexId) -> String {
     model
         .vertices
         .get(id.index())
-        .map_or_else(|| format!("#{}", id.0), |v| v.name.clone())
+        .map_or_else(|| format!("#{}", id.0), |v| v.name.to_string())
 }
 
 fn edge_name(model: &Model, id: EdgeId) -> String {
     model
         .edges
         .get(id.index())
-        .map_or_else(|| format!("#{}", id.0), |e| e.name.clone())
+        .map_or_else(|| format!("#{}", id.0), |e| e.name.to_string())
 }
 
 fn face_name(model: &Model, id: FaceId) -> String {
     model
         .faces
         .get(id.index())
-        .map_or_else(|| format!("#{}", id.0), |f| f.name.clone())
+        .map_or_else(|| format!("#{}", id.0), |f| f.name.to_string())
 }
 
 fn subdomain_name(model: &Model, id: SubdomainId) -> String {
@@ -1154,10 +1154,12 @@ mod tests {
     fn malformed_ids_do_not_panic() {
         let mut b = cube();
         b.model.edges[0].begin = VertexId(99);
-        b.model.faces[0].loops[0].push(OrientedEdge {
+        let mut loops = b.model.faces[0].loops.to_vecs();
+        loops[0].push(OrientedEdge {
             edge: EdgeId(77),
             forward: true,
         });
+        b.model.faces[0].loops = loops.into();
         boundary_mut(&mut b, 0).push(OrientedFace {
             face: FaceId(55),
             outward: true,
