@@ -394,7 +394,8 @@ fn check_shell(
     let uses = EdgeUses::of(model, boundary);
     let mut manifold = true;
     for (edge, list) in uses.lists() {
-        let span = source_map.subdomain(id).or_else(|| source_map.edge(edge));
+        // Looked up only for a finding: this runs for every edge of every subdomain.
+        let span = || source_map.subdomain(id).or_else(|| source_map.edge(edge));
         match list.len() {
             2 => {}
             1 => {
@@ -403,7 +404,7 @@ fn check_shell(
                 diags.push(
                     Diagnostic::new(
                         Code::OpenShell,
-                        span,
+                        span(),
                         format!(
                             "the boundary of subdomain '{}' is not closed: edge '{}' is used \
                              only by face '{face}'",
@@ -428,7 +429,7 @@ fn check_shell(
                 diags.push(
                     Diagnostic::new(
                         Code::NonManifoldEdge,
-                        span,
+                        span(),
                         format!(
                             "edge '{}' is used {n} times in the boundary of subdomain '{}' \
                              (faces {}), more than twice",
@@ -466,7 +467,7 @@ fn check_orientation(
     uses: &EdgeUses,
     diags: &mut Diagnostics,
 ) {
-    let name = subdomain_name(model, id);
+    // The subdomain's name is copied only for a finding: this runs for every subdomain.
     let n = boundary.len();
     // (neighbour, whether the flips must differ, shared edge)
     let mut adjacent: Vec<Vec<(usize, bool, EdgeId)>> = vec![Vec::new(); n];
@@ -513,6 +514,7 @@ fn check_orientation(
         }
 
         if let Some(edge) = conflict {
+            let name = subdomain_name(model, id);
             diags.push(
                 Diagnostic::new(
                     Code::InconsistentOrientation,
@@ -545,6 +547,7 @@ fn check_orientation(
             2 * odd < members.len()
         };
         members.sort_unstable();
+        let name = subdomain_name(model, id);
         for &e in members.iter().filter(|&&e| class(e) == wrong) {
             let face = boundary[e].face;
             let neighbour = adjacent[e].iter().find(|&&(b, _, _)| class(b) != wrong);
@@ -590,7 +593,6 @@ fn check_euler(
     uses: &EdgeUses,
     diags: &mut Diagnostics,
 ) {
-    let name = subdomain_name(model, id);
     let shells = shells_of(model, boundary, uses);
     let shared_vertices =
         shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices(model, boundary);
@@ -599,6 +601,7 @@ fn check_euler(
         // boundary is not a manifold there, and χ of the whole boundary shows it.
         let chi: i64 =
             shells.iter().map(Shell::euler_characteristic).sum::<i64>() - shared_vertices as i64;
+        let name = subdomain_name(model, id);
         diags.push(
             Diagnostic::new(
                 Code::EulerMismatch,
@@ -620,6 +623,7 @@ fn check_euler(
             format!(" (the shell with face '{}')", face_name(model, f))
         });
         let f = shell.faces.len();
+        let name = subdomain_name(model, id);
         diags.push(
             Diagnostic::new(
                 Code::EulerMismatch,
@@ -767,7 +771,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     for (i, vertex) in model.vertices.iter().enumerate() {
         let id = VertexId(i as u32);
         let explicit_unused = !in_solids_v[i] && !used_vertices[i];
-        if let Some(span) = source_map.vertex(id).filter(|_| explicit_unused) {
+        if let Some(span) = explicit_unused.then(|| source_map.vertex(id)).flatten() {
             unused(
                 Some(span),
                 format!("vertex '{}' is not used by any edge", vertex.name),
@@ -778,7 +782,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     for (i, edge) in model.edges.iter().enumerate() {
         let id = EdgeId(i as u32);
         let explicit_unused = !in_solids_e[i] && !used_edges[i];
-        if let Some(span) = source_map.edge(id).filter(|_| explicit_unused) {
+        if let Some(span) = explicit_unused.then(|| source_map.edge(id)).flatten() {
             unused(
                 Some(span),
                 format!("edge '{}' is not used by any face", edge.name),
@@ -789,7 +793,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     for (i, face) in model.faces.iter().enumerate() {
         let id = FaceId(i as u32);
         let explicit_unused = !in_solids_f[i] && !used_faces[i];
-        if let Some(span) = source_map.face(id).filter(|_| explicit_unused) {
+        if let Some(span) = explicit_unused.then(|| source_map.face(id)).flatten() {
             unused(
                 Some(span),
                 format!(
