@@ -218,7 +218,12 @@ impl EdgeUses {
 
 /// Groups boundary entries (with a valid face) connected through shared
 /// edges; components are ordered by their first entry, entries ascending.
-fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<Vec<usize>> {
+/// Also returns each entry's component (`usize::MAX` for an invalid face).
+fn components(
+    model: &Model,
+    boundary: &[OrientedFace],
+    uses: &EdgeUses,
+) -> (Vec<Vec<usize>>, Vec<usize>) {
     // Union–find over the entries rather than adjacency sets and a search:
     // the same components, without an allocation per face.
     let n = boundary.len();
@@ -241,6 +246,7 @@ fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<
     }
     // Entries in ascending order: a component starts at its first entry.
     let mut component_of_root = vec![usize::MAX; n];
+    let mut component_of_entry = vec![usize::MAX; n];
     let mut out: Vec<Vec<usize>> = Vec::new();
     for (entry, of) in boundary.iter().enumerate() {
         if of.face.index() >= model.faces.len() {
@@ -251,9 +257,10 @@ fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<
             component_of_root[r] = out.len();
             out.push(Vec::new());
         }
+        component_of_entry[entry] = component_of_root[r];
         out[component_of_root[r]].push(entry);
     }
-    out
+    (out, component_of_entry)
 }
 
 /// One connected shell of a subdomain's boundary (faces joined through shared
@@ -282,35 +289,49 @@ impl Shell {
 }
 
 fn shells_of(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<Shell> {
-    components(model, boundary, uses)
-        .into_iter()
-        .map(|members| {
-            let mut vertices = Vec::new();
-            let mut edges = Vec::new();
-            let mut loops = 0;
-            let mut faces = Vec::with_capacity(members.len());
-            for &entry in &members {
-                let id = boundary[entry].face;
-                let Some(face) = model.faces.get(id.index()) else {
-                    continue;
-                };
-                faces.push(id);
-                loops += face.loops.len();
-                for oe in face.loops.iter().flatten() {
-                    if let Some(edge) = model.edges.get(oe.edge.index()) {
-                        edges.push(oe.edge);
-                        vertices.extend([edge.begin, edge.end]);
-                    }
-                }
-            }
-            Shell {
-                faces,
-                vertices: count_distinct(&mut vertices),
-                edges: count_distinct(&mut edges),
-                loops,
-            }
+    shells_and_vertices(model, boundary, uses).0
+}
+
+/// The shells of [`shells_of`] and the number of distinct vertices of the
+/// whole boundary. The counts come from the edge uses (every valid edge of
+/// every valid face, grouped by edge, each group within one shell), so each
+/// edge is looked up once instead of once per use and per count.
+fn shells_and_vertices(
+    model: &Model,
+    boundary: &[OrientedFace],
+    uses: &EdgeUses,
+) -> (Vec<Shell>, usize) {
+    let (members, component_of_entry) = components(model, boundary, uses);
+    let mut shells: Vec<Shell> = members
+        .iter()
+        .map(|entries| Shell {
+            faces: entries.iter().map(|&e| boundary[e].face).collect(),
+            vertices: 0,
+            edges: 0,
+            loops: entries
+                .iter()
+                .filter_map(|&e| model.faces.get(boundary[e].face.index()))
+                .map(|f| f.loops.len())
+                .sum(),
         })
-        .collect()
+        .collect();
+    // (shell, vertex) for both ends of every distinct edge.
+    let mut vertices: Vec<(usize, VertexId)> = Vec::with_capacity(2 * uses.uses.len());
+    for (edge, list) in uses.lists() {
+        let shell = component_of_entry[list[0].1.entry];
+        let Some(e) = model.edges.get(edge.index()) else {
+            continue;
+        };
+        shells[shell].edges += 1;
+        vertices.extend([(shell, e.begin), (shell, e.end)]);
+    }
+    count_distinct(&mut vertices);
+    for &(shell, _) in &vertices {
+        shells[shell].vertices += 1;
+    }
+    let mut all: Vec<VertexId> = vertices.into_iter().map(|(_, v)| v).collect();
+    let distinct = count_distinct(&mut all);
+    (shells, distinct)
 }
 
 /// How many different values `items` holds (sorting it).
@@ -318,21 +339,6 @@ fn count_distinct<T: Ord>(items: &mut Vec<T>) -> usize {
     items.sort_unstable();
     items.dedup();
     items.len()
-}
-
-fn distinct_vertices(model: &Model, boundary: &[OrientedFace]) -> usize {
-    let mut vertices = Vec::new();
-    for of in boundary {
-        let Some(face) = model.faces.get(of.face.index()) else {
-            continue;
-        };
-        for oe in face.loops.iter().flatten() {
-            if let Some(edge) = model.edges.get(oe.edge.index()) {
-                vertices.extend([edge.begin, edge.end]);
-            }
-        }
-    }
-    count_distinct(&mut vertices)
 }
 
 /// The connected shells of a 3D subdomain's boundary; empty for a 2D region
@@ -593,9 +599,8 @@ fn check_euler(
     uses: &EdgeUses,
     diags: &mut Diagnostics,
 ) {
-    let shells = shells_of(model, boundary, uses);
-    let shared_vertices =
-        shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices(model, boundary);
+    let (shells, distinct_vertices) = shells_and_vertices(model, boundary, uses);
+    let shared_vertices = shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices;
     if shared_vertices > 0 && shells.iter().all(|s| s.genus().is_some()) {
         // Shells that touch only at vertices: each is a closed surface, but the
         // boundary is not a manifold there, and χ of the whole boundary shows it.
