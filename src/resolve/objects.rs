@@ -25,8 +25,8 @@ enum State {
 
 pub(super) struct Resolver<'a> {
     pub doc: &'a Document,
-    pub names: &'a NameTable,
-    pub values: Values,
+    pub names: &'a NameTable<'a>,
+    pub values: Values<'a>,
     pub diags: &'a mut Diagnostics,
     by_name: HashMap<&'a str, usize>,
     systems: HashMap<String, &'a CoordinateSystem>,
@@ -37,8 +37,8 @@ pub(super) struct Resolver<'a> {
 impl<'a> Resolver<'a> {
     pub fn new(
         doc: &'a Document,
-        names: &'a NameTable,
-        values: Values,
+        names: &'a NameTable<'a>,
+        values: Values<'a>,
         diags: &'a mut Diagnostics,
     ) -> Self {
         let mut by_name = HashMap::new();
@@ -65,7 +65,7 @@ impl<'a> Resolver<'a> {
         self.by_name.get(name)
     }
 
-    pub fn finish(self) -> Values {
+    pub fn finish(self) -> Values<'a> {
         self.values
     }
 
