@@ -221,16 +221,15 @@ fn read_document<'s>(
 ) -> (doc::Document, crate::implicit::xml::Extracted<'s>) {
     let heads = parsed.heads();
     // The root's check reports unknown elements; only known ones go deeper.
-    let known = doc::structure::check_element_heads(&root, &heads, &grammar::GEOMETRY, diags);
+    doc::structure::check_element_heads(&root, &heads, &grammar::GEOMETRY, diags);
     let extractor = crate::implicit::xml::Extractor::new(&heads);
     let mut builder = doc::DocumentBuilder::new(source, &root, &options.expressions);
     let subdomains = heads.iter().filter(|h| h.name == "subdomain").count();
     builder.reserve(heads.len() - subdomains, subdomains);
     drop(heads);
-    let mut known = known.into_iter().peekable();
     let mut extracted = crate::implicit::xml::Extracted::default();
-    for (i, element) in parsed.top_level().enumerate() {
-        if let Some((_, rule)) = known.next_if(|&(k, _)| k == i) {
+    for element in parsed.top_level() {
+        if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
             doc::structure::check(&element, rule, diags);
         }
         if let Some(element) = extractor.take(element, &mut extracted) {
