@@ -233,25 +233,27 @@ fn whole_solids(subdomains: &[crate::syntax::Element]) -> Vec<(String, String)> 
 /// Checks the structure of the parsed file and builds its typed document, one
 /// top-level element at a time: each element is built from the parser's
 /// document, checked, and dropped once its part of the typed document is made,
-/// so no whole element tree is ever alive. `root` is the root with its child
-/// elements as shells. Implicit solids and the subdomains using them are taken
-/// out for their own path.
+/// so no whole element tree is ever alive. `root` is the root without its
+/// children; the root's own check reads only their [`syntax::Head`]s. Implicit
+/// solids and the subdomains using them are taken out for their own path.
 fn read_document<'s>(
     source: &SourceFile,
     parsed: &syntax::Document<'s>,
-    mut root: syntax::Element<'s>,
+    root: syntax::Element<'s>,
     options: &Options,
     diags: &mut Diagnostics,
 ) -> (doc::Document, crate::implicit::xml::Extracted<'s>) {
-    doc::structure::check_element(&root, &grammar::GEOMETRY, diags);
-    let extractor = crate::implicit::xml::Extractor::new(&root);
+    let heads = parsed.heads();
+    // The root's check reports unknown elements; only known ones go deeper.
+    doc::structure::check_element_heads(&root, &heads, &grammar::GEOMETRY, diags);
+    let extractor = crate::implicit::xml::Extractor::new(&root, &heads);
     let mut builder = doc::DocumentBuilder::new(source, &root, &options.expressions);
-    root.children = Vec::new();
-    let rules = grammar::GEOMETRY.child_rules();
+    let subdomains = heads.iter().filter(|h| h.name == "subdomain").count();
+    builder.reserve(heads.len() - subdomains, subdomains);
+    drop(heads);
     let mut extracted = crate::implicit::xml::Extracted::default();
     for element in parsed.top_level() {
-        // The root's check reported unknown elements; only known ones go deeper.
-        if let Some(rule) = rules.iter().find(|r| r.name == element.name) {
+        if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
             doc::structure::check(&element, rule, diags);
         }
         if let Some(element) = extractor.take(element, &mut extracted) {

@@ -60,6 +60,13 @@ impl<'a> DocumentBuilder<'a> {
         }
     }
 
+    /// Sizes the object and subdomain lists for the top-level elements to come
+    /// (when the root given to [`DocumentBuilder::new`] came without children).
+    pub fn reserve(&mut self, objects: usize, subdomains: usize) {
+        self.doc.objects.reserve(objects);
+        self.doc.subdomains.reserve(subdomains);
+    }
+
     /// Adds what one top-level element defines.
     pub fn add(&mut self, element: &Element, diags: &mut Diagnostics) {
         Builder {

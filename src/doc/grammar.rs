@@ -90,8 +90,21 @@ impl Rule {
         }
     }
 
+    /// The rule of a child named `name`: the first in [`Rule::child_rules`]'
+    /// order, found without making that list (called for every element).
     pub fn child_rule(&self, name: &str) -> Option<&'static Rule> {
-        self.child_rules().into_iter().find(|r| r.name == name)
+        match self.content {
+            Content::Empty => None,
+            Content::All(children) | Content::Sequence(children) => {
+                children.iter().map(|c| c.rule).find(|r| r.name == name)
+            }
+            Content::Choice { options, .. } => options.iter().copied().find(|r| r.name == name),
+            Content::Forms(forms) => forms
+                .iter()
+                .flat_map(|f| f.iter())
+                .map(|c| c.rule)
+                .find(|r| r.name == name),
+        }
     }
 }
 

@@ -4,36 +4,43 @@
 
 use super::grammar::{AttrKind, Child, Content, Rule};
 use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
-use crate::syntax::Element;
+use crate::syntax::{Element, Head};
 
 /// Checks `root` (and everything below it) against `rule`.
 pub fn check(root: &Element, rule: &'static Rule, diags: &mut Diagnostics) {
     let mut stack = vec![(root, rule)];
     while let Some((element, rule)) = stack.pop() {
         let known = check_element(element, rule, diags);
-        // Listed once per element, not once per child (a list is made each time).
-        let rules = if known.is_empty() {
-            Vec::new()
-        } else {
-            rule.child_rules()
-        };
-        for child in known.into_iter().rev() {
-            if let Some(&child_rule) = rules.iter().find(|r| r.name == child.name) {
-                stack.push((child, child_rule));
-            }
+        for (child, child_rule) in known.into_iter().rev() {
+            stack.push((child, child_rule));
         }
     }
 }
 
 /// Checks `element` itself against `rule`: its attributes, its text, and the
-/// names, counts and order of its children, but nothing inside them (the
-/// driver checks a large file's root this way, then each child as it is built).
-/// Returns the children whose rules are known.
-pub fn check_element<'e>(
-    element: &'e Element,
+/// names, counts and order of its children, but nothing inside them.
+/// Returns the children whose rules are known, with their rules.
+pub fn check_element<'e, 's>(
+    element: &'e Element<'s>,
     rule: &'static Rule,
     diags: &mut Diagnostics,
-) -> Vec<&'e Element<'e>> {
+) -> Vec<(&'e Element<'s>, &'static Rule)> {
+    let heads: Vec<Head> = element.children.iter().map(Element::head).collect();
+    check_element_heads(element, &heads, rule, diags)
+        .into_iter()
+        .filter_map(|(i, r)| Some((element.children.get(i)?, r)))
+        .collect()
+}
+
+/// [`check_element`] with the children given as [`Head`]s (the driver checks a
+/// large file's root this way, then each child as it is built). Returns the
+/// indices of the children whose rules are known, with their rules.
+pub fn check_element_heads(
+    element: &Element,
+    children: &[Head],
+    rule: &'static Rule,
+    diags: &mut Diagnostics,
+) -> Vec<(usize, &'static Rule)> {
     check_attributes(element, rule, diags);
     for (text, span) in &element.text {
         diags.push(
@@ -49,7 +56,7 @@ pub fn check_element<'e>(
             .with_help("put data in attributes; use an XML comment <!-- … --> for notes"),
         );
     }
-    check_children(element, rule, diags)
+    check_children(element, children, rule, diags)
 }
 
 fn abbreviate(text: &str) -> String {
@@ -136,18 +143,22 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
     }
 }
 
-/// Reports problems with the children and returns the ones whose rules are known.
-fn check_children<'e>(
-    element: &'e Element,
+/// Reports problems with the children and returns the indices of the ones
+/// whose rules are known, with their rules.
+fn check_children(
+    element: &Element,
+    children: &[Head],
     rule: &'static Rule,
     diags: &mut Diagnostics,
-) -> Vec<&'e Element<'e>> {
-    let allowed = rule.child_rules();
-    let mut known = Vec::new();
-    for child in &element.children {
-        if allowed.iter().any(|r| r.name == child.name) {
-            known.push(child);
+) -> Vec<(usize, &'static Rule)> {
+    let mut known_rules = Vec::with_capacity(children.len());
+    let mut known: Vec<Head> = Vec::with_capacity(children.len());
+    for (i, child) in children.iter().enumerate() {
+        if let Some(child_rule) = rule.child_rule(child.name) {
+            known_rules.push((i, child_rule));
+            known.push(*child);
         } else {
+            let allowed = rule.child_rules();
             let mut d = Diagnostic::new(
                 Code::UnknownElement,
                 child.name_span,
@@ -189,7 +200,8 @@ fn check_children<'e>(
         Content::Choice { min, max, .. } => {
             let n = known.len() as u32;
             if n < min {
-                let options = allowed
+                let options = rule
+                    .child_rules()
                     .iter()
                     .map(|r| format!("<{}>", r.name))
                     .collect::<Vec<_>>()
@@ -228,15 +240,15 @@ fn check_children<'e>(
         }
         Content::Forms(forms) => check_forms(element, &known, forms, diags),
     }
-    known
+    known_rules
 }
 
 fn plural(n: u32) -> &'static str {
     if n == 1 { "" } else { "s" }
 }
 
-fn check_count(element: &Element, known: &[&Element], spec: &Child, diags: &mut Diagnostics) {
-    let found: Vec<&&Element> = known.iter().filter(|c| c.name == spec.rule.name).collect();
+fn check_count(element: &Element, known: &[Head], spec: &Child, diags: &mut Diagnostics) {
+    let found: Vec<&Head> = known.iter().filter(|c| c.name == spec.rule.name).collect();
     let n = found.len() as u32;
     if n < spec.min {
         let need = if spec.min == 1 {
@@ -286,9 +298,9 @@ fn check_count(element: &Element, known: &[&Element], spec: &Child, diags: &mut 
 }
 
 /// In a sequence, each child must come no earlier than the children before it.
-fn check_order(element: &Element, known: &[&Element], children: &[Child], diags: &mut Diagnostics) {
+fn check_order(element: &Element, known: &[Head], children: &[Child], diags: &mut Diagnostics) {
     let position = |name: &str| children.iter().position(|c| c.rule.name == name);
-    let mut latest: Option<(usize, &Element)> = None;
+    let mut latest: Option<(usize, &Head)> = None;
     for child in known {
         let Some(p) = position(child.name) else {
             continue;
@@ -321,7 +333,7 @@ fn check_order(element: &Element, known: &[&Element], children: &[Child], diags:
     }
 }
 
-fn check_forms(element: &Element, known: &[&Element], forms: &[&[Child]], diags: &mut Diagnostics) {
+fn check_forms(element: &Element, known: &[Head], forms: &[&[Child]], diags: &mut Diagnostics) {
     let in_form = |form: &[Child], name: &str| form.iter().any(|c| c.rule.name == name);
     let describe = |form: &[Child]| {
         form.iter()

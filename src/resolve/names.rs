@@ -12,15 +12,17 @@ pub struct Definition {
     pub span: Span,
 }
 
+/// Keys borrow the document's names (hundreds of thousands on large files:
+/// no string is copied).
 #[derive(Debug, Default)]
-pub struct NameTable {
-    pub defs: HashMap<String, Definition>,
+pub struct NameTable<'d> {
+    pub defs: HashMap<&'d str, Definition>,
 }
 
-impl NameTable {
-    pub fn build(source: &SourceFile, doc: &Document, diags: &mut Diagnostics) -> NameTable {
+impl<'d> NameTable<'d> {
+    pub fn build(source: &SourceFile, doc: &'d Document, diags: &mut Diagnostics) -> NameTable<'d> {
         let mut table = NameTable::default();
-        let mut all: Vec<(&str, &'static str, Span)> = Vec::new();
+        let mut all: Vec<(&'d str, &'static str, Span)> = Vec::new();
         all.extend(
             doc.parameters
                 .iter()
@@ -86,9 +88,7 @@ impl NameTable {
                     )),
                 );
             }
-            table
-                .defs
-                .insert(name.to_string(), Definition { kind, span });
+            table.defs.insert(name, Definition { kind, span });
         }
         table
     }

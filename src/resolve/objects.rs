@@ -25,8 +25,8 @@ enum State {
 
 pub(super) struct Resolver<'a> {
     pub doc: &'a Document,
-    pub names: &'a NameTable,
-    pub values: Values,
+    pub names: &'a NameTable<'a>,
+    pub values: Values<'a>,
     pub diags: &'a mut Diagnostics,
     by_name: HashMap<&'a str, usize>,
     systems: HashMap<String, &'a CoordinateSystem>,
@@ -37,8 +37,8 @@ pub(super) struct Resolver<'a> {
 impl<'a> Resolver<'a> {
     pub fn new(
         doc: &'a Document,
-        names: &'a NameTable,
-        values: Values,
+        names: &'a NameTable<'a>,
+        values: Values<'a>,
         diags: &'a mut Diagnostics,
     ) -> Self {
         let mut by_name = HashMap::new();
@@ -65,7 +65,7 @@ impl<'a> Resolver<'a> {
         self.by_name.get(name)
     }
 
-    pub fn finish(self) -> Values {
+    pub fn finish(self) -> Values<'a> {
         self.values
     }
 
@@ -82,24 +82,44 @@ impl<'a> Resolver<'a> {
             };
             self.frame_of(&reference);
         }
-        (0..self.doc.objects.len())
-            .map(|i| {
-                let object = &self.doc.objects[i];
-                let geometry = self.geometry(i);
-                ResolvedObject {
-                    name: object.name.text.clone(),
-                    span: object.span,
-                    geometry,
-                }
+        // Every object resolved once, in document order (a reference may
+        // resolve a later one first); then the geometries are moved out of the
+        // resolver's state instead of copied (nothing reads them after this:
+        // the subdomains' area limits are plain numbers).
+        for i in 0..self.doc.objects.len() {
+            self.resolve_once(i);
+        }
+        let states = std::mem::take(&mut self.state);
+        states
+            .into_iter()
+            .zip(&self.doc.objects)
+            .map(|(state, object)| ResolvedObject {
+                name: object.name.text.clone(),
+                span: object.span,
+                geometry: match state {
+                    Some(State::Done(geometry)) => geometry,
+                    _ => None,
+                },
             })
             .collect()
     }
 
     /// The geometry of object `i`, resolved once.
     pub fn geometry(&mut self, i: usize) -> Option<Geometry> {
-        match &self.state[i] {
-            Some(State::Done(g)) => return g.clone(),
-            Some(State::InProgress) => {
+        self.resolve_once(i);
+        match self.state.get(i) {
+            Some(Some(State::Done(geometry))) => geometry.clone(),
+            _ => None,
+        }
+    }
+
+    /// Resolves object `i` unless it was: its geometry (or `None` after an
+    /// error) is then in `state[i]`.
+    fn resolve_once(&mut self, i: usize) {
+        match self.state.get(i) {
+            // Out of range only after `resolve_all` moved the geometries out.
+            None | Some(Some(State::Done(_))) => return,
+            Some(Some(State::InProgress)) => {
                 let object = &self.doc.objects[i];
                 self.diags.push(
                     Diagnostic::new(
@@ -116,18 +136,17 @@ impl<'a> Resolver<'a> {
                     ),
                 );
                 self.state[i] = Some(State::Done(None));
-                return None;
+                return;
             }
-            None => {}
+            Some(None) => {}
         }
         self.state[i] = Some(State::InProgress);
         let object: &'a Object = &self.doc.objects[i];
         let geometry = self.resolve_object(object);
         if let Some(State::Done(None)) = self.state[i] {
-            return None;
+            return;
         }
-        self.state[i] = Some(State::Done(geometry.clone()));
-        geometry
+        self.state[i] = Some(State::Done(geometry));
     }
 
     fn resolve_object(&mut self, object: &'a Object) -> Option<Geometry> {

@@ -37,7 +37,7 @@ enum State {
 }
 
 /// The evaluator of numeric attributes.
-pub struct Values {
+pub struct Values<'d> {
     sources: HashMap<String, Source>,
     /// Parameter names in definition order.
     parameter_order: Vec<String>,
@@ -45,15 +45,15 @@ pub struct Values {
     used: HashSet<String>,
     /// Every defined name with its kind, to say "wrong kind" instead of
     /// "undefined" (shared with the resolver, not copied).
-    pub other_names: std::rc::Rc<super::NameTable>,
+    pub other_names: std::rc::Rc<super::NameTable<'d>>,
     stack: Vec<String>,
 }
 
-impl Values {
+impl<'d> Values<'d> {
     /// Collects parameters and basis coordinates; `overrides` (from `--set`)
     /// replace parameter expressions. Duplicate names are reported by the name
     /// table, so the first definition wins here.
-    pub fn new(doc: &Document, overrides: &[(String, Expr)]) -> Values {
+    pub fn new(doc: &Document, overrides: &[(String, Expr)]) -> Values<'d> {
         let mut sources = HashMap::new();
         let mut parameter_order = Vec::new();
         for p in &doc.parameters {

@@ -8,7 +8,7 @@
 
 mod tree;
 
-pub use tree::{Attribute, Element};
+pub use tree::{Attribute, Element, Head};
 
 use crate::diag::{Code, Diagnostic};
 use crate::span::{SourceFile, Span};
@@ -48,10 +48,18 @@ pub struct Document<'s> {
 }
 
 impl<'s> Document<'s> {
-    /// The root element with its attributes and text; each child element is a
-    /// shell with its name, spans and attributes but without content.
+    /// The root element with its attributes and text, without its children
+    /// (see [`Document::heads`] and [`Document::top_level`]).
     pub fn root(&self) -> Element<'s> {
         tree::shallow(self.xml.root_element())
+    }
+
+    /// The [`Head`]s of the root's child elements, in order.
+    pub fn heads(&self) -> Vec<Head<'_>> {
+        let root = self.xml.root_element();
+        let mut heads = Vec::with_capacity(root.children().filter(|c| c.is_element()).count());
+        heads.extend(root.children().filter(|c| c.is_element()).map(tree::head));
+        heads
     }
 
     /// The root's child elements, each built whole when the iterator reaches it.

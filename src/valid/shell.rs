@@ -218,7 +218,12 @@ impl EdgeUses {
 
 /// Groups boundary entries (with a valid face) connected through shared
 /// edges; components are ordered by their first entry, entries ascending.
-fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<Vec<usize>> {
+/// Also returns each entry's component (`usize::MAX` for an invalid face).
+fn components(
+    model: &Model,
+    boundary: &[OrientedFace],
+    uses: &EdgeUses,
+) -> (Vec<Vec<usize>>, Vec<usize>) {
     // Union–find over the entries rather than adjacency sets and a search:
     // the same components, without an allocation per face.
     let n = boundary.len();
@@ -241,6 +246,7 @@ fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<
     }
     // Entries in ascending order: a component starts at its first entry.
     let mut component_of_root = vec![usize::MAX; n];
+    let mut component_of_entry = vec![usize::MAX; n];
     let mut out: Vec<Vec<usize>> = Vec::new();
     for (entry, of) in boundary.iter().enumerate() {
         if of.face.index() >= model.faces.len() {
@@ -251,9 +257,10 @@ fn components(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<
             component_of_root[r] = out.len();
             out.push(Vec::new());
         }
+        component_of_entry[entry] = component_of_root[r];
         out[component_of_root[r]].push(entry);
     }
-    out
+    (out, component_of_entry)
 }
 
 /// One connected shell of a subdomain's boundary (faces joined through shared
@@ -282,35 +289,49 @@ impl Shell {
 }
 
 fn shells_of(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<Shell> {
-    components(model, boundary, uses)
-        .into_iter()
-        .map(|members| {
-            let mut vertices = Vec::new();
-            let mut edges = Vec::new();
-            let mut loops = 0;
-            let mut faces = Vec::with_capacity(members.len());
-            for &entry in &members {
-                let id = boundary[entry].face;
-                let Some(face) = model.faces.get(id.index()) else {
-                    continue;
-                };
-                faces.push(id);
-                loops += face.loops.len();
-                for oe in face.loops.iter().flatten() {
-                    if let Some(edge) = model.edges.get(oe.edge.index()) {
-                        edges.push(oe.edge);
-                        vertices.extend([edge.begin, edge.end]);
-                    }
-                }
-            }
-            Shell {
-                faces,
-                vertices: count_distinct(&mut vertices),
-                edges: count_distinct(&mut edges),
-                loops,
-            }
+    shells_and_vertices(model, boundary, uses).0
+}
+
+/// The shells of [`shells_of`] and the number of distinct vertices of the
+/// whole boundary. The counts come from the edge uses (every valid edge of
+/// every valid face, grouped by edge, each group within one shell), so each
+/// edge is looked up once instead of once per use and per count.
+fn shells_and_vertices(
+    model: &Model,
+    boundary: &[OrientedFace],
+    uses: &EdgeUses,
+) -> (Vec<Shell>, usize) {
+    let (members, component_of_entry) = components(model, boundary, uses);
+    let mut shells: Vec<Shell> = members
+        .iter()
+        .map(|entries| Shell {
+            faces: entries.iter().map(|&e| boundary[e].face).collect(),
+            vertices: 0,
+            edges: 0,
+            loops: entries
+                .iter()
+                .filter_map(|&e| model.faces.get(boundary[e].face.index()))
+                .map(|f| f.loops.len())
+                .sum(),
         })
-        .collect()
+        .collect();
+    // (shell, vertex) for both ends of every distinct edge.
+    let mut vertices: Vec<(usize, VertexId)> = Vec::with_capacity(2 * uses.uses.len());
+    for (edge, list) in uses.lists() {
+        let shell = component_of_entry[list[0].1.entry];
+        let Some(e) = model.edges.get(edge.index()) else {
+            continue;
+        };
+        shells[shell].edges += 1;
+        vertices.extend([(shell, e.begin), (shell, e.end)]);
+    }
+    count_distinct(&mut vertices);
+    for &(shell, _) in &vertices {
+        shells[shell].vertices += 1;
+    }
+    let mut all: Vec<VertexId> = vertices.into_iter().map(|(_, v)| v).collect();
+    let distinct = count_distinct(&mut all);
+    (shells, distinct)
 }
 
 /// How many different values `items` holds (sorting it).
@@ -318,21 +339,6 @@ fn count_distinct<T: Ord>(items: &mut Vec<T>) -> usize {
     items.sort_unstable();
     items.dedup();
     items.len()
-}
-
-fn distinct_vertices(model: &Model, boundary: &[OrientedFace]) -> usize {
-    let mut vertices = Vec::new();
-    for of in boundary {
-        let Some(face) = model.faces.get(of.face.index()) else {
-            continue;
-        };
-        for oe in face.loops.iter().flatten() {
-            if let Some(edge) = model.edges.get(oe.edge.index()) {
-                vertices.extend([edge.begin, edge.end]);
-            }
-        }
-    }
-    count_distinct(&mut vertices)
 }
 
 /// The connected shells of a 3D subdomain's boundary; empty for a 2D region
@@ -394,7 +400,8 @@ fn check_shell(
     let uses = EdgeUses::of(model, boundary);
     let mut manifold = true;
     for (edge, list) in uses.lists() {
-        let span = source_map.subdomain(id).or_else(|| source_map.edge(edge));
+        // Looked up only for a finding: this runs for every edge of every subdomain.
+        let span = || source_map.subdomain(id).or_else(|| source_map.edge(edge));
         match list.len() {
             2 => {}
             1 => {
@@ -403,7 +410,7 @@ fn check_shell(
                 diags.push(
                     Diagnostic::new(
                         Code::OpenShell,
-                        span,
+                        span(),
                         format!(
                             "the boundary of subdomain '{}' is not closed: edge '{}' is used \
                              only by face '{face}'",
@@ -428,7 +435,7 @@ fn check_shell(
                 diags.push(
                     Diagnostic::new(
                         Code::NonManifoldEdge,
-                        span,
+                        span(),
                         format!(
                             "edge '{}' is used {n} times in the boundary of subdomain '{}' \
                              (faces {}), more than twice",
@@ -466,7 +473,7 @@ fn check_orientation(
     uses: &EdgeUses,
     diags: &mut Diagnostics,
 ) {
-    let name = subdomain_name(model, id);
+    // The subdomain's name is copied only for a finding: this runs for every subdomain.
     let n = boundary.len();
     // (neighbour, whether the flips must differ, shared edge)
     let mut adjacent: Vec<Vec<(usize, bool, EdgeId)>> = vec![Vec::new(); n];
@@ -513,6 +520,7 @@ fn check_orientation(
         }
 
         if let Some(edge) = conflict {
+            let name = subdomain_name(model, id);
             diags.push(
                 Diagnostic::new(
                     Code::InconsistentOrientation,
@@ -545,6 +553,7 @@ fn check_orientation(
             2 * odd < members.len()
         };
         members.sort_unstable();
+        let name = subdomain_name(model, id);
         for &e in members.iter().filter(|&&e| class(e) == wrong) {
             let face = boundary[e].face;
             let neighbour = adjacent[e].iter().find(|&&(b, _, _)| class(b) != wrong);
@@ -590,15 +599,14 @@ fn check_euler(
     uses: &EdgeUses,
     diags: &mut Diagnostics,
 ) {
-    let name = subdomain_name(model, id);
-    let shells = shells_of(model, boundary, uses);
-    let shared_vertices =
-        shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices(model, boundary);
+    let (shells, distinct_vertices) = shells_and_vertices(model, boundary, uses);
+    let shared_vertices = shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices;
     if shared_vertices > 0 && shells.iter().all(|s| s.genus().is_some()) {
         // Shells that touch only at vertices: each is a closed surface, but the
         // boundary is not a manifold there, and χ of the whole boundary shows it.
         let chi: i64 =
             shells.iter().map(Shell::euler_characteristic).sum::<i64>() - shared_vertices as i64;
+        let name = subdomain_name(model, id);
         diags.push(
             Diagnostic::new(
                 Code::EulerMismatch,
@@ -620,6 +628,7 @@ fn check_euler(
             format!(" (the shell with face '{}')", face_name(model, f))
         });
         let f = shell.faces.len();
+        let name = subdomain_name(model, id);
         diags.push(
             Diagnostic::new(
                 Code::EulerMismatch,
@@ -767,7 +776,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     for (i, vertex) in model.vertices.iter().enumerate() {
         let id = VertexId(i as u32);
         let explicit_unused = !in_solids_v[i] && !used_vertices[i];
-        if let Some(span) = source_map.vertex(id).filter(|_| explicit_unused) {
+        if let Some(span) = explicit_unused.then(|| source_map.vertex(id)).flatten() {
             unused(
                 Some(span),
                 format!("vertex '{}' is not used by any edge", vertex.name),
@@ -778,7 +787,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     for (i, edge) in model.edges.iter().enumerate() {
         let id = EdgeId(i as u32);
         let explicit_unused = !in_solids_e[i] && !used_edges[i];
-        if let Some(span) = source_map.edge(id).filter(|_| explicit_unused) {
+        if let Some(span) = explicit_unused.then(|| source_map.edge(id)).flatten() {
             unused(
                 Some(span),
                 format!("edge '{}' is not used by any face", edge.name),
@@ -789,7 +798,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     for (i, face) in model.faces.iter().enumerate() {
         let id = FaceId(i as u32);
         let explicit_unused = !in_solids_f[i] && !used_faces[i];
-        if let Some(span) = source_map.face(id).filter(|_| explicit_unused) {
+        if let Some(span) = explicit_unused.then(|| source_map.face(id)).flatten() {
             unused(
                 Some(span),
                 format!(

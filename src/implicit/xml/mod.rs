@@ -80,17 +80,17 @@ pub struct Extractor {
 }
 
 impl Extractor {
-    /// Reads the root's children (shells are enough: names and attributes).
-    pub fn new(root: &Element) -> Extractor {
+    /// Reads the root's `dimension` and the heads of its children (names and
+    /// `name=` values).
+    pub fn new(root: &Element, children: &[crate::syntax::Head]) -> Extractor {
         Extractor {
-            names: root
-                .children
+            names: children
                 .iter()
                 .filter(|c| SOLIDS.contains(&c.name))
-                .filter_map(|c| c.attribute("name"))
-                .map(|a| a.value.trim().to_string())
+                .filter_map(|c| c.name_attribute)
+                .map(|a| a.trim().to_string())
                 .collect(),
-            any: root.children.iter().any(|c| ELEMENTS.contains(&c.name)),
+            any: children.iter().any(|c| ELEMENTS.contains(&c.name)),
             planar: root
                 .attribute("dimension")
                 .is_some_and(|a| a.value.trim() == "2"),
