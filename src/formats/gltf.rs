@@ -156,9 +156,10 @@ impl Piece {
                     StreamedNormals::Unit(v) => {
                         write_blocks(v.as_flattened(), block, out, f32::to_le_bytes)?;
                     }
-                    StreamedNormals::Sums { sums, fallback } => {
-                        write_blocks(sums, block, out, |s| {
-                            f32x3_bytes(StreamedNormals::unit_f32(s, *fallback))
+                    StreamedNormals::OneFace { used } => {
+                        let mesh = expander.mesh();
+                        groups::emit_unit_normals(mesh, &group.triangles, *used, &mut |run| {
+                            write_blocks(run.as_flattened(), block, out, f32::to_le_bytes)
                         })?;
                     }
                 }
