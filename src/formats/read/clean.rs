@@ -174,7 +174,11 @@ impl AreaFloor {
 }
 
 /// Edge use counts of all half-edges bucketed at once (any triangle order).
-pub(super) fn counts_by_sort(nodes: &[[f64; 3]], parts: &[&[[u32; 3]]], floor: &AreaFloor) -> EdgeCounts {
+pub(super) fn counts_by_sort(
+    nodes: &[[f64; 3]],
+    parts: &[&[[u32; 3]]],
+    floor: &AreaFloor,
+) -> EdgeCounts {
     let mut out = EdgeCounts::default();
     let n = nodes.len();
     // `end[v + 1]` counts node v's half-edges, then (prefix sums) ends its

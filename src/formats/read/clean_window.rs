@@ -93,7 +93,12 @@ fn complete(
         };
         let len = bucket.len as usize;
         if len > HELD {
-            overflow.extend(bucket.held.iter().map(|&h| u64::from(v) << 32 | u64::from(h)));
+            overflow.extend(
+                bucket
+                    .held
+                    .iter()
+                    .map(|&h| u64::from(v) << 32 | u64::from(h)),
+            );
         } else if let Some(held) = bucket.held.get_mut(..len) {
             count_bucket(held, out);
         }
@@ -141,7 +146,12 @@ mod tests {
         assert_eq!(whole, by_sort(&tris));
         // The bottom rim is open (40 edges), the rest closed and consistent.
         assert_eq!(
-            (whole.edges, whole.open, whole.non_manifold, whole.inconsistent),
+            (
+                whole.edges,
+                whole.open,
+                whole.non_manifold,
+                whole.inconsistent
+            ),
             (3 * 40 * 299 + 40 + 40, 40, 0, 0)
         );
         let mut changed = tris.clone();

@@ -166,7 +166,10 @@ impl BinaryStl {
                 continue;
             };
             // The node table's slots of a record a few ahead, asked for now.
-            if let Some(ahead) = records.get(50 * (k + AHEAD)..).and_then(|a| a.first_chunk::<50>()) {
+            if let Some(ahead) = records
+                .get(50 * (k + AHEAD)..)
+                .and_then(|a| a.first_chunk::<50>())
+            {
                 for &p in corners(ahead).as_chunks::<3>().0 {
                     self.nodes.prefetch(p);
                 }
