@@ -51,7 +51,8 @@ pub(crate) fn plan<'t>(parts: &[&'t [[u32; 3]]], n: usize, max: usize) -> Option
 /// the plan's time).
 fn range(values: &[u32]) -> (u32, u32) {
     const FLIP: u32 = 1 << 31;
-    let (lanes, rest) = values.as_chunks::<8>();
+    let lanes = values.chunks_exact(8);
+    let rest = lanes.remainder();
     let mut lo = [i32::MAX; 8];
     let mut hi = [i32::MIN; 8];
     for lane in lanes {

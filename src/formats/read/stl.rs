@@ -170,7 +170,8 @@ impl BinaryStl {
                 .get(50 * (k + AHEAD)..)
                 .and_then(|a| a.first_chunk::<50>())
             {
-                for &p in corners(ahead).as_chunks::<3>().0 {
+                let [a, b, c, d, e, f, g, h, i] = corners(ahead);
+                for p in [[a, b, c], [d, e, f], [g, h, i]] {
                     self.nodes.prefetch(p);
                 }
             }
