@@ -149,11 +149,10 @@ impl Piece {
                     // One face as it is: its vertices are the mesh's first
                     // nodes and its triangles the face's own.
                     write_blocks(&mesh.nodes[..used], block, out, position)?;
-                    let (sums, fallback) = expander.identity_sums(*face, used);
-                    write_blocks(&sums, block, out, |s| {
-                        f32x3_bytes(groups::unit_f32(s, fallback))
-                    })?;
                     let triangles = &mesh.faces[*face as usize].triangles;
+                    groups::emit_unit_normals(mesh, triangles, used, &mut |run| {
+                        write_blocks(run.as_flattened(), block, out, f32::to_le_bytes)
+                    })?;
                     return write_blocks(triangles.as_flattened(), block, out, u32::to_le_bytes);
                 }
                 let mut blocks = Blocks::new(block, out);

@@ -379,14 +379,6 @@ impl<'a> Expander<'a> {
         m
     }
 
-    /// The area-weighted normal sums of one face as it is whose nodes are
-    /// `0..used` (`Measure::identity`), to be made unit while written
-    /// ([`unit_f32`]): the expansion would copy nothing but its normals.
-    /// Returns the sums and the normal of a node whose sum is zero.
-    pub(crate) fn identity_sums(&self, face: u32, used: usize) -> (Vec<[f64; 3]>, [f64; 3]) {
-        node_sums(self.mesh, &self.mesh.faces[face as usize].triangles, used)
-    }
-
     /// The vertices [`Expander::expand`] would make for these faces, in its
     /// order, as the mesh node each copies: nothing is stored (a glTF
     /// writer streams their positions).
@@ -576,6 +568,106 @@ fn node_sums(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> (Vec<[f64; 3]>
     (sums, unit(total).unwrap_or([0.0, 0.0, 1.0]))
 }
 
+/// Normals handed to [`emit_unit_normals`]'s caller at a time (48 kB).
+const NORMAL_RUN: usize = 4096;
+
+/// Most ring slots of [`emit_unit_normals`] (1.5 MB of sums).
+const MAX_NORMAL_WINDOW: usize = 1 << 16;
+
+/// The unit normals of nodes `0..used` over one face's triangles, as `f32`
+/// (the numbers [`node_normals`] gives, converted), handed to `emit` in node
+/// order a run at a time. When the face uses its nodes in a sliding range
+/// (`node_window`), the sums live in a small ring and each node's normal
+/// goes out once no later triangle uses it: no vector of sums as large as
+/// the mesh (24 MB of fresh pages on 2 million triangles). Else all sums
+/// are formed first.
+pub(crate) fn emit_unit_normals(
+    mesh: &Mesh,
+    triangles: &[[u32; 3]],
+    used: usize,
+    emit: &mut dyn FnMut(&[[f32; 3]]) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let Some(plan) = super::node_window::plan(&[triangles], used, MAX_NORMAL_WINDOW) else {
+        let (sums, fallback) = node_sums(mesh, triangles, used);
+        let mut run = Vec::with_capacity(NORMAL_RUN);
+        for chunk in sums.chunks(NORMAL_RUN) {
+            run.clear();
+            run.extend(chunk.iter().map(|&s| unit_f32(s, fallback)));
+            emit(&run)?;
+        }
+        return Ok(());
+    };
+    let mut stream = NormalRing {
+        // Sums read before written: zeroed by writing (see `filled_vec`).
+        ring: crate::allocator::filled_vec(plan.size, [0.0; 3]),
+        mask: plan.size - 1,
+        done: 0,
+        run: Vec::with_capacity(NORMAL_RUN),
+        waiting: Vec::new(),
+    };
+    let mut total = [0.0; 3];
+    for (block, &start) in plan.blocks.iter().zip(&plan.first) {
+        stream.complete(start as usize, emit)?;
+        for &tri in *block {
+            let n = triangle_normal(mesh, tri);
+            total = add(total, n);
+            for v in tri {
+                let s = &mut stream.ring[v as usize & stream.mask];
+                *s = add(*s, n);
+            }
+        }
+    }
+    stream.complete(used, emit)?;
+    if !stream.run.is_empty() {
+        emit(&stream.run)?;
+    }
+    let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
+    for chunk in stream.waiting.chunks(NORMAL_RUN) {
+        stream.run.clear();
+        stream
+            .run
+            .extend(chunk.iter().map(|&s| unit_f32(s, fallback)));
+        emit(&stream.run)?;
+    }
+    Ok(())
+}
+
+/// [`emit_unit_normals`]' ring of sums and the normals ready to go out.
+struct NormalRing {
+    ring: Vec<[f64; 3]>,
+    mask: usize,
+    /// Nodes below are out of the ring.
+    done: usize,
+    run: Vec<[f32; 3]>,
+    /// The sums from the first node whose sum is zero on: its normal is the
+    /// face's total direction, known only at the end.
+    waiting: Vec<[f64; 3]>,
+}
+
+impl NormalRing {
+    /// Takes the sums of the nodes below `upto` out of the ring.
+    fn complete(
+        &mut self,
+        upto: usize,
+        emit: &mut dyn FnMut(&[[f32; 3]]) -> std::io::Result<()>,
+    ) -> std::io::Result<()> {
+        for v in self.done..upto {
+            let slot = &mut self.ring[v & self.mask];
+            let sum = std::mem::replace(slot, [0.0; 3]);
+            match unit(sum) {
+                Some(u) if self.waiting.is_empty() => self.run.push(u.map(|c| c as f32)),
+                _ => self.waiting.push(sum),
+            }
+            if self.run.len() == NORMAL_RUN {
+                emit(&self.run)?;
+                self.run.clear();
+            }
+        }
+        self.done = self.done.max(upto);
+        Ok(())
+    }
+}
+
 fn expand_into<'a>(ex: &mut Expander<'a>, faces: &[(u32, bool)]) -> Expanded<'a> {
     let (nodes, normals, triangles) = expand_faces(ex, faces, |n| n);
     Expanded {
@@ -745,6 +837,82 @@ mod tests {
         assert_eq!(identity_prefix(&long), Some(3002));
         long.push([0, 1, 5000]);
         assert_eq!(identity_prefix(&long), None);
+    }
+
+    /// The normals [`emit_unit_normals`] hands out, gathered.
+    fn emitted(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> Vec<[f32; 3]> {
+        let mut all = Vec::new();
+        emit_unit_normals(mesh, triangles, used, &mut |run| {
+            all.extend_from_slice(run);
+            Ok(())
+        })
+        .expect("no write fails");
+        all
+    }
+
+    /// A wavy strip of triangles numbered in first-use order, with a node
+    /// in the middle whose only triangle has no area (a zero sum: its
+    /// normal is the face's direction, known only at the end): the ring and
+    /// the whole-table path give `node_normals`' numbers exactly.
+    #[test]
+    fn streamed_normals_equal_the_whole_table() {
+        let columns = 40_000u32;
+        let mut points = Vec::new();
+        for i in 0..columns {
+            let x = f64::from(i) * 0.01;
+            points.push([x, 0.0, (x * 7.0).sin()]);
+            points.push([x, 1.0, (x * 5.0).cos()]);
+        }
+        let mut triangles = Vec::new();
+        for i in 0..columns - 1 {
+            let (a, b, c, d) = (2 * i, 2 * i + 1, 2 * i + 2, 2 * i + 3);
+            triangles.push([a, c, b]);
+            triangles.push([b, c, d]);
+        }
+        let lone = points.len() as u32;
+        points.push([5.0, 5.0, 5.0]);
+        triangles.insert(2000, [lone, lone, 900]);
+        // Numbered in first-use order, as an STL reader numbers them.
+        let mut number = vec![u32::MAX; points.len()];
+        let mut mesh = Mesh {
+            dimension: 3,
+            ..Mesh::default()
+        };
+        for v in triangles.iter_mut().flatten() {
+            if number[*v as usize] == u32::MAX {
+                number[*v as usize] = mesh.nodes.len() as u32;
+                mesh.nodes.push(points[*v as usize]);
+            }
+            *v = number[*v as usize];
+        }
+        let check = |triangles: &[[u32; 3]]| {
+            let used = identity_prefix(triangles).expect("first-use order");
+            let whole: Vec<[f32; 3]> = node_normals(&mesh, triangles, used)
+                .iter()
+                .map(|v| v.map(|c| c as f32))
+                .collect();
+            assert_eq!(emitted(&mesh, triangles, used), whole);
+            whole
+        };
+        let windowed = |triangles: &[[u32; 3]]| {
+            super::super::node_window::plan(&[triangles], mesh.nodes.len(), MAX_NORMAL_WINDOW)
+                .is_some()
+        };
+        assert!(windowed(&triangles));
+        let ring = check(&triangles);
+        assert_eq!(ring.len(), mesh.nodes.len());
+        let zero_sum = number[lone as usize] as usize;
+        assert!(zero_sum > 1000 && zero_sum < ring.len() - 1000);
+        let total = triangles
+            .iter()
+            .fold([0.0; 3], |t, &tri| add(t, triangle_normal(&mesh, tri)));
+        let direction = unit(total).expect("a direction").map(|c| c as f32);
+        assert_eq!(ring[zero_sum], direction);
+        // Node 0 used again at the end: too wide a window, all sums at once.
+        let mut late = triangles.clone();
+        late.push([0, 1, 2]);
+        assert!(!windowed(&late));
+        assert_eq!(check(&late).len(), ring.len());
     }
 
     #[test]

@@ -17,6 +17,7 @@ mod groups;
 mod msh;
 mod msh22;
 mod msh_bounds;
+pub(crate) mod node_window;
 mod obj;
 pub mod read;
 mod stl;

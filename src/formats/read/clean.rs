@@ -128,18 +128,58 @@ pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCou
     counts_of_parts(nodes, &[triangles], scale)
 }
 
-/// [`counts`] of the triangles of several lists together.
+/// [`counts`] of the triangles of several lists together: in a window of
+/// live nodes when the triangles allow one (see `window.rs`), else by a
+/// counting sort of all half-edges.
 fn counts_of_parts(nodes: &[[f64; 3]], parts: &[&[[u32; 3]]], scale: f64) -> EdgeCounts {
+    let floor = AreaFloor::of(scale);
+    if let Some(counts) = super::clean_window::counts(nodes, parts, &floor) {
+        return counts;
+    }
+    counts_by_sort(nodes, parts, &floor)
+}
+
+/// The degenerate-triangle test's floor on twice the area.
+pub(super) struct AreaFloor {
+    floor: f64,
+    /// Above this squared area the square root cannot be at or under the
+    /// floor (the margin covers the rounding of the square): most triangles
+    /// skip it.
+    clearly_above: f64,
+}
+
+impl AreaFloor {
+    pub(super) fn of(scale: f64) -> AreaFloor {
+        let floor = (scale * scale) * 1e-14;
+        let floor_squared = floor * floor;
+        let clearly_above = if floor_squared.is_normal() {
+            floor_squared * (1.0 + 1e-9)
+        } else {
+            f64::INFINITY
+        };
+        AreaFloor {
+            floor,
+            clearly_above,
+        }
+    }
+
+    /// A repeated node or no area.
+    #[inline(always)]
+    pub(super) fn degenerate(&self, nodes: &[[f64; 3]], t: &[u32; 3]) -> bool {
+        t[0] == t[1]
+            || t[1] == t[2]
+            || t[0] == t[2]
+            || twice_area_at_most(nodes, *t, self.floor, self.clearly_above)
+    }
+}
+
+/// Edge use counts of all half-edges bucketed at once (any triangle order).
+pub(super) fn counts_by_sort(
+    nodes: &[[f64; 3]],
+    parts: &[&[[u32; 3]]],
+    floor: &AreaFloor,
+) -> EdgeCounts {
     let mut out = EdgeCounts::default();
-    let area_floor = (scale * scale) * 1e-14;
-    // Above this squared area the square root cannot be at or under the floor
-    // (the margin covers the rounding of the square): most triangles skip it.
-    let floor_squared = area_floor * area_floor;
-    let clearly_above = if floor_squared.is_normal() {
-        floor_squared * (1.0 + 1e-9)
-    } else {
-        f64::INFINITY
-    };
     let n = nodes.len();
     // `end[v + 1]` counts node v's half-edges, then (prefix sums) ends its
     // bucket; filling steps each end back, so `end[v + 1]` finally starts
@@ -147,11 +187,7 @@ fn counts_of_parts(nodes: &[[f64; 3]], parts: &[&[[u32; 3]]], scale: f64) -> Edg
     // Counts read before written: zeroed by writing (see `filled_vec`).
     let mut end = crate::allocator::filled_vec(n + 2, 0u32);
     for t in parts.iter().copied().flatten() {
-        if t[0] == t[1]
-            || t[1] == t[2]
-            || t[0] == t[2]
-            || twice_area_at_most(nodes, *t, area_floor, clearly_above)
-        {
+        if floor.degenerate(nodes, t) {
             out.degenerate += 1;
         }
         each_half(t, n, |lo, _| {
@@ -193,7 +229,7 @@ fn counts_of_parts(nodes: &[[f64; 3]], parts: &[&[[u32; 3]]], scale: f64) -> Edg
 /// Three plain calls: the iterator chain this replaced (an array, a filter,
 /// a map) kept its state on the stack in the two hottest loops.
 #[inline(always)]
-fn each_half(&[a, b, c]: &[u32; 3], n: usize, mut f: impl FnMut(u32, u32)) {
+pub(super) fn each_half(&[a, b, c]: &[u32; 3], n: usize, mut f: impl FnMut(u32, u32)) {
     let mut half = |x: u32, y: u32| {
         if x != y && (x as usize) < n && (y as usize) < n {
             if x < y {
@@ -211,7 +247,7 @@ fn each_half(&[a, b, c]: &[u32; 3], n: usize, mut f: impl FnMut(u32, u32)) {
 /// Adds the edges of one node's bucket to the counts. A bucket holds a few
 /// entries (about six on a closed surface): up to 32 are grouped by a
 /// pairwise scan with a bit mask of those already counted, larger ones sorted.
-fn count_bucket(bucket: &mut [u32], out: &mut EdgeCounts) {
+pub(super) fn count_bucket(bucket: &mut [u32], out: &mut EdgeCounts) {
     if bucket.len() > 32 {
         bucket.sort_unstable();
         let mut i = 0;

@@ -14,7 +14,9 @@ const EMPTY: u32 = u32::MAX;
 const RECENT: usize = 1 << 12;
 
 pub struct F32Nodes {
-    /// (x, y, z bits, id); a power-of-two length, at most half full.
+    /// (x, y, z bits, id); a power-of-two length, at most three quarters
+    /// full (half full made it 128 MB for 2.5 million nodes, a quarter of
+    /// the peak of a 5-million-triangle conversion).
     table: Vec<[u32; 4]>,
     recent: Vec<[u32; 4]>,
     len: usize,
@@ -24,9 +26,26 @@ impl F32Nodes {
     /// A table for about `expected` distinct nodes.
     pub fn with_capacity(expected: usize) -> F32Nodes {
         F32Nodes {
-            table: vec![[0, 0, 0, EMPTY]; (2 * expected + 16).next_power_of_two()],
+            table: vec![[0, 0, 0, EMPTY]; (expected / 3 * 4 + 16).next_power_of_two()],
             recent: vec![[0, 0, 0, EMPTY]; RECENT],
             len: 0,
+        }
+    }
+
+    /// The key of a corner: its bits, with −0 as 0.
+    fn key(p: [f32; 3]) -> [u32; 3] {
+        p.map(|c| if c == 0.0 { 0 } else { c.to_bits() })
+    }
+
+    /// Asks for the table slot of `p` a few corners before [`F32Nodes::node`]
+    /// looks it up: the table is far larger than the processor's caches, and
+    /// waiting for each slot in turn was most of the STL reading (0.73 →
+    /// 0.45 s of CPU on 5 million triangles, measured alone).
+    #[inline(always)]
+    pub fn prefetch(&self, p: [f32; 3]) {
+        let slot = Self::hash(Self::key(p)) as usize & (self.table.len() - 1);
+        if let Some(entry) = self.table.get(slot) {
+            prefetch(entry);
         }
     }
 
@@ -38,7 +57,7 @@ impl F32Nodes {
 
     /// The id of the node at `p` (−0 equals 0), appended to `nodes` when new.
     pub fn node(&mut self, nodes: &mut Vec<[f64; 3]>, p: [f32; 3]) -> u32 {
-        let key = p.map(|c| if c == 0.0 { 0 } else { c.to_bits() });
+        let key = Self::key(p);
         let h = Self::hash(key);
         // The top bits pick the cache slot, the low bits the table slot.
         let slot = (h >> 52) as usize & (RECENT - 1);
@@ -62,7 +81,7 @@ impl F32Nodes {
         nodes: &mut Vec<[f64; 3]>,
         p: [f32; 3],
     ) -> u32 {
-        if 2 * (self.len + 1) > self.table.len() {
+        if 4 * (self.len + 1) > 3 * self.table.len() {
             self.grow();
         }
         let mask = self.table.len() - 1;
@@ -100,6 +119,21 @@ impl F32Nodes {
             }
         }
     }
+}
+
+/// Asks for the cache line of `value` without waiting for it (a hint: it
+/// reads nothing).
+#[inline(always)]
+fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        // SAFETY: a prefetch reads nothing (it is only a hint, and the
+        // pointer comes from a reference), and SSE is part of every x86-64.
+        unsafe { _mm_prefetch::<_MM_HINT_T0>((value as *const T).cast()) };
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
 }
 
 #[cfg(test)]

@@ -17,6 +17,7 @@
 mod base64;
 pub mod build;
 pub mod clean;
+mod clean_window;
 mod f32_nodes;
 mod frag;
 mod gltf;

@@ -127,6 +127,16 @@ fn read_binary(bytes: &[u8]) -> Result<Builder, Vec<Diagnostic>> {
     Ok(r.finish())
 }
 
+/// Records ahead whose node table slots are fetched while one is read.
+const AHEAD: usize = 8;
+
+/// A record's nine corner coordinates.
+#[inline(always)]
+fn corners(r: &[u8; 50]) -> [f32; 9] {
+    let f = |at: usize| super::bytes_at::<4>(r, at).map_or(0.0, f32::from_le_bytes);
+    std::array::from_fn(|j| f(12 + 4 * j))
+}
+
 /// A binary STL read record by record (from memory, or in pieces from a file).
 pub(super) struct BinaryStl {
     b: Builder,
@@ -155,8 +165,17 @@ impl BinaryStl {
             let Some(r) = record.first_chunk::<50>() else {
                 continue;
             };
-            let f = |at: usize| super::bytes_at::<4>(r, at).map_or(0.0, f32::from_le_bytes);
-            let coords: [f32; 9] = std::array::from_fn(|j| f(12 + 4 * j));
+            // The node table's slots of a record a few ahead, asked for now.
+            if let Some(ahead) = records
+                .get(50 * (k + AHEAD)..)
+                .and_then(|a| a.first_chunk::<50>())
+            {
+                let [a, b, c, d, e, f, g, h, i] = corners(ahead);
+                for p in [[a, b, c], [d, e, f], [g, h, i]] {
+                    self.nodes.prefetch(p);
+                }
+            }
+            let coords = corners(r);
             if let Some(j) = coords.iter().position(|v| !v.is_finite()) {
                 let i = first + k;
                 return Err(vec![error_at_byte(
