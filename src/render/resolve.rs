@@ -50,6 +50,7 @@ impl Image {
     }
 }
 
+#[inline]
 fn shade(
     scene: &Scene,
     proj: &Projected,
@@ -133,11 +134,22 @@ fn uniform(
 }
 
 /// Whether every sample of the pixel shows the background (no edge mark).
+/// An empty sample is all ones, so the pixel's samples are all empty when
+/// their bitwise AND is: one pass over its `ss` runs of samples, without a
+/// branch per sample (most pixels of a picture are background).
 #[inline]
 fn background_only(samples: &Samples, ss: usize, px: usize, py: usize) -> bool {
-    (py * ss..(py + 1) * ss).all(|sy| {
-        (px * ss..(px + 1) * ss).all(|sx| samples.value(sx, sy) == EMPTY && !samples.edge(sx, sy))
-    })
+    let mut all = EMPTY;
+    for sy in py * ss..(py + 1) * ss {
+        let start = (sy - samples.y0) * samples.width + px * ss;
+        all = samples.data[start..start + ss]
+            .iter()
+            .fold(all, |a, &v| a & v);
+    }
+    all == EMPTY
+        && (samples.edges.is_empty()
+            || (py * ss..(py + 1) * ss)
+                .all(|sy| (px * ss..(px + 1) * ss).all(|sx| !samples.edge(sx, sy))))
 }
 
 /// Samples of sample rows `y0..` (stored from `data[0]`), `width` per row,
@@ -206,9 +218,21 @@ pub fn resolve_rows(
         let value = samples.value(px * ss, py * ss);
         (value != EMPTY).then_some(((value & 0xffff_ffff) >> 1) as usize)
     };
+    let bg = if background[3] == 0 {
+        [0; 4]
+    } else {
+        background
+    };
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
         for px in 0..width {
+            // Background first: such a pixel shows no triangle (`uniform`
+            // would find none), so it skips the look-ahead fetches too.
+            if background_only(samples, ss, px, py) {
+                // The average of equal samples, as the sums below give it.
+                row[px * 4..px * 4 + 4].copy_from_slice(&bg);
+                continue;
+            }
             // Shading gathers a triangle, then its corners' positions and
             // light: fetch the triangle of the pixel 16 ahead and the
             // corners of the one 8 ahead, so the loads overlap.
@@ -230,16 +254,6 @@ pub fn resolve_rows(
             }
             if let Some(color) = uniform(scene, proj, samples, ss, px, py) {
                 row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
-                continue;
-            }
-            if background_only(samples, ss, px, py) {
-                // The average of equal samples, as the sums below give it.
-                let bg = if background[3] == 0 {
-                    [0; 4]
-                } else {
-                    background
-                };
-                row[px * 4..px * 4 + 4].copy_from_slice(&bg);
                 continue;
             }
             let mut sum = [0u32; 4];

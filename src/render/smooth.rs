@@ -17,6 +17,7 @@ const BLOCK: usize = 1 << 12;
 /// chunks reach further (nodes numbered without locality) is summed serially.
 const LOCAL_SPAN: usize = 2 * CHUNK;
 
+#[inline]
 pub fn tri_normal(p: &[[f64; 3]], t: [u32; 3]) -> [f64; 3] {
     let (a, b, c) = (p[t[0] as usize], p[t[1] as usize], p[t[2] as usize]);
     cross(
