@@ -5,11 +5,14 @@
 //! the true curve, diagnostics, MSH files read by gmsh and meshio, and a
 //! scikit-fem solve (the tools are installed by ./scripts/test.sh).
 
+mod mesh2d_common;
+
 use geomc::diag::Code;
 use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
+use mesh2d_common::python;
 use std::f64::consts::PI;
 use std::path::Path;
 use std::process::Command;
@@ -302,24 +305,6 @@ fn diagnostics_for_empty_cut_and_sampled_regions() {
     );
     let found: Vec<Code> = checked.diagnostics.items.iter().map(|d| d.code).collect();
     assert_eq!(found, vec![Code::RegionNotFunction]);
-}
-
-fn python(script: &str, args: &[&Path], extra: &[&str]) -> serde_json::Value {
-    let path = format!("{}/tests/tools/{script}", env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("python3")
-        .arg(path)
-        .args(args)
-        .args(extra)
-        .output()
-        .expect("run python3");
-    assert!(
-        out.status.success(),
-        "{script} failed (./scripts/test.sh installs gmsh, meshio, scikit-fem): {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout.lines().last().unwrap_or("");
-    serde_json::from_str(line).unwrap_or_else(|e| panic!("bad output {stdout:?}: {e}"))
 }
 
 fn compile(body: &str, dir: &Path, name: &str, args: &[&str]) -> std::path::PathBuf {

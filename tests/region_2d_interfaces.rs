@@ -7,14 +7,16 @@
 //! triangles, the minimum angle, and the MSH groups as gmsh and meshio read
 //! them (the tools are installed by ./scripts/test.sh).
 
+mod mesh2d_common;
+
 use geomc::diag::Code;
 use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
+use mesh2d_common::{min_angle_degrees, python};
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
-use std::path::Path;
 use std::process::Command;
 
 fn model_xml(body: &str) -> String {
@@ -107,20 +109,6 @@ fn area(m: &Mesh, tris: &[[u32; 3]]) -> f64 {
         .sum()
 }
 
-fn min_angle(m: &Mesh) -> f64 {
-    let mut smallest = 180.0f64;
-    for t in m.faces.iter().flat_map(|f| f.triangles.iter()) {
-        let p = t.map(|n| m.nodes[n as usize]);
-        for k in 0..3 {
-            let (a, b, c) = (p[k], p[(k + 1) % 3], p[(k + 2) % 3]);
-            let (u, v) = ([b[0] - a[0], b[1] - a[1]], [c[0] - a[0], c[1] - a[1]]);
-            let cos = (u[0] * v[0] + u[1] * v[1]) / (u[0].hypot(u[1]) * v[0].hypot(v[1]));
-            smallest = smallest.min(cos.clamp(-1.0, 1.0).acos().to_degrees());
-        }
-    }
-    smallest
-}
-
 /// The segments (node pairs) of a fragment's edges.
 fn fragment_segments(m: &Mesh, name: &str) -> Vec<[u32; 2]> {
     let fragment = m
@@ -186,7 +174,11 @@ fn region_carved_from_a_kernel_square_is_a_conforming_inclusion() {
     );
     // Together they fill the square (the inscribed polygon is the same one).
     assert!((blob + plate - 1.0).abs() < 1e-12, "{}", blob + plate);
-    assert!(min_angle(&m) >= 30.0 - 1e-9, "min angle {}", min_angle(&m));
+    assert!(
+        min_angle_degrees(&m) >= 30.0 - 1e-9,
+        "min angle {}",
+        min_angle_degrees(&m)
+    );
     // The fragments: the interface (kernel subdomain first), the square's
     // four sides, and no blob|exterior.
     let names: BTreeSet<&str> = m.fragments.iter().map(|f| f.name.as_str()).collect();
@@ -238,7 +230,11 @@ fn region_on_a_side_of_a_kernel_square_shares_that_piece_of_the_side() {
     );
     assert!((cap_area - half).abs() / half < 2e-3, "cap area {cap_area}");
     assert!((plate - 1.0).abs() < 1e-12, "plate area {plate}");
-    assert!(min_angle(&m) >= 30.0 - 1e-9, "min angle {}", min_angle(&m));
+    assert!(
+        min_angle_degrees(&m) >= 30.0 - 1e-9,
+        "min angle {}",
+        min_angle_degrees(&m)
+    );
     let interface = fragment_segments(&m, "plate|cap");
     let nodes = assert_conforming(&m, "plate|cap", "plate", "cap");
     // An open chain along x = 1 from y = 0.2 to y = 0.8.
@@ -354,23 +350,6 @@ fn overlap_diagnostic_names_both_subdomains_and_a_point() {
     assert!(d.span.is_some(), "located");
 }
 
-fn python(script: &str, args: &[&Path]) -> serde_json::Value {
-    let path = format!("{}/tests/tools/{script}", env!("CARGO_MANIFEST_DIR"));
-    let out = Command::new("python3")
-        .arg(path)
-        .args(args)
-        .output()
-        .expect("run python3");
-    assert!(
-        out.status.success(),
-        "{script} failed (./scripts/test.sh installs gmsh and meshio): {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    let stdout = String::from_utf8_lossy(&out.stdout);
-    let line = stdout.lines().last().unwrap_or("");
-    serde_json::from_str(line).unwrap_or_else(|e| panic!("bad output {stdout:?}: {e}"))
-}
-
 #[test]
 fn msh_of_an_inclusion_keeps_the_interface_group_for_gmsh_and_meshio() {
     let dir = tempfile::tempdir().expect("tempdir");
@@ -386,7 +365,7 @@ fn msh_of_an_inclusion_keeps_the_interface_group_for_gmsh_and_meshio() {
         .expect("run geomc");
     assert!(status.success());
     let expected = mesh(&inclusion(), &at_30_degrees(Some(0.005)));
-    let r = python("check_mesh.py", &[&msh]);
+    let r = python("check_mesh.py", &[&msh], &[]);
     let groups = r["gmsh"]["groups"].as_array().expect("groups");
     let by_name = |name: &str| {
         groups

@@ -52,6 +52,20 @@ pub fn join(
     check(model, source_map, first_region, &reported, diags);
 }
 
+/// The edges of the faces of subdomains `subdomains` (2D: one face each).
+fn face_edges(
+    model: &Model,
+    subdomains: std::ops::Range<usize>,
+) -> impl Iterator<Item = EdgeId> + '_ {
+    subdomains.filter_map(|k| face_of(model, k)).flat_map(|f| {
+        model.faces[f.index()]
+            .loops
+            .edges()
+            .iter()
+            .map(|oe| oe.edge)
+    })
+}
+
 /// The one face of a 2D subdomain.
 fn face_of(model: &Model, k: usize) -> Option<FaceId> {
     match &model.subdomains[k].cells {
@@ -154,25 +168,9 @@ fn share_box_sides(
         return;
     }
     // Carved regions' contours are in kernel faces too: not kernel edges.
-    let region_edges: BTreeSet<EdgeId> = (first_region..model.subdomains.len())
-        .filter_map(|k| face_of(model, k))
-        .flat_map(|f| {
-            model.faces[f.index()]
-                .loops
-                .iter()
-                .flatten()
-                .map(|oe| oe.edge)
-        })
-        .collect();
-    let kernel_edges: BTreeSet<EdgeId> = (0..first_region)
-        .filter_map(|k| face_of(model, k))
-        .flat_map(|f| {
-            model.faces[f.index()]
-                .loops
-                .iter()
-                .flatten()
-                .map(|oe| oe.edge)
-        })
+    let region_edges: BTreeSet<EdgeId> =
+        face_edges(model, first_region..model.subdomains.len()).collect();
+    let kernel_edges: BTreeSet<EdgeId> = face_edges(model, 0..first_region)
         .filter(|e| !region_edges.contains(e))
         .filter(|&e| matches!(model.edge(e).curve, Curve::Segment { .. }))
         .collect();

@@ -1,9 +1,11 @@
-//! Facts about 2D meshes shared by the crack tests: chain lengths, how many
-//! triangles use each edge, and the smallest angle.
+//! Facts about 2D meshes shared by the 2D tests: chain lengths, how many
+//! triangles use each edge, the smallest angle, and the Python checkers.
 #![allow(dead_code)]
 
 use geomc::mesh::Mesh;
 use std::collections::HashMap;
+use std::path::Path;
+use std::process::Command;
 
 /// The length of a node chain.
 pub fn length(mesh: &Mesh, nodes: &[u32]) -> f64 {
@@ -45,4 +47,24 @@ pub fn min_angle_degrees(mesh: &Mesh) -> f64 {
         }
     }
     least
+}
+
+/// Runs `tests/tools/SCRIPT` on `args` then `extra`; its last output line is
+/// JSON.
+pub fn python(script: &str, args: &[&Path], extra: &[&str]) -> serde_json::Value {
+    let path = format!("{}/tests/tools/{script}", env!("CARGO_MANIFEST_DIR"));
+    let out = Command::new("python3")
+        .arg(path)
+        .args(args)
+        .args(extra)
+        .output()
+        .expect("run python3");
+    assert!(
+        out.status.success(),
+        "{script} failed (./scripts/test.sh installs gmsh, meshio, scikit-fem): {}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let line = stdout.lines().last().unwrap_or("");
+    serde_json::from_str(line).unwrap_or_else(|e| panic!("bad output {stdout:?}: {e}"))
 }
