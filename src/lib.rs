@@ -11,6 +11,7 @@
 #![cfg_attr(not(test), deny(clippy::unwrap_used, clippy::expect_used))]
 
 pub mod allocator;
+mod cache_hint;
 pub mod diag;
 pub mod doc;
 pub mod driver;

@@ -6,6 +6,7 @@
 //! cracks) and the top-left rule decides which triangle owns a sample on one.
 
 use super::scene::{HIDDEN, Scene};
+use crate::cache_hint::prefetch;
 use rayon::prelude::*;
 
 pub const EMPTY: u64 = u64::MAX;
@@ -180,20 +181,6 @@ pub fn draw_band(
 
 /// Triangles ahead whose corners are fetched while one is drawn.
 const AHEAD: usize = 8;
-
-/// Asks for the cache line of `value` without waiting for it.
-#[inline(always)]
-pub(super) fn prefetch<T>(value: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        // SAFETY: a prefetch reads nothing (it is only a hint, and the
-        // pointer comes from a reference), and SSE is part of every x86-64.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>((value as *const T).cast()) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
-}
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
     let bins = bin(scene, proj, width, height, BAND);

@@ -3,8 +3,9 @@
 //! (as multisampling does, so anti-aliasing costs coverage tests, not shading),
 //! and the samples of a pixel are averaged with straight alpha.
 
-use super::raster::{EMPTY, Projected, ZBuffer, prefetch};
+use super::raster::{EMPTY, Projected, ZBuffer};
 use super::scene::Scene;
+use crate::cache_hint::prefetch;
 use rayon::prelude::*;
 
 /// Pixels ahead whose triangle's corners are fetched while one is shaded.

@@ -7,6 +7,8 @@
 //! per distinct node. Nodes are numbered in order of first appearance, as
 //! [`super::build::NodeDedup`] numbers them, so the mesh is the same.
 
+use crate::cache_hint::prefetch;
+
 /// An empty slot's id.
 const EMPTY: u32 = u32::MAX;
 
@@ -119,21 +121,6 @@ impl F32Nodes {
             }
         }
     }
-}
-
-/// Asks for the cache line of `value` without waiting for it (a hint: it
-/// reads nothing).
-#[inline(always)]
-fn prefetch<T>(value: &T) {
-    #[cfg(target_arch = "x86_64")]
-    {
-        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
-        // SAFETY: a prefetch reads nothing (it is only a hint, and the
-        // pointer comes from a reference), and SSE is part of every x86-64.
-        unsafe { _mm_prefetch::<_MM_HINT_T0>((value as *const T).cast()) };
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    let _ = value;
 }
 
 #[cfg(test)]
