@@ -12,7 +12,7 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
-use mesh2d_common::python;
+use mesh2d_common::{at_30_degrees, python};
 use std::f64::consts::PI;
 use std::path::Path;
 use std::process::Command;
@@ -52,14 +52,6 @@ fn mesh(body: &str, options: &MeshOptions) -> Mesh {
     );
     let model = checked.lowered.expect("a model").model;
     mesh_model(&model, options).expect("meshes")
-}
-
-fn at_30_degrees(max_area: Option<f64>) -> MeshOptions {
-    MeshOptions {
-        min_angle_degrees: 30.0,
-        max_area,
-        ..MeshOptions::default()
-    }
 }
 
 fn triangles(m: &Mesh) -> Vec<[u32; 3]> {

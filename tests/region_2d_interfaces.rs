@@ -14,7 +14,7 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
-use mesh2d_common::{min_angle_degrees, python};
+use mesh2d_common::{at_30_degrees, min_angle_degrees, python};
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
 use std::process::Command;
@@ -76,14 +76,6 @@ fn mesh(body: &str, options: &MeshOptions) -> Mesh {
     assert!(checked.is_valid(), "{:#?}", checked.diagnostics.items);
     let model = checked.lowered.expect("a model").model;
     mesh_model(&model, options).expect("meshes")
-}
-
-fn at_30_degrees(max_area: Option<f64>) -> MeshOptions {
-    MeshOptions {
-        min_angle_degrees: 30.0,
-        max_area,
-        ..MeshOptions::default()
-    }
 }
 
 /// The triangles of one subdomain.

@@ -3,6 +3,7 @@
 #![allow(dead_code)]
 
 use geomc::mesh::Mesh;
+use geomc::meshing::MeshOptions;
 use std::collections::HashMap;
 use std::path::Path;
 use std::process::Command;
@@ -47,6 +48,15 @@ pub fn min_angle_degrees(mesh: &Mesh) -> f64 {
         }
     }
     least
+}
+
+/// Meshing at a 30° minimum angle, with an optional area limit.
+pub fn at_30_degrees(max_area: Option<f64>) -> MeshOptions {
+    MeshOptions {
+        min_angle_degrees: 30.0,
+        max_area,
+        ..MeshOptions::default()
+    }
 }
 
 /// Runs `tests/tools/SCRIPT` on `args` then `extra`; its last output line is
