@@ -12,7 +12,7 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
-use mesh2d_common::{at_30_degrees, python};
+use mesh2d_common::{at_30_degrees, gmsh_group, python};
 use std::f64::consts::PI;
 use std::path::Path;
 use std::process::Command;
@@ -326,17 +326,13 @@ fn msh_of_a_region_is_read_by_gmsh_and_meshio_and_solved_by_scikit_fem() {
     );
     let expected = mesh(DISK, &at_30_degrees(Some(0.01)));
     let r = python("check_mesh.py", &[&msh], &[]);
-    let groups = r["gmsh"]["groups"].as_array().expect("groups");
-    let by_name = |name: &str| {
-        groups
-            .iter()
-            .find(|g| g["name"] == name)
-            .unwrap_or_else(|| panic!("no group {name} in {groups:?}"))
-    };
     let segments = boundary_segments(&expected) as u64;
-    assert_eq!(by_name("inside|exterior")["elements"]["line"], segments);
     assert_eq!(
-        by_name("inside")["elements"]["triangle"],
+        gmsh_group(&r, "inside|exterior")["elements"]["line"],
+        segments
+    );
+    assert_eq!(
+        gmsh_group(&r, "inside")["elements"]["triangle"],
         triangles(&expected).len() as u64
     );
     assert_eq!(r["gmsh"]["nodes"], expected.nodes.len() as u64);

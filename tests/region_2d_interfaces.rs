@@ -14,7 +14,7 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
-use mesh2d_common::{at_30_degrees, min_angle_degrees, python};
+use mesh2d_common::{at_30_degrees, gmsh_group, min_angle_degrees, python};
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
 use std::process::Command;
@@ -358,19 +358,12 @@ fn msh_of_an_inclusion_keeps_the_interface_group_for_gmsh_and_meshio() {
     assert!(status.success());
     let expected = mesh(&inclusion(), &at_30_degrees(Some(0.005)));
     let r = python("check_mesh.py", &[&msh], &[]);
-    let groups = r["gmsh"]["groups"].as_array().expect("groups");
-    let by_name = |name: &str| {
-        groups
-            .iter()
-            .find(|g| g["name"] == name)
-            .unwrap_or_else(|| panic!("no group {name} in {groups:?}"))
-    };
     let interface = fragment_segments(&expected, "plate|blob").len() as u64;
-    assert_eq!(by_name("plate|blob")["elements"]["line"], interface);
+    assert_eq!(gmsh_group(&r, "plate|blob")["elements"]["line"], interface);
     assert_eq!(r["meshio"]["cell_sets"]["plate|blob"], interface);
     for sub in ["plate", "blob"] {
         assert_eq!(
-            by_name(sub)["elements"]["triangle"],
+            gmsh_group(&r, sub)["elements"]["triangle"],
             triangles_of(&expected, sub).len() as u64
         );
     }

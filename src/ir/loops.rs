@@ -84,8 +84,13 @@ impl Loops {
 
     /// Appends a loop.
     pub fn push(&mut self, lp: Vec<OrientedEdge>) {
+        self.extend([lp]);
+    }
+
+    /// Appends loops (the list is rebuilt once, whatever their number).
+    pub fn extend(&mut self, more: impl IntoIterator<Item = Vec<OrientedEdge>>) {
         let mut loops = self.to_vecs();
-        loops.push(lp);
+        loops.extend(more);
         *self = Loops::from(loops);
     }
 }

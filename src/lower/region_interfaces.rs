@@ -137,10 +137,7 @@ fn carve(
                 .collect()
         })
         .collect();
-    let face = &mut model.faces[fk.index()];
-    let mut loops = face.loops.to_vecs();
-    loops.extend(holes);
-    face.loops = Loops::from(loops);
+    model.faces[fk.index()].loops.extend(holes);
     None
 }
 

@@ -78,3 +78,12 @@ pub fn python(script: &str, args: &[&Path], extra: &[&str]) -> serde_json::Value
     let line = stdout.lines().last().unwrap_or("");
     serde_json::from_str(line).unwrap_or_else(|e| panic!("bad output {stdout:?}: {e}"))
 }
+
+/// The group `name` in `check_mesh.py`'s report of what gmsh read.
+pub fn gmsh_group<'a>(report: &'a serde_json::Value, name: &str) -> &'a serde_json::Value {
+    let groups = report["gmsh"]["groups"].as_array().expect("groups");
+    groups
+        .iter()
+        .find(|g| g["name"] == name)
+        .unwrap_or_else(|| panic!("no group {name} in {groups:?}"))
+}
