@@ -1025,7 +1025,13 @@ mod tests {
         };
         // Face 3 is listed twice with different flags (the first wins), face 5
         // has no sample (skipped), the list is not in id order.
-        let faces = vec![of(3, true), of(1, false), of(5, true), of(3, false), of(0, true)];
+        let faces = vec![
+            of(3, true),
+            of(1, false),
+            of(5, true),
+            of(3, false),
+            of(0, true),
+        ];
         model.solids.push(Solid {
             name: "s".into(),
             shape: SolidShape::Box {

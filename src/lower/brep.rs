@@ -520,7 +520,9 @@ mod tests {
     fn brep_points(shape: &SolidShape) -> Vec<Point3> {
         let brep = of(shape);
         let vertices = brep.vertices.iter().map(|v| v.position);
-        vertices.chain(brep.faces.iter().map(|f| f.sample)).collect()
+        vertices
+            .chain(brep.faces.iter().map(|f| f.sample))
+            .collect()
     }
 
     #[test]
@@ -532,10 +534,26 @@ mod tests {
             let f = frame(linear);
             shapes.push(SolidShape::Box { frame: f });
             shapes.push(SolidShape::Ball { frame: f });
-            shapes.push(SolidShape::Cone { frame: f, r0: 0.4, r1: 0.2 });
-            shapes.push(SolidShape::Cone { frame: f, r0: 0.0, r1: 0.3 });
-            shapes.push(SolidShape::Cone { frame: f, r0: 0.5, r1: 0.0 });
-            shapes.push(SolidShape::Torus { frame: f, major: 0.5, minor: 0.15 });
+            shapes.push(SolidShape::Cone {
+                frame: f,
+                r0: 0.4,
+                r1: 0.2,
+            });
+            shapes.push(SolidShape::Cone {
+                frame: f,
+                r0: 0.0,
+                r1: 0.3,
+            });
+            shapes.push(SolidShape::Cone {
+                frame: f,
+                r0: 0.5,
+                r1: 0.0,
+            });
+            shapes.push(SolidShape::Torus {
+                frame: f,
+                major: 0.5,
+                minor: 0.15,
+            });
             shapes.push(SolidShape::Disk { frame: f });
             shapes.push(SolidShape::Polygon {
                 frame: f,

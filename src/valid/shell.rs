@@ -264,10 +264,7 @@ fn components(
     }
     for (_, list) in uses.lists() {
         for pair in list.windows(2) {
-            let (a, b) = (
-                root(parent, pair[0].1.entry),
-                root(parent, pair[1].1.entry),
-            );
+            let (a, b) = (root(parent, pair[0].1.entry), root(parent, pair[1].1.entry));
             parent[a.max(b)] = a.min(b);
         }
     }
@@ -478,7 +475,9 @@ fn check_shell(
         return;
     }
     let uses = EdgeUses::of(model, boundary, std::mem::take(&mut scratch.uses));
-    check_edge_uses(model, source_map, id, subdomain, boundary, &uses, scratch, diags);
+    check_edge_uses(
+        model, source_map, id, subdomain, boundary, &uses, scratch, diags,
+    );
     scratch.uses = uses.uses;
 }
 
@@ -739,8 +738,11 @@ fn check_euler(
     if shared_vertices > 0 && shells.iter().all(|s| s.genus().is_some()) {
         // Shells that touch only at vertices: each is a closed surface, but the
         // boundary is not a manifold there, and χ of the whole boundary shows it.
-        let chi: i64 =
-            shells.iter().map(ShellCounts::euler_characteristic).sum::<i64>() - shared_vertices as i64;
+        let chi: i64 = shells
+            .iter()
+            .map(ShellCounts::euler_characteristic)
+            .sum::<i64>()
+            - shared_vertices as i64;
         let name = subdomain_name(model, id);
         diags.push(
             Diagnostic::new(
