@@ -284,7 +284,7 @@ fn lower_implicit(
         .parent()
         .filter(|p| !p.as_os_str().is_empty())
         .map_or_else(|| std::path::PathBuf::from("."), Path::to_path_buf);
-    let taken = |name: &str| resolved.by_name.contains_key(name);
+    let taken = |name: &str| resolved.object(name).is_some();
     let env = crate::implicit::xml::Env {
         source,
         parameters: &resolved.parameters,

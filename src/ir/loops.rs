@@ -95,22 +95,74 @@ impl Loops {
     }
 }
 
-impl<L: AsRef<[OrientedEdge]>> FromIterator<L> for Loops {
-    fn from_iter<I: IntoIterator<Item = L>>(iter: I) -> Loops {
-        let mut edges = Vec::new();
-        let mut ends = Vec::new();
-        for lp in iter {
-            edges.extend_from_slice(lp.as_ref());
-            ends.push(edges.len() as u32);
+impl Loops {
+    /// The loops of `loops`, `total` edges in all: the edge list is sized
+    /// once and no vector is made per loop (lowering builds hundreds of
+    /// thousands of faces this way).
+    pub fn from_nested<I, J>(loops: I, total: usize) -> Loops
+    where
+        I: IntoIterator<Item = J>,
+        J: IntoIterator<Item = OrientedEdge>,
+    {
+        let mut builder = Builder::with_capacity(total);
+        for lp in loops {
+            builder.edges.extend(lp);
+            builder.end_loop();
         }
-        // One non-empty loop needs no ends (see the struct's comment).
-        if ends.len() == 1 && !edges.is_empty() {
-            ends.clear();
+        builder.finish()
+    }
+}
+
+/// Collects loops end to end; `ends` is allocated only once a second loop
+/// comes (most faces have one).
+struct Builder {
+    edges: Vec<OrientedEdge>,
+    ends: Vec<u32>,
+    count: usize,
+    first_end: u32,
+}
+
+impl Builder {
+    fn with_capacity(edges: usize) -> Builder {
+        Builder {
+            edges: Vec::with_capacity(edges),
+            ends: Vec::new(),
+            count: 0,
+            first_end: 0,
+        }
+    }
+
+    fn end_loop(&mut self) {
+        let end = self.edges.len() as u32;
+        self.count += 1;
+        match self.count {
+            1 => self.first_end = end,
+            2 => self.ends.extend([self.first_end, end]),
+            _ => self.ends.push(end),
+        }
+    }
+
+    fn finish(mut self) -> Loops {
+        // One non-empty loop needs no ends (see the struct's comment); a
+        // single empty one does.
+        if self.count == 1 && self.edges.is_empty() {
+            self.ends.push(0);
         }
         Loops {
-            edges: edges.into_boxed_slice(),
-            ends: ends.into_boxed_slice(),
+            edges: self.edges.into_boxed_slice(),
+            ends: self.ends.into_boxed_slice(),
         }
+    }
+}
+
+impl<L: AsRef<[OrientedEdge]>> FromIterator<L> for Loops {
+    fn from_iter<I: IntoIterator<Item = L>>(iter: I) -> Loops {
+        let mut builder = Builder::with_capacity(0);
+        for lp in iter {
+            builder.edges.extend_from_slice(lp.as_ref());
+            builder.end_loop();
+        }
+        builder.finish()
     }
 }
 
@@ -224,5 +276,22 @@ mod tests {
         let empty = Loops::from(vec![Vec::new()]);
         assert_eq!((empty.len(), empty.first()), (1, Some(&[][..])));
         assert_eq!(two.get(3), None);
+    }
+
+    #[test]
+    fn nested_loops_match_collected_ones() {
+        let cases: Vec<Vec<Vec<OrientedEdge>>> = vec![
+            vec![],
+            vec![vec![]],
+            vec![vec![oe(4), oe(1)]],
+            vec![vec![oe(0)], vec![oe(3), oe(2)], vec![]],
+            vec![vec![], vec![oe(9)]],
+        ];
+        for case in cases {
+            let total = case.iter().map(Vec::len).sum();
+            let nested = Loops::from_nested(case.iter().map(|l| l.iter().copied()), total);
+            assert_eq!(nested, Loops::from(case.clone()));
+            assert_eq!(nested.to_vecs(), case);
+        }
     }
 }

@@ -542,6 +542,9 @@ fn check_pair(
 
 /// The faces of the subdomain's boundary, with `outward` set.
 fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<OrientedFace> {
+    if let (Tree::Leaf(0), [leaf]) = (&built.tree, built.leaves.as_slice()) {
+        return single_solid_faces(&model.solids[leaf.index()].faces, samples);
+    }
     let mut result: BTreeMap<FaceId, bool> = BTreeMap::new();
     // Each leaf's faces sorted once: a linear search per face and leaf was
     // quadratic in a solid's face count.
@@ -583,6 +586,22 @@ fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<Or
         .into_iter()
         .map(|(face, outward)| OrientedFace { face, outward })
         .collect()
+}
+
+/// [`classify_faces`] for a tree of one solid (every subdomain of a file of
+/// separate primitives), without the general evaluation: each face with a
+/// sample has its own solid behind (outward) or in front of it (inward), so
+/// the sides always differ and the first listing of a face gives its flag.
+fn single_solid_faces(faces: &[OrientedFace], samples: &FaceSamples) -> Vec<OrientedFace> {
+    let mut out: Vec<OrientedFace> = faces
+        .iter()
+        .filter(|of| samples.get(&of.face).is_some())
+        .copied()
+        .collect();
+    // Stable: a repeated face keeps its first flag, as the general path does.
+    out.sort_by_key(|of| of.face);
+    out.dedup_by_key(|of| of.face);
+    out
 }
 
 /// (key, flag) pairs sorted by key; a stable sort keeps a repeated key's
@@ -989,4 +1008,55 @@ fn face_volume(model: &Model, face_id: FaceId) -> f64 {
         }
     }
     total
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Frame, Mat3, SolidShape};
+    use crate::ir::Solid;
+
+    #[test]
+    fn a_one_solid_tree_classifies_as_the_general_evaluation() {
+        let mut model = Model::empty(Dimension::Three);
+        let of = |face: u32, outward: bool| OrientedFace {
+            face: FaceId(face),
+            outward,
+        };
+        // Face 3 is listed twice with different flags (the first wins), face 5
+        // has no sample (skipped), the list is not in id order.
+        let faces = vec![
+            of(3, true),
+            of(1, false),
+            of(5, true),
+            of(3, false),
+            of(0, true),
+        ];
+        model.solids.push(Solid {
+            name: "s".into(),
+            shape: SolidShape::Box {
+                frame: Frame {
+                    origin: Point3::origin(),
+                    linear: Mat3::identity(),
+                },
+            },
+            faces,
+            boundary_edges: Vec::new(),
+            edges: Vec::new(),
+            vertices: Vec::new(),
+        });
+        let mut samples = FaceSamples::default();
+        for f in [0, 1, 3] {
+            samples.insert(FaceId(f), Point3::new(f as f64, 0.0, 0.0));
+        }
+        let built = |tree| Built {
+            tree,
+            leaves: vec![SolidId(0)],
+            span: crate::span::Span::default(),
+        };
+        let fast = classify_faces(&model, &built(Tree::Leaf(0)), &samples);
+        let general = classify_faces(&model, &built(Tree::Union(vec![Tree::Leaf(0)])), &samples);
+        assert_eq!(fast, vec![of(0, true), of(1, false), of(3, true)]);
+        assert_eq!(fast, general);
+    }
 }

@@ -53,6 +53,64 @@ pub fn of(shape: &SolidShape) -> Brep {
     }
 }
 
+/// The points the welder places for `shape` (its vertices' positions and its
+/// faces' samples), without building the boundary: the isolation test boxes
+/// them for every solid. Each point is computed as in [`of`], so the box is
+/// the same (`anchors_are_the_brep_points` checks it).
+pub fn anchors(shape: &SolidShape, mut visit: impl FnMut(Point3)) {
+    match shape {
+        SolidShape::Box { frame } => {
+            for n in 0..8 {
+                visit(frame.to_global(&Point3::new(
+                    (n & 1) as f64,
+                    ((n >> 1) & 1) as f64,
+                    ((n >> 2) & 1) as f64,
+                )));
+            }
+            for axis in 0..3 {
+                for side in 0..2 {
+                    let mut center = Point3::new(0.5, 0.5, 0.5);
+                    center[axis] = side as f64;
+                    visit(frame.to_global(&center));
+                }
+            }
+        }
+        SolidShape::Ball { frame } => {
+            visit(frame.to_global(&Point3::new(1.0, 0.0, 0.0)));
+            visit(frame.to_global(&Point3::new(0.0, 0.0, 1.0)));
+            visit(frame.to_global(&Point3::new(0.0, 0.0, -1.0)));
+        }
+        SolidShape::Cone { frame, r0, r1 } => {
+            // Vertices, then samples, in the order `cone` makes them.
+            let rims = [(0.0, *r0), (1.0, *r1)];
+            for &(z, r) in rims.iter().filter(|(_, r)| *r > 0.0) {
+                visit(frame.to_global(&Point3::new(r, 0.0, z)));
+            }
+            for &(z, _) in rims.iter().filter(|(_, r)| *r > 0.0) {
+                visit(frame.to_global(&Point3::new(0.0, 0.0, z)));
+            }
+            let mid_r = 0.5 * (r0 + r1);
+            visit(frame.to_global(&Point3::new(-mid_r, 0.0, 0.5)));
+        }
+        SolidShape::Torus {
+            frame,
+            major,
+            minor,
+        } => {
+            visit(frame.to_global(&Point3::new(major + minor, 0.0, 0.0)));
+            visit(frame.to_global(&Point3::new(-(major + minor), 0.0, 0.0)));
+        }
+        SolidShape::Disk { frame } => {
+            visit(frame.to_global(&Point3::new(1.0, 0.0, 0.0)));
+            visit(frame.origin);
+        }
+        SolidShape::Polygon { frame, vertices } => {
+            vertices.iter().for_each(|v| visit(frame.to_global(v)));
+            visit(shape.interior_point());
+        }
+    }
+}
+
 /// True when the frame mirrors, so loops built counter-clockwise in local
 /// coordinates run clockwise in global ones.
 fn mirrors(frame: &Frame) -> bool {
@@ -443,5 +501,78 @@ fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
             sample,
         }],
         boundary: ring,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::Mat3;
+
+    fn frame(linear: Mat3) -> Frame {
+        Frame {
+            origin: Point3::new(0.3, -1.7, 2.9),
+            linear,
+        }
+    }
+
+    /// The brep's own points: vertex positions, then face samples.
+    fn brep_points(shape: &SolidShape) -> Vec<Point3> {
+        let brep = of(shape);
+        let vertices = brep.vertices.iter().map(|v| v.position);
+        vertices
+            .chain(brep.faces.iter().map(|f| f.sample))
+            .collect()
+    }
+
+    #[test]
+    fn anchors_are_the_brep_points() {
+        let turned = Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7);
+        let mirrored = Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0));
+        let mut shapes = Vec::new();
+        for linear in [turned, mirrored] {
+            let f = frame(linear);
+            shapes.push(SolidShape::Box { frame: f });
+            shapes.push(SolidShape::Ball { frame: f });
+            shapes.push(SolidShape::Cone {
+                frame: f,
+                r0: 0.4,
+                r1: 0.2,
+            });
+            shapes.push(SolidShape::Cone {
+                frame: f,
+                r0: 0.0,
+                r1: 0.3,
+            });
+            shapes.push(SolidShape::Cone {
+                frame: f,
+                r0: 0.5,
+                r1: 0.0,
+            });
+            shapes.push(SolidShape::Torus {
+                frame: f,
+                major: 0.5,
+                minor: 0.15,
+            });
+            shapes.push(SolidShape::Disk { frame: f });
+            shapes.push(SolidShape::Polygon {
+                frame: f,
+                vertices: vec![
+                    Point3::new(0.0, 0.0, 0.0),
+                    Point3::new(2.0, 0.0, 0.0),
+                    Point3::new(2.0, 1.0, 0.0),
+                    Point3::new(1.0, 0.4, 0.0),
+                    Point3::new(0.0, 1.0, 0.0),
+                ],
+            });
+        }
+        for shape in &shapes {
+            let mut points = Vec::new();
+            anchors(shape, |p| points.push(p));
+            let expected = brep_points(shape);
+            assert!(expected.len() >= 2, "{shape:?}");
+            // Bit for bit, in the same order.
+            assert_eq!(points, expected, "{shape:?}");
+        }
     }
 }

@@ -47,10 +47,8 @@ pub(super) fn isolated(shapes: &[&SolidShape], tol: f64) -> Vec<bool> {
         .par_iter()
         .with_min_len(1024)
         .map(|shape| {
-            let brep = brep::of(shape);
             let mut bbox = Aabb::empty();
-            brep.vertices.iter().for_each(|v| bbox.include(&v.position));
-            brep.faces.iter().for_each(|f| bbox.include(&f.sample));
+            brep::anchors(shape, |p| bbox.include(&p));
             bbox
         })
         .collect();

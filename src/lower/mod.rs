@@ -348,11 +348,9 @@ fn lower_solid(
     };
     let mut faces = Vec::with_capacity(brep.faces.len());
     for f in brep.faces {
-        let loops: Loops = f
-            .loops
-            .iter()
-            .map(|l| l.iter().copied().map(orient).collect::<Vec<_>>())
-            .collect();
+        let total = f.loops.iter().map(Vec::len).sum();
+        let loops =
+            Loops::from_nested(f.loops.iter().map(|l| l.iter().copied().map(orient)), total);
         let first = loops.first().and_then(|l| l.first()).copied();
         let face = Face {
             name: EntityName::local(&base, f.name),

@@ -3,6 +3,7 @@
 //! in global coordinates, ready to be lowered into the model IR.
 
 mod geometry;
+mod name_index;
 mod names;
 mod objects;
 mod point_calculus;
@@ -12,6 +13,7 @@ mod trimmed;
 mod values;
 
 pub use geometry::{Geometry, LineCarrier, Link};
+pub use name_index::NameIndex;
 pub use names::{NameTable, is_plain_name};
 pub use objects::a;
 pub use shapes::{fmt, fmt_point, perpendicular_pair};
@@ -21,7 +23,6 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::Document;
 use crate::expr::Expr;
 use crate::span::{SourceFile, Span};
-use foldhash::HashMap;
 
 /// One object of the document after resolution.
 #[derive(Debug, Clone, PartialEq)]
@@ -38,7 +39,8 @@ pub struct Resolved {
     pub dimension: u8,
     /// In document order: `objects[i]` resolves `doc.objects[i]`.
     pub objects: Vec<ResolvedObject>,
-    pub by_name: HashMap<String, usize>,
+    /// Objects by name (the last of a repeated name).
+    pub by_name: NameIndex,
     /// Parameter values in force, in definition order.
     pub parameters: Vec<(String, f64)>,
     /// `subdomain_areas[i]`: the `area=` limit of `doc.subdomains[i]`, when
@@ -48,7 +50,9 @@ pub struct Resolved {
 
 impl Resolved {
     pub fn object(&self, name: &str) -> Option<&ResolvedObject> {
-        self.by_name.get(name).and_then(|&i| self.objects.get(i))
+        self.by_name
+            .get(&self.objects, name)
+            .and_then(|i| self.objects.get(i))
     }
 }
 
@@ -147,11 +151,7 @@ pub fn resolve(
             .with_help("remove it, or use it in an attribute"),
         );
     }
-    let by_name = objects
-        .iter()
-        .enumerate()
-        .map(|(i, o)| (o.name.clone(), i))
-        .collect();
+    let by_name = NameIndex::build(&objects);
     Resolved {
         dimension: doc.dimension,
         objects,

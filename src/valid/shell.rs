@@ -190,8 +190,10 @@ struct EdgeUses {
 }
 
 impl EdgeUses {
-    fn of(model: &Model, boundary: &[OrientedFace]) -> EdgeUses {
-        let mut uses = Vec::new();
+    /// Fills `buffer` (emptied first, its capacity reused).
+    fn of(model: &Model, boundary: &[OrientedFace], buffer: Vec<(EdgeId, EdgeUse)>) -> EdgeUses {
+        let mut uses = buffer;
+        uses.clear();
         for (entry, of) in boundary.iter().enumerate() {
             let Some(face) = model.faces.get(of.face.index()) else {
                 continue;
@@ -216,18 +218,43 @@ impl EdgeUses {
     }
 }
 
+/// Buffers the shell checks reuse from one subdomain to the next (one set
+/// per parallel job): fresh vectors were about fifteen allocations per
+/// subdomain, and files of many primitives have one subdomain per solid.
+#[derive(Default)]
+struct Scratch {
+    uses: Vec<(EdgeId, EdgeUse)>,
+    parent: Vec<usize>,
+    component_of_root: Vec<usize>,
+    component_of_entry: Vec<usize>,
+    /// Entry `a`'s neighbours are `adjacent[adjacent_start[a]..adjacent_start[a + 1]]`.
+    adjacent_start: Vec<usize>,
+    adjacent: Vec<(usize, bool, EdgeId)>,
+    seam_conflict: Vec<Option<EdgeId>>,
+    flip: Vec<Option<bool>>,
+    members: Vec<usize>,
+    queue: VecDeque<usize>,
+    vertices: Vec<(usize, VertexId)>,
+    all_vertices: Vec<VertexId>,
+    counts: Vec<ShellCounts>,
+}
+
 /// Groups boundary entries (with a valid face) connected through shared
-/// edges; components are ordered by their first entry, entries ascending.
-/// Also returns each entry's component (`usize::MAX` for an invalid face).
+/// edges into components numbered by their first entry; fills
+/// `scratch.component_of_entry` (`usize::MAX` for an invalid face) and
+/// returns the number of components.
 fn components(
     model: &Model,
     boundary: &[OrientedFace],
     uses: &EdgeUses,
-) -> (Vec<Vec<usize>>, Vec<usize>) {
+    scratch: &mut Scratch,
+) -> usize {
     // Union–find over the entries rather than adjacency sets and a search:
     // the same components, without an allocation per face.
     let n = boundary.len();
-    let mut parent: Vec<usize> = (0..n).collect();
+    let parent = &mut scratch.parent;
+    parent.clear();
+    parent.extend(0..n);
     fn root(parent: &mut [usize], mut a: usize) -> usize {
         while parent[a] != a {
             parent[a] = parent[parent[a]];
@@ -237,30 +264,41 @@ fn components(
     }
     for (_, list) in uses.lists() {
         for pair in list.windows(2) {
-            let (a, b) = (
-                root(&mut parent, pair[0].1.entry),
-                root(&mut parent, pair[1].1.entry),
-            );
+            let (a, b) = (root(parent, pair[0].1.entry), root(parent, pair[1].1.entry));
             parent[a.max(b)] = a.min(b);
         }
     }
     // Entries in ascending order: a component starts at its first entry.
-    let mut component_of_root = vec![usize::MAX; n];
-    let mut component_of_entry = vec![usize::MAX; n];
-    let mut out: Vec<Vec<usize>> = Vec::new();
+    let component_of_root = &mut scratch.component_of_root;
+    component_of_root.clear();
+    component_of_root.resize(n, usize::MAX);
+    let component_of_entry = &mut scratch.component_of_entry;
+    component_of_entry.clear();
+    component_of_entry.resize(n, usize::MAX);
+    let mut count = 0;
     for (entry, of) in boundary.iter().enumerate() {
         if of.face.index() >= model.faces.len() {
             continue;
         }
-        let r = root(&mut parent, entry);
+        let r = root(parent, entry);
         if component_of_root[r] == usize::MAX {
-            component_of_root[r] = out.len();
-            out.push(Vec::new());
+            component_of_root[r] = count;
+            count += 1;
         }
         component_of_entry[entry] = component_of_root[r];
-        out[component_of_root[r]].push(entry);
     }
-    (out, component_of_entry)
+    count
+}
+
+/// V − E + F − (L − F): inner loops (rings) count against faces.
+fn euler_characteristic(vertices: usize, edges: usize, faces: usize, loops: usize) -> i64 {
+    let f = faces as i64;
+    vertices as i64 - edges as i64 + f - (loops as i64 - f)
+}
+
+/// G from χ = 2(1 − G) for one shell; `None` when no whole G ≥ 0 fits.
+fn genus(chi: i64) -> Option<u64> {
+    (chi <= 2 && chi % 2 == 0).then(|| ((2 - chi) / 2) as u64)
 }
 
 /// One connected shell of a subdomain's boundary (faces joined through shared
@@ -277,61 +315,82 @@ pub struct Shell {
 impl Shell {
     /// χ = V − E + F − (L − F): inner loops (rings) count against faces.
     pub fn euler_characteristic(&self) -> i64 {
-        let f = self.faces.len() as i64;
-        self.vertices as i64 - self.edges as i64 + f - (self.loops as i64 - f)
+        euler_characteristic(self.vertices, self.edges, self.faces.len(), self.loops)
     }
 
     /// G from χ = 2(1 − G) for one shell; `None` when no whole G ≥ 0 fits.
     pub fn genus(&self) -> Option<u64> {
-        let chi = self.euler_characteristic();
-        (chi <= 2 && chi % 2 == 0).then(|| ((2 - chi) / 2) as u64)
+        genus(self.euler_characteristic())
     }
 }
 
-fn shells_of(model: &Model, boundary: &[OrientedFace], uses: &EdgeUses) -> Vec<Shell> {
-    shells_and_vertices(model, boundary, uses).0
+/// A [`Shell`]'s counts without its face list (the checks need only the
+/// first face, for messages).
+#[derive(Debug, Clone, Copy, Default)]
+struct ShellCounts {
+    first_face: Option<FaceId>,
+    faces: usize,
+    vertices: usize,
+    edges: usize,
+    loops: usize,
 }
 
-/// The shells of [`shells_of`] and the number of distinct vertices of the
-/// whole boundary. The counts come from the edge uses (every valid edge of
-/// every valid face, grouped by edge, each group within one shell), so each
-/// edge is looked up once instead of once per use and per count.
-fn shells_and_vertices(
+impl ShellCounts {
+    fn euler_characteristic(&self) -> i64 {
+        euler_characteristic(self.vertices, self.edges, self.faces, self.loops)
+    }
+
+    fn genus(&self) -> Option<u64> {
+        genus(self.euler_characteristic())
+    }
+}
+
+/// The counts of every shell (in `scratch.counts`, shells numbered by their
+/// first entry; `scratch.component_of_entry` gives each entry's shell) and
+/// the number of distinct vertices of the whole boundary. The counts come
+/// from the edge uses (every valid edge of every valid face, grouped by
+/// edge, each group within one shell), so each edge is looked up once
+/// instead of once per use and per count.
+fn shell_counts(
     model: &Model,
     boundary: &[OrientedFace],
     uses: &EdgeUses,
-) -> (Vec<Shell>, usize) {
-    let (members, component_of_entry) = components(model, boundary, uses);
-    let mut shells: Vec<Shell> = members
-        .iter()
-        .map(|entries| Shell {
-            faces: entries.iter().map(|&e| boundary[e].face).collect(),
-            vertices: 0,
-            edges: 0,
-            loops: entries
-                .iter()
-                .filter_map(|&e| model.faces.get(boundary[e].face.index()))
-                .map(|f| f.loops.len())
-                .sum(),
-        })
-        .collect();
+    scratch: &mut Scratch,
+) -> usize {
+    let count = components(model, boundary, uses, scratch);
+    let counts = &mut scratch.counts;
+    counts.clear();
+    counts.resize(count, ShellCounts::default());
+    for (entry, &shell) in scratch.component_of_entry.iter().enumerate() {
+        if shell == usize::MAX {
+            continue;
+        }
+        let face = boundary[entry].face;
+        let c = &mut counts[shell];
+        c.first_face.get_or_insert(face);
+        c.faces += 1;
+        c.loops += model.faces.get(face.index()).map_or(0, |f| f.loops.len());
+    }
     // (shell, vertex) for both ends of every distinct edge.
-    let mut vertices: Vec<(usize, VertexId)> = Vec::with_capacity(2 * uses.uses.len());
+    let vertices = &mut scratch.vertices;
+    vertices.clear();
+    vertices.reserve(2 * uses.uses.len());
     for (edge, list) in uses.lists() {
-        let shell = component_of_entry[list[0].1.entry];
+        let shell = scratch.component_of_entry[list[0].1.entry];
         let Some(e) = model.edges.get(edge.index()) else {
             continue;
         };
-        shells[shell].edges += 1;
+        counts[shell].edges += 1;
         vertices.extend([(shell, e.begin), (shell, e.end)]);
     }
-    count_distinct(&mut vertices);
-    for &(shell, _) in &vertices {
-        shells[shell].vertices += 1;
+    count_distinct(vertices);
+    for &(shell, _) in vertices.iter() {
+        counts[shell].vertices += 1;
     }
-    let mut all: Vec<VertexId> = vertices.into_iter().map(|(_, v)| v).collect();
-    let distinct = count_distinct(&mut all);
-    (shells, distinct)
+    let all = &mut scratch.all_vertices;
+    all.clear();
+    all.extend(vertices.iter().map(|&(_, v)| v));
+    count_distinct(all)
 }
 
 /// How many different values `items` holds (sorting it).
@@ -344,12 +403,28 @@ fn count_distinct<T: Ord>(items: &mut Vec<T>) -> usize {
 /// The connected shells of a 3D subdomain's boundary; empty for a 2D region
 /// or an id out of range.
 pub fn shells(model: &Model, subdomain: SubdomainId) -> Vec<Shell> {
-    match model.subdomains.get(subdomain.index()).map(|s| &s.cells) {
-        Some(SubdomainCells::Volume { boundary }) => {
-            shells_of(model, boundary, &EdgeUses::of(model, boundary))
+    let Some(SubdomainCells::Volume { boundary }) =
+        model.subdomains.get(subdomain.index()).map(|s| &s.cells)
+    else {
+        return Vec::new();
+    };
+    let mut scratch = Scratch::default();
+    let uses = EdgeUses::of(model, boundary, Vec::new());
+    shell_counts(model, boundary, &uses, &mut scratch);
+    let mut shells: Vec<Shell> = (scratch.counts.iter())
+        .map(|c| Shell {
+            faces: Vec::with_capacity(c.faces),
+            vertices: c.vertices,
+            edges: c.edges,
+            loops: c.loops,
+        })
+        .collect();
+    for (entry, &shell) in scratch.component_of_entry.iter().enumerate() {
+        if shell != usize::MAX {
+            shells[shell].faces.push(boundary[entry].face);
         }
-        _ => Vec::new(),
     }
+    shells
 }
 
 /// E402/E403 (every edge used exactly twice), then, for 2-manifold
@@ -363,13 +438,14 @@ pub fn check_subdomain_shells(model: &Model, source_map: &SourceMap, diags: &mut
         .par_iter()
         .enumerate()
         .with_min_len(SHELLS_PER_JOB)
-        .map(|(k, subdomain)| {
+        .map_init(Scratch::default, |scratch, (k, subdomain)| {
             let mut found = Diagnostics::default();
             check_shell(
                 model,
                 source_map,
                 SubdomainId(k as u32),
                 subdomain,
+                scratch,
                 &mut found,
             );
             found
@@ -387,6 +463,7 @@ fn check_shell(
     source_map: &SourceMap,
     id: SubdomainId,
     subdomain: &crate::ir::Subdomain,
+    scratch: &mut Scratch,
     diags: &mut Diagnostics,
 ) {
     let SubdomainCells::Volume { boundary } = &subdomain.cells else {
@@ -397,7 +474,25 @@ fn check_shell(
     if !subdomain.trimmed.is_empty() {
         return;
     }
-    let uses = EdgeUses::of(model, boundary);
+    let uses = EdgeUses::of(model, boundary, std::mem::take(&mut scratch.uses));
+    check_edge_uses(
+        model, source_map, id, subdomain, boundary, &uses, scratch, diags,
+    );
+    scratch.uses = uses.uses;
+}
+
+/// The checks of [`check_shell`] on the boundary's edge uses.
+#[allow(clippy::too_many_arguments)]
+fn check_edge_uses(
+    model: &Model,
+    source_map: &SourceMap,
+    id: SubdomainId,
+    subdomain: &crate::ir::Subdomain,
+    boundary: &[OrientedFace],
+    uses: &EdgeUses,
+    scratch: &mut Scratch,
+    diags: &mut Diagnostics,
+) {
     let mut manifold = true;
     for (edge, list) in uses.lists() {
         // Looked up only for a finding: this runs for every edge of every subdomain.
@@ -456,8 +551,8 @@ fn check_shell(
     if !manifold {
         return;
     }
-    check_orientation(model, source_map, id, boundary, &uses, diags);
-    check_euler(model, source_map, id, boundary, &uses, diags);
+    check_orientation(model, source_map, id, boundary, uses, scratch, diags);
+    check_euler(model, source_map, id, boundary, uses, scratch, diags);
 }
 
 /// Two faces sharing an edge must traverse it in opposite directions once
@@ -471,39 +566,76 @@ fn check_orientation(
     id: SubdomainId,
     boundary: &[OrientedFace],
     uses: &EdgeUses,
+    scratch: &mut Scratch,
     diags: &mut Diagnostics,
 ) {
     // The subdomain's name is copied only for a finding: this runs for every subdomain.
     let n = boundary.len();
-    // (neighbour, whether the flips must differ, shared edge)
-    let mut adjacent: Vec<Vec<(usize, bool, EdgeId)>> = vec![Vec::new(); n];
+    // Faces sharing an edge, both ways: (face a, face b, whether the flips
+    // must differ, shared edge), in edge order.
+    let pairs = || {
+        uses.lists().filter_map(|(edge, list)| match list {
+            [(_, a), (_, b)] if a.entry != b.entry => Some((a, b, a.forward == b.forward, edge)),
+            _ => None,
+        })
+    };
     // A seam used twice the same way by one face makes that face one-sided.
-    let mut seam_conflict: Vec<Option<EdgeId>> = vec![None; n];
+    let seam_conflict = &mut scratch.seam_conflict;
+    seam_conflict.clear();
+    seam_conflict.resize(n, None);
     for (edge, list) in uses.lists() {
-        let [(_, a), (_, b)] = list else { continue };
-        let differ = a.forward == b.forward;
-        if a.entry == b.entry {
-            if differ {
+        if let [(_, a), (_, b)] = list {
+            if a.entry == b.entry && a.forward == b.forward {
                 seam_conflict[a.entry].get_or_insert(edge);
             }
-            continue;
         }
-        adjacent[a.entry].push((b.entry, differ, edge));
-        adjacent[b.entry].push((a.entry, differ, edge));
     }
+    // (neighbour, whether the flips must differ, shared edge), each face's
+    // neighbours in edge order, all in one vector.
+    let start = &mut scratch.adjacent_start;
+    start.clear();
+    start.resize(n + 1, 0);
+    for (a, b, _, _) in pairs() {
+        start[a.entry + 1] += 1;
+        start[b.entry + 1] += 1;
+    }
+    for i in 0..n {
+        start[i + 1] += start[i];
+    }
+    let adjacent = &mut scratch.adjacent;
+    adjacent.clear();
+    adjacent.resize(start[n], (0, false, EdgeId(0)));
+    // Filled at each face's next free slot: `members` counts them.
+    let next = &mut scratch.members;
+    next.clear();
+    next.extend_from_slice(&start[..n]);
+    for (a, b, differ, edge) in pairs() {
+        adjacent[next[a.entry]] = (b.entry, differ, edge);
+        next[a.entry] += 1;
+        adjacent[next[b.entry]] = (a.entry, differ, edge);
+        next[b.entry] += 1;
+    }
+    let (start, adjacent) = (&scratch.adjacent_start, &scratch.adjacent);
+    let neighbours = |a: usize| &adjacent[start[a]..start[a + 1]];
 
-    let mut flip: Vec<Option<bool>> = vec![None; n];
-    for start in 0..n {
-        if flip[start].is_some() || boundary[start].face.index() >= model.faces.len() {
+    let flip = &mut scratch.flip;
+    flip.clear();
+    flip.resize(n, None);
+    let members = &mut scratch.members;
+    let queue = &mut scratch.queue;
+    for first in 0..n {
+        if flip[first].is_some() || boundary[first].face.index() >= model.faces.len() {
             continue;
         }
-        flip[start] = Some(false);
-        let mut members = vec![start];
-        let mut queue = VecDeque::from([start]);
-        let mut conflict = seam_conflict[start];
+        flip[first] = Some(false);
+        members.clear();
+        members.push(first);
+        queue.clear();
+        queue.push_back(first);
+        let mut conflict = seam_conflict[first];
         while let Some(a) = queue.pop_front() {
             let fa = flip[a].unwrap_or(false);
-            for &(b, differ, edge) in &adjacent[a] {
+            for &(b, differ, edge) in neighbours(a) {
                 match flip[b] {
                     None => {
                         flip[b] = Some(fa ^ differ);
@@ -556,7 +688,7 @@ fn check_orientation(
         let name = subdomain_name(model, id);
         for &e in members.iter().filter(|&&e| class(e) == wrong) {
             let face = boundary[e].face;
-            let neighbour = adjacent[e].iter().find(|&&(b, _, _)| class(b) != wrong);
+            let neighbour = neighbours(e).iter().find(|&&(b, _, _)| class(b) != wrong);
             let along = neighbour.map_or_else(String::new, |&(b, _, edge)| {
                 format!(
                     ": it runs along edge '{}' in the same direction as face '{}'",
@@ -597,15 +729,20 @@ fn check_euler(
     id: SubdomainId,
     boundary: &[OrientedFace],
     uses: &EdgeUses,
+    scratch: &mut Scratch,
     diags: &mut Diagnostics,
 ) {
-    let (shells, distinct_vertices) = shells_and_vertices(model, boundary, uses);
+    let distinct_vertices = shell_counts(model, boundary, uses, scratch);
+    let shells = &scratch.counts;
     let shared_vertices = shells.iter().map(|s| s.vertices).sum::<usize>() - distinct_vertices;
     if shared_vertices > 0 && shells.iter().all(|s| s.genus().is_some()) {
         // Shells that touch only at vertices: each is a closed surface, but the
         // boundary is not a manifold there, and χ of the whole boundary shows it.
-        let chi: i64 =
-            shells.iter().map(Shell::euler_characteristic).sum::<i64>() - shared_vertices as i64;
+        let chi: i64 = shells
+            .iter()
+            .map(ShellCounts::euler_characteristic)
+            .sum::<i64>()
+            - shared_vertices as i64;
         let name = subdomain_name(model, id);
         diags.push(
             Diagnostic::new(
@@ -624,10 +761,10 @@ fn check_euler(
         if shell.genus().is_some() {
             continue;
         }
-        let first = shell.faces.first().map_or_else(String::new, |&f| {
+        let first = shell.first_face.map_or_else(String::new, |f| {
             format!(" (the shell with face '{}')", face_name(model, f))
         });
-        let f = shell.faces.len();
+        let f = shell.faces;
         let name = subdomain_name(model, id);
         diags.push(
             Diagnostic::new(
