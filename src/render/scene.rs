@@ -228,7 +228,7 @@ pub fn build<'a>(mesh: &'a Mesh, options: &RenderOptions, camera: &Camera) -> Sc
         .first()
         .copied()
         .filter(|first| face_sides.iter().all(|s| s == first));
-    let (tris, tri_face, one_face) = triangles(mesh);
+    let (tris, tri_face, one_face, spans) = triangles(mesh);
     let mut scene = Scene {
         same_sides,
         points: Cow::Borrowed(&mesh.nodes),
@@ -239,7 +239,7 @@ pub fn build<'a>(mesh: &'a Mesh, options: &RenderOptions, camera: &Camera) -> Sc
         groups,
         ..Scene::default()
     };
-    shade(&mut scene, options.shading, camera);
+    shade(&mut scene, options.shading, camera, spans.as_deref());
     if let Some(section) = options.section {
         cut(&mut scene, section);
     }
@@ -266,12 +266,18 @@ fn intensity(normal: [f64; 3], light: [f64; 3]) -> [f32; 2] {
     ]
 }
 
-/// The triangles, each one's face (empty for one face) and the one face.
-type Borrowed<'a> = (Cow<'a, [[u32; 3]]>, Vec<u32>, Option<u32>);
+/// The triangles and, per chunk of them, the span of nodes they name.
+type Borrowed<'a> = (
+    Cow<'a, [[u32; 3]]>,
+    Vec<u32>,
+    Option<u32>,
+    Option<Vec<(usize, usize)>>,
+);
 
 /// The mesh's triangles grouped by face in face order, with their face; those
 /// naming a node the mesh lacks are left out. Borrowed, with no per-triangle
-/// face array, when one face holds them all.
+/// face array, when one face holds them all; the node spans that check made
+/// are kept for the smooth-shading sums (one pass over the triangles, not two).
 fn triangles(mesh: &Mesh) -> Borrowed<'_> {
     let n = mesh.nodes.len();
     let valid = |t: &[u32; 3]| t.iter().all(|&i| (i as usize) < n);
@@ -279,7 +285,12 @@ fn triangles(mesh: &Mesh) -> Borrowed<'_> {
     if let (Some((f, face)), None) = (filled.next(), filled.next()) {
         let spans = smooth::node_spans(&face.triangles);
         if spans.iter().all(|&(_, hi)| hi <= n) {
-            return (Cow::Borrowed(&face.triangles), Vec::new(), Some(f as u32));
+            return (
+                Cow::Borrowed(&face.triangles),
+                Vec::new(),
+                Some(f as u32),
+                Some(spans),
+            );
         }
     }
     let total: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
@@ -291,13 +302,13 @@ fn triangles(mesh: &Mesh) -> Borrowed<'_> {
             tri_face.push(f as u32);
         }
     }
-    (Cow::Owned(tris), tri_face, None)
+    (Cow::Owned(tris), tri_face, None, None)
 }
 
 /// Light per corner: flat gives each triangle one slot; smooth averages the
 /// area-weighted normals of a node within one face (creases between faces
 /// stay sharp).
-fn shade(scene: &mut Scene, shading: Shading, camera: &Camera) {
+fn shade(scene: &mut Scene, shading: Shading, camera: &Camera, spans: Option<&[(usize, usize)]>) {
     let light = light_direction(camera);
     match shading {
         Shading::Flat => {
@@ -314,7 +325,7 @@ fn shade(scene: &mut Scene, shading: Shading, camera: &Camera) {
         }
         Shading::Smooth => {
             let (slots, light) =
-                smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, |n| {
+                smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, spans, |n| {
                     intensity(n, light)
                 });
             scene.corner_slots = match slots {
