@@ -107,7 +107,7 @@ fn read_glb(path: &std::path::Path) -> (Vec<[f32; 3]>, Vec<u32>) {
     (positions, indices)
 }
 
-/// `--child read GLB` or `--child render NU NV ANTIALIAS`: one timed step in
+/// `--child read GLB` or `--child render NU NV ANTIALIAS [REPEATS]`: one timed step in
 /// a fresh process, as `geomc render` meets it (no memory left warm by earlier
 /// repetitions); prints its wall and CPU seconds.
 fn child(args: &[String]) {
@@ -116,7 +116,7 @@ fn child(args: &[String]) {
             let (wall, cpu, _) = timed(|| read_glb(std::path::Path::new(path)));
             (wall, cpu)
         }
-        [what, nu, nv, aa] if what == "render" => {
+        [what, nu, nv, aa, repeats @ ..] if what == "render" && repeats.len() <= 1 => {
             let parse = |v: &String| v.parse::<u32>().expect("a count");
             let mesh = torus(parse(nu) as usize, parse(nv) as usize);
             let options = RenderOptions {
@@ -125,10 +125,15 @@ fn child(args: &[String]) {
                 antialias: parse(aa),
                 ..RenderOptions::default()
             };
-            let (wall, cpu, _) = timed(|| render_png(&mesh, &options).expect("renders"));
-            (wall, cpu)
+            // Repeated (for profiles of warm renders): the last one's times.
+            let mut times = (0.0, 0.0);
+            for _ in 0..repeats.first().map_or(1, parse) {
+                let (wall, cpu, _) = timed(|| render_png(&mesh, &options).expect("renders"));
+                times = (wall, cpu);
+            }
+            times
         }
-        _ => panic!("--child read GLB | --child render NU NV ANTIALIAS"),
+        _ => panic!("--child read GLB | --child render NU NV ANTIALIAS [REPEATS]"),
     };
     println!("{wall} {cpu}");
 }
