@@ -135,8 +135,13 @@ struct Run {
     start: usize,
     len: usize,
     arc: EdgeId,
+    curve: Arc,
     closed: bool,
 }
+
+/// A run's place in its loop (first piece, count) and the arc pieces that
+/// replace it.
+type Swap = (usize, usize, Vec<OrientedEdge>);
 
 /// Replaces each run of region contour pieces lying on a kernel arc by the
 /// arc's pieces. Returns the (kernel subdomain, region) pairs it reported.
@@ -197,7 +202,7 @@ pub(super) fn share_arcs(
     let mut canonical: BTreeMap<VertexId, VertexId> = BTreeMap::new();
     let mut splits: BTreeMap<EdgeId, Vec<(f64, VertexId)>> = BTreeMap::new();
     for run in runs.iter().filter(|r| !r.closed) {
-        let arc = arc_of(&arcs, run.arc);
+        let arc = run.curve;
         let lp = &model.faces[run.face.index()].loops[run.lp];
         let n = lp.len();
         let after = run.start + run.len;
@@ -257,13 +262,12 @@ pub(super) fn share_arcs(
     // The runs replaced by the arcs' pieces, their own pieces dropped.
     let mut dropped_edges = BTreeSet::new();
     let mut dropped_vertices: BTreeSet<VertexId> = canonical.keys().copied().collect();
-    let mut by_loop: BTreeMap<(FaceId, usize), Vec<(usize, usize, Vec<OrientedEdge>)>> =
-        BTreeMap::new();
+    let mut by_loop: BTreeMap<(FaceId, usize), Vec<Swap>> = BTreeMap::new();
     for run in &runs {
         let lp = &model.faces[run.face.index()].loops[run.lp];
         let n = lp.len();
         let own: Vec<OrientedEdge> = (0..run.len).map(|i| lp[(run.start + i) % n]).collect();
-        let arc = arc_of(&arcs, run.arc);
+        let arc = run.curve;
         let chain = &pieces[&run.arc];
         let first = begin(model, own[0]);
         let second = end(model, own[0]);
@@ -352,13 +356,6 @@ pub(super) fn share_arcs(
     reported
 }
 
-fn arc_of(arcs: &[(EdgeId, Arc)], e: EdgeId) -> Arc {
-    arcs.iter()
-        .find(|(id, _)| *id == e)
-        .map(|(_, a)| *a)
-        .expect("runs are found on these arcs")
-}
-
 fn begin(model: &Model, oe: OrientedEdge) -> VertexId {
     let e = model.edge(oe.edge);
     if oe.forward { e.begin } else { e.end }
@@ -414,6 +411,7 @@ fn find_runs(
             start: 0,
             len: n,
             arc: arc_edge,
+            curve: *arc,
             closed: true,
         }];
     }
@@ -427,6 +425,7 @@ fn find_runs(
                 start: k,
                 len,
                 arc: arc_edge,
+                curve: *arc,
                 closed: false,
             });
         }
