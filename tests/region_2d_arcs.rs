@@ -384,3 +384,23 @@ fn two_touching_regions_are_refused_naming_both_and_the_fix() {
         )
     );
 }
+
+#[test]
+fn a_region_on_a_kernel_disk_without_a_carve_is_an_overlap() {
+    // The region is the kernel disk itself: its whole contour becomes the
+    // disk's rim, run the same way by both faces, so both cover the disk.
+    let twin = COAT.replace(
+        r#"<difference> <disk r="0.8" x0="0" y0="0"/> <disk r="0.5" x0="0" y0="0"/> </difference>"#,
+        r#"<disk r="0.5" x0="0" y0="0"/>"#,
+    );
+    let found = diagnostics(&twin);
+    assert_eq!(found.len(), 1, "{found:#?}");
+    assert_eq!(found[0].code, geomc::diag::Code::SubdomainsOverlap);
+    assert!(
+        found[0]
+            .message
+            .starts_with("region 'coat' and subdomain 'core' overlap at ("),
+        "{}",
+        found[0].message
+    );
+}

@@ -609,31 +609,49 @@ fn check(
                 .iter()
                 .flat_map(|&e| [model.edge(e).begin, model.edge(e).end])
                 .collect();
-            let finding = loop_vertices(model, fr)
-                .into_iter()
-                .filter(|v| !exempt.contains(v))
-                .map(|v| model.vertex(v).position)
-                .find_map(|p| {
-                    if ok.distance(&p) <= touch {
-                        Some((Code::RegionTouches, p))
-                    } else if k < first_region && ok.contains(&p) {
-                        Some((Code::SubdomainsOverlap, p))
-                    } else {
-                        None
-                    }
+            // A shared edge both faces run the same way has both on one side:
+            // they overlap there (a region along a kernel rim, uncarved).
+            let forward_in = |f: Option<FaceId>, e: EdgeId| {
+                f.and_then(|f| {
+                    model.faces[f.index()]
+                        .loops
+                        .edges()
+                        .iter()
+                        .find(|oe| oe.edge == e)
+                        .map(|oe| oe.forward)
                 })
-                .or_else(|| {
-                    let far = |p: &Point3| or.distance(p) > touch;
-                    ok.points_off(&shared).find_map(|p| {
-                        if !far(&p) {
-                            (k >= first_region).then_some((Code::RegionTouches, p))
-                        } else if k < first_region && or.contains(&p) {
+            };
+            let same_side = shared
+                .iter()
+                .find(|&&e| forward_in(faces[k], e) == forward_in(Some(fr), e))
+                .map(|&e| (Code::SubdomainsOverlap, model.edge(e).curve.point(0.5)));
+            let finding = same_side.or_else(|| {
+                loop_vertices(model, fr)
+                    .into_iter()
+                    .filter(|v| !exempt.contains(v))
+                    .map(|v| model.vertex(v).position)
+                    .find_map(|p| {
+                        if ok.distance(&p) <= touch {
+                            Some((Code::RegionTouches, p))
+                        } else if k < first_region && ok.contains(&p) {
                             Some((Code::SubdomainsOverlap, p))
                         } else {
                             None
                         }
                     })
-                });
+                    .or_else(|| {
+                        let far = |p: &Point3| or.distance(p) > touch;
+                        ok.points_off(&shared).find_map(|p| {
+                            if !far(&p) {
+                                (k >= first_region).then_some((Code::RegionTouches, p))
+                            } else if k < first_region && or.contains(&p) {
+                                Some((Code::SubdomainsOverlap, p))
+                            } else {
+                                None
+                            }
+                        })
+                    })
+            });
             if let Some((code, p)) = finding {
                 report(
                     model,
