@@ -623,7 +623,7 @@ fn check(
             };
             let same_side = shared
                 .iter()
-                .find(|&&e| forward_in(faces[k], e) == forward_in(Some(fr), e))
+                .find(|&&e| forward_in(face_of(model, k), e) == forward_in(Some(fr), e))
                 .map(|&e| (Code::SubdomainsOverlap, model.edge(e).curve.point(0.5)));
             let finding = same_side.or_else(|| {
                 loop_vertices(model, fr)
