@@ -14,7 +14,10 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
-use mesh2d_common::{at_30_degrees, gmsh_group, min_angle_degrees, python};
+use mesh2d_common::{
+    area, assert_conforming, at_30_degrees, fragment_segments, gmsh_group, min_angle_degrees,
+    python, triangles_of,
+};
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
 use std::process::Command;
@@ -76,79 +79,6 @@ fn mesh(body: &str, options: &MeshOptions) -> Mesh {
     assert!(checked.is_valid(), "{:#?}", checked.diagnostics.items);
     let model = checked.lowered.expect("a model").model;
     mesh_model(&model, options).expect("meshes")
-}
-
-/// The triangles of one subdomain.
-fn triangles_of(m: &Mesh, name: &str) -> Vec<[u32; 3]> {
-    let sub = m
-        .subdomains
-        .iter()
-        .find(|s| s.name == name)
-        .unwrap_or_else(|| panic!("no subdomain {name}"));
-    sub.faces
-        .iter()
-        .flat_map(|&(f, _)| m.faces[f as usize].triangles.iter().copied())
-        .collect()
-}
-
-fn area(m: &Mesh, tris: &[[u32; 3]]) -> f64 {
-    tris.iter()
-        .map(|t| {
-            let [p, q, r] = t.map(|n| m.nodes[n as usize]);
-            0.5 * ((q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0]))
-        })
-        .inspect(|&a| assert!(a > 0.0, "a triangle runs clockwise"))
-        .sum()
-}
-
-/// The segments (node pairs) of a fragment's edges.
-fn fragment_segments(m: &Mesh, name: &str) -> Vec<[u32; 2]> {
-    let fragment = m
-        .fragments
-        .iter()
-        .find(|f| f.name == name)
-        .unwrap_or_else(|| {
-            let names: Vec<_> = m.fragments.iter().map(|f| &f.name).collect();
-            panic!("no fragment {name} in {names:?}")
-        });
-    fragment
-        .edges
-        .iter()
-        .flat_map(|&e| m.edges[e as usize].nodes.windows(2).map(|w| [w[0], w[1]]))
-        .collect()
-}
-
-/// The undirected sides of a set of triangles.
-fn sides(tris: &[[u32; 3]]) -> BTreeSet<[u32; 2]> {
-    tris.iter()
-        .flat_map(|t| (0..3).map(move |k| sorted([t[k], t[(k + 1) % 3]])))
-        .collect()
-}
-
-fn sorted([a, b]: [u32; 2]) -> [u32; 2] {
-    [a.min(b), a.max(b)]
-}
-
-/// Every interface segment is a triangle side on both sides (no hanging
-/// node): returns the interface's node count.
-fn assert_conforming(m: &Mesh, fragment: &str, a: &str, b: &str) -> usize {
-    let segments = fragment_segments(m, fragment);
-    assert!(!segments.is_empty());
-    let (sa, sb) = (sides(&triangles_of(m, a)), sides(&triangles_of(m, b)));
-    for s in &segments {
-        let s = sorted(*s);
-        assert!(sa.contains(&s), "interface segment {s:?} is no side of {a}");
-        assert!(sb.contains(&s), "interface segment {s:?} is no side of {b}");
-    }
-    let nodes: BTreeSet<u32> = segments.iter().flatten().copied().collect();
-    let of =
-        |name: &str| -> BTreeSet<u32> { triangles_of(m, name).into_iter().flatten().collect() };
-    let (na, nb) = (of(a), of(b));
-    let shared = na.intersection(&nb).count();
-    // The subdomains meet only on the interface: their common nodes are its nodes.
-    assert_eq!(shared, nodes.len(), "common nodes of {a} and {b}");
-    assert!(nodes.iter().all(|n| na.contains(n) && nb.contains(n)));
-    nodes.len()
 }
 
 #[test]

@@ -9,6 +9,7 @@ mod explicit;
 mod isolation;
 mod point_calculus;
 mod prune;
+mod region_arcs;
 pub mod region_interfaces;
 pub mod rfunction_region;
 pub mod trimmed_topology;

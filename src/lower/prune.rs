@@ -103,6 +103,22 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     apply(model, source_map, &face_map, &edge_map, &vertex_map);
 }
 
+/// Drops the edges and vertices whose flag is false (faces stay), renumbering
+/// what refers to the rest: what `region_arcs` replaced by kernel arcs.
+pub(super) fn drop_entities(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    keep_edge: &[bool],
+    keep_vertex: &[bool],
+) {
+    if keep_edge.iter().all(|&k| k) && keep_vertex.iter().all(|&k| k) {
+        return;
+    }
+    let faces = compact(&vec![true; model.faces.len()]);
+    let (edges, vertices) = (compact(keep_edge), compact(keep_vertex));
+    apply(model, source_map, &faces, &edges, &vertices);
+}
+
 fn compact(keep: &[bool]) -> Vec<Option<u32>> {
     let mut next = 0u32;
     keep.iter()

@@ -39,8 +39,8 @@ pub fn join(
     region_of: &[(String, String)],
     diags: &mut Diagnostics,
 ) {
-    // Pairs a refused carve reported already.
-    let mut reported = BTreeSet::new();
+    // Pairs a refused carve or arc run reported already.
+    let mut reported = super::region_arcs::share_arcs(model, source_map, first_region, diags);
     for c in carves {
         if let Some(pair) = carve(model, first_region, c, region_of, diags) {
             reported.insert(pair);
@@ -67,7 +67,7 @@ fn face_edges(
 }
 
 /// The one face of a 2D subdomain.
-fn face_of(model: &Model, k: usize) -> Option<FaceId> {
+pub(super) fn face_of(model: &Model, k: usize) -> Option<FaceId> {
     match &model.subdomains[k].cells {
         SubdomainCells::Region { faces } if faces.len() == 1 => Some(faces[0]),
         _ => None,
@@ -106,8 +106,17 @@ fn carve(
     let (fk, fr) = (face_of(model, k)?, face_of(model, r)?);
     let outline = Outline::of(model, fk);
     let touch = touch_distance(model, fr);
+    // Arcs the region runs along (`region_arcs`) are in both faces already.
+    let shared: BTreeSet<EdgeId> = face_edges(model, k..k + 1)
+        .filter(|e| face_edges(model, r..r + 1).any(|x| x == *e))
+        .collect();
+    let on_shared: BTreeSet<VertexId> = shared
+        .iter()
+        .flat_map(|&e| [model.edge(e).begin, model.edge(e).end])
+        .collect();
     let outside = loop_vertices(model, fr)
         .into_iter()
+        .filter(|v| !on_shared.contains(v))
         .map(|v| model.vertex(v).position)
         .find(|p| outline.distance(p) <= touch || !outline.contains(p));
     if let Some(p) = outside {
@@ -124,6 +133,28 @@ fn carve(
         );
         return Some((k, r));
     }
+    if !shared.is_empty() {
+        return match rejoin(model, fk, fr, &shared) {
+            Ok(loops) => {
+                model.faces[fk.index()].loops = Loops::from(loops);
+                None
+            }
+            Err(p) => {
+                diags.push(
+                    Diagnostic::new(
+                        Code::RegionTouches,
+                        c.span,
+                        format!(
+                            "subdomain '{}' subtracts region '{}', whose contour leaves the curved edge it runs along and meets the boundary again at ({:.6}, {:.6}): the remaining boundary is no set of simple loops",
+                            c.subdomain, region, p.x, p.y
+                        ),
+                    )
+                    .with_help("let the region touch the kernel boundary along one stretch of each edge, or move it clear of the boundary"),
+                );
+                Some((k, r))
+            }
+        };
+    }
     let holes: Vec<Vec<OrientedEdge>> = model.faces[fr.index()]
         .loops
         .iter()
@@ -139,6 +170,84 @@ fn carve(
         .collect();
     model.faces[fk.index()].loops.extend(holes);
     None
+}
+
+/// The loops of kernel face `fk` less region face `fr`, which lies inside
+/// it and shares the `shared` edges of its boundary: the kernel's edges but
+/// the shared ones, and the region's others reversed, chained end to start.
+/// Err(point) where the chaining is ambiguous (the boundaries touch at a
+/// point as well) or does not close.
+fn rejoin(
+    model: &Model,
+    fk: FaceId,
+    fr: FaceId,
+    shared: &BTreeSet<EdgeId>,
+) -> Result<Vec<Vec<OrientedEdge>>, Point3> {
+    let faces = &model.faces;
+    let region_forward: BTreeMap<EdgeId, bool> = faces[fr.index()]
+        .loops
+        .edges()
+        .iter()
+        .map(|oe| (oe.edge, oe.forward))
+        .collect();
+    // A shared edge the region runs the same way (inside the kernel face
+    // there) leaves the kernel face; one run the other way is a neighbour's.
+    let mut pool: Vec<OrientedEdge> = faces[fk.index()]
+        .loops
+        .edges()
+        .iter()
+        .filter(|oe| region_forward.get(&oe.edge) != Some(&oe.forward))
+        .copied()
+        .collect();
+    pool.extend(
+        faces[fr.index()]
+            .loops
+            .edges()
+            .iter()
+            .filter(|oe| !shared.contains(&oe.edge))
+            .map(|oe| OrientedEdge {
+                edge: oe.edge,
+                forward: !oe.forward,
+            }),
+    );
+    let start_of = |oe: &OrientedEdge| {
+        let e = model.edge(oe.edge);
+        if oe.forward { e.begin } else { e.end }
+    };
+    let end_of = |oe: &OrientedEdge| {
+        let e = model.edge(oe.edge);
+        if oe.forward { e.end } else { e.begin }
+    };
+    let mut leaving: BTreeMap<VertexId, Vec<usize>> = BTreeMap::new();
+    for (i, oe) in pool.iter().enumerate() {
+        leaving.entry(start_of(oe)).or_default().push(i);
+    }
+    if let Some((v, _)) = leaving.iter().find(|(_, out)| out.len() > 1) {
+        return Err(model.vertex(*v).position);
+    }
+    let mut used = vec![false; pool.len()];
+    let mut loops = Vec::new();
+    for first in 0..pool.len() {
+        if used[first] {
+            continue;
+        }
+        let mut lp = Vec::new();
+        let mut at = first;
+        loop {
+            used[at] = true;
+            lp.push(pool[at]);
+            let v = end_of(&pool[at]);
+            if v == start_of(&pool[first]) {
+                break;
+            }
+            match leaving.get(&v).and_then(|out| out.first()) {
+                Some(&next) if !used[next] => at = next,
+                _ => return Err(model.vertex(v).position),
+            }
+        }
+        loops.push(lp);
+    }
+    Ok(loops)
 }
 
 /// Straight contour pieces of region `r` (its box sides) lying on a straight
@@ -245,32 +354,38 @@ fn share_box_sides(
             continue;
         }
         let replacement = split_edge(model, source_map, ke, &chain);
-        for face in &mut model.faces {
-            if !face.loops.edges().iter().any(|oe| oe.edge == ke) {
+        replace_edge(model, ke, &replacement);
+    }
+}
+
+/// Every face using edge `ke` walks `replacement` (in `ke`'s direction)
+/// instead.
+pub(super) fn replace_edge(model: &mut Model, ke: EdgeId, replacement: &[OrientedEdge]) {
+    for face in &mut model.faces {
+        if !face.loops.edges().iter().any(|oe| oe.edge == ke) {
+            continue;
+        }
+        let mut loops = face.loops.to_vecs();
+        for lp in &mut loops {
+            if !lp.iter().any(|oe| oe.edge == ke) {
                 continue;
             }
-            let mut loops = face.loops.to_vecs();
-            for lp in &mut loops {
-                if !lp.iter().any(|oe| oe.edge == ke) {
-                    continue;
+            let mut out = Vec::with_capacity(lp.len() + replacement.len());
+            for oe in lp.iter() {
+                if oe.edge != ke {
+                    out.push(*oe);
+                } else if oe.forward {
+                    out.extend(replacement.iter().copied());
+                } else {
+                    out.extend(replacement.iter().rev().map(|p| OrientedEdge {
+                        edge: p.edge,
+                        forward: !p.forward,
+                    }));
                 }
-                let mut out = Vec::with_capacity(lp.len() + replacement.len());
-                for oe in lp.iter() {
-                    if oe.edge != ke {
-                        out.push(*oe);
-                    } else if oe.forward {
-                        out.extend(replacement.iter().copied());
-                    } else {
-                        out.extend(replacement.iter().rev().map(|p| OrientedEdge {
-                            edge: p.edge,
-                            forward: !p.forward,
-                        }));
-                    }
-                }
-                *lp = out;
             }
-            face.loops = Loops::from(loops);
+            *lp = out;
         }
+        face.loops = Loops::from(loops);
     }
 }
 
@@ -494,33 +609,59 @@ fn check(
                 .iter()
                 .flat_map(|&e| [model.edge(e).begin, model.edge(e).end])
                 .collect();
-            let finding = loop_vertices(model, fr)
-                .into_iter()
-                .filter(|v| !exempt.contains(v))
-                .map(|v| model.vertex(v).position)
-                .find_map(|p| {
-                    if ok.distance(&p) <= touch {
-                        Some((Code::RegionTouches, p))
-                    } else if k < first_region && ok.contains(&p) {
-                        Some((Code::SubdomainsOverlap, p))
-                    } else {
-                        None
-                    }
+            // A shared edge both faces run the same way has both on one side:
+            // they overlap there (a region along a kernel rim, uncarved).
+            let forward_in = |f: Option<FaceId>, e: EdgeId| {
+                f.and_then(|f| {
+                    model.faces[f.index()]
+                        .loops
+                        .edges()
+                        .iter()
+                        .find(|oe| oe.edge == e)
+                        .map(|oe| oe.forward)
                 })
-                .or_else(|| {
-                    let far = |p: &Point3| or.distance(p) > touch;
-                    ok.points_off(&shared).find_map(|p| {
-                        if !far(&p) {
-                            (k >= first_region).then_some((Code::RegionTouches, p))
-                        } else if k < first_region && or.contains(&p) {
+            };
+            let same_side = shared
+                .iter()
+                .find(|&&e| forward_in(face_of(model, k), e) == forward_in(Some(fr), e))
+                .map(|&e| (Code::SubdomainsOverlap, model.edge(e).curve.point(0.5)));
+            let finding = same_side.or_else(|| {
+                loop_vertices(model, fr)
+                    .into_iter()
+                    .filter(|v| !exempt.contains(v))
+                    .map(|v| model.vertex(v).position)
+                    .find_map(|p| {
+                        if ok.distance(&p) <= touch {
+                            Some((Code::RegionTouches, p))
+                        } else if k < first_region && ok.contains(&p) {
                             Some((Code::SubdomainsOverlap, p))
                         } else {
                             None
                         }
                     })
-                });
+                    .or_else(|| {
+                        let far = |p: &Point3| or.distance(p) > touch;
+                        ok.points_off(&shared).find_map(|p| {
+                            if !far(&p) {
+                                (k >= first_region).then_some((Code::RegionTouches, p))
+                            } else if k < first_region && or.contains(&p) {
+                                Some((Code::SubdomainsOverlap, p))
+                            } else {
+                                None
+                            }
+                        })
+                    })
+            });
             if let Some((code, p)) = finding {
-                report(model, source_map, code, (k, r), p, diags);
+                report(
+                    model,
+                    source_map,
+                    code,
+                    (k, r),
+                    (p, ok),
+                    first_region,
+                    diags,
+                );
             }
         }
     }
@@ -531,30 +672,62 @@ fn report(
     source_map: &SourceMap,
     code: Code,
     (k, r): (usize, usize),
-    p: Point3,
+    (p, outline): (Point3, &Outline),
+    first_region: usize,
     diags: &mut Diagnostics,
 ) {
     let (kernel, region) = (&model.subdomains[k].name, &model.subdomains[r].name);
     let span = source_map.subdomain(SubdomainId(r as u32));
+    let at = format!("({:.6}, {:.6})", p.x, p.y);
     let d = if code == Code::SubdomainsOverlap {
         Diagnostic::new(
             code,
             span,
-            format!("region '{region}' and subdomain '{kernel}' overlap at ({:.6}, {:.6})", p.x, p.y),
+            format!("region '{region}' and subdomain '{kernel}' overlap at {at}"),
         )
         .with_help(format!(
             "carve one out of the other: <subdomain name=\"{kernel}\"><difference> … <solid ref=\"…\"/></difference></subdomain> subtracting the region's solid"
         ))
-    } else {
+    } else if k >= first_region {
         Diagnostic::new(
             code,
             span,
             format!(
-                "region '{region}' touches subdomain '{kernel}' at ({:.6}, {:.6}), where their boundaries cannot share nodes",
-                p.x, p.y
+                "region '{region}' touches region '{kernel}' at {at}: two R-function regions do not share interface edges"
             ),
         )
-        .with_help("move them apart, carve the region out of a kernel subdomain with <difference>, or let a side of the region's box lie on a straight kernel edge")
+        .with_help("move them apart, or make one of them a kernel shape (a circle, polygon or rectangle): a region's contour on a kernel edge becomes their interface")
+    } else {
+        // The kernel edge nearest the contact says which rule was missed.
+        let nearest = outline
+            .segments
+            .iter()
+            .min_by(|a, b| {
+                let d = |s: &([f64; 2], [f64; 2], EdgeId)| segment_distance([p.x, p.y], s.0, s.1);
+                d(a).total_cmp(&d(b))
+            })
+            .map(|s| s.2);
+        match nearest.map(|e| (model.edge(e), matches!(model.edge(e).curve, Curve::Ellipse { .. }))) {
+            Some((edge, true)) => Diagnostic::new(
+                code,
+                span,
+                format!(
+                    "region '{region}' touches the curved edge '{}' of subdomain '{kernel}' at {at} without running along it: a contour shares a curved edge only where its points lie on that curve",
+                    edge.name
+                ),
+            )
+            .with_help("let the region's R-function contain the same circle or ellipse as the kernel edge, so its contour lies on it, or move the region clear of the edge"),
+            Some((edge, false)) => Diagnostic::new(
+                code,
+                span,
+                format!(
+                    "region '{region}' touches the edge '{}' of subdomain '{kernel}' at {at}, where their boundaries cannot share nodes: a region shares a straight edge only along a side of its box",
+                    edge.name
+                ),
+            )
+            .with_help("move them apart, carve the region out of a kernel subdomain with <difference>, or let a side of the region's box lie on the straight kernel edge"),
+            None => return,
+        }
     };
     diags.push(d);
 }

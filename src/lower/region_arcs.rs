@@ -1,0 +1,580 @@
+//! Region contours on curved kernel edges (issue 6): where a 2D R-function
+//! region's contour runs along a kernel circle or ellipse arc (a material
+//! patch against a hole or the outer circle, a coating around a disk), that
+//! run of contour pieces is replaced by the kernel arc itself, split at the
+//! run's ends. Both faces then use the same arc edges, so their meshes share
+//! the nodes, and the mesher puts every new node on the true curve (the arc),
+//! not on the traced contour. The run's own vertices and pieces are dropped.
+//!
+//! A run's end is the last contour vertex on the arc, moved onto it exactly
+//! (marching squares cut a corner of the contour there by at most its
+//! chordal tolerance); an end at a kernel vertex, or at another run's end,
+//! becomes that vertex.
+
+use crate::diag::{Code, Diagnostic, Diagnostics};
+use crate::geom::{Curve, Point3, Vec3};
+use crate::ir::{Edge, EdgeId, FaceId, Model, OrientedEdge, SourceMap, SubdomainId, VertexId};
+use std::collections::{BTreeMap, BTreeSet};
+use std::f64::consts::TAU;
+
+/// How far a contour vertex may be from an arc to count as on it, as a
+/// fraction of the region's extent: the traced points lie on f = 0 to root
+/// finding's precision, far inside the contour's chordal tolerance (5e-4).
+const ON_ARC_FRACTION: f64 = 1e-6;
+
+/// A kernel edge's circle or ellipse: center + major·cos t + minor·sin t for
+/// t from t0 over `span`.
+#[derive(Clone, Copy)]
+struct Arc {
+    center: Point3,
+    major: Vec3,
+    minor: Vec3,
+    t0: f64,
+    span: f64,
+}
+
+impl Arc {
+    fn of(curve: &Curve) -> Option<Arc> {
+        match *curve {
+            Curve::Ellipse {
+                center,
+                major,
+                minor,
+                t0,
+                t1,
+            } => Some(Arc {
+                center,
+                major,
+                minor,
+                t0,
+                span: t1 - t0,
+            }),
+            _ => None,
+        }
+    }
+
+    fn closed(&self) -> bool {
+        self.span >= TAU * (1.0 - 1e-12)
+    }
+
+    fn point(&self, u: f64) -> Point3 {
+        let t = self.t0 + u;
+        self.center + self.major * t.cos() + self.minor * t.sin()
+    }
+
+    fn tangent(&self, u: f64) -> Vec3 {
+        let t = self.t0 + u;
+        self.minor * t.cos() - self.major * t.sin()
+    }
+
+    /// The parameter u ∈ [0, 2π) of the curve point along p's direction in
+    /// the arc's (major, minor) frame: exact for a point on the curve.
+    fn parameter(&self, p: &Point3) -> f64 {
+        let d = p - self.center;
+        let (m, n) = (self.major, self.minor);
+        let det = m.x * n.y - m.y * n.x;
+        let (c, s) = ((d.x * n.y - d.y * n.x) / det, (m.x * d.y - m.y * d.x) / det);
+        (s.atan2(c) - self.t0).rem_euclid(TAU)
+    }
+
+    /// Where the contour leaving the arc at `a` towards `b` and `c` really
+    /// meets it: marching squares cut that corner off with the chord a → b,
+    /// so the line c → b is followed back to the curve. None when that point
+    /// is not near `a` (the contour leaves the arc smoothly).
+    fn corner(&self, a: Point3, b: Point3, c: Point3) -> Option<Point3> {
+        // In the frame where the curve is the unit circle (lines stay lines).
+        let (m, n) = (self.major, self.minor);
+        let det = m.x * n.y - m.y * n.x;
+        let local = |p: Point3| {
+            let d = p - self.center;
+            [(d.x * n.y - d.y * n.x) / det, (m.x * d.y - m.y * d.x) / det]
+        };
+        let (lb, lc) = (local(b), local(c));
+        let dir = [lb[0] - lc[0], lb[1] - lc[1]];
+        // |lb + s·dir|² = 1 for the smallest s ≥ 0.
+        let qa = dir[0] * dir[0] + dir[1] * dir[1];
+        let qb = 2.0 * (lb[0] * dir[0] + lb[1] * dir[1]);
+        let qc = lb[0] * lb[0] + lb[1] * lb[1] - 1.0;
+        let disc = qb * qb - 4.0 * qa * qc;
+        if qa == 0.0 || disc < 0.0 {
+            return None;
+        }
+        let s = [
+            (-qb - disc.sqrt()) / (2.0 * qa),
+            (-qb + disc.sqrt()) / (2.0 * qa),
+        ]
+        .into_iter()
+        .filter(|&s| s >= 0.0)
+        .fold(f64::INFINITY, f64::min);
+        if !s.is_finite() {
+            return None;
+        }
+        let x = self.center + m * (lb[0] + s * dir[0]) + n * (lb[1] + s * dir[1]);
+        // Within a few chords of a: the same corner.
+        ((x - a).norm() <= 2.0 * (b - a).norm()).then_some(x)
+    }
+
+    /// The parameter of p if p lies on the arc within `tol`.
+    fn on(&self, p: &Point3, tol: f64) -> Option<f64> {
+        let u = self.parameter(p);
+        let reach = tol / self.major.norm().min(self.minor.norm());
+        let u = if !self.closed() && u > self.span && u > TAU - reach {
+            0.0
+        } else {
+            u
+        };
+        (u <= self.span + reach && (self.point(u) - p).norm() <= tol).then_some(u.min(self.span))
+    }
+}
+
+/// A run of a region loop's pieces on one kernel arc: `len` pieces from
+/// piece `start` (cyclically), or the whole loop when `closed`.
+struct Run {
+    face: FaceId,
+    lp: usize,
+    start: usize,
+    len: usize,
+    arc: EdgeId,
+    curve: Arc,
+    closed: bool,
+}
+
+/// A run's place in its loop (first piece, count) and the arc pieces that
+/// replace it.
+type Swap = (usize, usize, Vec<OrientedEdge>);
+
+/// Replaces each run of region contour pieces lying on a kernel arc by the
+/// arc's pieces. Returns the (kernel subdomain, region) pairs it reported.
+pub(super) fn share_arcs(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    first_region: usize,
+    diags: &mut Diagnostics,
+) -> BTreeSet<(usize, usize)> {
+    let mut reported = BTreeSet::new();
+    let kernel_faces: Vec<(usize, FaceId)> = (0..first_region)
+        .filter_map(|k| super::region_interfaces::face_of(model, k).map(|f| (k, f)))
+        .collect();
+    let region_faces: Vec<(usize, FaceId)> = (first_region..model.subdomains.len())
+        .filter_map(|r| super::region_interfaces::face_of(model, r).map(|f| (r, f)))
+        .collect();
+    let region_edges: BTreeSet<EdgeId> = region_faces
+        .iter()
+        .flat_map(|&(_, f)| {
+            model.faces[f.index()]
+                .loops
+                .edges()
+                .iter()
+                .map(|oe| oe.edge)
+        })
+        .collect();
+    let arcs: Vec<(EdgeId, Arc)> = kernel_faces
+        .iter()
+        .flat_map(|&(_, f)| {
+            model.faces[f.index()]
+                .loops
+                .edges()
+                .iter()
+                .map(|oe| oe.edge)
+        })
+        .filter(|e| !region_edges.contains(e))
+        .collect::<BTreeSet<EdgeId>>()
+        .into_iter()
+        .filter_map(|e| Arc::of(&model.edge(e).curve).map(|a| (e, a)))
+        .collect();
+    if arcs.is_empty() {
+        return reported;
+    }
+    let mut runs = Vec::new();
+    for &(_, f) in &region_faces {
+        let tol = ON_ARC_FRACTION * extent(model, f);
+        for (l, lp) in model.faces[f.index()].loops.iter().enumerate() {
+            for &(arc_edge, arc) in &arcs {
+                runs.extend(find_runs(model, f, l, lp, arc_edge, &arc, tol));
+            }
+        }
+    }
+    if runs.is_empty() {
+        return reported;
+    }
+    // Where each run ends on its arc: (arc, u, region vertex).
+    let merge = 16.0 * model.tolerance;
+    let mut canonical: BTreeMap<VertexId, VertexId> = BTreeMap::new();
+    let mut splits: BTreeMap<EdgeId, Vec<(f64, VertexId)>> = BTreeMap::new();
+    for run in runs.iter().filter(|r| !r.closed) {
+        let arc = run.curve;
+        let lp = &model.faces[run.face.index()].loops[run.lp];
+        let n = lp.len();
+        let after = run.start + run.len;
+        // Each end with the two contour vertices beyond it.
+        let ends = [
+            (
+                begin(model, lp[run.start]),
+                begin(model, lp[(run.start + n - 1) % n]),
+                begin(model, lp[(run.start + n - 2) % n]),
+            ),
+            (
+                end(model, lp[(after + n - 1) % n]),
+                end(model, lp[after % n]),
+                end(model, lp[(after + 1) % n]),
+            ),
+        ];
+        let edge = model.edge(run.arc);
+        let (kernel_begin, kernel_end) = (edge.begin, edge.end);
+        for (v, b, c) in ends {
+            let p = |w: VertexId| model.vertex(w).position;
+            let at = arc
+                .corner(p(v), p(b), p(c))
+                .unwrap_or_else(|| arc.point(arc.parameter(&p(v))));
+            let u = arc.parameter(&at);
+            let list = splits.entry(run.arc).or_default();
+            let near = |w: VertexId, m: &Model| (m.vertex(w).position - at).norm() <= merge;
+            let target = if near(kernel_begin, model) {
+                Some(kernel_begin)
+            } else if near(kernel_end, model) {
+                Some(kernel_end)
+            } else {
+                list.iter().map(|&(_, w)| w).find(|&w| near(w, model))
+            };
+            match target {
+                Some(w) => {
+                    canonical.insert(v, w);
+                }
+                None => {
+                    model.vertices[v.index()].position = at;
+                    list.push((u, v));
+                }
+            }
+        }
+    }
+    // Each arc cut into pieces at the runs' ends.
+    let mut pieces: BTreeMap<EdgeId, Vec<OrientedEdge>> = BTreeMap::new();
+    for &(arc_edge, arc) in &arcs {
+        if !runs.iter().any(|r| r.arc == arc_edge) {
+            continue;
+        }
+        let mut cuts = splits.remove(&arc_edge).unwrap_or_default();
+        cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
+        let chain = split_arc(model, source_map, arc_edge, &arc, &cuts);
+        super::region_interfaces::replace_edge(model, arc_edge, &chain);
+        pieces.insert(arc_edge, chain);
+    }
+    // The runs replaced by the arcs' pieces, their own pieces dropped.
+    let mut dropped_edges = BTreeSet::new();
+    let mut dropped_vertices: BTreeSet<VertexId> = canonical.keys().copied().collect();
+    let mut by_loop: BTreeMap<(FaceId, usize), Vec<Swap>> = BTreeMap::new();
+    for run in &runs {
+        let lp = &model.faces[run.face.index()].loops[run.lp];
+        let n = lp.len();
+        let own: Vec<OrientedEdge> = (0..run.len).map(|i| lp[(run.start + i) % n]).collect();
+        let arc = run.curve;
+        let chain = &pieces[&run.arc];
+        let first = begin(model, own[0]);
+        let second = end(model, own[0]);
+        let u = arc.parameter(&model.vertex(first).position);
+        let step = model.vertex(second).position - model.vertex(first).position;
+        let forward = arc.tangent(u).dot(&step) > 0.0;
+        let resolve = |v: VertexId| canonical.get(&v).copied().unwrap_or(v);
+        let replacement = if run.closed {
+            oriented(chain, forward)
+        } else {
+            let last = end(model, own[run.len - 1]);
+            match walk(model, chain, resolve(first), resolve(last), forward) {
+                Some(w) => w,
+                None => {
+                    report_run(model, source_map, run, first_region, &mut reported, diags);
+                    continue;
+                }
+            }
+        };
+        for (i, oe) in own.iter().enumerate() {
+            dropped_edges.insert(oe.edge);
+            if i > 0 || run.closed {
+                dropped_vertices.insert(begin(model, *oe));
+            }
+        }
+        by_loop
+            .entry((run.face, run.lp))
+            .or_default()
+            .push((run.start, run.len, replacement));
+    }
+    for ((f, l), mut swaps) in by_loop {
+        swaps.sort_by_key(|s| s.0);
+        let lp: Vec<OrientedEdge> = model.faces[f.index()].loops[l].to_vec();
+        let n = lp.len();
+        let mut covered = vec![None; n];
+        for (k, (start, len, _)) in swaps.iter().enumerate() {
+            for i in 0..*len {
+                covered[(start + i) % n] = Some(k);
+            }
+        }
+        // Start the walk where a run starts (or anywhere if none wraps).
+        let origin = swaps[0].0;
+        let mut out = Vec::with_capacity(n);
+        let mut i = 0;
+        while i < n {
+            let at = (origin + i) % n;
+            match covered[at] {
+                Some(k) if swaps[k].0 == at => {
+                    out.extend(swaps[k].2.iter().copied());
+                    i += swaps[k].1;
+                }
+                Some(_) => i += 1,
+                None => {
+                    out.push(lp[at]);
+                    i += 1;
+                }
+            }
+        }
+        let mut loops = model.faces[f.index()].loops.to_vecs();
+        loops[l] = out;
+        model.faces[f.index()].loops = loops.into();
+    }
+    // The region's pieces next to a merged or moved run end follow it.
+    for e in region_edges.iter().filter(|e| !dropped_edges.contains(e)) {
+        let edge = &mut model.edges[e.index()];
+        for v in [&mut edge.begin, &mut edge.end] {
+            if let Some(&w) = canonical.get(v) {
+                *v = w;
+            }
+        }
+        let (pa, pb) = (
+            model.vertices[edge.begin.index()].position,
+            model.vertices[edge.end.index()].position,
+        );
+        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = &mut edge.curve {
+            (*a, *b) = (pa, pb);
+        }
+    }
+    let keep_edge: Vec<bool> = (0..model.edges.len())
+        .map(|e| !dropped_edges.contains(&EdgeId(e as u32)))
+        .collect();
+    let keep_vertex: Vec<bool> = (0..model.vertices.len())
+        .map(|v| !dropped_vertices.contains(&VertexId(v as u32)))
+        .collect();
+    super::prune::drop_entities(model, source_map, &keep_edge, &keep_vertex);
+    reported
+}
+
+fn begin(model: &Model, oe: OrientedEdge) -> VertexId {
+    let e = model.edge(oe.edge);
+    if oe.forward { e.begin } else { e.end }
+}
+
+fn end(model: &Model, oe: OrientedEdge) -> VertexId {
+    let e = model.edge(oe.edge);
+    if oe.forward { e.end } else { e.begin }
+}
+
+/// The diagonal of a face's vertices' box.
+fn extent(model: &Model, f: FaceId) -> f64 {
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for oe in model.faces[f.index()].loops.edges() {
+        let p = model.vertex(model.edge(oe.edge).begin).position;
+        lo = [lo[0].min(p.x), lo[1].min(p.y)];
+        hi = [hi[0].max(p.x), hi[1].max(p.y)];
+    }
+    (hi[0] - lo[0]).hypot(hi[1] - lo[1])
+}
+
+/// The maximal runs of a loop's pieces whose ends and middle lie on `arc`.
+fn find_runs(
+    model: &Model,
+    face: FaceId,
+    l: usize,
+    lp: &[OrientedEdge],
+    arc_edge: EdgeId,
+    arc: &Arc,
+    tol: f64,
+) -> Vec<Run> {
+    let n = lp.len();
+    let on_vertex: Vec<bool> = lp
+        .iter()
+        .map(|&oe| {
+            arc.on(&model.vertex(begin(model, oe)).position, tol)
+                .is_some()
+        })
+        .collect();
+    let on: Vec<bool> = (0..n)
+        .map(|k| {
+            on_vertex[k]
+                && on_vertex[(k + 1) % n]
+                && arc
+                    .on(&model.edge(lp[k].edge).curve.point(0.5), tol)
+                    .is_some()
+        })
+        .collect();
+    if on.iter().all(|&x| x) {
+        return vec![Run {
+            face,
+            lp: l,
+            start: 0,
+            len: n,
+            arc: arc_edge,
+            curve: *arc,
+            closed: true,
+        }];
+    }
+    let mut runs = Vec::new();
+    for k in 0..n {
+        if on[k] && !on[(k + n - 1) % n] {
+            let len = (0..n).take_while(|i| on[(k + i) % n]).count();
+            runs.push(Run {
+                face,
+                lp: l,
+                start: k,
+                len,
+                arc: arc_edge,
+                curve: *arc,
+                closed: false,
+            });
+        }
+    }
+    runs
+}
+
+/// Cuts the kernel arc `ke` at `cuts` (sorted by parameter): the first
+/// piece keeps its id, name and boundaries, the others are `NAME.2`, … in
+/// the same boundaries. Returns the pieces in the arc's direction.
+fn split_arc(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    ke: EdgeId,
+    arc: &Arc,
+    cuts: &[(f64, VertexId)],
+) -> Vec<OrientedEdge> {
+    let name = model.edge(ke).name.clone();
+    let origin = source_map.edges.get(&ke).copied();
+    let (b, e) = (model.edge(ke).begin, model.edge(ke).end);
+    let mut stops = vec![(0.0, b)];
+    stops.extend(cuts.iter().copied());
+    stops.push((arc.span, e));
+    let mut out = Vec::with_capacity(stops.len() - 1);
+    let mut added = Vec::new();
+    for (k, w) in stops.windows(2).enumerate() {
+        let curve = Curve::Ellipse {
+            center: arc.center,
+            major: arc.major,
+            minor: arc.minor,
+            t0: arc.t0 + w[0].0,
+            t1: arc.t0 + w[1].0,
+        };
+        let id = if k == 0 {
+            let edge = &mut model.edges[ke.index()];
+            (edge.curve, edge.begin, edge.end) = (curve, w[0].1, w[1].1);
+            ke
+        } else {
+            let id = EdgeId(model.edges.len() as u32);
+            model.edges.push(Edge {
+                name: format!("{name}.{}", k + 1).into(),
+                curve,
+                begin: w[0].1,
+                end: w[1].1,
+            });
+            if let Some(o) = origin {
+                source_map.edges.insert(id, o);
+            }
+            added.push(id);
+            id
+        };
+        out.push(OrientedEdge {
+            edge: id,
+            forward: true,
+        });
+    }
+    for boundary in &mut model.boundaries {
+        if boundary.edges.contains(&ke) {
+            boundary.edges.extend(added.iter().copied());
+        }
+    }
+    out
+}
+
+/// The chain in the given direction.
+fn oriented(chain: &[OrientedEdge], forward: bool) -> Vec<OrientedEdge> {
+    if forward {
+        chain.to_vec()
+    } else {
+        chain.iter().rev().map(|oe| reversed(*oe)).collect()
+    }
+}
+
+fn reversed(oe: OrientedEdge) -> OrientedEdge {
+    OrientedEdge {
+        edge: oe.edge,
+        forward: !oe.forward,
+    }
+}
+
+/// The pieces of `chain` (cyclic when closed) from vertex `from` to `to` in
+/// the given direction, or None if the walk leaves the arc first.
+fn walk(
+    model: &Model,
+    chain: &[OrientedEdge],
+    from: VertexId,
+    to: VertexId,
+    forward: bool,
+) -> Option<Vec<OrientedEdge>> {
+    let steps = oriented(chain, forward);
+    let n = steps.len();
+    let closed = begin(model, steps[0]) == end(model, steps[n - 1]);
+    let start = steps.iter().position(|&oe| begin(model, oe) == from)?;
+    let mut out = Vec::new();
+    for i in 0..n {
+        if !closed && start + i >= n {
+            return None;
+        }
+        let oe = steps[(start + i) % n];
+        out.push(oe);
+        if end(model, oe) == to {
+            return Some(out);
+        }
+    }
+    None
+}
+
+fn report_run(
+    model: &Model,
+    source_map: &SourceMap,
+    run: &Run,
+    first_region: usize,
+    reported: &mut BTreeSet<(usize, usize)>,
+    diags: &mut Diagnostics,
+) {
+    let Some(r) = (first_region..model.subdomains.len())
+        .find(|&r| super::region_interfaces::face_of(model, r) == Some(run.face))
+    else {
+        return;
+    };
+    for k in 0..first_region {
+        if let Some(f) = super::region_interfaces::face_of(model, k)
+            && model.faces[f.index()]
+                .loops
+                .edges()
+                .iter()
+                .any(|oe| oe.edge == run.arc)
+        {
+            reported.insert((k, r));
+        }
+    }
+    let p: Point3 = model
+        .vertex(begin(
+            model,
+            model.faces[run.face.index()].loops[run.lp][run.start],
+        ))
+        .position;
+    diags.push(
+        Diagnostic::new(
+            Code::RegionTouches,
+            source_map.subdomain(SubdomainId(r as u32)),
+            format!(
+                "region '{}' runs along the curved edge '{}' from ({:.6}, {:.6}) past its end; a contour on a curved kernel edge must stay within that one edge",
+                model.subdomains[r].name,
+                model.edge(run.arc).name,
+                p.x,
+                p.y
+            ),
+        )
+        .with_help("end the region's contour inside the curved edge, or split the kernel shape so that one edge holds the whole run"),
+    );
+}
