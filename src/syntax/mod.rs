@@ -70,17 +70,18 @@ impl<'s> Document<'s> {
         }
     }
 
-    /// The [`Head`]s of the root's child elements, in order.
-    pub fn heads(&self) -> Vec<Head<'_>> {
+    /// The [`Head`]s of the root's child elements, in order (a split
+    /// document keeps them from its scan).
+    pub fn heads(&self) -> std::borrow::Cow<'_, [Head<'_>]> {
         match &self.0 {
             Parsed::Whole(xml) => {
                 let root = xml.root_element();
                 let mut heads =
                     Vec::with_capacity(root.children().filter(|c| c.is_element()).count());
                 heads.extend(root.children().filter(|c| c.is_element()).map(tree::head));
-                heads
+                std::borrow::Cow::Owned(heads)
             }
-            Parsed::Split(split) => split.heads(),
+            Parsed::Split(split) => std::borrow::Cow::Borrowed(split.heads()),
         }
     }
 

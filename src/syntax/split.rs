@@ -90,8 +90,8 @@ impl<'s> Split<'s> {
         self.root.clone()
     }
 
-    pub fn heads(&self) -> Vec<Head<'s>> {
-        self.heads.clone()
+    pub fn heads(&self) -> &[Head<'s>] {
+        &self.heads
     }
 
     pub fn top_level(&self) -> Runs<'_, 's> {
