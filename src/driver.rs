@@ -120,48 +120,10 @@ fn run(
     diags: &mut Diagnostics,
     implicit: &mut Vec<ImplicitSubdomain>,
 ) -> Option<Lowered> {
-    let parsed = match syntax::parse_document(source, &options.limits) {
-        Ok(parsed) => parsed,
-        Err(d) => {
-            diags.push(d);
-            return None;
-        }
-    };
-    let root = parsed.root();
-    if root.name != grammar::GEOMETRY.name {
-        diags.push(
-            Diagnostic::new(
-                Code::WrongRoot,
-                root.name_span,
-                format!(
-                    "the root element is <{}>; a geomc file's root is <geometry>",
-                    root.name
-                ),
-            )
-            .with_help("wrap the content in <geometry version=\"1\"> … </geometry>"),
-        );
-        return None;
-    }
-    if let Some(version) = root.attribute("version") {
-        if version.value.trim() != "1" {
-            diags.push(
-                Diagnostic::new(
-                    Code::UnsupportedVersion,
-                    version.value_span,
-                    format!(
-                        "format version \"{}\" is not supported; this geomc reads version 1",
-                        version.value
-                    ),
-                )
-                .with_help("set version=\"1\""),
-            );
-            return None;
-        }
-    }
-    let (mut document, extracted) = read_document(source, &parsed, root, options, diags);
+    let (mut document, extracted) = read(source, options, diags)?;
     // Each stage's input is dropped as soon as the next no longer needs it,
-    // which keeps the peak memory of large files down.
-    drop(parsed);
+    // which keeps the peak memory of large files down (the parsed document
+    // is gone already).
     release(options);
     let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     // Everything later reads the resolved objects, not the document's: on large
@@ -230,6 +192,89 @@ fn whole_solids(subdomains: &[crate::syntax::Element]) -> Vec<(String, String)> 
         .collect()
 }
 
+/// Parses the file and reads its typed document; the parser's document is
+/// dropped on return. `None` when the file did not parse or its root is not a
+/// version-1 `<geometry>` (reported).
+fn read<'s>(
+    source: &'s SourceFile,
+    options: &Options,
+    diags: &mut Diagnostics,
+) -> Option<(doc::Document, crate::implicit::xml::Extracted<'s>)> {
+    let start = diags.items.len();
+    match syntax::parse_document(source, &options.limits) {
+        Ok(parsed) => match read_checked(source, &parsed, options, diags) {
+            Ok(read) => return read,
+            // A piece of a split file could not be read on its own: the whole
+            // file is read as one below, which reports what the piece could not take.
+            Err(syntax::Reparse) => diags.items.truncate(start),
+        },
+        Err(d) => {
+            diags.push(d);
+            return None;
+        }
+    }
+    let whole = match syntax::parse_whole_document(source, &options.limits) {
+        Ok(whole) => whole,
+        Err(d) => {
+            diags.push(d);
+            return None;
+        }
+    };
+    read_checked(source, &whole, options, diags).unwrap_or_else(|syntax::Reparse| {
+        diags.push(syntax::lost_position(None));
+        None
+    })
+}
+
+/// The root's checks (its name and version), then [`read_document`]; `None`
+/// when the root is not a version-1 `<geometry>` (reported).
+#[allow(clippy::type_complexity)]
+fn read_checked<'s>(
+    source: &SourceFile,
+    parsed: &syntax::Document<'s>,
+    options: &Options,
+    diags: &mut Diagnostics,
+) -> Result<Option<(doc::Document, crate::implicit::xml::Extracted<'s>)>, syntax::Reparse> {
+    let root = match parsed.root() {
+        Ok(root) => root,
+        Err(d) => {
+            diags.push(d);
+            return Ok(None);
+        }
+    };
+    if root.name != grammar::GEOMETRY.name {
+        diags.push(
+            Diagnostic::new(
+                Code::WrongRoot,
+                root.name_span,
+                format!(
+                    "the root element is <{}>; a geomc file's root is <geometry>",
+                    root.name
+                ),
+            )
+            .with_help("wrap the content in <geometry version=\"1\"> … </geometry>"),
+        );
+        return Ok(None);
+    }
+    if let Some(version) = root.attribute("version") {
+        if version.value.trim() != "1" {
+            diags.push(
+                Diagnostic::new(
+                    Code::UnsupportedVersion,
+                    version.value_span,
+                    format!(
+                        "format version \"{}\" is not supported; this geomc reads version 1",
+                        version.value
+                    ),
+                )
+                .with_help("set version=\"1\""),
+            );
+            return Ok(None);
+        }
+    }
+    read_document(source, parsed, root, options, diags).map(Some)
+}
+
 /// Checks the structure of the parsed file and builds its typed document, one
 /// top-level element at a time: each element is built from the parser's
 /// document, checked, and dropped once its part of the typed document is made,
@@ -242,7 +287,7 @@ fn read_document<'s>(
     root: syntax::Element<'s>,
     options: &Options,
     diags: &mut Diagnostics,
-) -> (doc::Document, crate::implicit::xml::Extracted<'s>) {
+) -> Result<(doc::Document, crate::implicit::xml::Extracted<'s>), syntax::Reparse> {
     let heads = parsed.heads();
     // The root's check reports unknown elements; only known ones go deeper.
     doc::structure::check_element_heads(&root, &heads, &grammar::GEOMETRY, diags);
@@ -253,6 +298,7 @@ fn read_document<'s>(
     drop(heads);
     let mut extracted = crate::implicit::xml::Extracted::default();
     for element in parsed.top_level() {
+        let element = element?;
         if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
             doc::structure::check(&element, rule, diags);
         }
@@ -260,7 +306,7 @@ fn read_document<'s>(
             builder.add(&element, diags);
         }
     }
-    (builder.finish(), extracted)
+    Ok((builder.finish(), extracted))
 }
 
 fn release(options: &Options) {

@@ -6,9 +6,12 @@
 // User-controlled bytes and values: no panicking index (docs/reliability.md).
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 
+mod split;
 mod tree;
 
+pub use split::Reparse;
 pub use tree::{Attribute, Element, Head};
+use tree::{Misplaced, Origin};
 
 use crate::diag::{Code, Diagnostic};
 use crate::span::{SourceFile, Span};
@@ -36,48 +39,115 @@ impl Default for Limits {
 
 /// Parses `source` into an owned tree, or says why it cannot.
 pub fn parse<'s>(source: &'s SourceFile, limits: &Limits) -> Result<Element<'s>, Diagnostic> {
-    let document = parse_document(source, limits)?;
-    Ok(tree::build(document.xml.root_element()))
+    let document = parse_whole(source, limits)?;
+    let root = document.root_element();
+    tree::build(root, Origin::whole(&source.text)).map_err(|Misplaced| misplaced(root))
 }
 
 /// A parsed document whose elements become [`Element`]s one top-level child at
 /// a time: a large file never holds the parser's document and a whole element
-/// tree together (they were the first of the front end's memory peaks).
-pub struct Document<'s> {
-    xml: roxmltree::Document<'s>,
+/// tree together (they were the first of the front end's memory peaks). Most
+/// files are read in runs of the root's children ([`split`]), so not even the
+/// parser's document of the whole file is ever alive.
+pub struct Document<'s>(Parsed<'s>);
+
+enum Parsed<'s> {
+    Whole(roxmltree::Document<'s>),
+    Split(split::Split<'s>),
 }
 
 impl<'s> Document<'s> {
     /// The root element with its attributes and text, without its children
     /// (see [`Document::heads`] and [`Document::top_level`]).
-    pub fn root(&self) -> Element<'s> {
-        tree::shallow(self.xml.root_element())
+    pub fn root(&self) -> Result<Element<'s>, Diagnostic> {
+        match &self.0 {
+            Parsed::Whole(xml) => {
+                let root = xml.root_element();
+                tree::shallow(root, Origin::whole(xml.input_text()))
+                    .map_err(|Misplaced| misplaced(root))
+            }
+            Parsed::Split(split) => Ok(split.root()),
+        }
     }
 
-    /// The [`Head`]s of the root's child elements, in order.
-    pub fn heads(&self) -> Vec<Head<'_>> {
-        let root = self.xml.root_element();
-        let mut heads = Vec::with_capacity(root.children().filter(|c| c.is_element()).count());
-        heads.extend(root.children().filter(|c| c.is_element()).map(tree::head));
-        heads
+    /// The [`Head`]s of the root's child elements, in order (a split
+    /// document keeps them from its scan).
+    pub fn heads(&self) -> std::borrow::Cow<'_, [Head<'_>]> {
+        match &self.0 {
+            Parsed::Whole(xml) => {
+                let root = xml.root_element();
+                let mut heads =
+                    Vec::with_capacity(root.children().filter(|c| c.is_element()).count());
+                heads.extend(root.children().filter(|c| c.is_element()).map(tree::head));
+                std::borrow::Cow::Owned(heads)
+            }
+            Parsed::Split(split) => std::borrow::Cow::Borrowed(split.heads()),
+        }
     }
 
-    /// The root's child elements, each built whole when the iterator reaches it.
-    pub fn top_level(&self) -> impl Iterator<Item = Element<'s>> + '_ {
-        self.xml
-            .root_element()
-            .children()
-            .filter(|c| c.is_element())
-            .map(tree::build)
+    /// The root's child elements, each built whole when the iterator reaches
+    /// it. [`Reparse`] ends a split document's iteration: read the file again
+    /// from [`parse_whole`], which reports what the piece could not take.
+    pub fn top_level(&self) -> Box<dyn Iterator<Item = Result<Element<'s>, Reparse>> + '_> {
+        match &self.0 {
+            Parsed::Whole(xml) => {
+                let at = Origin::whole(xml.input_text());
+                Box::new(
+                    xml.root_element()
+                        .children()
+                        .filter(|c| c.is_element())
+                        .map(move |c| tree::build(c, at).map_err(|Misplaced| Reparse)),
+                )
+            }
+            Parsed::Split(split) => Box::new(split.top_level()),
+        }
     }
 }
 
 /// Parses `source`, refusing what [`Limits`] and the format forbid (size, DTDs,
-/// node count, nesting), or says why it cannot.
+/// node count, nesting), or says why it cannot. The root's children are read
+/// in runs when the file allows it ([`split`]).
 pub fn parse_document<'s>(
     source: &'s SourceFile,
     limits: &Limits,
 ) -> Result<Document<'s>, Diagnostic> {
+    check_text(source, limits)?;
+    Ok(Document(match split::Split::scan(&source.text, limits) {
+        Some(split) => Parsed::Split(split),
+        None => Parsed::Whole(parse_checked(source, limits)?),
+    }))
+}
+
+/// [`parse_document`] of the whole file at once: every XML error, the node
+/// limit and the nesting limit are reported exactly here.
+pub fn parse_whole_document<'s>(
+    source: &'s SourceFile,
+    limits: &Limits,
+) -> Result<Document<'s>, Diagnostic> {
+    Ok(Document(Parsed::Whole(parse_whole(source, limits)?)))
+}
+
+fn parse_whole<'s>(
+    source: &'s SourceFile,
+    limits: &Limits,
+) -> Result<roxmltree::Document<'s>, Diagnostic> {
+    check_text(source, limits)?;
+    parse_checked(source, limits)
+}
+
+/// [`parse_whole`] after [`check_text`].
+fn parse_checked<'s>(
+    source: &'s SourceFile,
+    limits: &Limits,
+) -> Result<roxmltree::Document<'s>, Diagnostic> {
+    let document = roxmltree::Document::parse_with_options(&source.text, split::options(limits))
+        .map_err(|error| xml_error(source, &error, limits))?;
+    check_depth(document.root_element(), limits)?;
+    Ok(document)
+}
+
+/// The size limit and the refusal of DTDs, before any parser sees the text.
+fn check_text(source: &SourceFile, limits: &Limits) -> Result<(), Diagnostic> {
     let text = source.text.as_str();
     if text.len() > limits.max_file_size {
         return Err(Diagnostic::new(
@@ -100,15 +170,24 @@ pub fn parse_document<'s>(
         )
         .with_help("remove the <!DOCTYPE …> block"));
     }
-    let options = roxmltree::ParsingOptions {
-        allow_dtd: false,
-        nodes_limit: limits.max_nodes,
-        ..roxmltree::ParsingOptions::default()
-    };
-    let document = roxmltree::Document::parse_with_options(text, options)
-        .map_err(|error| xml_error(source, &error, limits))?;
-    check_depth(document.root_element(), limits)?;
-    Ok(Document { xml: document })
+    Ok(())
+}
+
+/// The guard of [`tree::Misplaced`] as a diagnostic (never seen).
+fn misplaced(node: roxmltree::Node) -> Diagnostic {
+    let start = node.range().start;
+    lost_position(Span::new(start, start + 1))
+}
+
+/// A whole-file parse that could not place a name in the file (never seen:
+/// the guard of a [`Reparse`] from [`parse_whole_document`]).
+pub fn lost_position(span: impl Into<Option<Span>>) -> Diagnostic {
+    Diagnostic::new(
+        Code::XmlSyntax,
+        span,
+        "a name in the file could not be located by geomc's XML reader",
+    )
+    .with_help("report this file: geomc's XML reader lost a position")
 }
 
 /// The first "<!DOCTYPE", in any case. "<!" has no case variants, so only

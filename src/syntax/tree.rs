@@ -40,19 +40,73 @@ impl<'s> Element<'s> {
     }
 }
 
+/// Where a parsed node's text lies in the source: the node's positions plus
+/// `shift` are source offsets. A whole-file parse has shift 0; a piece of the
+/// file parsed inside a wrapper (`super::split`) is shifted by its place.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Origin<'s> {
+    pub source: &'s str,
+    pub shift: isize,
+}
+
+impl<'s> Origin<'s> {
+    pub fn whole(source: &'s str) -> Origin<'s> {
+        Origin { source, shift: 0 }
+    }
+
+    fn at(&self, pos: usize) -> usize {
+        pos.wrapping_add_signed(self.shift)
+    }
+
+    fn span(&self, range: std::ops::Range<usize>) -> Span {
+        Span::new(self.at(range.start), self.at(range.end))
+    }
+
+    /// The source's text at a parsed node's `range`, when it is `expected`
+    /// (names and unexpanded values are slices of the source, not of the
+    /// parser's input, so they outlive a wrapper's buffer).
+    fn text(&self, start: usize, expected: &str) -> Option<&'s str> {
+        let start = self.at(start);
+        self.source
+            .get(start..start + expected.len())
+            .filter(|t| *t == expected)
+    }
+
+    /// An element's (local) name as a slice of the source.
+    fn element_name(&self, node: roxmltree::Node) -> Option<&'s str> {
+        let rest = self.source.get(self.at(node.range().start + 1)..)?;
+        let len = rest
+            .find(|c: char| c.is_ascii_whitespace() || c == '/' || c == '>')
+            .unwrap_or(rest.len());
+        let local = rest.get(..len)?.rsplit(':').next()?;
+        (local == node.tag_name().name()).then_some(local)
+    }
+}
+
+/// A parsed name that is not in the source where the parser put it (never
+/// seen: a guard, since names must be slices of the source, not of a buffer).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Misplaced;
+
 /// Converts a parsed roxmltree node into the tree. Iterative, so depth
 /// is bounded only by memory (the caller has already checked the depth limit).
-pub(super) fn build<'s>(root: roxmltree::Node<'_, 's>) -> Element<'s> {
+pub(super) fn build<'s>(
+    root: roxmltree::Node<'_, '_>,
+    at: Origin<'s>,
+) -> Result<Element<'s>, Misplaced> {
     // Post-order assembly: each frame keeps its child iterator and collects its
     // finished children.
-    let mut stack = vec![(root.children(), shell(root))];
+    let mut stack = vec![(root.children(), shell(root, at)?)];
     loop {
         let Some((children, element)) = stack.last_mut() else {
             unreachable!("the stack holds the root until it is returned")
         };
         match children.next() {
-            Some(child) if child.is_element() => stack.push((child.children(), shell(child))),
-            Some(child) if child.is_text() => push_text(element, child),
+            Some(child) if child.is_element() => {
+                let shell = shell(child, at)?;
+                stack.push((child.children(), shell));
+            }
+            Some(child) if child.is_text() => push_text(element, child, at),
             Some(_) => {}
             None => {
                 let Some((_, finished)) = stack.pop() else {
@@ -60,7 +114,7 @@ pub(super) fn build<'s>(root: roxmltree::Node<'_, 's>) -> Element<'s> {
                 };
                 match stack.last_mut() {
                     Some(parent) => parent.1.children.push(finished),
-                    None => return finished,
+                    None => return Ok(finished),
                 }
             }
         }
@@ -92,12 +146,15 @@ impl<'s> Element<'s> {
 }
 
 /// The element with its attributes and non-whitespace text, without children.
-pub(super) fn shallow<'s>(node: roxmltree::Node<'_, 's>) -> Element<'s> {
-    let mut element = shell_with(node, 0);
+pub(super) fn shallow<'s>(
+    node: roxmltree::Node<'_, '_>,
+    at: Origin<'s>,
+) -> Result<Element<'s>, Misplaced> {
+    let mut element = shell_with(node, 0, at)?;
     for child in node.children().filter(|c| c.is_text()) {
-        push_text(&mut element, child);
+        push_text(&mut element, child, at);
     }
-    element
+    Ok(element)
 }
 
 /// The [`Head`] of an element node.
@@ -114,45 +171,53 @@ pub(super) fn head<'a>(node: roxmltree::Node<'a, '_>) -> Head<'a> {
     }
 }
 
-fn push_text(element: &mut Element, node: roxmltree::Node) {
+fn push_text(element: &mut Element, node: roxmltree::Node, at: Origin) {
     let text = node.text().unwrap_or("");
     if !text.trim().is_empty() {
         element
             .text
-            .push((text.trim().to_string(), Span::from_range(node.range())));
+            .push((text.trim().to_string(), at.span(node.range())));
     }
 }
 
-fn shell<'s>(node: roxmltree::Node<'_, 's>) -> Element<'s> {
+fn shell<'s>(node: roxmltree::Node<'_, '_>, at: Origin<'s>) -> Result<Element<'s>, Misplaced> {
     // Sized exactly: no growth by doubling (the root of a large file has
     // hundreds of thousands of children).
-    shell_with(node, node.children().filter(|c| c.is_element()).count())
+    shell_with(node, node.children().filter(|c| c.is_element()).count(), at)
 }
 
-fn shell_with<'s>(node: roxmltree::Node<'_, 's>, children: usize) -> Element<'s> {
+fn shell_with<'s>(
+    node: roxmltree::Node<'_, '_>,
+    children: usize,
+    at: Origin<'s>,
+) -> Result<Element<'s>, Misplaced> {
     let range = node.range();
-    let name = node.tag_name().name();
-    let name_start = range.start + 1;
-    Element {
+    let name = at.element_name(node).ok_or(Misplaced)?;
+    let name_start = at.at(range.start + 1);
+    let mut attributes = Vec::new();
+    // Namespaced attributes (xsi:noNamespaceSchemaLocation) belong to the XML
+    // tooling, not to the format.
+    for a in node.attributes().filter(|a| a.namespace().is_none()) {
+        let qname = a.range_qname();
+        let value_range = a.range_value();
+        attributes.push(Attribute {
+            name: at.text(qname.start, a.name()).ok_or(Misplaced)?,
+            name_span: at.span(qname),
+            value: match a.value_storage() {
+                roxmltree::StringStorage::Borrowed(text) => at
+                    .text(value_range.start, text)
+                    .map_or_else(|| Cow::Owned(text.to_string()), Cow::Borrowed),
+                other => Cow::Owned(other.as_str().to_string()),
+            },
+            value_span: at.span(value_range),
+        });
+    }
+    Ok(Element {
         name_span: Span::new(name_start, name_start + name.len()),
         name,
-        span: Span::from_range(range),
-        attributes: node
-            .attributes()
-            // Namespaced attributes (xsi:noNamespaceSchemaLocation) belong to
-            // the XML tooling, not to the format.
-            .filter(|a| a.namespace().is_none())
-            .map(|a| Attribute {
-                name: a.name(),
-                name_span: Span::from_range(a.range_qname()),
-                value: match a.value_storage() {
-                    roxmltree::StringStorage::Borrowed(text) => Cow::Borrowed(*text),
-                    other => Cow::Owned(other.as_str().to_string()),
-                },
-                value_span: Span::from_range(a.range_value()),
-            })
-            .collect(),
+        span: at.span(range),
+        attributes,
         children: Vec::with_capacity(children),
         text: Vec::new(),
-    }
+    })
 }

@@ -1,0 +1,491 @@
+//! The root's children parsed a few at a time instead of the whole file at
+//! once: roxmltree's document of a large file is several times its size, and
+//! it was alive beside the typed document (the front end's memory peak).
+//!
+//! A scan finds the root's start tag, each child element's extent and its
+//! [`Head`], and the root's end. Every piece of the file is still parsed by
+//! roxmltree with the same options: the prolog and root start tag (closed by
+//! hand), then runs of consecutive children inside a wrapper element. The
+//! split is taken only when the text between the children is whitespace;
+//! anything the scan does not expect (comments or text at the top level,
+//! prefixed names, entities in a `name=` value) or any error of a piece means
+//! the whole file is parsed as before, so diagnostics never depend on the split.
+
+use super::tree::{self, Element, Head, Misplaced, Origin};
+use super::{Limits, check_depth};
+use crate::span::Span;
+use std::collections::VecDeque;
+use std::ops::Range;
+
+/// A piece of the file could not be read on its own (an XML error, a name
+/// bound by the root's namespace declarations, nesting over the limit, or a
+/// mismatch with the scan): parse the whole file, which reports it as before.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct Reparse;
+
+/// A file whose root's children are parsed in runs (see the module).
+pub(super) struct Split<'s> {
+    text: &'s str,
+    root: Element<'s>,
+    heads: Vec<Head<'s>>,
+    /// Byte ranges of the root's child elements, in order.
+    children: Vec<Range<usize>>,
+    limits: Limits,
+}
+
+/// Bytes of children parsed at once: large enough that a parse's fixed costs
+/// do not count, small enough that its document stays a few hundred kB.
+const RUN_BYTES: usize = 64 * 1024;
+
+/// The wrapper of a run of children (its name is never read).
+const OPEN: &str = "<r>";
+const CLOSE: &str = "</r>";
+
+impl<'s> Split<'s> {
+    /// Scans `text`; `None` when the file must be parsed whole.
+    pub fn scan(text: &'s str, limits: &Limits) -> Option<Split<'s>> {
+        // Each node starts at a byte of its own, so a file shorter than the
+        // node limit cannot reach it in any piece: the limit's error comes only
+        // from the whole parse.
+        if text.len().saturating_add(OPEN.len() + CLOSE.len() + 2) >= limits.max_nodes as usize {
+            return None;
+        }
+        let bytes = text.as_bytes();
+        let root_start = prolog_end(bytes)?;
+        let (tag_end, self_closing) = start_tag_end(bytes, root_start)?;
+        if self_closing {
+            return None;
+        }
+        let root_name = name_at(text, root_start + 1)?;
+        let root = parse_root(text, tag_end, root_name, limits)?;
+        let mut heads = Vec::new();
+        let mut children = Vec::new();
+        let mut pos = tag_end;
+        loop {
+            pos = skip_whitespace(bytes, pos);
+            match bytes.get(pos..pos + 2)? {
+                b"</" => break,
+                [b'<', c] if !matches!(c, b'!' | b'?') => {
+                    let end = element_end(bytes, pos)?;
+                    heads.push(scan_head(text, pos)?);
+                    children.push(pos..end);
+                    pos = end;
+                }
+                _ => return None,
+            }
+        }
+        let end = root_end(text, pos, root_name)?;
+        let mut root = root;
+        root.span = Span::new(root_start, end);
+        Some(Split {
+            text,
+            root,
+            heads,
+            children,
+            limits: *limits,
+        })
+    }
+
+    pub fn root(&self) -> Element<'s> {
+        self.root.clone()
+    }
+
+    pub fn heads(&self) -> &[Head<'s>] {
+        &self.heads
+    }
+
+    pub fn top_level(&self) -> Runs<'_, 's> {
+        Runs {
+            split: self,
+            next: 0,
+            ready: VecDeque::new(),
+        }
+    }
+
+    /// Parses the run of children starting at `first`; returns the index
+    /// after its last child.
+    fn parse_run(&self, first: usize, out: &mut VecDeque<Element<'s>>) -> Result<usize, Reparse> {
+        let start = self.children.get(first).ok_or(Reparse)?.start;
+        let mut last = first;
+        while let Some(next) = self.children.get(last + 1) {
+            if next.end - start > RUN_BYTES {
+                break;
+            }
+            last += 1;
+        }
+        let end = self.children.get(last).ok_or(Reparse)?.end;
+        let piece = self.text.get(start..end).ok_or(Reparse)?;
+        let mut buffer = String::with_capacity(OPEN.len() + piece.len() + CLOSE.len());
+        buffer.push_str(OPEN);
+        buffer.push_str(piece);
+        buffer.push_str(CLOSE);
+        let document = roxmltree::Document::parse_with_options(&buffer, options(&self.limits))
+            .map_err(|_| Reparse)?;
+        let wrapper = document.root_element();
+        check_depth(wrapper, &self.limits).map_err(|_| Reparse)?;
+        let at = Origin {
+            source: self.text,
+            shift: start as isize - OPEN.len() as isize,
+        };
+        let mut index = first;
+        for node in wrapper.children() {
+            if node.is_element() {
+                let element = tree::build(node, at).map_err(|Misplaced| Reparse)?;
+                if self.heads.get(index) != Some(&element.head()) {
+                    return Err(Reparse);
+                }
+                out.push_back(element);
+                index += 1;
+            } else if !node.text().is_some_and(|t| t.trim().is_empty()) {
+                return Err(Reparse);
+            }
+        }
+        if index != last + 1 {
+            return Err(Reparse);
+        }
+        Ok(index)
+    }
+}
+
+/// The root's children, each built whole when the iterator reaches it (a run
+/// of them is parsed at a time).
+pub struct Runs<'a, 's> {
+    split: &'a Split<'s>,
+    next: usize,
+    ready: VecDeque<Element<'s>>,
+}
+
+impl<'s> Iterator for Runs<'_, 's> {
+    type Item = Result<Element<'s>, Reparse>;
+
+    fn next(&mut self) -> Option<Self::Item> {
+        if self.ready.is_empty() {
+            if self.next >= self.split.children.len() {
+                return None;
+            }
+            match self.split.parse_run(self.next, &mut self.ready) {
+                Ok(next) => self.next = next,
+                Err(reparse) => {
+                    self.next = self.split.children.len();
+                    return Some(Err(reparse));
+                }
+            }
+        }
+        self.ready.pop_front().map(Ok)
+    }
+}
+
+pub(super) fn options<'a>(limits: &Limits) -> roxmltree::ParsingOptions<'a> {
+    roxmltree::ParsingOptions {
+        allow_dtd: false,
+        nodes_limit: limits.max_nodes,
+        ..roxmltree::ParsingOptions::default()
+    }
+}
+
+/// The root's start tag closed by hand and parsed: the XML declaration,
+/// prolog and the root's attributes and namespaces get roxmltree's checks.
+fn parse_root<'s>(
+    text: &'s str,
+    tag_end: usize,
+    root_name: &str,
+    limits: &Limits,
+) -> Option<Element<'s>> {
+    let head = text.get(..tag_end)?;
+    let mut buffer = String::with_capacity(tag_end + root_name.len() + 3);
+    buffer.push_str(head);
+    buffer.push_str("</");
+    buffer.push_str(root_name);
+    buffer.push('>');
+    let document = roxmltree::Document::parse_with_options(&buffer, options(limits)).ok()?;
+    tree::shallow(document.root_element(), Origin::whole(text)).ok()
+}
+
+/// Where the root element starts: after an optional byte order mark, XML
+/// declaration and whitespace (anything else in the prolog: parse whole).
+fn prolog_end(bytes: &[u8]) -> Option<usize> {
+    let mut pos = if bytes.starts_with("\u{feff}".as_bytes()) {
+        3
+    } else {
+        0
+    };
+    if bytes.get(pos..)?.starts_with(b"<?xml") {
+        pos += memchr::memmem::find(bytes.get(pos..)?, b"?>")? + 2;
+    }
+    pos = skip_whitespace(bytes, pos);
+    match bytes.get(pos..pos + 2)? {
+        [b'<', c] if !matches!(c, b'!' | b'?' | b'/') => Some(pos),
+        _ => None,
+    }
+}
+
+fn skip_whitespace(bytes: &[u8], mut pos: usize) -> usize {
+    while bytes
+        .get(pos)
+        .is_some_and(|b| matches!(b, b' ' | b'\t' | b'\r' | b'\n'))
+    {
+        pos += 1;
+    }
+    pos
+}
+
+/// The end (after `>`) of the start tag at `pos`, and whether it is `/>`.
+/// Quoted attribute values may hold `>`.
+fn start_tag_end(bytes: &[u8], pos: usize) -> Option<(usize, bool)> {
+    let mut quote = None;
+    let mut i = pos + 1;
+    loop {
+        let b = *bytes.get(i)?;
+        match quote {
+            Some(q) if b == q => quote = None,
+            Some(_) => {}
+            None if b == b'"' || b == b'\'' => quote = Some(b),
+            None if b == b'<' => return None,
+            None if b == b'>' => return Some((i + 1, bytes.get(i - 1) == Some(&b'/'))),
+            None => {}
+        }
+        i += 1;
+    }
+}
+
+/// The end of the element starting at `pos` (after its end tag's `>`).
+/// Comments, CDATA sections and processing instructions inside are skipped;
+/// roxmltree checks everything else when the run is parsed.
+fn element_end(bytes: &[u8], mut pos: usize) -> Option<usize> {
+    let mut depth = 0usize;
+    loop {
+        let rest = bytes.get(pos..)?;
+        if rest.starts_with(b"<!--") {
+            pos += 4 + memchr::memmem::find(bytes.get(pos + 4..)?, b"-->")? + 3;
+        } else if rest.starts_with(b"<![CDATA[") {
+            pos += memchr::memmem::find(rest, b"]]>")? + 3;
+        } else if rest.starts_with(b"<?") {
+            pos += memchr::memmem::find(rest, b"?>")? + 2;
+        } else if rest.starts_with(b"<!") {
+            return None;
+        } else if rest.starts_with(b"</") {
+            pos += memchr::memchr(b'>', rest)? + 1;
+            depth = depth.checked_sub(1)?;
+            if depth == 0 {
+                return Some(pos);
+            }
+        } else {
+            let (end, self_closing) = start_tag_end(bytes, pos)?;
+            pos = end;
+            if !self_closing {
+                depth += 1;
+            } else if depth == 0 {
+                return Some(pos);
+            }
+        }
+        pos += memchr::memchr(b'<', bytes.get(pos..)?)?;
+    }
+}
+
+/// The name starting at `pos`, up to whitespace, `/` or `>`; `None` for a
+/// prefixed name (roxmltree's name would be its local part).
+fn name_at(text: &str, pos: usize) -> Option<&str> {
+    let rest = text.get(pos..)?;
+    let len = rest
+        .find(|c: char| c.is_ascii_whitespace() || c == '/' || c == '>')
+        .unwrap_or(rest.len());
+    let name = rest.get(..len)?;
+    (!name.is_empty() && !name.contains(':')).then_some(name)
+}
+
+/// The [`Head`] of the child element at `pos`, read from its start tag. A
+/// `name=` value roxmltree would change (entities, whitespace normalisation)
+/// gives `None`: parse whole.
+fn scan_head(text: &str, pos: usize) -> Option<Head<'_>> {
+    let bytes = text.as_bytes();
+    let name = name_at(text, pos + 1)?;
+    let mut i = pos + 1 + name.len();
+    let mut name_attribute = None;
+    loop {
+        i = skip_whitespace(bytes, i);
+        match bytes.get(i)? {
+            b'>' | b'/' => break,
+            _ => {}
+        }
+        let attr_len = text
+            .get(i..)?
+            .find(|c: char| c.is_ascii_whitespace() || c == '=')?;
+        let attr = text.get(i..i + attr_len)?;
+        i = skip_whitespace(bytes, i + attr_len);
+        if bytes.get(i) != Some(&b'=') {
+            return None;
+        }
+        i = skip_whitespace(bytes, i + 1);
+        let quote = *bytes.get(i)?;
+        if quote != b'"' && quote != b'\'' {
+            return None;
+        }
+        let value_len = memchr::memchr(quote, bytes.get(i + 1..)?)?;
+        let value = text.get(i + 1..i + 1 + value_len)?;
+        if attr == "name" {
+            if value.contains(['&', '\t', '\n', '\r', '<']) || name_attribute.is_some() {
+                return None;
+            }
+            name_attribute = Some(value);
+        }
+        i += value_len + 2;
+    }
+    let name_start = pos + 1;
+    Some(Head {
+        name,
+        name_span: Span::new(name_start, name_start + name.len()),
+        name_attribute,
+    })
+}
+
+/// The end of the file when `pos` is the root's end tag and only whitespace
+/// follows it; that end tag's end is the root's end.
+fn root_end(text: &str, pos: usize, root_name: &str) -> Option<usize> {
+    let bytes = text.as_bytes();
+    let after_name = pos + 2 + root_name.len();
+    if text.get(pos + 2..after_name)? != root_name {
+        return None;
+    }
+    let close = skip_whitespace(bytes, after_name);
+    if bytes.get(close) != Some(&b'>') {
+        return None;
+    }
+    (skip_whitespace(bytes, close + 1) == bytes.len()).then_some(close + 1)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::span::SourceFile;
+
+    /// The children as a whole-file parse builds them.
+    fn whole_children(text: &str) -> Vec<Element<'_>> {
+        let document = roxmltree::Document::parse(text).expect("test XML parses");
+        document
+            .root_element()
+            .children()
+            .filter(|c| c.is_element())
+            .map(|c| tree::build(c, Origin::whole(text)).expect("names are in the text"))
+            .collect()
+    }
+
+    fn split_children<'s>(split: &Split<'s>) -> Vec<Element<'s>> {
+        split
+            .top_level()
+            .collect::<Result<_, _>>()
+            .expect("every run parses")
+    }
+
+    #[test]
+    fn runs_build_the_children_of_a_whole_parse() {
+        let text = "<?xml version=\"1.0\"?>\n<geometry version=\"1\" name='a &amp; b'>\n  \
+            <sphere name=\"s1\"><center x=\"1\" y=\"2&lt;3\" z=\"3\"/><!-- a > b --><radius value=\"r\"/></sphere>\n\
+            <subdomain name='d1' material='&#x31;'  ><solid ref=\"s1\"/><![CDATA[ <x> ]]></subdomain>\n\
+            <parameters><parameter name=\"r\" value=\"0.5\"/>text</parameters>\n</geometry >\n";
+        let split = Split::scan(text, &Limits::default()).expect("a plain file splits");
+        let children = split_children(&split);
+        assert_eq!(children, whole_children(text));
+        assert_eq!(children.len(), 3);
+        assert_eq!(children[0].children[0].attributes[1].value, "2<3");
+        let at = text.find(">text<").expect("the test has text") + 1;
+        assert_eq!(
+            children[2].text,
+            vec![("text".to_string(), Span::new(at, at + 4))]
+        );
+        let root = split.root();
+        assert_eq!(
+            root.attribute("name").map(|a| a.value.as_ref()),
+            Some("a & b")
+        );
+        assert_eq!(root.span, Span::new(22, text.len() - 1));
+        assert_eq!(children[1].attributes[1].value, "1");
+        assert_eq!(split.heads()[1].name_attribute, Some("d1"));
+        let source = SourceFile::new("t.xml", text);
+        let whole = roxmltree::Document::parse(&source.text).expect("parses");
+        let heads: Vec<Head> = (whole.root_element().children())
+            .filter(|c| c.is_element())
+            .map(tree::head)
+            .collect();
+        assert_eq!(heads, split.heads());
+    }
+
+    #[test]
+    fn many_children_are_parsed_in_several_runs() {
+        let mut text = String::from("<geometry>");
+        for i in 0..5000 {
+            text.push_str(&format!(
+                "\n <sphere name=\"s{i}\"><center x=\"{i}\" y=\"0\" z=\"0\"/></sphere>"
+            ));
+        }
+        text.push_str("\n</geometry>");
+        assert!(text.len() > 3 * RUN_BYTES);
+        let split = Split::scan(&text, &Limits::default()).expect("a plain file splits");
+        assert_eq!(split.heads().len(), 5000);
+        let children = split_children(&split);
+        assert_eq!(children.len(), 5000);
+        assert_eq!(children, whole_children(&text));
+        assert_eq!(children[4999].attributes[0].value, "s4999");
+    }
+
+    #[test]
+    fn unusual_top_levels_are_parsed_whole() {
+        let limits = Limits::default();
+        for text in [
+            "<geometry><!-- note --><sphere name=\"s\"/></geometry>",
+            "<geometry>text<sphere name=\"s\"/></geometry>",
+            "<!-- c --><geometry><sphere name=\"s\"/></geometry>",
+            "<geometry><sphere name=\"s\"/></geometry><!-- after -->",
+            "<g:geometry xmlns:g=\"u\"><sphere name=\"s\"/></g:geometry>",
+            "<geometry><x:sphere xmlns:x=\"u\" name=\"s\"/></geometry>",
+            "<geometry><sphere name=\"s\ttab\"/></geometry>",
+            "<geometry><sphere name=\"&#x31;\"/></geometry>",
+            "<geometry><sphere name=\"s\" name=\"t\"/></geometry>",
+            "<geometry/>",
+        ] {
+            assert!(Split::scan(text, &limits).is_none(), "{text}");
+        }
+        let few_nodes = Limits {
+            max_nodes: 40,
+            ..limits
+        };
+        assert!(Split::scan("<geometry><sphere name=\"s\"/></geometry>", &few_nodes).is_none());
+    }
+
+    #[test]
+    fn pieces_the_whole_file_would_read_differently_ask_for_a_reparse() {
+        let limits = Limits::default();
+        // A prefix bound on the root, an XML error inside a child, nesting over the limit.
+        let deep = Limits {
+            max_depth: 2,
+            ..limits
+        };
+        for (text, limits) in [
+            (
+                "<geometry xmlns:p=\"u\"><sphere p:name=\"s\"/></geometry>",
+                limits,
+            ),
+            (
+                "<geometry><sphere name=\"s\"><center></centre></sphere></geometry>",
+                limits,
+            ),
+            (
+                "<geometry><sphere name=\"s\">&bogus;</sphere></geometry>",
+                limits,
+            ),
+            (
+                "<geometry><sphere name=\"s\" x=\"1\" x=\"2\"/></geometry>",
+                limits,
+            ),
+            (
+                "<geometry><sphere name=\"s\"><center/></sphere></geometry>",
+                deep,
+            ),
+        ] {
+            let Some(split) = Split::scan(text, &limits) else {
+                panic!("the scan alone accepts {text}");
+            };
+            let first = split.top_level().next();
+            assert_eq!(first, Some(Err(Reparse)), "{text}");
+        }
+    }
+}
