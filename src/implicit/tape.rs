@@ -704,6 +704,50 @@ mod tests {
     }
 
     #[test]
+    fn a_sine_and_cosine_of_one_argument_are_one_instruction_with_their_own_bits() {
+        // cos before sin, a lone sine, and the pair used after other
+        // operations freed slots: one SinCos, values bit for bit those of
+        // the separate lane functions.
+        let mut ctx = Ctx::new();
+        let (x, y, z) = (ctx.var(0), ctx.var(1), ctx.var(2));
+        let xy = ctx.mul(x, y);
+        let c = ctx.unary(Unary::Cos, xy);
+        let sz = ctx.unary(Unary::Sin, z);
+        let zz = ctx.square(sz);
+        let t = ctx.add(c, zz);
+        let s = ctx.unary(Unary::Sin, xy);
+        let root = ctx.sub(t, s);
+        let ssa = Ssa::from_ctx(&ctx, root);
+        let tape = Tape::new(&ssa);
+        let fused = |ins: &[Instr]| ins.iter().filter(|i| matches!(i.op, Op::SinCos)).count();
+        assert_eq!(fused(&tape.instrs), 1);
+        assert_eq!(tape.len(), 6, "mul, sincos, sin, square, add, sub");
+        let n = 50;
+        let p: [Vec<f64>; 3] =
+            [0.37, 0.11, 0.73].map(|w| (0..n).map(|i| (i as f64 * w).sin() * 3.0).collect());
+        let mut got = vec![0.0; n];
+        tape.eval(&mut tape.workspace(), &p[0], &p[1], &p[2], &mut got);
+        let xy: Vec<f64> = (0..n).map(|i| p[0][i] * p[1][i]).collect();
+        let (mut sin, mut cos, mut sinz) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        super::super::trig::sin_lanes(&mut sin, &xy);
+        super::super::trig::cos_lanes(&mut cos, &xy);
+        super::super::trig::sin_lanes(&mut sinz, &p[2]);
+        for i in 0..n {
+            let want = (cos[i] + sinz[i] * sinz[i]) - sin[i];
+            assert_eq!(got[i].to_bits(), want.to_bits(), "point {i}");
+        }
+        // The axis tapes too: along z the pair is set up once per segment.
+        let along = AxisTape::new(&ssa, 2);
+        assert_eq!(fused(&along.setup), 1);
+        let mut ws = along.workspace();
+        along.setup(&mut ws, [&p[0], &p[1], &p[2]]);
+        let mut out = vec![0.0; n];
+        along.eval(&mut ws, &p[2], &mut out);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&out), bits(&got));
+    }
+
+    #[test]
     fn constants_after_operations_keep_their_slots() {
         // Regression: a constant first used after a freed operation slot must
         // not share that slot (its value is written before the tape runs).
