@@ -516,18 +516,22 @@ fn io(
     (out.try_into().expect("slot is BATCH long"), a, b)
 }
 
-/// A `SinCos` instruction over the first `len` lanes.
-// Slot numbers come from the tape compiler, never from input: a bad one is a bug.
-#[allow(clippy::expect_used)]
+/// A `SinCos` instruction over the first `len` lanes (the allocator gives
+/// it three distinct slots; the argument is copied out first, so the two
+/// outputs are the only borrows of `buf`).
 fn sin_cos(buf: &mut [f64], ins: &Instr, len: usize) {
-    if len == 0 {
-        return;
-    }
-    let lanes = |s: u32| s as usize * BATCH..s as usize * BATCH + len;
-    let [sin, cos, arg] = buf
-        .get_disjoint_mut([lanes(ins.out), lanes(ins.b), lanes(ins.a)])
-        .expect("the allocator gives a SinCos three distinct slots");
-    super::trig::sin_cos_lanes(sin, cos, arg);
+    let mut arg = [0.0; BATCH];
+    arg[..len].copy_from_slice(&buf[ins.a as usize * BATCH..][..len]);
+    let (s, c) = (ins.out as usize, ins.b as usize);
+    let (lo, hi) = buf.split_at_mut(s.max(c) * BATCH);
+    let first = &mut lo[s.min(c) * BATCH..][..len];
+    let second = &mut hi[..len];
+    let (sin, cos) = if s < c {
+        (first, second)
+    } else {
+        (second, first)
+    };
+    super::trig::sin_cos_lanes(sin, cos, &arg[..len]);
 }
 
 fn unary(u: Unary, o: &mut [f64], a: &[f64]) {
