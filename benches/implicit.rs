@@ -11,7 +11,8 @@
 //! Run: `cargo bench --bench implicit` (add `-- --quick` for 128 cells,
 //! `-- --no-fidget` to skip the slow peer, `-- --no-dense` to skip the dense
 //! evaluation of M2 and M3, `-- --model M1` to mesh only M1, `-- --dense-only` for the dense
-//! evaluation alone). Without `--bench` (as under
+//! evaluation alone, `-- --whole-only` for the whole paths alone, `-- --reps N`
+//! for N runs of each instead of 3: profiles of the product path). Without `--bench` (as under
 //! `cargo test --all-targets`) a 32-cell smoke run without peers.
 
 // The allocator of the `geomc` command, so the whole path is timed as users
@@ -296,11 +297,19 @@ fn main() {
     let quick = args.iter().any(|a| a == "--quick");
     let with_fidget = !smoke && !args.iter().any(|a| a == "--no-fidget");
     let no_dense = smoke || args.iter().any(|a| a == "--no-dense");
-    let (n, reps) = match (smoke, quick) {
+    let (n, mut reps) = match (smoke, quick) {
         (true, _) => (32, 1),
         (false, true) => (128, 3),
         (false, false) => (256, 3),
     };
+    if let Some(r) = args
+        .iter()
+        .position(|a| a == "--reps")
+        .and_then(|p| args.get(p + 1)?.parse::<usize>().ok())
+    {
+        reps = r.max(1);
+    }
+    let whole_only = args.iter().any(|a| a == "--whole-only");
     let depth = (n as f64).log2().round() as u8;
     let threads = rayon::current_num_threads();
     println!("implicit benchmark: {n} cells per axis, {threads} threads, median of {reps}");
@@ -340,6 +349,9 @@ fn main() {
             s.pruned_blocks,
             s.blocks
         );
+        if whole_only {
+            continue;
+        }
         let t_cpu = last_cpu();
         let ssa = build();
         // Contouring only, on the same densely sampled field as VTK.
@@ -380,6 +392,9 @@ fn main() {
                 last_cpu() / t_cpu
             );
         }
+    }
+    if whole_only {
+        return;
     }
     let ssa = m1();
     let tape = geomc::implicit::rows::RowTape::new(&ssa);

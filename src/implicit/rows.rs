@@ -94,7 +94,17 @@ pub struct RowWorkspace {
     /// at first, so the first row evaluates everything).
     last_y: u64,
     last_z: u64,
+    /// The y-only values of the first `Y_CACHE` ys seen: their bits, and
+    /// per y the values of `y_nodes` in order. A block's rows take z in the
+    /// outer loop and y in the inner one, so without them the y terms (the
+    /// gyroid's sin 6y and cos 6y, libm calls) were evaluated for every row
+    /// instead of once per y.
+    y_seen: Vec<u64>,
+    y_values: Vec<f64>,
 }
+
+/// The ys whose y-only values a workspace keeps (a block's rows).
+const Y_CACHE: usize = 8;
 
 const X: u8 = 1;
 
@@ -268,6 +278,8 @@ impl RowTape {
             offs: vec![-0.0; 2 * self.shifts.len()],
             last_y: f64::NAN.to_bits(),
             last_z: f64::NAN.to_bits(),
+            y_seen: Vec::new(),
+            y_values: Vec::new(),
         };
         // x-only nodes, evaluated in f64 point by point (after the
         // constants they may use).
@@ -295,8 +307,7 @@ impl RowTape {
     pub fn eval_row(&self, ws: &mut RowWorkspace, y: f64, z: f64, out: &mut [f32]) {
         // Constants were set by `workspace`; z-only and y-only terms only
         // change with z and y (a plane's rows share z).
-        let s = &mut ws.scalars;
-        let mut eval = |nodes: &[u32]| {
+        let eval = |s: &mut [f64], nodes: &[u32]| {
             for &i in nodes {
                 s[i as usize] = match self.ssa.ops[i as usize] {
                     Node::Var(1) => y,
@@ -305,13 +316,30 @@ impl RowTape {
                 };
             }
         };
+        let s = &mut ws.scalars;
         if z.to_bits() != ws.last_z {
-            eval(&self.z_nodes);
+            eval(s, &self.z_nodes);
         }
         if y.to_bits() != ws.last_y {
-            eval(&self.y_nodes);
+            let count = self.y_nodes.len();
+            match ws.y_seen.iter().position(|&b| b == y.to_bits()) {
+                Some(c) => {
+                    let seen = &ws.y_values[c * count..][..count];
+                    for (&i, &v) in self.y_nodes.iter().zip(seen) {
+                        s[i as usize] = v;
+                    }
+                }
+                None => {
+                    eval(s, &self.y_nodes);
+                    if count > 0 && ws.y_seen.len() < Y_CACHE {
+                        ws.y_seen.push(y.to_bits());
+                        ws.y_values
+                            .extend(self.y_nodes.iter().map(|&i| s[i as usize]));
+                    }
+                }
+            }
         }
-        eval(&self.yz_nodes);
+        eval(s, &self.yz_nodes);
         (ws.last_y, ws.last_z) = (y.to_bits(), z.to_bits());
         for (k, terms) in self.shifts.iter().enumerate() {
             for (t, term) in terms.iter().enumerate() {
@@ -493,6 +521,41 @@ fn binary(bin: Binary, o: &mut [f32], a: Opd, b: Opd) {
 mod tests {
     use super::*;
     use crate::implicit::ir::Ctx;
+
+    #[test]
+    fn remembered_y_terms_give_the_bits_of_a_fresh_workspace() {
+        // z outer, y inner, as a block's rows, with more ys than the
+        // workspace remembers: every row as from a workspace of its own.
+        let mut ctx = Ctx::new();
+        let v = [ctx.var(0), ctx.var(1), ctx.var(2)];
+        let six = ctx.constant(6.0);
+        let s: Vec<_> = v.iter().map(|&a| ctx.mul(six, a)).collect();
+        let mut g = ctx.constant(0.0);
+        for k in 0..3 {
+            let sn = ctx.unary(Unary::Sin, s[k]);
+            let cs = ctx.unary(Unary::Cos, s[(k + 1) % 3]);
+            let t = ctx.mul(sn, cs);
+            g = ctx.add(g, t);
+        }
+        let ssa = Ssa::from_ctx(&ctx, g);
+        let tape = RowTape::new(&ssa);
+        assert!(!tape.y_nodes.is_empty());
+        let xs: Vec<f64> = (0..8).map(|i| -0.3 + i as f64 * 0.07).collect();
+        let mut ws = tape.workspace(&xs);
+        let (mut got, mut want) = (vec![0.0f32; 8], vec![0.0f32; 8]);
+        let mut remembered = 0;
+        for k in 0..3 {
+            for j in 0..(Y_CACHE + 3) {
+                let (y, z) = (0.1 * j as f64 - 0.4, 0.05 * k as f64);
+                tape.eval_row(&mut ws, y, z, &mut got);
+                tape.eval_row(&mut tape.workspace(&xs), y, z, &mut want);
+                let bits = |v: &[f32]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+                assert_eq!(bits(&got), bits(&want), "row y {y}, z {z}");
+                remembered = ws.y_seen.len();
+            }
+        }
+        assert_eq!(remembered, Y_CACHE);
+    }
 
     #[test]
     fn rows_match_scalar_evaluation_for_every_dependency_class() {

@@ -80,6 +80,58 @@ pub fn remap(node: Node, map: &[u32]) -> Node {
     }
 }
 
+/// For each node, the index of the later `cos` of its argument when it is a
+/// `sin`, or of the later `sin` when it is a `cos`: the tapes compute such a
+/// pair with one [`Op::SinCos`] at the first of the two. The IR is
+/// hash-consed, so an argument has at most one of each.
+fn sin_cos_partners(ssa: &Ssa) -> Vec<Option<u32>> {
+    let mut partner = vec![None; ssa.ops.len()];
+    let mut seen: std::collections::HashMap<(bool, NodeId), usize> = Default::default();
+    for (i, op) in ssa.ops.iter().enumerate() {
+        let (is_sin, arg) = match *op {
+            Node::Unary(Unary::Sin, a) => (true, a),
+            Node::Unary(Unary::Cos, a) => (false, a),
+            _ => continue,
+        };
+        match seen.get(&(!is_sin, arg)) {
+            Some(&first) if partner[first].is_none() => partner[first] = Some(i as u32),
+            _ => {
+                seen.insert((is_sin, arg), i);
+            }
+        }
+    }
+    partner
+}
+
+/// The instruction computing a node into slot `out`; `second` is the slot
+/// of its sin/cos partner, allocated together with `out` (the pair becomes
+/// one `SinCos`).
+fn instruction(op: &Node, out: u32, slot_of: &[u32], second: Option<u32>) -> Instr {
+    let mut args = children(op);
+    let a = args.next().map_or(out, |c| slot_of[c as usize]);
+    let b = args.next().map_or(a, |c| slot_of[c as usize]);
+    match (op, second) {
+        (Node::Unary(Unary::Sin, _), Some(cos)) => Instr {
+            op: Op::SinCos,
+            out,
+            a,
+            b: cos,
+        },
+        (Node::Unary(Unary::Cos, _), Some(sin)) => Instr {
+            op: Op::SinCos,
+            out: sin,
+            a,
+            b: out,
+        },
+        _ => Instr {
+            op: op_of(op),
+            out,
+            a,
+            b,
+        },
+    }
+}
+
 #[derive(Debug, Clone, Copy, PartialEq)]
 enum Op {
     Unary(Unary),
@@ -89,6 +141,9 @@ enum Op {
     RvOr,
     RAnd(f64),
     ROr(f64),
+    /// sin and cos of the same argument in one pass (`trig::sin_cos_lanes`):
+    /// the sine goes to `out`, the cosine to `b`.
+    SinCos,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -126,6 +181,9 @@ impl Tape {
         let mut consts = Vec::new();
         let mut vars = [None; 3];
         let mut instrs = Vec::new();
+        let partner = sin_cos_partners(ssa);
+        // Nodes already computed by their partner's `SinCos`.
+        let mut paired = vec![false; n];
         // Constants and coordinates get slots of their own, never reused:
         // their values are written before the instructions run.
         let mut alloc = |free: &mut Vec<u32>, fresh: bool| {
@@ -149,21 +207,16 @@ impl Tape {
                     fixed[i] = true;
                     s
                 }
+                _ if paired[i] => slot_of[i],
                 _ => {
                     let s = alloc(&mut free, false);
-                    let mut args = children(op);
-                    let a = args.next().map_or(s, |c| slot_of[c as usize]);
-                    let b = args.next().map_or(a, |c| slot_of[c as usize]);
-                    let op = match *op {
-                        Node::Unary(u, _) => Op::Unary(u),
-                        Node::Binary(bin, _, _) => Op::Binary(bin),
-                        Node::RAnd(_, _, al) if f64::from_bits(al) == 0.0 => Op::RvAnd,
-                        Node::ROr(_, _, al) if f64::from_bits(al) == 0.0 => Op::RvOr,
-                        Node::RAnd(_, _, al) => Op::RAnd(f64::from_bits(al)),
-                        Node::ROr(_, _, al) => Op::ROr(f64::from_bits(al)),
-                        Node::Const(_) | Node::Var(_) => unreachable!("handled above"),
-                    };
-                    instrs.push(Instr { op, out: s, a, b });
+                    let second = partner[i].map(|j| {
+                        let t = alloc(&mut free, false);
+                        slot_of[j as usize] = t;
+                        paired[j as usize] = true;
+                        t
+                    });
+                    instrs.push(instruction(op, s, &slot_of, second));
                     s
                 }
             };
@@ -238,6 +291,10 @@ impl Tape {
 fn run(instrs: &[Instr], buf: &mut [f64], len: usize) {
     {
         for ins in instrs {
+            if matches!(ins.op, Op::SinCos) {
+                sin_cos(buf, ins, len);
+                continue;
+            }
             let (o, a, b) = io(buf, ins.out as usize, ins.a as usize, ins.b as usize);
             let (o, a, b) = (&mut o[..len], &a[..len], &b[..len]);
             match ins.op {
@@ -263,6 +320,7 @@ fn run(instrs: &[Instr], buf: &mut [f64], len: usize) {
                         o[i] = r_or(a[i], b[i], al);
                     }
                 }
+                Op::SinCos => unreachable!("run before `io`"),
             }
         }
     }
@@ -302,6 +360,8 @@ impl AxisTape {
         let mut slot_of = vec![0u32; n];
         let mut free: Vec<u32> = Vec::new();
         let mut slots = 0u32;
+        let partner = sin_cos_partners(ssa);
+        let mut paired = vec![false; n];
         let mut tape = AxisTape {
             axis,
             setup: Vec::new(),
@@ -315,27 +375,32 @@ impl AxisTape {
             // Everything that does not vary along the axis keeps its slot for
             // the whole segment; varying results reuse freed slots.
             let fixed = !varies[i] || matches!(op, Node::Var(_));
-            let out = match if fixed { None } else { free.pop() } {
+            let mut alloc = |free: &mut Vec<u32>| match if fixed { None } else { free.pop() } {
                 Some(s) => s,
                 None => {
                     slots += 1;
                     slots - 1
                 }
             };
-            slot_of[i] = out;
+            if paired[i] {
+                // Computed with its partner (same `varies`: same argument).
+            } else {
+                let out = alloc(&mut free);
+                slot_of[i] = out;
+            }
+            let out = slot_of[i];
             match *op {
                 Node::Const(bits) => tape.consts.push((out, f64::from_bits(bits))),
                 Node::Var(a) => tape.vars[a as usize] = Some(out),
+                _ if paired[i] => {}
                 _ => {
-                    let mut args = children(op);
-                    let a = args.next().map_or(out, |c| slot_of[c as usize]);
-                    let b = args.next().map_or(a, |c| slot_of[c as usize]);
-                    let ins = Instr {
-                        op: op_of(op),
-                        out,
-                        a,
-                        b,
-                    };
+                    let second = partner[i].map(|j| {
+                        let t = alloc(&mut free);
+                        slot_of[j as usize] = t;
+                        paired[j as usize] = true;
+                        t
+                    });
+                    let ins = instruction(op, out, &slot_of, second);
                     if varies[i] {
                         tape.step.push(ins);
                     } else {
@@ -449,6 +514,24 @@ fn io(
     };
     let (a, b) = (pick(a), pick(b));
     (out.try_into().expect("slot is BATCH long"), a, b)
+}
+
+/// A `SinCos` instruction over the first `len` lanes (the allocator gives
+/// it three distinct slots; the argument is copied out first, so the two
+/// outputs are the only borrows of `buf`).
+fn sin_cos(buf: &mut [f64], ins: &Instr, len: usize) {
+    let mut arg = [0.0; BATCH];
+    arg[..len].copy_from_slice(&buf[ins.a as usize * BATCH..][..len]);
+    let (s, c) = (ins.out as usize, ins.b as usize);
+    let (lo, hi) = buf.split_at_mut(s.max(c) * BATCH);
+    let first = &mut lo[s.min(c) * BATCH..][..len];
+    let second = &mut hi[..len];
+    let (sin, cos) = if s < c {
+        (first, second)
+    } else {
+        (second, first)
+    };
+    super::trig::sin_cos_lanes(sin, cos, &arg[..len]);
 }
 
 fn unary(u: Unary, o: &mut [f64], a: &[f64]) {
@@ -622,6 +705,50 @@ mod tests {
                 }
             }
         }
+    }
+
+    #[test]
+    fn a_sine_and_cosine_of_one_argument_are_one_instruction_with_their_own_bits() {
+        // cos before sin, a lone sine, and the pair used after other
+        // operations freed slots: one SinCos, values bit for bit those of
+        // the separate lane functions.
+        let mut ctx = Ctx::new();
+        let (x, y, z) = (ctx.var(0), ctx.var(1), ctx.var(2));
+        let xy = ctx.mul(x, y);
+        let c = ctx.unary(Unary::Cos, xy);
+        let sz = ctx.unary(Unary::Sin, z);
+        let zz = ctx.square(sz);
+        let t = ctx.add(c, zz);
+        let s = ctx.unary(Unary::Sin, xy);
+        let root = ctx.sub(t, s);
+        let ssa = Ssa::from_ctx(&ctx, root);
+        let tape = Tape::new(&ssa);
+        let fused = |ins: &[Instr]| ins.iter().filter(|i| matches!(i.op, Op::SinCos)).count();
+        assert_eq!(fused(&tape.instrs), 1);
+        assert_eq!(tape.len(), 6, "mul, sincos, sin, square, add, sub");
+        let n = 50;
+        let p: [Vec<f64>; 3] =
+            [0.37, 0.11, 0.73].map(|w| (0..n).map(|i| (i as f64 * w).sin() * 3.0).collect());
+        let mut got = vec![0.0; n];
+        tape.eval(&mut tape.workspace(), &p[0], &p[1], &p[2], &mut got);
+        let xy: Vec<f64> = (0..n).map(|i| p[0][i] * p[1][i]).collect();
+        let (mut sin, mut cos, mut sinz) = (vec![0.0; n], vec![0.0; n], vec![0.0; n]);
+        super::super::trig::sin_lanes(&mut sin, &xy);
+        super::super::trig::cos_lanes(&mut cos, &xy);
+        super::super::trig::sin_lanes(&mut sinz, &p[2]);
+        for i in 0..n {
+            let want = (cos[i] + sinz[i] * sinz[i]) - sin[i];
+            assert_eq!(got[i].to_bits(), want.to_bits(), "point {i}");
+        }
+        // The axis tapes too: along z the pair is set up once per segment.
+        let along = AxisTape::new(&ssa, 2);
+        assert_eq!(fused(&along.setup), 1);
+        let mut ws = along.workspace();
+        along.setup(&mut ws, [&p[0], &p[1], &p[2]]);
+        let mut out = vec![0.0; n];
+        along.eval(&mut ws, &p[2], &mut out);
+        let bits = |v: &[f64]| v.iter().map(|x| x.to_bits()).collect::<Vec<_>>();
+        assert_eq!(bits(&out), bits(&got));
     }
 
     #[test]

@@ -59,8 +59,11 @@ pub(super) fn planes_vertices(
 ) -> Vec<PlaneVertices> {
     let n1 = field.n1;
     // All the planes' edges in one list; plane p's are first[p]..first[p + 1].
-    let mut keys = Vec::new();
-    let mut ends: Vec<Ends> = Vec::new();
+    // Sized from the sign bits first: grown push by push, the lists were
+    // copied and their fresh pages faulted in several times over.
+    let total: usize = ks.clone().map(|k| count_crossed(signs, n1, k)).sum();
+    let mut keys = Vec::with_capacity(total);
+    let mut ends: Vec<Ends> = Vec::with_capacity(total);
     let mut first = Vec::with_capacity(ks.len() + 1);
     for k in ks.clone() {
         first.push(keys.len());
@@ -81,6 +84,31 @@ pub(super) fn planes_vertices(
         .collect()
 }
 
+/// The crossed x, y and z edges of word w of row j in plane k, as bit masks
+/// over the row's samples (bits past the row are 0).
+#[inline]
+fn crossed_words(signs: &SignRows, n1: [usize; 3], j: usize, k: usize, w: usize) -> [u64; 3] {
+    let r = signs.row(j, k);
+    let ry = (j + 1 < n1[1]).then(|| signs.row(j + 1, k));
+    let rz = (k + 1 < n1[2]).then(|| signs.row(j, k + 1));
+    [
+        (r[w] ^ signs::shifted(r, w)) & signs::low_bits(n1[0] - 1, w),
+        ry.map_or(0, |q| r[w] ^ q[w]),
+        rz.map_or(0, |q| r[w] ^ q[w]),
+    ]
+}
+
+/// The number of crossed edges whose lower end lies in plane k.
+fn count_crossed(signs: &SignRows, n1: [usize; 3], k: usize) -> usize {
+    (0..n1[1])
+        .flat_map(|j| (0..signs.words).map(move |w| (j, w)))
+        .map(|(j, w)| {
+            let c = crossed_words(signs, n1, j, k, w);
+            (c[0].count_ones() + c[1].count_ones() + c[2].count_ones()) as usize
+        })
+        .sum()
+}
+
 /// Appends plane k's crossed edges (keys ascending) and their end samples.
 fn crossed_edges(
     field: &Field,
@@ -93,16 +121,9 @@ fn crossed_edges(
     let n1 = field.n1;
     for j in 0..n1[1] {
         // Crossed edges from the sign bits: x edges within the row, y and z
-        // edges against the next row and plane (bits past the row are 0).
-        let r = signs.row(j, k);
-        let ry = (j + 1 < n1[1]).then(|| signs.row(j + 1, k));
-        let rz = (k + 1 < n1[2]).then(|| signs.row(j, k + 1));
+        // edges against the next row and plane.
         for w in 0..signs.words {
-            let crossed = [
-                (r[w] ^ signs::shifted(r, w)) & signs::low_bits(n1[0] - 1, w),
-                ry.map_or(0, |q| r[w] ^ q[w]),
-                rz.map_or(0, |q| r[w] ^ q[w]),
-            ];
+            let crossed = crossed_words(signs, n1, j, k, w);
             for i in signs::bits(crossed[0] | crossed[1] | crossed[2], w) {
                 let v0 = field.value(i, j, k) as f64;
                 let bit = 1u64 << (i % 64);
@@ -153,48 +174,41 @@ fn refine_by_kernel(
     let layers = ks.start / BS..last / BS + 1;
     let per_layer = nb[0] * nb[1];
     let blocks = &field.blocks[layers.start * per_layer..layers.end * per_layer];
-    // Each edge's kernel, `none` for edges of proven blocks (their linear
+    // Each edge's bucket, kernel id · 3 + axis (the axis tapes take one
+    // axis at a time), `none` for edges of proven blocks (their linear
     // guess stays).
-    let none = field.kernels.len() as u32;
-    let mut kernel_of = Vec::with_capacity(keys.len());
+    let none = field.kernels.len() as u32 * 3;
+    let mut bucket_of = Vec::with_capacity(keys.len());
     for (p, k) in ks.clone().enumerate() {
         let layer = (k / BS - layers.start) * per_layer;
-        kernel_of.extend(keys[first[p]..first[p + 1]].iter().map(|&key| {
-            let key = key as usize / 3;
+        bucket_of.extend(keys[first[p]..first[p + 1]].iter().map(|&key| {
+            let (key, axis) = (key as usize / 3, key % 3);
             let b = layer + (key / n1[0] / BS) * nb[0] + (key % n1[0]) / BS;
             match &blocks[b] {
-                Block::Mixed(kernel) => kernel.id,
+                Block::Mixed(kernel) => kernel.id * 3 + axis,
                 _ => none,
             }
         }));
     }
-    let mut start = vec![0u32; field.kernels.len() + 2];
-    for &id in &kernel_of {
+    let mut start = vec![0u32; none as usize + 2];
+    for &id in &bucket_of {
         start[id as usize + 1] += 1;
     }
-    for id in 0..=field.kernels.len() {
+    for id in 0..=none as usize {
         start[id + 1] += start[id];
     }
     let mut order = vec![0usize; keys.len()];
     let mut next = start.clone();
-    for (e, &id) in kernel_of.iter().enumerate() {
+    for (e, &id) in bucket_of.iter().enumerate() {
         order[next[id as usize] as usize] = e;
         next[id as usize] += 1;
     }
-    let (mut ws, mut group) = (Workspace::default(), Vec::new());
+    let mut ws = Workspace::default();
     for (id, kernel) in field.kernels.iter().enumerate() {
-        let edges = &order[start[id] as usize..start[id + 1] as usize];
-        if !edges.is_empty() {
-            refine(
-                kernel,
-                &mut ws,
-                &mut group,
-                keys,
-                edges,
-                ends,
-                t,
-                options.iterations,
-            );
+        let axes: [&[usize]; 3] =
+            [0, 1, 2].map(|a| &order[start[id * 3 + a] as usize..start[id * 3 + a + 1] as usize]);
+        if axes.iter().any(|e| !e.is_empty()) {
+            refine(kernel, &mut ws, axes, ends, t, options.iterations);
         }
     }
 }
@@ -251,26 +265,25 @@ fn finish(n1: [usize; 3], k: usize, keys: &[u32], ends: &[Ends], t: &[f64]) -> P
     }
 }
 
-/// Refines one block's crossed edges (`edges` index `keys` and `ends`).
-/// Edges are grouped by axis and evaluated on the block's axis tapes, so the
-/// terms constant along an edge are computed once per edge instead of at
-/// every step; the values, and so the vertices, are bit-identical to the
-/// plain tape's. Coordinates that `p + 0.0` would change (−0.0, NaN) or that
-/// are infinite take the plain tape.
-#[allow(clippy::too_many_arguments)] // scratch buffers reused across blocks
+/// Refines one kernel's crossed edges (`axes[a]`: those along axis a,
+/// indices into `ends` and `t`). Edges are evaluated on the kernel's axis
+/// tapes, so the terms constant along an edge are computed once per edge
+/// instead of at every step; the values, and so the vertices, are
+/// bit-identical to the plain tape's. Coordinates that `p + 0.0` would
+/// change (−0.0, NaN) or that are infinite take the plain tape.
 fn refine(
     kernel: &Kernel,
     ws: &mut Workspace,
-    group: &mut Vec<usize>,
-    keys: &[u32],
-    edges: &[usize],
+    axes: [&[usize]; 3],
     ends: &[Ends],
     t: &mut [f64],
     iterations: usize,
 ) {
     let plain = |c: f64| c.is_finite() && (c + 0.0).to_bits() == c.to_bits();
-    if !edges.iter().all(|&e| ends[e].0.iter().all(|&c| plain(c))) {
+    let all = || axes.iter().flat_map(|e| e.iter());
+    if !all().all(|&e| ends[e].0.iter().all(|&c| plain(c))) {
         let mut ws = kernel.tape.workspace();
+        let edges: Vec<usize> = all().copied().collect();
         for chunk in edges.chunks(BATCH) {
             let eval_at = |s: &[f64], out: &mut [f64]| {
                 let [xs, ys, zs] = [0, 1, 2].map(|a| {
@@ -291,25 +304,26 @@ fn refine(
     // Scratch reused by every chunk (zeroing fresh 1 kB arrays per call cost
     // as much as a short batch's arithmetic).
     let (mut fixed, mut coord) = ([[0.0; BATCH]; 3], [0.0; BATCH]);
-    for (axis, along) in kernel.along.iter().enumerate() {
-        group.clear();
-        group.extend(edges.iter().filter(|&&e| keys[e] as usize % 3 == axis));
+    let (mut base, mut span) = ([0.0; BATCH], [0.0; BATCH]);
+    for (axis, (along, group)) in kernel.along.iter().zip(axes).enumerate() {
         if group.is_empty() {
             continue;
         }
         along.prepare(ws, group.len().min(BATCH));
         for chunk in group.chunks(BATCH) {
             let n = chunk.len();
-            for (b, fixed) in fixed.iter_mut().enumerate() {
-                for (c, &e) in fixed.iter_mut().zip(chunk) {
-                    *c = ends[e].0[b];
+            for (m, &e) in chunk.iter().enumerate() {
+                let (p0, p1, _, _) = ends[e];
+                for (b, fixed) in fixed.iter_mut().enumerate() {
+                    fixed[m] = p0[b];
                 }
+                // The point at s is base + s · span, as p0 + s · (p1 − p0).
+                (base[m], span[m]) = (p0[axis], p1[axis] - p0[axis]);
             }
             along.setup(ws, [&fixed[0][..n], &fixed[1][..n], &fixed[2][..n]]);
             let eval_at = |s: &[f64], out: &mut [f64]| {
-                for ((c, &e), &s) in coord.iter_mut().zip(chunk).zip(s) {
-                    let (p0, p1, _, _) = ends[e];
-                    *c = p0[axis] + s * (p1[axis] - p0[axis]);
+                for m in 0..s.len() {
+                    coord[m] = base[m] + s[m] * span[m];
                 }
                 along.eval(ws, &coord[..n], out);
             };
@@ -342,7 +356,8 @@ fn illinois(
             && (fr[m] > 0.0) == (v1 > 0.0)
             && (fl[m] > 0.0) != (fr[m] > 0.0);
     }
-    let mut side = [0i8; BATCH];
+    // The side each lane's last step replaced: −1 left, 1 right, 0 none yet.
+    let mut side = [0.0; BATCH];
     let mut s = [0.0; BATCH];
     for m in 0..n {
         s[m] = t[edges[m]];
@@ -361,22 +376,18 @@ fn illinois(
             };
         }
         eval_at(&s[..n], &mut fs[..n]);
+        // Selects, not branches (the side taken is data, about a coin flip
+        // per lane): the step replaces the end of f's sign and halves the
+        // other end's value when that end was kept twice in a row.
         for m in 0..n {
-            if (fs[m] > 0.0) == (fl[m] > 0.0) {
-                tl[m] = s[m];
-                fl[m] = fs[m];
-                if side[m] == -1 {
-                    fr[m] *= 0.5;
-                }
-                side[m] = -1;
-            } else {
-                tr[m] = s[m];
-                fr[m] = fs[m];
-                if side[m] == 1 {
-                    fl[m] *= 0.5;
-                }
-                side[m] = 1;
-            }
+            let left = (fs[m] > 0.0) == (fl[m] > 0.0);
+            let halved_l = if side[m] == 1.0 { fl[m] * 0.5 } else { fl[m] };
+            let halved_r = if side[m] == -1.0 { fr[m] * 0.5 } else { fr[m] };
+            tl[m] = if left { s[m] } else { tl[m] };
+            tr[m] = if left { tr[m] } else { s[m] };
+            fl[m] = if left { fs[m] } else { halved_l };
+            fr[m] = if left { halved_r } else { fs[m] };
+            side[m] = if left { -1.0 } else { 1.0 };
         }
     }
     for m in 0..n {
