@@ -246,6 +246,23 @@ impl Ctx {
     }
 }
 
+/// The gyroid sin 6x cos 6y + sin 6y cos 6z + sin 6z cos 6x (the surface of
+/// PERF-ANCHORS.md's M2), for the evaluators' tests.
+#[cfg(test)]
+pub(crate) fn gyroid(ctx: &mut Ctx) -> NodeId {
+    let v = [ctx.var(0), ctx.var(1), ctx.var(2)];
+    let six = ctx.constant(6.0);
+    let s: Vec<NodeId> = v.iter().map(|&a| ctx.mul(six, a)).collect();
+    let mut g = ctx.constant(0.0);
+    for k in 0..3 {
+        let sn = ctx.unary(Unary::Sin, s[k]);
+        let cs = ctx.unary(Unary::Cos, s[(k + 1) % 3]);
+        let t = ctx.mul(sn, cs);
+        g = ctx.add(g, t);
+    }
+    g
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -520,23 +520,14 @@ fn binary(bin: Binary, o: &mut [f32], a: Opd, b: Opd) {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::implicit::ir::Ctx;
+    use crate::implicit::ir::{Ctx, gyroid};
 
     #[test]
     fn remembered_y_terms_give_the_bits_of_a_fresh_workspace() {
         // z outer, y inner, as a block's rows, with more ys than the
         // workspace remembers: every row as from a workspace of its own.
         let mut ctx = Ctx::new();
-        let v = [ctx.var(0), ctx.var(1), ctx.var(2)];
-        let six = ctx.constant(6.0);
-        let s: Vec<_> = v.iter().map(|&a| ctx.mul(six, a)).collect();
-        let mut g = ctx.constant(0.0);
-        for k in 0..3 {
-            let sn = ctx.unary(Unary::Sin, s[k]);
-            let cs = ctx.unary(Unary::Cos, s[(k + 1) % 3]);
-            let t = ctx.mul(sn, cs);
-            g = ctx.add(g, t);
-        }
+        let g = gyroid(&mut ctx);
         let ssa = Ssa::from_ctx(&ctx, g);
         let tape = RowTape::new(&ssa);
         assert!(!tape.y_nodes.is_empty());

@@ -575,6 +575,7 @@ fn binary(bin: Binary, o: &mut [f64], a: &[f64], b: &[f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::implicit::ir::gyroid;
 
     #[test]
     fn tape_matches_scalar_evaluation() {
@@ -646,16 +647,8 @@ mod tests {
     /// PERF-ANCHORS.md's M2: min(0.04 − g², 0.81 − |p|²), g the gyroid.
     fn gyroid_in_ball() -> (Ctx, NodeId) {
         let mut ctx = Ctx::new();
+        let g = gyroid(&mut ctx);
         let v = [ctx.var(0), ctx.var(1), ctx.var(2)];
-        let six = ctx.constant(6.0);
-        let s: Vec<NodeId> = v.iter().map(|&a| ctx.mul(six, a)).collect();
-        let mut g = ctx.constant(0.0);
-        for k in 0..3 {
-            let sn = ctx.unary(Unary::Sin, s[k]);
-            let cs = ctx.unary(Unary::Cos, s[(k + 1) % 3]);
-            let t = ctx.mul(sn, cs);
-            g = ctx.add(g, t);
-        }
         let gg = ctx.square(g);
         let c = ctx.constant(0.04);
         let shell = ctx.sub(c, gg);

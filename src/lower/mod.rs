@@ -5,6 +5,7 @@
 
 mod booleans;
 mod brep;
+mod edge_parts;
 mod explicit;
 mod isolation;
 mod point_calculus;

@@ -11,9 +11,10 @@
 //! chordal tolerance); an end at a kernel vertex, or at another run's end,
 //! becomes that vertex.
 
+use super::edge_parts::EdgeParts;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::geom::{Curve, Point3, Vec3};
-use crate::ir::{Edge, EdgeId, FaceId, Model, OrientedEdge, SourceMap, SubdomainId, VertexId};
+use crate::ir::{EdgeId, FaceId, Model, OrientedEdge, SourceMap, SubdomainId, VertexId};
 use std::collections::{BTreeMap, BTreeSet};
 use std::f64::consts::TAU;
 
@@ -152,31 +153,12 @@ pub(super) fn share_arcs(
     diags: &mut Diagnostics,
 ) -> BTreeSet<(usize, usize)> {
     let mut reported = BTreeSet::new();
-    let kernel_faces: Vec<(usize, FaceId)> = (0..first_region)
-        .filter_map(|k| super::region_interfaces::face_of(model, k).map(|f| (k, f)))
-        .collect();
     let region_faces: Vec<(usize, FaceId)> = (first_region..model.subdomains.len())
         .filter_map(|r| super::region_interfaces::face_of(model, r).map(|f| (r, f)))
         .collect();
-    let region_edges: BTreeSet<EdgeId> = region_faces
-        .iter()
-        .flat_map(|&(_, f)| {
-            model.faces[f.index()]
-                .loops
-                .edges()
-                .iter()
-                .map(|oe| oe.edge)
-        })
-        .collect();
-    let arcs: Vec<(EdgeId, Arc)> = kernel_faces
-        .iter()
-        .flat_map(|&(_, f)| {
-            model.faces[f.index()]
-                .loops
-                .edges()
-                .iter()
-                .map(|oe| oe.edge)
-        })
+    let region_edges: BTreeSet<EdgeId> =
+        super::region_interfaces::face_edges(model, first_region..model.subdomains.len()).collect();
+    let arcs: Vec<(EdgeId, Arc)> = super::region_interfaces::face_edges(model, 0..first_region)
         .filter(|e| !region_edges.contains(e))
         .collect::<BTreeSet<EdgeId>>()
         .into_iter()
@@ -443,15 +425,13 @@ fn split_arc(
     arc: &Arc,
     cuts: &[(f64, VertexId)],
 ) -> Vec<OrientedEdge> {
-    let name = model.edge(ke).name.clone();
-    let origin = source_map.edges.get(&ke).copied();
     let (b, e) = (model.edge(ke).begin, model.edge(ke).end);
     let mut stops = vec![(0.0, b)];
     stops.extend(cuts.iter().copied());
     stops.push((arc.span, e));
+    let mut parts = EdgeParts::new(model, ke);
     let mut out = Vec::with_capacity(stops.len() - 1);
-    let mut added = Vec::new();
-    for (k, w) in stops.windows(2).enumerate() {
+    for w in stops.windows(2) {
         let curve = Curve::Ellipse {
             center: arc.center,
             major: arc.major,
@@ -459,34 +439,12 @@ fn split_arc(
             t0: arc.t0 + w[0].0,
             t1: arc.t0 + w[1].0,
         };
-        let id = if k == 0 {
-            let edge = &mut model.edges[ke.index()];
-            (edge.curve, edge.begin, edge.end) = (curve, w[0].1, w[1].1);
-            ke
-        } else {
-            let id = EdgeId(model.edges.len() as u32);
-            model.edges.push(Edge {
-                name: format!("{name}.{}", k + 1).into(),
-                curve,
-                begin: w[0].1,
-                end: w[1].1,
-            });
-            if let Some(o) = origin {
-                source_map.edges.insert(id, o);
-            }
-            added.push(id);
-            id
-        };
         out.push(OrientedEdge {
-            edge: id,
+            edge: parts.push(model, source_map, curve, w[0].1, w[1].1),
             forward: true,
         });
     }
-    for boundary in &mut model.boundaries {
-        if boundary.edges.contains(&ke) {
-            boundary.edges.extend(added.iter().copied());
-        }
-    }
+    parts.finish(model);
     out
 }
 

@@ -14,12 +14,12 @@
 //! Anything else that touches is E543 (the interface would have hanging
 //! nodes) and an overlap is E407, as for kernel subdomains.
 
+use super::edge_parts::EdgeParts;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::geom::{Curve, Point3};
 use crate::implicit::xml::Carve;
 use crate::ir::{
-    Edge, EdgeId, FaceId, Loops, Model, OrientedEdge, SourceMap, SubdomainCells, SubdomainId,
-    VertexId,
+    EdgeId, FaceId, Loops, Model, OrientedEdge, SourceMap, SubdomainCells, SubdomainId, VertexId,
 };
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -53,7 +53,7 @@ pub fn join(
 }
 
 /// The edges of the faces of subdomains `subdomains` (2D: one face each).
-fn face_edges(
+pub(super) fn face_edges(
     model: &Model,
     subdomains: std::ops::Range<usize>,
 ) -> impl Iterator<Item = EdgeId> + '_ {
@@ -405,11 +405,8 @@ fn split_edge(
     ke: EdgeId,
     chain: &[Piece],
 ) -> Vec<OrientedEdge> {
-    let name = model.edge(ke).name.clone();
-    let origin = source_map.edges.get(&ke).copied();
+    let mut parts = EdgeParts::new(model, ke);
     let mut out = Vec::with_capacity(chain.len());
-    let mut added = Vec::new();
-    let mut gaps = 0;
     for piece in chain {
         match *piece {
             Piece::Shared(oe) => out.push(oe),
@@ -418,37 +415,14 @@ fn split_edge(
                     a: model.vertex(from).position,
                     b: model.vertex(to).position,
                 };
-                gaps += 1;
-                let id = if gaps == 1 {
-                    let edge = &mut model.edges[ke.index()];
-                    (edge.curve, edge.begin, edge.end) = (curve, from, to);
-                    ke
-                } else {
-                    let id = EdgeId(model.edges.len() as u32);
-                    model.edges.push(Edge {
-                        name: format!("{name}.{gaps}").into(),
-                        curve,
-                        begin: from,
-                        end: to,
-                    });
-                    if let Some(o) = origin {
-                        source_map.edges.insert(id, o);
-                    }
-                    added.push(id);
-                    id
-                };
                 out.push(OrientedEdge {
-                    edge: id,
+                    edge: parts.push(model, source_map, curve, from, to),
                     forward: true,
                 });
             }
         }
     }
-    for boundary in &mut model.boundaries {
-        if boundary.edges.contains(&ke) {
-            boundary.edges.extend(added.iter().copied());
-        }
-    }
+    parts.finish(model);
     out
 }
 
