@@ -1,9 +1,10 @@
 //! Issue 6: 2D R-function regions whose contour runs along a curved kernel
 //! edge (a material patch against the outer circle or a hole, a coating
-//! around a kernel disk). The run of contour pieces is replaced by the kernel
-//! arc, split at the run's ends, so both faces use one set of edges: the
-//! meshes share their nodes there and every node on the arc lies on the true
-//! circle. Checked on areas (against closed forms, and the subdomains
+//! around a kernel disk) or a straight one that is no side of the region's
+//! box (a patch against a triangle's slanted side, a neighbour on a side).
+//! The run of contour pieces is replaced by the kernel arc or segment, split
+//! at the run's ends, so both faces use one set of edges: the meshes share
+//! their nodes there and every node on it lies on the true curve. Checked on areas (against closed forms, and the subdomains
 //! summing to the domain), the interface's nodes in both subdomains'
 //! triangles, the minimum angle, the fragments, the MSH groups as gmsh and
 //! meshio read them, and a scikit-fem solve whose flux is continuous across
@@ -57,6 +58,18 @@ const COAT: &str = r#"<geometry version="1" dimension="2">
   </rfunction>
   <subdomain name="core"><solid ref="core_disk"/></subdomain>
   <subdomain name="coat"><solid ref="coat"/></subdomain>
+</geometry>"#;
+
+/// A triangle with the slanted side x + y = 2 and a half-disk patch of
+/// radius 0.5 about (1, 1) on that side, carved from it: the patch's
+/// contour runs along a straight kernel edge that is no side of its box.
+const SLANT: &str = r#"<geometry version="1" dimension="2">
+  <triangle name="tri"><vertex x="0" y="0"/><vertex x="2" y="0"/><vertex x="0" y="2"/></triangle>
+  <rfunction name="patch" nx="40" ny="40" x_min="0.4" x_max="1.6" y_min="0.4" y_max="1.6">
+    <intersection> <disk r="0.5" x0="1" y0="1"/> <formula value="2 - x - y"/> </intersection>
+  </rfunction>
+  <subdomain name="plate"><difference><solid ref="tri"/><solid ref="patch"/></difference></subdomain>
+  <subdomain name="patch"><solid ref="patch"/></subdomain>
 </geometry>"#;
 
 fn mesh(xml: &str, max_area: f64) -> Mesh {
@@ -402,5 +415,176 @@ fn a_region_on_a_kernel_disk_without_a_carve_is_an_overlap() {
             .starts_with("region 'coat' and subdomain 'core' overlap at ("),
         "{}",
         found[0].message
+    );
+}
+
+/// How far p is from the line x + y = 2.
+fn off_slant(p: [f64; 3]) -> f64 {
+    (p[0] + p[1] - 2.0).abs() / 2f64.sqrt()
+}
+
+#[test]
+fn patch_against_a_slanted_straight_side_shares_the_split_side() {
+    let m = mesh(SLANT, 0.01);
+    assert_eq!(
+        fragment_names(&m),
+        BTreeSet::from(["plate|exterior", "plate|patch", "patch|exterior"])
+    );
+    // The patch's outer boundary is a piece of the triangle's slanted side,
+    // between the circle's points (1 ± √0.125, 1 ∓ √0.125).
+    let side = fragment_segments(&m, "patch|exterior");
+    let half = 0.125f64.sqrt();
+    let xs: Vec<f64> = side
+        .iter()
+        .flatten()
+        .map(|&n| {
+            let p = m.nodes[n as usize];
+            assert!(off_slant(p) < 1e-12, "side node off x + y = 2: {p:?}");
+            p[0]
+        })
+        .collect();
+    let (lo, hi) = xs
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
+            (l.min(x), h.max(x))
+        });
+    // The ends are the contour's cut corners restored by extending its last
+    // chord to the side: off the circle by about that chord's sagitta.
+    assert!(
+        (lo - (1.0 - half)).abs() < 1e-4 && (hi - (1.0 + half)).abs() < 1e-4,
+        "{lo}..{hi}"
+    );
+    // The interface: the half circle, an open chain ending on the side.
+    let nodes = assert_conforming(&m, "plate|patch", "plate", "patch");
+    let interface = fragment_segments(&m, "plate|patch");
+    assert_eq!(interface.len() + 1, nodes);
+    let on_side: BTreeSet<u32> = side.iter().flatten().copied().collect();
+    let ends: BTreeSet<u32> = interface
+        .iter()
+        .flatten()
+        .copied()
+        .filter(|n| on_side.contains(n))
+        .collect();
+    assert_eq!(ends.len(), 2, "interface ends on the side: {ends:?}");
+    for &n in &ends {
+        let p = m.nodes[n as usize];
+        assert!(((p[0] - 1.0).abs() - half).abs() < 1e-4, "end {p:?}");
+        assert!(off_slant(p) < 1e-12, "end off the side: {p:?}");
+    }
+    for &n in interface.iter().flatten() {
+        let p = m.nodes[n as usize];
+        let r = (p[0] - 1.0).hypot(p[1] - 1.0);
+        assert!((r - 0.5).abs() < 1e-3, "interface node {p:?}, r = {r}");
+    }
+    let (patch, plate) = (
+        area(&m, &triangles_of(&m, "patch")),
+        area(&m, &triangles_of(&m, "plate")),
+    );
+    let exact = PI * 0.25 / 2.0;
+    assert!((patch - exact).abs() / exact < 2e-3, "patch area {patch}");
+    // The triangle's sides are straight: the two fill its area exactly.
+    assert!((patch + plate - 2.0).abs() < 1e-12, "{}", patch + plate);
+    assert_min_angle(&m);
+}
+
+#[test]
+fn msh_of_a_patch_against_a_slanted_side_keeps_its_groups_for_gmsh_and_meshio() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let msh = compile(SLANT, dir.path(), "slant", "0.01");
+    let expected = mesh(SLANT, 0.01);
+    let r = python("check_mesh.py", &[&msh], &[]);
+    for group in ["plate|patch", "patch|exterior", "plate|exterior"] {
+        let lines = fragment_segments(&expected, group).len() as u64;
+        assert!(lines > 0, "{group}");
+        assert_eq!(gmsh_group(&r, group)["elements"]["line"], lines, "{group}");
+        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
+    }
+    for sub in ["plate", "patch"] {
+        assert_eq!(
+            gmsh_group(&r, sub)["elements"]["triangle"],
+            triangles_of(&expected, sub).len() as u64
+        );
+    }
+}
+
+/// The unit square and a half disk of radius 0.3 outside it against its
+/// side x = 1, neighbours without a carve; the region's box starts at
+/// x = 0.5, so the shared piece is a run of its contour, not a box side.
+const CAP: &str = r#"<geometry version="1" dimension="2">
+  <rectangle name="sq"><first_point x="0" y="0"/><second_point x="1" y="1"/></rectangle>
+  <rfunction name="cap" nx="40" ny="40" x_min="0.5" x_max="1.5" y_min="0" y_max="1">
+    <intersection> <disk r="0.3" x0="1" y0="0.5"/> <formula value="x - 1"/> </intersection>
+  </rfunction>
+  <subdomain name="plate"><solid ref="sq"/></subdomain>
+  <subdomain name="cap"><solid ref="cap"/></subdomain>
+</geometry>"#;
+
+#[test]
+fn neighbour_along_a_straight_side_shares_the_split_side() {
+    let m = mesh(CAP, 0.01);
+    assert_eq!(
+        fragment_names(&m),
+        BTreeSet::from(["plate|exterior", "plate|cap", "cap|exterior"])
+    );
+    let nodes = assert_conforming(&m, "plate|cap", "plate", "cap");
+    let interface = fragment_segments(&m, "plate|cap");
+    assert_eq!(interface.len() + 1, nodes);
+    let ys: Vec<f64> = interface
+        .iter()
+        .flatten()
+        .map(|&n| {
+            let p = m.nodes[n as usize];
+            assert!(
+                (p[0] - 1.0).abs() < 1e-12,
+                "interface node off x = 1: {p:?}"
+            );
+            p[1]
+        })
+        .collect();
+    let (lo, hi) = ys
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &y| {
+            (l.min(y), h.max(y))
+        });
+    // Ends near (1, 0.2) and (1, 0.8): at y = 0.8 the corner falls on a
+    // grid node, marching squares cut it with a chord across one cell
+    // (0.025) that the contour splits in two, so following its last chord
+    // back leads to the chord's own end, one cell short.
+    assert!(
+        (lo - 0.2).abs() < 1e-3 && (hi - 0.8).abs() <= 0.025 + 1e-9,
+        "{lo}..{hi}"
+    );
+    // The square keeps its whole area; the cap is about half the disk.
+    let plate = area(&m, &triangles_of(&m, "plate"));
+    assert!((plate - 1.0).abs() < 1e-12, "plate area {plate}");
+    let cap = area(&m, &triangles_of(&m, "cap"));
+    let exact = PI * 0.09 / 2.0;
+    // Short of the half disk by about the cut corner's triangle, ½·0.025².
+    let corner = 0.5 * 0.025 * 0.025;
+    assert!((cap - exact).abs() < corner + 1e-4, "cap area {cap}");
+    assert_min_angle(&m);
+}
+
+#[test]
+fn contour_going_on_past_the_end_of_a_straight_edge_is_refused() {
+    // The cap about the square's corner (1, 1): its contour follows x = 1
+    // beyond the side's end, where the square's corner would hang.
+    let xml = CAP
+        .replace(r#"y0="0.5""#, r#"y0="1""#)
+        .replace(r#"y_max="1""#, r#"y_max="1.5""#);
+    let touching: Vec<_> = diagnostics(&xml)
+        .into_iter()
+        .filter(|d| d.code == geomc::diag::Code::RegionTouches)
+        .collect();
+    assert_eq!(touching.len(), 1, "{touching:#?}");
+    let d = &touching[0];
+    assert!(
+        d.message
+            .starts_with("region 'cap' runs along the straight edge 'sq.e2' from (1.000000, ")
+            && d.message.ends_with(
+                "past its end; a contour on a straight kernel edge must stay within that one edge"
+            ),
+        "{}",
+        d.message
     );
 }

@@ -1,12 +1,14 @@
-//! Region contours on curved kernel edges (issue 6): where a 2D R-function
+//! Region contours on kernel curves (issue 6): where a 2D R-function
 //! region's contour runs along a kernel circle or ellipse arc (a material
-//! patch against a hole or the outer circle, a coating around a disk), that
-//! run of contour pieces is replaced by the kernel arc itself, split at the
-//! run's ends. Both faces then use the same arc edges, so their meshes share
-//! the nodes, and the mesher puts every new node on the true curve (the arc),
-//! not on the traced contour. The run's own vertices and pieces are dropped.
+//! patch against a hole or the outer circle, a coating around a disk) or
+//! along a straight kernel edge (a patch against a triangle's slanted side),
+//! that run of contour pieces is replaced by the kernel edge itself, split at
+//! the run's ends. Both faces then use the same edges, so their meshes share
+//! the nodes, and the mesher puts every new node on the true curve, not on
+//! the traced contour. The run's own vertices and pieces are dropped. Box
+//! sides on a straight kernel edge are left to `region_interfaces`' split.
 //!
-//! A run's end is the last contour vertex on the arc, moved onto it exactly
+//! A run's end is the last contour vertex on the kernel curve, moved onto it exactly
 //! (marching squares cut a corner of the contour there by at most its
 //! chordal tolerance); an end at a kernel vertex, or at another run's end,
 //! becomes that vertex.
@@ -18,7 +20,7 @@ use crate::ir::{EdgeId, FaceId, Model, OrientedEdge, SourceMap, SubdomainId, Ver
 use std::collections::{BTreeMap, BTreeSet};
 use std::f64::consts::TAU;
 
-/// How far a contour vertex may be from an arc to count as on it, as a
+/// How far a contour vertex may be from a kernel curve to count as on it, as a
 /// fraction of the region's extent: the traced points lie on f = 0 to root
 /// finding's precision, far inside the contour's chordal tolerance (5e-4).
 const ON_ARC_FRACTION: f64 = 1e-6;
@@ -34,8 +36,24 @@ struct Arc {
     span: f64,
 }
 
-impl Arc {
-    fn of(curve: &Curve) -> Option<Arc> {
+/// A straight kernel edge: from + direction·u for u from 0 to `length`
+/// (`direction` a unit vector, so u is the distance along the edge).
+#[derive(Clone, Copy)]
+struct Line {
+    from: Point3,
+    direction: Vec3,
+    length: f64,
+}
+
+/// The kernel curve a region's contour may run along.
+#[derive(Clone, Copy)]
+enum KernelCurve {
+    Arc(Arc),
+    Line(Line),
+}
+
+impl KernelCurve {
+    fn of(curve: &Curve) -> Option<KernelCurve> {
         match *curve {
             Curve::Ellipse {
                 center,
@@ -43,17 +61,106 @@ impl Arc {
                 minor,
                 t0,
                 t1,
-            } => Some(Arc {
+            } => Some(KernelCurve::Arc(Arc {
                 center,
                 major,
                 minor,
                 t0,
                 span: t1 - t0,
-            }),
+            })),
+            Curve::Segment { a, b } => {
+                let length = (b - a).norm();
+                (length > 0.0).then(|| {
+                    KernelCurve::Line(Line {
+                        from: a,
+                        direction: (b - a) / length,
+                        length,
+                    })
+                })
+            }
             _ => None,
         }
     }
 
+    fn is_line(&self) -> bool {
+        matches!(self, KernelCurve::Line(_))
+    }
+
+    fn span(&self) -> f64 {
+        match self {
+            KernelCurve::Arc(a) => a.span,
+            KernelCurve::Line(l) => l.length,
+        }
+    }
+
+    fn point(&self, u: f64) -> Point3 {
+        match self {
+            KernelCurve::Arc(a) => a.point(u),
+            KernelCurve::Line(l) => l.from + l.direction * u,
+        }
+    }
+
+    fn tangent(&self, u: f64) -> Vec3 {
+        match self {
+            KernelCurve::Arc(a) => a.tangent(u),
+            KernelCurve::Line(l) => l.direction,
+        }
+    }
+
+    fn parameter(&self, p: &Point3) -> f64 {
+        match self {
+            KernelCurve::Arc(a) => a.parameter(p),
+            KernelCurve::Line(l) => (p - l.from).dot(&l.direction),
+        }
+    }
+
+    /// Where the contour leaving the curve at `a` towards `b` and `c` really
+    /// meets it: marching squares cut that corner off with the chord a → b,
+    /// so the line c → b is followed back to the curve. None when that point
+    /// is not near `a` (the contour leaves the curve smoothly).
+    fn corner(&self, a: Point3, b: Point3, c: Point3) -> Option<Point3> {
+        let x = match self {
+            KernelCurve::Arc(arc) => arc.corner(b, c)?,
+            // Kept on the edge: a corner past its end is at that end.
+            KernelCurve::Line(line) => {
+                self.point(self.parameter(&line.corner(b, c)?).clamp(0.0, line.length))
+            }
+        };
+        // Within a few chords of a: the same corner.
+        ((x - a).norm() <= 2.0 * (b - a).norm()).then_some(x)
+    }
+
+    /// The parameter of p if p lies on the curve within `tol`.
+    fn on(&self, p: &Point3, tol: f64) -> Option<f64> {
+        let (u, reach) = match self {
+            KernelCurve::Arc(a) => a.unwrapped(p, tol),
+            KernelCurve::Line(_) => (self.parameter(p), tol),
+        };
+        ((-reach..=self.span() + reach).contains(&u) && (self.point(u) - p).norm() <= tol)
+            .then_some(u.clamp(0.0, self.span()))
+    }
+
+    /// The kernel edge's piece between parameters u0 and u1, whose end
+    /// vertices are at `ends`.
+    fn piece(&self, u0: f64, u1: f64, ends: (Point3, Point3)) -> Curve {
+        match self {
+            KernelCurve::Arc(arc) => Curve::Ellipse {
+                center: arc.center,
+                major: arc.major,
+                minor: arc.minor,
+                t0: arc.t0 + u0,
+                t1: arc.t0 + u1,
+            },
+            // The vertices' own positions, so the piece ends exactly there.
+            KernelCurve::Line(_) => Curve::Segment {
+                a: ends.0,
+                b: ends.1,
+            },
+        }
+    }
+}
+
+impl Arc {
     fn closed(&self) -> bool {
         self.span >= TAU * (1.0 - 1e-12)
     }
@@ -68,29 +175,38 @@ impl Arc {
         self.minor * t.cos() - self.major * t.sin()
     }
 
+    /// p's coordinates in the frame where the curve is the unit circle
+    /// (lines stay lines).
+    fn local(&self, p: &Point3) -> [f64; 2] {
+        let (m, n) = (self.major, self.minor);
+        let det = m.x * n.y - m.y * n.x;
+        let d = p - self.center;
+        [(d.x * n.y - d.y * n.x) / det, (m.x * d.y - m.y * d.x) / det]
+    }
+
     /// The parameter u ∈ [0, 2π) of the curve point along p's direction in
     /// the arc's (major, minor) frame: exact for a point on the curve.
     fn parameter(&self, p: &Point3) -> f64 {
-        let d = p - self.center;
-        let (m, n) = (self.major, self.minor);
-        let det = m.x * n.y - m.y * n.x;
-        let (c, s) = ((d.x * n.y - d.y * n.x) / det, (m.x * d.y - m.y * d.x) / det);
+        let [c, s] = self.local(p);
         (s.atan2(c) - self.t0).rem_euclid(TAU)
     }
 
-    /// Where the contour leaving the arc at `a` towards `b` and `c` really
-    /// meets it: marching squares cut that corner off with the chord a → b,
-    /// so the line c → b is followed back to the curve. None when that point
-    /// is not near `a` (the contour leaves the arc smoothly).
-    fn corner(&self, a: Point3, b: Point3, c: Point3) -> Option<Point3> {
-        // In the frame where the curve is the unit circle (lines stay lines).
-        let (m, n) = (self.major, self.minor);
-        let det = m.x * n.y - m.y * n.x;
-        let local = |p: Point3| {
-            let d = p - self.center;
-            [(d.x * n.y - d.y * n.x) / det, (m.x * d.y - m.y * d.x) / det]
+    /// p's parameter, just before 0 rather than just before 2π on an open
+    /// arc, with how far past the ends a parameter may be within `tol`.
+    fn unwrapped(&self, p: &Point3, tol: f64) -> (f64, f64) {
+        let u = self.parameter(p);
+        let reach = tol / self.major.norm().min(self.minor.norm());
+        let u = if !self.closed() && u > self.span && u > TAU - reach {
+            0.0
+        } else {
+            u
         };
-        let (lb, lc) = (local(b), local(c));
+        (u, reach)
+    }
+
+    /// The first point of the ray from b away from c on the curve.
+    fn corner(&self, b: Point3, c: Point3) -> Option<Point3> {
+        let (lb, lc) = (self.local(&b), self.local(&c));
         let dir = [lb[0] - lc[0], lb[1] - lc[1]];
         // |lb + s·dir|² = 1 for the smallest s ≥ 0.
         let qa = dir[0] * dir[0] + dir[1] * dir[1];
@@ -110,25 +226,25 @@ impl Arc {
         if !s.is_finite() {
             return None;
         }
-        let x = self.center + m * (lb[0] + s * dir[0]) + n * (lb[1] + s * dir[1]);
-        // Within a few chords of a: the same corner.
-        ((x - a).norm() <= 2.0 * (b - a).norm()).then_some(x)
-    }
-
-    /// The parameter of p if p lies on the arc within `tol`.
-    fn on(&self, p: &Point3, tol: f64) -> Option<f64> {
-        let u = self.parameter(p);
-        let reach = tol / self.major.norm().min(self.minor.norm());
-        let u = if !self.closed() && u > self.span && u > TAU - reach {
-            0.0
-        } else {
-            u
-        };
-        (u <= self.span + reach && (self.point(u) - p).norm() <= tol).then_some(u.min(self.span))
+        Some(self.center + self.major * (lb[0] + s * dir[0]) + self.minor * (lb[1] + s * dir[1]))
     }
 }
 
-/// A run of a region loop's pieces on one kernel arc: `len` pieces from
+impl Line {
+    /// Where the ray from b away from c crosses the line.
+    fn corner(&self, b: Point3, c: Point3) -> Option<Point3> {
+        let ray = b - c;
+        let cross = |u: Vec3, v: Vec3| u.x * v.y - u.y * v.x;
+        let across = cross(ray, self.direction);
+        if across == 0.0 {
+            return None;
+        }
+        let s = -cross(b - self.from, self.direction) / across;
+        (s >= 0.0).then(|| b + ray * s)
+    }
+}
+
+/// A run of a region loop's pieces on one kernel arc or line: `len` pieces from
 /// piece `start` (cyclically), or the whole loop when `closed`.
 struct Run {
     face: FaceId,
@@ -136,7 +252,7 @@ struct Run {
     start: usize,
     len: usize,
     arc: EdgeId,
-    curve: Arc,
+    curve: KernelCurve,
     closed: bool,
 }
 
@@ -144,8 +260,8 @@ struct Run {
 /// replace it.
 type Swap = (usize, usize, Vec<OrientedEdge>);
 
-/// Replaces each run of region contour pieces lying on a kernel arc by the
-/// arc's pieces. Returns the (kernel subdomain, region) pairs it reported.
+/// Replaces each run of region contour pieces lying on a kernel arc or
+/// straight edge by that edge's pieces. Returns the (kernel subdomain, region) pairs it reported.
 pub(super) fn share_arcs(
     model: &mut Model,
     source_map: &mut SourceMap,
@@ -158,12 +274,13 @@ pub(super) fn share_arcs(
         .collect();
     let region_edges: BTreeSet<EdgeId> =
         super::region_interfaces::face_edges(model, first_region..model.subdomains.len()).collect();
-    let arcs: Vec<(EdgeId, Arc)> = super::region_interfaces::face_edges(model, 0..first_region)
-        .filter(|e| !region_edges.contains(e))
-        .collect::<BTreeSet<EdgeId>>()
-        .into_iter()
-        .filter_map(|e| Arc::of(&model.edge(e).curve).map(|a| (e, a)))
-        .collect();
+    let arcs: Vec<(EdgeId, KernelCurve)> =
+        super::region_interfaces::face_edges(model, 0..first_region)
+            .filter(|e| !region_edges.contains(e))
+            .collect::<BTreeSet<EdgeId>>()
+            .into_iter()
+            .filter_map(|e| KernelCurve::of(&model.edge(e).curve).map(|a| (e, a)))
+            .collect();
     if arcs.is_empty() {
         return reported;
     }
@@ -176,6 +293,14 @@ pub(super) fn share_arcs(
             }
         }
     }
+    // A contour going on along a straight edge's line past its end would
+    // meet the edge's end vertex inside one of its pieces (a hanging node).
+    let (past, runs): (Vec<Run>, Vec<Run>) = runs
+        .into_iter()
+        .partition(|r| goes_on_past_its_line(model, r));
+    for run in &past {
+        report_run(model, source_map, run, first_region, &mut reported, diags);
+    }
     if runs.is_empty() {
         return reported;
     }
@@ -185,22 +310,7 @@ pub(super) fn share_arcs(
     let mut splits: BTreeMap<EdgeId, Vec<(f64, VertexId)>> = BTreeMap::new();
     for run in runs.iter().filter(|r| !r.closed) {
         let arc = run.curve;
-        let lp = &model.faces[run.face.index()].loops[run.lp];
-        let n = lp.len();
-        let after = run.start + run.len;
-        // Each end with the two contour vertices beyond it.
-        let ends = [
-            (
-                begin(model, lp[run.start]),
-                begin(model, lp[(run.start + n - 1) % n]),
-                begin(model, lp[(run.start + n - 2) % n]),
-            ),
-            (
-                end(model, lp[(after + n - 1) % n]),
-                end(model, lp[after % n]),
-                end(model, lp[(after + 1) % n]),
-            ),
-        ];
+        let ends = run_ends(model, run);
         let edge = model.edge(run.arc);
         let (kernel_begin, kernel_end) = (edge.begin, edge.end);
         for (v, b, c) in ends {
@@ -237,7 +347,7 @@ pub(super) fn share_arcs(
         }
         let mut cuts = splits.remove(&arc_edge).unwrap_or_default();
         cuts.sort_by(|a, b| a.0.total_cmp(&b.0));
-        let chain = split_arc(model, source_map, arc_edge, &arc, &cuts);
+        let chain = split_kernel_edge(model, source_map, arc_edge, &arc, &cuts);
         super::region_interfaces::replace_edge(model, arc_edge, &chain);
         pieces.insert(arc_edge, chain);
     }
@@ -348,6 +458,40 @@ fn end(model: &Model, oe: OrientedEdge) -> VertexId {
     if oe.forward { e.end } else { e.begin }
 }
 
+/// Each end of an open run with the two contour vertices beyond it.
+fn run_ends(model: &Model, run: &Run) -> [(VertexId, VertexId, VertexId); 2] {
+    let lp = &model.faces[run.face.index()].loops[run.lp];
+    let n = lp.len();
+    let after = run.start + run.len;
+    [
+        (
+            begin(model, lp[run.start]),
+            begin(model, lp[(run.start + n - 1) % n]),
+            begin(model, lp[(run.start + n - 2) % n]),
+        ),
+        (
+            end(model, lp[(after + n - 1) % n]),
+            end(model, lp[after % n]),
+            end(model, lp[(after + 1) % n]),
+        ),
+    ]
+}
+
+/// Whether the contour beyond an end of a run on a straight kernel edge
+/// stays on the edge's line, outside the edge.
+fn goes_on_past_its_line(model: &Model, run: &Run) -> bool {
+    if !run.curve.is_line() || run.closed {
+        return false;
+    }
+    let tol = ON_ARC_FRACTION * extent(model, run.face);
+    run_ends(model, run).iter().any(|&(_, beyond, _)| {
+        let p = model.vertex(beyond).position;
+        let u = run.curve.parameter(&p);
+        let off = (run.curve.point(u) - p).norm();
+        off <= tol && !(-tol..=run.curve.span() + tol).contains(&u)
+    })
+}
+
 /// The diagonal of a face's vertices' box.
 fn extent(model: &Model, f: FaceId) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
@@ -366,7 +510,7 @@ fn find_runs(
     l: usize,
     lp: &[OrientedEdge],
     arc_edge: EdgeId,
-    arc: &Arc,
+    arc: &KernelCurve,
     tol: f64,
 ) -> Vec<Run> {
     let n = lp.len();
@@ -379,8 +523,11 @@ fn find_runs(
         .collect();
     let on: Vec<bool> = (0..n)
         .map(|k| {
+            // Box sides on a straight edge are share_box_sides' to split.
+            let box_side = matches!(model.edge(lp[k].edge).curve, Curve::Segment { .. });
             on_vertex[k]
                 && on_vertex[(k + 1) % n]
+                && !(arc.is_line() && box_side)
                 && arc
                     .on(&model.edge(lp[k].edge).curve.point(0.5), tol)
                     .is_some()
@@ -415,30 +562,25 @@ fn find_runs(
     runs
 }
 
-/// Cuts the kernel arc `ke` at `cuts` (sorted by parameter): the first
+/// Cuts the kernel edge `ke` (an arc or a line) at `cuts` (sorted by parameter): the first
 /// piece keeps its id, name and boundaries, the others are `NAME.2`, … in
 /// the same boundaries. Returns the pieces in the arc's direction.
-fn split_arc(
+fn split_kernel_edge(
     model: &mut Model,
     source_map: &mut SourceMap,
     ke: EdgeId,
-    arc: &Arc,
+    arc: &KernelCurve,
     cuts: &[(f64, VertexId)],
 ) -> Vec<OrientedEdge> {
     let (b, e) = (model.edge(ke).begin, model.edge(ke).end);
     let mut stops = vec![(0.0, b)];
     stops.extend(cuts.iter().copied());
-    stops.push((arc.span, e));
+    stops.push((arc.span(), e));
     let mut parts = EdgeParts::new(model, ke);
     let mut out = Vec::with_capacity(stops.len() - 1);
     for w in stops.windows(2) {
-        let curve = Curve::Ellipse {
-            center: arc.center,
-            major: arc.major,
-            minor: arc.minor,
-            t0: arc.t0 + w[0].0,
-            t1: arc.t0 + w[1].0,
-        };
+        let ends = (model.vertex(w[0].1).position, model.vertex(w[1].1).position);
+        let curve = arc.piece(w[0].0, w[1].0, ends);
         out.push(OrientedEdge {
             edge: parts.push(model, source_map, curve, w[0].1, w[1].1),
             forward: true,
@@ -515,6 +657,11 @@ fn report_run(
             reported.insert((k, r));
         }
     }
+    let kind = if run.curve.is_line() {
+        "straight"
+    } else {
+        "curved"
+    };
     let p: Point3 = model
         .vertex(begin(
             model,
@@ -526,13 +673,13 @@ fn report_run(
             Code::RegionTouches,
             source_map.subdomain(SubdomainId(r as u32)),
             format!(
-                "region '{}' runs along the curved edge '{}' from ({:.6}, {:.6}) past its end; a contour on a curved kernel edge must stay within that one edge",
+                "region '{}' runs along the {kind} edge '{}' from ({:.6}, {:.6}) past its end; a contour on a {kind} kernel edge must stay within that one edge",
                 model.subdomains[r].name,
                 model.edge(run.arc).name,
                 p.x,
                 p.y
             ),
         )
-        .with_help("end the region's contour inside the curved edge, or split the kernel shape so that one edge holds the whole run"),
+        .with_help(format!("end the region's contour inside the {kind} edge, or split the kernel shape so that one edge holds the whole run")),
     );
 }

@@ -9,7 +9,10 @@
 //!   region's contour loops become holes of the kernel face (an inclusion);
 //! - **a box side on a straight kernel edge**: contour pieces along a side of
 //!   the region's box that lie on a straight kernel edge replace that part of
-//!   the edge, which is split around them.
+//!   the edge, which is split around them;
+//! - **a contour run on a kernel curve** (`region_arcs`): a run of contour
+//!   pieces on a kernel arc or straight edge is replaced by that edge, split
+//!   at the run's ends.
 //!
 //! Anything else that touches is E543 (the interface would have hanging
 //! nodes) and an overlap is E407, as for kernel subdomains.
@@ -695,11 +698,11 @@ fn report(
                 code,
                 span,
                 format!(
-                    "region '{region}' touches the edge '{}' of subdomain '{kernel}' at {at}, where their boundaries cannot share nodes: a region shares a straight edge only along a side of its box",
+                    "region '{region}' touches the edge '{}' of subdomain '{kernel}' at {at}, where their boundaries cannot share nodes: a region shares a straight edge only along a side of its box or where its contour runs along that edge",
                     edge.name
                 ),
             )
-            .with_help("move them apart, carve the region out of a kernel subdomain with <difference>, or let a side of the region's box lie on the straight kernel edge"),
+            .with_help("move them apart, carve the region out of a kernel subdomain with <difference>, or let the region's R-function contain the kernel edge's half-plane (or a side of its box lie on the edge)"),
             None => return,
         }
     };
