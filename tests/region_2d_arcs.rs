@@ -17,8 +17,8 @@ use geomc::mesh::Mesh;
 use geomc::meshing::mesh_model;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, at_30_degrees, fragment_segments, gmsh_group, min_angle_degrees,
-    python, triangles_of,
+    area, assert_conforming, at_30_degrees, coordinate_range, fragment_segments, gmsh_group,
+    min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -137,23 +137,12 @@ fn patch_against_the_outer_circle_shares_its_line_and_keeps_the_arc_on_the_circl
     let interface = fragment_segments(&m, "plate|patch");
     let nodes = assert_conforming(&m, "plate|patch", "plate", "patch");
     assert_eq!(interface.len() + 1, nodes);
-    let ys: Vec<f64> = interface
-        .iter()
-        .flatten()
-        .map(|&n| {
-            let p = m.nodes[n as usize];
-            assert!(
-                (p[0] - 0.5).abs() < 1e-9,
-                "interface node off x = 0.5: {p:?}"
-            );
-            p[1]
-        })
-        .collect();
-    let (lo, hi) = ys
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &y| {
-            (l.min(y), h.max(y))
-        });
+    let (lo, hi) = coordinate_range(&m, &interface, 1, |p| {
+        assert!(
+            (p[0] - 0.5).abs() < 1e-9,
+            "interface node off x = 0.5: {p:?}"
+        )
+    });
     let end = 0.75f64.sqrt();
     assert!(
         (lo + end).abs() < 1e-9 && (hi - end).abs() < 1e-9,
@@ -434,20 +423,9 @@ fn patch_against_a_slanted_straight_side_shares_the_split_side() {
     // between the circle's points (1 ± √0.125, 1 ∓ √0.125).
     let side = fragment_segments(&m, "patch|exterior");
     let half = 0.125f64.sqrt();
-    let xs: Vec<f64> = side
-        .iter()
-        .flatten()
-        .map(|&n| {
-            let p = m.nodes[n as usize];
-            assert!(off_slant(p) < 1e-12, "side node off x + y = 2: {p:?}");
-            p[0]
-        })
-        .collect();
-    let (lo, hi) = xs
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &x| {
-            (l.min(x), h.max(x))
-        });
+    let (lo, hi) = coordinate_range(&m, &side, 0, |p| {
+        assert!(off_slant(p) < 1e-12, "side node off x + y = 2: {p:?}")
+    });
     // The ends are the contour's cut corners restored by extending its last
     // chord to the side: off the circle by about that chord's sagitta.
     assert!(
@@ -529,23 +507,12 @@ fn neighbour_along_a_straight_side_shares_the_split_side() {
     let nodes = assert_conforming(&m, "plate|cap", "plate", "cap");
     let interface = fragment_segments(&m, "plate|cap");
     assert_eq!(interface.len() + 1, nodes);
-    let ys: Vec<f64> = interface
-        .iter()
-        .flatten()
-        .map(|&n| {
-            let p = m.nodes[n as usize];
-            assert!(
-                (p[0] - 1.0).abs() < 1e-12,
-                "interface node off x = 1: {p:?}"
-            );
-            p[1]
-        })
-        .collect();
-    let (lo, hi) = ys
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &y| {
-            (l.min(y), h.max(y))
-        });
+    let (lo, hi) = coordinate_range(&m, &interface, 1, |p| {
+        assert!(
+            (p[0] - 1.0).abs() < 1e-12,
+            "interface node off x = 1: {p:?}"
+        )
+    });
     // Ends near (1, 0.2) and (1, 0.8): at y = 0.8 the corner falls on a
     // grid node, marching squares cut it with a chord across one cell
     // (0.025) that the contour splits in two, so following its last chord

@@ -15,8 +15,8 @@ use geomc::mesh::Mesh;
 use geomc::meshing::{MeshOptions, mesh_model};
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, at_30_degrees, fragment_segments, gmsh_group, min_angle_degrees,
-    python, triangles_of,
+    area, assert_conforming, at_30_degrees, coordinate_range, fragment_segments, gmsh_group,
+    min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -161,20 +161,9 @@ fn region_on_a_side_of_a_kernel_square_shares_that_piece_of_the_side() {
     let nodes = assert_conforming(&m, "plate|cap", "plate", "cap");
     // An open chain along x = 1 from y = 0.2 to y = 0.8.
     assert_eq!(interface.len() + 1, nodes);
-    let ys: Vec<f64> = interface
-        .iter()
-        .flatten()
-        .map(|&n| {
-            let p = m.nodes[n as usize];
-            assert_eq!(p[0], 1.0, "interface node off x = 1");
-            p[1]
-        })
-        .collect();
-    let (lo, hi) = ys
-        .iter()
-        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), &y| {
-            (l.min(y), h.max(y))
-        });
+    let (lo, hi) = coordinate_range(&m, &interface, 1, |p| {
+        assert_eq!(p[0], 1.0, "interface node off x = 1")
+    });
     assert!(
         (lo - 0.2).abs() < 1e-9 && (hi - 0.8).abs() < 1e-9,
         "{lo}..{hi}"

@@ -128,6 +128,28 @@ pub fn fragment_segments(m: &Mesh, name: &str) -> Vec<[u32; 2]> {
         .collect()
 }
 
+/// The smallest and largest coordinate `axis` (0 = x, 1 = y) over the nodes
+/// of `segments`, each node first given to `check` (which asserts that it
+/// lies where the test expects, e.g. on the interface's line).
+pub fn coordinate_range(
+    m: &Mesh,
+    segments: &[[u32; 2]],
+    axis: usize,
+    check: impl Fn([f64; 3]),
+) -> (f64, f64) {
+    segments
+        .iter()
+        .flatten()
+        .map(|&n| {
+            let p = m.nodes[n as usize];
+            check(p);
+            p[axis]
+        })
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), v| {
+            (l.min(v), h.max(v))
+        })
+}
+
 /// The undirected sides of a set of triangles.
 pub fn sides(tris: &[[u32; 3]]) -> BTreeSet<[u32; 2]> {
     tris.iter()
