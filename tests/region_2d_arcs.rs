@@ -318,44 +318,6 @@ fn diagnostics(xml: &str) -> Vec<geomc::diag::Diagnostic> {
 }
 
 #[test]
-fn a_region_touching_a_kernel_circle_at_a_point_is_refused_naming_the_curved_edge() {
-    // A disk of radius 0.3 against the kernel circle r = 0.5 at (0.5, 0):
-    // its contour meets the rim in one point, it does not run along it.
-    let xml = r#"<geometry version="1" dimension="2">
-      <circle name="core_disk"><center x="0" y="0"/><radius value="0.5"/></circle>
-      <rfunction name="bead" nx="32" ny="32" x_min="0.4" x_max="1.2" y_min="-0.4" y_max="0.4">
-        <disk r="0.3" x0="0.8" y0="0"/> </rfunction>
-      <subdomain name="core"><solid ref="core_disk"/></subdomain>
-      <subdomain name="bead"><solid ref="bead"/></subdomain>
-    </geometry>"#;
-    let found = diagnostics(xml);
-    assert_eq!(found.len(), 1, "{found:#?}");
-    let d = &found[0];
-    assert_eq!(d.code, geomc::diag::Code::RegionTouches);
-    assert!(
-        d.message.starts_with(
-            "region 'bead' touches the curved edge 'core_disk.rim' of subdomain 'core' at (0.5"
-        ),
-        "{}",
-        d.message
-    );
-    assert!(
-        d.message.ends_with(
-            "without running along it: a contour shares a curved edge only where its points lie on that curve"
-        ),
-        "{}",
-        d.message
-    );
-    assert_eq!(
-        d.help.as_deref(),
-        Some(
-            "let the region's R-function contain the same circle or ellipse as the kernel edge, so its contour lies on it, or move the region clear of the edge"
-        )
-    );
-    assert!(d.span.is_some(), "located");
-}
-
-#[test]
 fn two_touching_regions_are_refused_naming_both_and_the_fix() {
     let xml = r#"<geometry version="1" dimension="2">
       <rfunction name="left" nx="32" ny="32" x_min="-1" x_max="0" y_min="-1" y_max="1">

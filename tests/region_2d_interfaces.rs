@@ -206,11 +206,11 @@ fn overlapping_and_touching_regions_are_refused_with_their_codes() {
       <subdomain name="big"> <solid ref="big"/> </subdomain>"#
     );
     assert_eq!(codes(&around), vec![Code::SubdomainsOverlap]);
-    // A disk touching the square's corner region from outside along a curve:
-    // the region sits on the side x = 1 but its box does not start there.
+    // A region whose flat side runs 2e-4 off the square's side x = 1, within
+    // the touch distance along 0.98 of it: no tangency, no shared edge.
     let touching = format!(
         r#"<rfunction name="lens" nx="32" ny="32" x_min="0.5" x_max="2.2" y_min="-0.5" y_max="1.5">
-        <intersection> <disk r="0.5" x0="1.5" y0="0.5"/> <formula value="x - 1"/> </intersection>
+        <intersection> <disk r="0.5" x0="1.3" y0="0.5"/> <formula value="x - 1.0002"/> </intersection>
       </rfunction> {SQUARE}
       <subdomain name="plate"> <solid ref="sq"/> </subdomain>
       <subdomain name="lens"> <solid ref="lens"/> </subdomain>"#

@@ -12,6 +12,7 @@ mod point_calculus;
 mod prune;
 mod region_arcs;
 pub mod region_interfaces;
+mod region_touch;
 pub mod rfunction_region;
 pub mod trimmed_topology;
 mod weld;

@@ -23,12 +23,12 @@ use std::f64::consts::TAU;
 /// How far a contour vertex may be from a kernel curve to count as on it, as a
 /// fraction of the region's extent: the traced points lie on f = 0 to root
 /// finding's precision, far inside the contour's chordal tolerance (5e-4).
-const ON_ARC_FRACTION: f64 = 1e-6;
+pub(super) const ON_ARC_FRACTION: f64 = 1e-6;
 
 /// A kernel edge's circle or ellipse: center + major·cos t + minor·sin t for
 /// t from t0 over `span`.
 #[derive(Clone, Copy)]
-struct Arc {
+pub(super) struct Arc {
     center: Point3,
     major: Vec3,
     minor: Vec3,
@@ -39,7 +39,7 @@ struct Arc {
 /// A straight kernel edge: from + direction·u for u from 0 to `length`
 /// (`direction` a unit vector, so u is the distance along the edge).
 #[derive(Clone, Copy)]
-struct Line {
+pub(super) struct Line {
     from: Point3,
     direction: Vec3,
     length: f64,
@@ -47,13 +47,13 @@ struct Line {
 
 /// The kernel curve a region's contour may run along.
 #[derive(Clone, Copy)]
-enum KernelCurve {
+pub(super) enum KernelCurve {
     Arc(Arc),
     Line(Line),
 }
 
 impl KernelCurve {
-    fn of(curve: &Curve) -> Option<KernelCurve> {
+    pub(super) fn of(curve: &Curve) -> Option<KernelCurve> {
         match *curve {
             Curve::Ellipse {
                 center,
@@ -82,18 +82,18 @@ impl KernelCurve {
         }
     }
 
-    fn is_line(&self) -> bool {
+    pub(super) fn is_line(&self) -> bool {
         matches!(self, KernelCurve::Line(_))
     }
 
-    fn span(&self) -> f64 {
+    pub(super) fn span(&self) -> f64 {
         match self {
             KernelCurve::Arc(a) => a.span,
             KernelCurve::Line(l) => l.length,
         }
     }
 
-    fn point(&self, u: f64) -> Point3 {
+    pub(super) fn point(&self, u: f64) -> Point3 {
         match self {
             KernelCurve::Arc(a) => a.point(u),
             KernelCurve::Line(l) => l.from + l.direction * u,
@@ -107,7 +107,7 @@ impl KernelCurve {
         }
     }
 
-    fn parameter(&self, p: &Point3) -> f64 {
+    pub(super) fn parameter(&self, p: &Point3) -> f64 {
         match self {
             KernelCurve::Arc(a) => a.parameter(p),
             KernelCurve::Line(l) => (p - l.from).dot(&l.direction),
@@ -493,7 +493,7 @@ fn goes_on_past_its_line(model: &Model, run: &Run) -> bool {
 }
 
 /// The diagonal of a face's vertices' box.
-fn extent(model: &Model, f: FaceId) -> f64 {
+pub(super) fn extent(model: &Model, f: FaceId) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for oe in model.faces[f.index()].loops.edges() {
         let p = model.vertex(model.edge(oe.edge).begin).position;
@@ -565,7 +565,7 @@ fn find_runs(
 /// Cuts the kernel edge `ke` (an arc or a line) at `cuts` (sorted by parameter): the first
 /// piece keeps its id, name and boundaries, the others are `NAME.2`, … in
 /// the same boundaries. Returns the pieces in the arc's direction.
-fn split_kernel_edge(
+pub(super) fn split_kernel_edge(
     model: &mut Model,
     source_map: &mut SourceMap,
     ke: EdgeId,

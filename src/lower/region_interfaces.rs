@@ -52,7 +52,14 @@ pub fn join(
     for r in first_region..model.subdomains.len() {
         share_box_sides(model, source_map, first_region, r, diags);
     }
-    check(model, source_map, first_region, &reported, diags);
+    let touched = super::region_touch::share_touch_points(
+        model,
+        source_map,
+        first_region,
+        |m, r| face_of(m, r).map_or(0.0, |f| touch_distance(m, f)),
+        &reported,
+    );
+    check(model, source_map, first_region, &reported, &touched, diags);
 }
 
 /// The edges of the faces of subdomains `subdomains` (2D: one face each).
@@ -552,6 +559,7 @@ fn check(
     source_map: &SourceMap,
     first_region: usize,
     reported: &BTreeSet<(usize, usize)>,
+    touched: &BTreeSet<VertexId>,
     diags: &mut Diagnostics,
 ) {
     let n = model.subdomains.len();
@@ -582,9 +590,11 @@ fn check(
                 .map(|s| s.2)
                 .filter(|e| region_edges.contains(e))
                 .collect();
+            // Touch points (`region_touch`) are shared vertices too.
             let exempt: BTreeSet<VertexId> = shared
                 .iter()
                 .flat_map(|&e| [model.edge(e).begin, model.edge(e).end])
+                .chain(touched.iter().copied())
                 .collect();
             // A shared edge both faces run the same way has both on one side:
             // they overlap there (a region along a kernel rim, uncarved).

@@ -4,7 +4,9 @@ mesh written by geomc, with scikit-fem (P1, or P2 for 6-node triangles).
 usage: fem_poisson.py MESH.msh CASE [BOUNDARY ...]
 CASE: disk (unit disk, exact (1 - r^2)/4), annulus (radii 0.5 and 1),
       twomat (unit square, k = 1 for x < 0.5 and 10 beyond; reports the
-      flux jump across the interface line named 'interface').
+      flux jump across the interface line named 'interface'),
+      disks:X,Y,R;X,Y,R;... (disjoint or touching disks, k = 1, exact
+      (R^2 - |x - c|^2)/4 in the disk holding the point).
 Prints one JSON object: triangles, nodes, max_u, max_error (nodal, against
 the exact solution where there is one), flux_jump (twomat).
 """
@@ -81,6 +83,11 @@ def main():
         c1 = (b_**2 - a_**2) / (4 * np.log(b_ / a_))
         exact = -r**2 / 4 + c1 * np.log(r) + b_**2 / 4 - c1 * np.log(b_)
         out["max_error"] = float(np.abs(u - exact).max())
+    elif case.startswith("disks:"):
+        disks = [[float(v) for v in d.split(",")] for d in case[len("disks:"):].split(";")]
+        exact = np.max([(R**2 - (x[0] - cx)**2 - (x[1] - cy)**2) / 4 for cx, cy, R in disks],
+                       axis=0)
+        out["max_error"] = float(np.abs(u - np.maximum(exact, 0.0)).max())
     elif case == "twomat":
         # Normal flux k du/dx on each side of x = 0.5, from the elements that
         # touch the interface, integrated over it: equal for the exact solution.
