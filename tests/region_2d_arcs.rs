@@ -497,7 +497,8 @@ fn neighbour_along_a_straight_side_shares_the_split_side() {
 #[test]
 fn contour_going_on_past_the_end_of_a_straight_edge_is_refused() {
     // The cap about the square's corner (1, 1): its contour follows x = 1
-    // beyond the side's end, where the square's corner would hang.
+    // beyond the side's end, where the square's corner would hang (no
+    // collinear kernel edge carries the line on there).
     let xml = CAP
         .replace(r#"y0="0.5""#, r#"y0="1""#)
         .replace(r#"y_max="1""#, r#"y_max="1.5""#);
@@ -511,9 +512,15 @@ fn contour_going_on_past_the_end_of_a_straight_edge_is_refused() {
         d.message
             .starts_with("region 'cap' runs along the straight edge 'sq.e2' from (1.000000, ")
             && d.message.ends_with(
-                "past its end; a contour on a straight kernel edge must stay within that one edge"
+                "past its end; a contour on a straight kernel edge must stay within that one edge or the collinear kernel edges continuing it"
             ),
         "{}",
         d.message
+    );
+    assert_eq!(
+        d.help.as_deref(),
+        Some(
+            "end the region's contour inside the straight edge, or give the kernel shape a collinear straight edge where the run goes on"
+        )
     );
 }

@@ -11,6 +11,7 @@ mod isolation;
 mod point_calculus;
 mod prune;
 mod region_arcs;
+mod region_collinear;
 pub mod region_interfaces;
 mod region_touch;
 pub mod rfunction_region;

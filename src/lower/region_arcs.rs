@@ -484,11 +484,13 @@ fn goes_on_past_its_line(model: &Model, run: &Run) -> bool {
         return false;
     }
     let tol = ON_ARC_FRACTION * extent(model, run.face);
-    run_ends(model, run).iter().any(|&(_, beyond, _)| {
+    run_ends(model, run).iter().any(|&(end, beyond, _)| {
         let p = model.vertex(beyond).position;
         let u = run.curve.parameter(&p);
         let off = (run.curve.point(u) - p).norm();
-        off <= tol && !(-tol..=run.curve.span() + tol).contains(&u)
+        off <= tol
+            && !(-tol..=run.curve.span() + tol).contains(&u)
+            && !super::region_collinear::continues_past(model, run.arc, end, beyond, tol)
     })
 }
 
@@ -673,13 +675,18 @@ fn report_run(
             Code::RegionTouches,
             source_map.subdomain(SubdomainId(r as u32)),
             format!(
-                "region '{}' runs along the {kind} edge '{}' from ({:.6}, {:.6}) past its end; a contour on a {kind} kernel edge must stay within that one edge",
+                "region '{}' runs along the {kind} edge '{}' from ({:.6}, {:.6}) past its end; a contour on a {kind} kernel edge must stay within that one edge{}",
                 model.subdomains[r].name,
                 model.edge(run.arc).name,
                 p.x,
-                p.y
+                p.y,
+                if run.curve.is_line() { " or the collinear kernel edges continuing it" } else { "" }
             ),
         )
-        .with_help(format!("end the region's contour inside the {kind} edge, or split the kernel shape so that one edge holds the whole run")),
+        .with_help(if run.curve.is_line() {
+            "end the region's contour inside the straight edge, or give the kernel shape a collinear straight edge where the run goes on".to_string()
+        } else {
+            "end the region's contour inside the curved edge, or split the kernel shape so that one edge holds the whole run".to_string()
+        }),
     );
 }

@@ -42,6 +42,7 @@ pub fn join(
     region_of: &[(String, String)],
     diags: &mut Diagnostics,
 ) {
+    super::region_collinear::split_at_joints(model, source_map, first_region);
     // Pairs a refused carve or arc run reported already.
     let mut reported = super::region_arcs::share_arcs(model, source_map, first_region, diags);
     for c in carves {

@@ -1,0 +1,211 @@
+//! Issue 6: a 2D R-function region whose contour runs along a straight
+//! kernel edge and on past its end onto a collinear kernel edge (two
+//! squares stacked, a polygon with a vertex on a straight side). The contour
+//! piece over the joint is cut at the kernel vertex, each edge takes its run,
+//! and both interfaces meet at the joint: no hanging node. Checked on the
+//! interface nodes (on the line, conforming, the joint shared), the
+//! interfaces' ends, the areas, the minimum angle and the MSH groups as
+//! gmsh and meshio read them.
+
+mod mesh2d_common;
+
+use geomc::driver::{Options, check_source};
+use geomc::mesh::Mesh;
+use geomc::meshing::mesh_model;
+use geomc::span::SourceFile;
+use mesh2d_common::{
+    area, assert_conforming, at_30_degrees, coordinate_range, fragment_segments, gmsh_group,
+    min_angle_degrees, python, triangles_of,
+};
+use std::collections::BTreeSet;
+use std::f64::consts::PI;
+use std::process::Command;
+
+/// Two unit squares stacked (low below y = 1, high above) and a half disk
+/// of radius 0.31 about (1, 1) right of x = 1: its flat side runs along both
+/// squares' right sides, over their common vertex (1, 1).
+const STACKED: &str = r#"<geometry version="1" dimension="2">
+  <rectangle name="lo"><first_point x="0" y="0"/><second_point x="1" y="1"/></rectangle>
+  <rectangle name="hi"><first_point x="0" y="1"/><second_point x="1" y="2"/></rectangle>
+  <rfunction name="cap" nx="40" ny="40" x_min="0.5" x_max="1.5" y_min="0.5" y_max="1.5">
+    <intersection> <disk r="0.31" x0="1" y0="1"/> <formula value="x - 1"/> </intersection>
+  </rfunction>
+  <subdomain name="low"><solid ref="lo"/></subdomain>
+  <subdomain name="high"><solid ref="hi"/></subdomain>
+  <subdomain name="cap"><solid ref="cap"/></subdomain>
+</geometry>"#;
+
+/// A unit square as a polygon with a fifth vertex (1, 0.5) on its right
+/// side, and the half disk about that vertex.
+const POLYGON: &str = r#"<geometry version="1" dimension="2">
+  <polygon name="pg"><vertex x="0" y="0"/><vertex x="1" y="0"/><vertex x="1" y="0.5"/><vertex x="1" y="1"/><vertex x="0" y="1"/></polygon>
+  <rfunction name="cap" nx="40" ny="40" x_min="0.5" x_max="1.5" y_min="0" y_max="1">
+    <intersection> <disk r="0.31" x0="1" y0="0.5"/> <formula value="x - 1"/> </intersection>
+  </rfunction>
+  <subdomain name="plate"><solid ref="pg"/></subdomain>
+  <subdomain name="cap"><solid ref="cap"/></subdomain>
+</geometry>"#;
+
+fn mesh(xml: &str) -> Mesh {
+    let checked = check_source(
+        SourceFile::new("t.xml", xml.to_string()),
+        &Options::default(),
+    );
+    assert!(
+        checked.diagnostics.items.is_empty(),
+        "{:#?}",
+        checked.diagnostics.items
+    );
+    let model = checked.lowered.expect("a model").model;
+    mesh_model(&model, &at_30_degrees(Some(0.01))).expect("meshes")
+}
+
+fn fragment_names(m: &Mesh) -> BTreeSet<&str> {
+    m.fragments.iter().map(|f| f.name.as_str()).collect()
+}
+
+/// The y range of an interface on x = 1, every node on the line exactly.
+fn on_the_side(m: &Mesh, fragment: &str) -> (f64, f64) {
+    coordinate_range(m, &fragment_segments(m, fragment), 1, |p| {
+        assert!(
+            (p[0] - 1.0).abs() < 1e-12,
+            "{fragment} node off x = 1: {p:?}"
+        )
+    })
+}
+
+/// The area inside the segments seen from `c` (a half disk's boundary about
+/// its centre; segments through c add nothing).
+fn fan_area(m: &Mesh, segments: &[[u32; 2]], c: [f64; 2]) -> f64 {
+    segments
+        .iter()
+        .map(|s| {
+            let (p, q) = (m.nodes[s[0] as usize], m.nodes[s[1] as usize]);
+            0.5 * ((p[0] - c[0]) * (q[1] - c[1]) - (p[1] - c[1]) * (q[0] - c[0])).abs()
+        })
+        .sum()
+}
+
+fn node_at(m: &Mesh, p: [f64; 2]) -> u32 {
+    let found: Vec<u32> = (0..m.nodes.len() as u32)
+        .filter(|&n| {
+            let q = m.nodes[n as usize];
+            q[0] == p[0] && q[1] == p[1]
+        })
+        .collect();
+    assert_eq!(found.len(), 1, "nodes at {p:?}");
+    found[0]
+}
+
+#[test]
+fn contour_along_two_stacked_squares_follows_onto_the_upper_side() {
+    let m = mesh(STACKED);
+    assert_eq!(
+        fragment_names(&m),
+        BTreeSet::from([
+            "low|exterior",
+            "high|exterior",
+            "low|high",
+            "low|cap",
+            "high|cap",
+            "cap|exterior"
+        ])
+    );
+    let below = assert_conforming(&m, "low|cap", "low", "cap");
+    let above = assert_conforming(&m, "high|cap", "high", "cap");
+    assert_eq!(fragment_segments(&m, "low|cap").len() + 1, below);
+    assert_eq!(fragment_segments(&m, "high|cap").len() + 1, above);
+    // The interfaces meet at the squares' common vertex; the run's far ends
+    // are the half disk's corners (restored by extending the last chord).
+    let (lo_a, hi_a) = on_the_side(&m, "low|cap");
+    let (lo_b, hi_b) = on_the_side(&m, "high|cap");
+    assert_eq!((hi_a, lo_b), (1.0, 1.0));
+    assert!(
+        (lo_a - 0.69).abs() < 1e-4 && (hi_b - 1.31).abs() < 1e-4,
+        "{lo_a}, {hi_b}"
+    );
+    // The joint is one node of all three subdomains.
+    let joint = node_at(&m, [1.0, 1.0]);
+    for sub in ["low", "high", "cap"] {
+        assert!(
+            triangles_of(&m, sub).iter().flatten().any(|&n| n == joint),
+            "{sub} misses the joint"
+        );
+    }
+    // Both squares keep their areas exactly; the cap is its boundary polygon.
+    for sub in ["low", "high"] {
+        let a = area(&m, &triangles_of(&m, sub));
+        assert!((a - 1.0).abs() < 1e-12, "{sub} area {a}");
+    }
+    let cap = area(&m, &triangles_of(&m, "cap"));
+    let outline: Vec<[u32; 2]> = ["cap|exterior", "low|cap", "high|cap"]
+        .iter()
+        .flat_map(|f| fragment_segments(&m, f))
+        .collect();
+    let polygon = fan_area(&m, &outline, [1.0, 1.0]);
+    assert!((cap - polygon).abs() < 1e-12, "{cap} vs {polygon}");
+    let exact = PI * 0.31 * 0.31 / 2.0;
+    assert!((cap - exact).abs() / exact < 2e-3, "cap area {cap}");
+    let least = min_angle_degrees(&m);
+    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+}
+
+#[test]
+fn contour_over_a_polygon_vertex_on_a_straight_side_shares_both_sides() {
+    let m = mesh(POLYGON);
+    assert_eq!(
+        fragment_names(&m),
+        BTreeSet::from(["plate|exterior", "plate|cap", "cap|exterior"])
+    );
+    let nodes = assert_conforming(&m, "plate|cap", "plate", "cap");
+    let interface = fragment_segments(&m, "plate|cap");
+    // One open chain through the polygon's vertex (1, 0.5).
+    assert_eq!(interface.len() + 1, nodes);
+    let vertex = node_at(&m, [1.0, 0.5]);
+    assert!(interface.iter().flatten().any(|&n| n == vertex));
+    let (lo, hi) = on_the_side(&m, "plate|cap");
+    assert!(
+        (lo - 0.19).abs() < 1e-4 && (hi - 0.81).abs() < 1e-4,
+        "{lo}..{hi}"
+    );
+    let plate = area(&m, &triangles_of(&m, "plate"));
+    assert!((plate - 1.0).abs() < 1e-12, "plate area {plate}");
+    let cap = area(&m, &triangles_of(&m, "cap"));
+    let outline: Vec<[u32; 2]> = ["cap|exterior", "plate|cap"]
+        .iter()
+        .flat_map(|f| fragment_segments(&m, f))
+        .collect();
+    assert!((cap - fan_area(&m, &outline, [1.0, 0.5])).abs() < 1e-12);
+    assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
+}
+
+#[test]
+fn msh_of_the_stacked_squares_keeps_its_groups_for_gmsh_and_meshio() {
+    let dir = tempfile::tempdir().expect("tempdir");
+    let input = dir.path().join("stacked.xml");
+    std::fs::write(&input, STACKED).expect("write input");
+    let msh = dir.path().join("stacked.msh");
+    let status = Command::new(env!("CARGO_BIN_EXE_geomc"))
+        .args(["compile", "-q"])
+        .arg(&input)
+        .args(["--min-angle", "30", "--max-area", "0.01", "-o"])
+        .arg(&msh)
+        .status()
+        .expect("run geomc");
+    assert!(status.success());
+    let expected = mesh(STACKED);
+    let r = python("check_mesh.py", &[&msh], &[]);
+    for group in ["low|cap", "high|cap", "low|high", "cap|exterior"] {
+        let lines = fragment_segments(&expected, group).len() as u64;
+        assert!(lines > 0, "{group}");
+        assert_eq!(gmsh_group(&r, group)["elements"]["line"], lines, "{group}");
+        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
+    }
+    for sub in ["low", "high", "cap"] {
+        assert_eq!(
+            gmsh_group(&r, sub)["elements"]["triangle"],
+            triangles_of(&expected, sub).len() as u64
+        );
+    }
+    assert_eq!(r["gmsh"]["nodes"], expected.nodes.len() as u64);
+}
