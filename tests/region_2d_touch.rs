@@ -297,3 +297,53 @@ fn carved_bead_touching_the_rim_from_inside_is_still_refused() {
         found[0].message
     );
 }
+
+#[test]
+fn carved_bead_crossing_a_square_side_is_refused_naming_the_crossing() {
+    // The disk about (1, 0.5) sticks out of the square's side x = 1: the
+    // crossing is not split yet, and the message says how to clip it.
+    let xml = r#"<geometry version="1" dimension="2">
+  <rectangle name="sq"><first_point x="0" y="0"/><second_point x="1" y="1"/></rectangle>
+  <rfunction name="bead" nx="40" ny="40" x_min="0.5" x_max="1.5" y_min="0" y_max="1">
+    <disk r="0.3" x0="1" y0="0.5"/> </rfunction>
+  <subdomain name="plate"><difference><solid ref="sq"/><solid ref="bead"/></difference></subdomain>
+  <subdomain name="bead"><solid ref="bead"/></subdomain>
+</geometry>"#;
+    let found = check_source(
+        SourceFile::new("t.xml", xml.to_string()),
+        &Options::default(),
+    )
+    .diagnostics
+    .items;
+    assert_eq!(found.len(), 1, "{found:#?}");
+    let d = &found[0];
+    assert_eq!(d.code, geomc::diag::Code::RegionCarveOutside);
+    // The contour point nearest the side, at one of the crossings (1, 0.2)
+    // and (1, 0.8).
+    assert!(
+        d.message.starts_with(
+            "subdomain 'plate' subtracts region 'bead', whose contour crosses the kernel edge 'sq.e2' near (1.000000, 0."
+        ) && d.message.ends_with(
+            "): a carved region that crosses a kernel edge is not split at the crossings"
+        ),
+        "{}",
+        d.message
+    );
+    assert_eq!(
+        d.help.as_deref(),
+        Some(
+            "clip the region to the kernel region (intersect its R-function with the kernel shape's disk or half-planes, so that its contour runs along the edge instead of crossing it), or move the region inside, clear of the boundary"
+        )
+    );
+    assert!(d.span.is_some(), "located");
+    // Not carved, the same bead overlaps the square.
+    let neighbours = xml.replace(
+        r#"<difference><solid ref="sq"/><solid ref="bead"/></difference>"#,
+        r#"<solid ref="sq"/>"#,
+    );
+    let found = check_source(SourceFile::new("t.xml", neighbours), &Options::default())
+        .diagnostics
+        .items;
+    let codes: Vec<_> = found.iter().map(|d| d.code).collect();
+    assert_eq!(codes, vec![geomc::diag::Code::SubdomainsOverlap]);
+}

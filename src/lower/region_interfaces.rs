@@ -125,10 +125,27 @@ fn carve(
         .iter()
         .flat_map(|&e| [model.edge(e).begin, model.edge(e).end])
         .collect();
-    let outside = loop_vertices(model, fr)
+    let points: Vec<Point3> = loop_vertices(model, fr)
         .into_iter()
         .filter(|v| !on_shared.contains(v))
         .map(|v| model.vertex(v).position)
+        .collect();
+    if let Some((p, edge)) = crossing(&outline, &points, touch) {
+        diags.push(
+            Diagnostic::new(
+                Code::RegionCarveOutside,
+                c.span,
+                format!(
+                    "subdomain '{}' subtracts region '{}', whose contour crosses the kernel edge '{}' near ({:.6}, {:.6}): a carved region that crosses a kernel edge is not split at the crossings",
+                    c.subdomain, region, model.edge(edge).name, p.x, p.y
+                ),
+            )
+            .with_help("clip the region to the kernel region (intersect its R-function with the kernel shape's disk or half-planes, so that its contour runs along the edge instead of crossing it), or move the region inside, clear of the boundary"),
+        );
+        return Some((k, r));
+    }
+    let outside = points
+        .into_iter()
         .find(|p| outline.distance(p) <= touch || !outline.contains(p));
     if let Some(p) = outside {
         diags.push(
@@ -181,6 +198,30 @@ fn carve(
         .collect();
     model.faces[fk.index()].loops.extend(holes);
     None
+}
+
+/// Where a region's contour (`points`) crosses a kernel outline: some of
+/// its points lie clearly inside, some clearly outside. Returns the contour
+/// point nearest the outline and the kernel edge there.
+fn crossing(outline: &Outline, points: &[Point3], touch: f64) -> Option<(Point3, EdgeId)> {
+    let clear = |p: &&Point3| outline.distance(p) > touch;
+    let inside = points.iter().filter(clear).any(|p| outline.contains(p));
+    let outside = points.iter().filter(clear).any(|p| !outline.contains(p));
+    if !(inside && outside) {
+        return None;
+    }
+    let p = *points
+        .iter()
+        .min_by(|a, b| outline.distance(a).total_cmp(&outline.distance(b)))?;
+    let edge = outline
+        .segments
+        .iter()
+        .min_by(|a, b| {
+            let d = |s: &([f64; 2], [f64; 2], EdgeId)| segment_distance([p.x, p.y], s.0, s.1);
+            d(a).total_cmp(&d(b))
+        })?
+        .2;
+    Some((p, edge))
 }
 
 /// The loops of kernel face `fk` less region face `fr`, which lies inside
