@@ -210,6 +210,29 @@ fn bead_tangent_to_a_square_side_splits_the_side() {
     assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
 }
 
+#[test]
+fn bead_touching_a_polygon_corner_takes_the_corner() {
+    // A regular octagon with a vertex at (1, 0) and a bead about (1.3, 0):
+    // the contour passes the corner, seen from both sides meeting there.
+    let xml = r#"<geometry version="1" dimension="2">
+  <regular_polygon name="pg" sides="8"><center x="0" y="0"/><radius value="1"/></regular_polygon>
+  <rfunction name="bead" nx="40" ny="40" x_min="0.95" x_max="1.7" y_min="-0.375" y_max="0.375">
+    <disk r="0.3" x0="1.3" y0="0"/> </rfunction>
+  <subdomain name="plate"><solid ref="pg"/></subdomain>
+  <subdomain name="bead"><solid ref="bead"/></subdomain>
+</geometry>"#;
+    let m = mesh(xml, 0.01);
+    let p = touch_node(&m, "plate", "bead");
+    assert_eq!([p[0], p[1]], [1.0, 0.0]);
+    // The octagon keeps its area, 2·√2, exactly.
+    let plate = area(&m, &triangles_of(&m, "plate"));
+    assert!((plate - 8f64.sqrt()).abs() < 1e-12, "plate area {plate}");
+    let bead = area(&m, &triangles_of(&m, "bead"));
+    let polygon = fan_area(&m, &fragment_segments(&m, "bead|exterior"), [1.3, 0.0]);
+    assert!((bead - polygon).abs() < 1e-12, "{bead} vs {polygon}");
+    assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
+}
+
 fn compile(xml: &str, dir: &Path, name: &str, max_area: &str) -> PathBuf {
     let input = dir.join(format!("{name}.xml"));
     std::fs::write(&input, xml).expect("write input");

@@ -100,13 +100,16 @@ pub(super) fn share_touch_points(
                     let Some((v, landing)) = land(model, lp, &run, k, (fr, touch)) else {
                         continue;
                     };
-                    // One landing per vertex, one vertex per kernel vertex.
-                    let taken = |l: &Landing| matches!((l, &landing), (Landing::Merge(a), Landing::Merge(b)) if a == b);
-                    if landings.contains_key(&v) || landings.values().any(taken) {
-                        continue;
+                    // One landing per vertex, one vertex per kernel vertex: a
+                    // touch at a kernel vertex is seen from both its edges.
+                    let same = |l: &Landing| matches!((l, &landing), (Landing::Merge(a), Landing::Merge(b)) if a == b);
+                    let seen = landings.values().any(same);
+                    if seen || !landings.contains_key(&v) {
+                        touched.extend(run.iter().map(|&i| vertex_at(model, lp, i)));
                     }
-                    touched.extend(run.iter().map(|&i| vertex_at(model, lp, i)));
-                    landings.insert(v, landing);
+                    if !seen && !landings.contains_key(&v) {
+                        landings.insert(v, landing);
+                    }
                 }
             }
         }
