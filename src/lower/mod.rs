@@ -5,6 +5,7 @@
 
 mod booleans;
 mod brep;
+mod contour_straight;
 mod edge_parts;
 mod explicit;
 mod isolation;
@@ -12,6 +13,7 @@ mod point_calculus;
 mod prune;
 mod region_arcs;
 pub mod region_interfaces;
+mod region_pairs;
 pub mod rfunction_region;
 pub mod trimmed_topology;
 mod weld;
