@@ -52,12 +52,7 @@ pub fn join(
     for r in first_region..model.subdomains.len() {
         share_box_sides(model, source_map, first_region, r, diags);
     }
-    reported.extend(super::region_pairs::share_region_interfaces(
-        model,
-        source_map,
-        first_region,
-        diags,
-    ));
+    super::region_pairs::share_region_interfaces(model, source_map, first_region);
     check(model, source_map, first_region, &reported, diags);
 }
 

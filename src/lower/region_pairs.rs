@@ -8,14 +8,14 @@
 //! one set of edges (shared nodes, one fragment `A|B`), and splits by the
 //! mesher land on the earlier region's f = 0. The later run's ends become the
 //! earlier run's ends; where the interface is straight, both contours' cut
-//! corners are restored first (the next piece beyond each end, extended, meets
-//! the interface line), so the shared end is the true corner within the
-//! chords' sagitta, and the later region's neighbouring pieces follow it.
-//! Anything else (runs that do not pair up) is E543, naming the case.
+//! corners are restored first (the parabola through the next contour points
+//! beyond each end, extended, meets the interface line), so the shared end is
+//! the true corner, and the later region's neighbouring pieces follow it.
+//! Anything else (a tangent contact, runs that do not pair up one to one) is
+//! left to the touch check: E543.
 
-use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::geom::{Curve, Point3};
-use crate::ir::{EdgeId, FaceId, Model, OrientedEdge, SourceMap, SubdomainId, VertexId};
+use crate::ir::{EdgeId, FaceId, Model, OrientedEdge, SourceMap, VertexId};
 use std::collections::{BTreeMap, BTreeSet};
 
 /// How far a contour point may be from the other contour to be on it, as a
@@ -35,15 +35,13 @@ struct Run {
 }
 
 /// Shares the interfaces of every pair of regions (subdomains
-/// `first_region..`). Returns the (earlier, later) pairs it refused (E543
-/// reported), so the touch check does not report them again.
+/// `first_region..`). Pairs whose runs do not pair up one to one are left
+/// as they are, for the touch check to report (E543).
 pub(super) fn share_region_interfaces(
     model: &mut Model,
     source_map: &mut SourceMap,
     first_region: usize,
-    diags: &mut Diagnostics,
-) -> BTreeSet<(usize, usize)> {
-    let mut refused = BTreeSet::new();
+) {
     let n = model.subdomains.len();
     let mut dropped_edges = BTreeSet::new();
     let mut dropped_vertices = BTreeSet::new();
@@ -55,21 +53,14 @@ pub(super) fn share_region_interfaces(
             ) else {
                 continue;
             };
-            match share_pair(model, fa, fb) {
-                Ok(Some((edges, vertices))) => {
-                    dropped_edges.extend(edges);
-                    dropped_vertices.extend(vertices);
-                }
-                Ok(None) => {}
-                Err((what, p)) => {
-                    refused.insert((ra, rb));
-                    report(model, source_map, (ra, rb), what, p, diags);
-                }
+            if let Some((edges, vertices)) = share_pair(model, fa, fb) {
+                dropped_edges.extend(edges);
+                dropped_vertices.extend(vertices);
             }
         }
     }
     if dropped_edges.is_empty() {
-        return refused;
+        return;
     }
     let keep_edge: Vec<bool> = (0..model.edges.len())
         .map(|e| !dropped_edges.contains(&EdgeId(e as u32)))
@@ -78,32 +69,22 @@ pub(super) fn share_region_interfaces(
         .map(|v| !dropped_vertices.contains(&VertexId(v as u32)))
         .collect();
     super::prune::drop_entities(model, source_map, &keep_edge, &keep_vertex);
-    refused
 }
 
 /// The edges and vertices of face `fb` that its shared runs replaced, or
-/// None when the two faces share nothing; Err(what, where) when their
-/// runs do not pair up.
+/// None when the two faces share nothing or their runs do not pair up.
 type Shared = Option<(Vec<EdgeId>, Vec<VertexId>)>;
 
-fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Result<Shared, (&'static str, Point3)> {
+fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
     let tol_a = ON_FRACTION * extent(model, fa);
     let tol_b = ON_FRACTION * extent(model, fb);
     let runs_b = runs_on(model, fb, fa, tol_a);
     if runs_b.is_empty() {
-        return Ok(None);
+        return None;
     }
     let runs_a = runs_on(model, fa, fb, tol_b);
-    let first_b = |r: &Run| {
-        model
-            .vertex(begin(model, loop_of(model, fb, r.lp)[r.start]))
-            .position
-    };
     if runs_a.len() != runs_b.len() {
-        return Err((
-            "the contours meet along stretches that do not pair up",
-            first_b(&runs_b[0]),
-        ));
+        return None;
     }
     // Each later run with the earlier run whose ends are nearest its ends
     // (the earlier run goes the other way).
@@ -111,12 +92,7 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Result<Shared, (&'st
     let mut used = vec![false; runs_a.len()];
     for rb in &runs_b {
         if rb.closed {
-            let Some(k) = (0..runs_a.len()).find(|&k| runs_a[k].closed && !used[k]) else {
-                return Err((
-                    "a whole loop of one lies on the other's contour, which leaves it",
-                    first_b(rb),
-                ));
-            };
+            let k = (0..runs_a.len()).find(|&k| runs_a[k].closed && !used[k])?;
             used[k] = true;
             pairs.push((runs_a[k], *rb));
             continue;
@@ -131,12 +107,7 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Result<Shared, (&'st
                 };
                 d(i).total_cmp(&d(j))
             });
-        let Some(k) = best else {
-            return Err((
-                "the contours meet along stretches that do not pair up",
-                first_b(rb),
-            ));
-        };
+        let k = best?;
         used[k] = true;
         pairs.push((runs_a[k], *rb));
     }
@@ -209,7 +180,7 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Result<Shared, (&'st
             (*a, *b) = (pa, pb);
         }
     }
-    Ok(Some((dropped_edges, dropped_vertices)))
+    Some((dropped_edges, dropped_vertices))
 }
 
 /// Loop `lp` with each (start, len) stretch replaced by its pieces.
@@ -545,28 +516,4 @@ fn extent(model: &Model, f: FaceId) -> f64 {
         hi = [hi[0].max(p.x), hi[1].max(p.y)];
     }
     (hi[0] - lo[0]).hypot(hi[1] - lo[1])
-}
-
-fn report(
-    model: &Model,
-    source_map: &SourceMap,
-    (ra, rb): (usize, usize),
-    what: &str,
-    p: Point3,
-    diags: &mut Diagnostics,
-) {
-    let (a, b) = (&model.subdomains[ra].name, &model.subdomains[rb].name);
-    diags.push(
-        Diagnostic::new(
-            Code::RegionTouches,
-            source_map.subdomain(SubdomainId(rb as u32)),
-            format!(
-                "regions '{a}' and '{b}' touch at ({:.6}, {:.6}), but {what}: only a stretch of both contours on one zero set, met once by each, becomes their interface",
-                p.x, p.y
-            ),
-        )
-        .with_help(format!(
-            "let '{a}' and '{b}' meet along one stretch of a shared zero set (e.g. one uses x - c, the other c - x), or move them apart"
-        )),
-    );
 }
