@@ -5,6 +5,7 @@
 
 mod booleans;
 mod brep;
+mod contour_straight;
 mod edge_parts;
 mod explicit;
 mod isolation;
@@ -13,6 +14,7 @@ mod prune;
 mod region_arcs;
 mod region_collinear;
 pub mod region_interfaces;
+mod region_pairs;
 mod region_touch;
 pub mod rfunction_region;
 pub mod trimmed_topology;

@@ -315,8 +315,18 @@ pub(super) fn share_arcs(
         let (kernel_begin, kernel_end) = (edge.begin, edge.end);
         for (v, b, c) in ends {
             let p = |w: VertexId| model.vertex(w).position;
-            let at = arc
-                .corner(p(v), p(b), p(c))
+            // On a line, the contour's curvature beyond the corner is kept
+            // (a corner on a grid node leaves only one piece's chord to follow).
+            let on_line = match arc {
+                KernelCurve::Line(l) => {
+                    let lp = &model.faces[run.face.index()].loops[run.lp];
+                    super::region_pairs::corner_on_line(model, lp, [v, b, c], l.from, l.direction)
+                        .map(|x| arc.point(arc.parameter(&x).clamp(0.0, l.length)))
+                }
+                KernelCurve::Arc(_) => None,
+            };
+            let at = on_line
+                .or_else(|| arc.corner(p(v), p(b), p(c)))
                 .unwrap_or_else(|| arc.point(arc.parameter(&p(v))));
             let u = arc.parameter(&at);
             let list = splits.entry(run.arc).or_default();

@@ -53,6 +53,7 @@ pub fn join(
     for r in first_region..model.subdomains.len() {
         share_box_sides(model, source_map, first_region, r, diags);
     }
+    super::region_pairs::share_region_interfaces(model, source_map, first_region);
     let touched = super::region_touch::share_touch_points(
         model,
         source_map,
@@ -670,15 +671,23 @@ fn check(
                     })
                     .or_else(|| {
                         let far = |p: &Point3| or.distance(p) > touch;
-                        ok.points_off(&shared).find_map(|p| {
-                            if !far(&p) {
-                                (k >= first_region).then_some((Code::RegionTouches, p))
-                            } else if k < first_region && or.contains(&p) {
-                                Some((Code::SubdomainsOverlap, p))
-                            } else {
-                                None
-                            }
-                        })
+                        // The other's pieces leaving a shared end start on it.
+                        let at_shared_end = |p: &Point3| {
+                            exempt
+                                .iter()
+                                .any(|&v| (model.vertex(v).position - p).norm() <= touch)
+                        };
+                        ok.points_off(&shared)
+                            .filter(|p| !at_shared_end(p))
+                            .find_map(|p| {
+                                if !far(&p) {
+                                    (k >= first_region).then_some((Code::RegionTouches, p))
+                                } else if k < first_region && or.contains(&p) {
+                                    Some((Code::SubdomainsOverlap, p))
+                                } else {
+                                    None
+                                }
+                            })
                     })
             });
             if let Some((code, p)) = finding {
@@ -722,10 +731,10 @@ fn report(
             code,
             span,
             format!(
-                "region '{region}' touches region '{kernel}' at {at}: two R-function regions do not share interface edges"
+                "region '{region}' touches region '{kernel}' at {at} outside a shared stretch: two R-function regions share edges only where both contours run along one zero set"
             ),
         )
-        .with_help("move them apart, or make one of them a kernel shape (a circle, polygon or rectangle): a region's contour on a kernel edge becomes their interface")
+        .with_help("move them apart, or let them meet along a stretch of one curve (e.g. one R-function holds x - c, the other c - x)")
     } else {
         // The kernel edge nearest the contact says which rule was missed.
         let nearest = outline

@@ -111,6 +111,10 @@ fn trace_with_sides(
             let mut points: Vec<[f64; 2]> = lp.iter().map(|&p| b.points[p]).collect();
             let sides: Vec<u8> = lp.iter().map(|&p| b.sides[p]).collect();
             let mut sides = grade(s, &mut points, sides);
+            // Straight stretches laid out graded from their ends (within
+            // the bound by construction), not cut to the shortest piece.
+            let straight = super::contour_straight::STRAIGHT_FRACTION * (x1 - x0).hypot(y1 - y0);
+            super::contour_straight::merge_straight_runs(s, &mut points, &mut sides, straight);
             if !material_on_left(s, &points) {
                 points.reverse();
                 sides.reverse();
