@@ -21,8 +21,8 @@ use crate::diag::Diagnostics;
 use crate::doc::Document;
 use crate::geom::{Aabb, SolidShape};
 use crate::ir::{
-    Dimension, EntityName, Face, Loops, Model, OrientedEdge, OrientedFace, Origin, PointSet,
-    Polyline, Solid, SolidId, SourceMap,
+    Carrier, Dimension, EntityName, Face, Loops, Model, OrientedEdge, OrientedFace, Origin,
+    PointSet, Polyline, Solid, SolidId, SourceMap,
 };
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
@@ -309,6 +309,19 @@ fn lower_solid(
     let origin = Origin { span };
     let brep = brep::of(shape);
     welder.begin_solid(model);
+    // The solid comes first: its faces and edges make their carriers from its
+    // shape (3D primitives; a 2D region's entities keep their own), and the
+    // welder may read them while the solid is lowered.
+    let id = SolidId(model.solids.len() as u32);
+    model.solids.push(Solid {
+        name: name.to_string(),
+        shape: shape.clone(),
+        faces: Vec::new(),
+        boundary_edges: Vec::new(),
+        edges: Vec::new(),
+        vertices: Vec::new(),
+    });
+    let by_solid = !shape.is_planar();
     // The entities' names share the solid's ("{name}.{local}"); the name
     // tables for faces= and edges= lists are built later, and only when a
     // file has such lists.
@@ -327,11 +340,19 @@ fn lower_solid(
     let edge_ids: Vec<_> = brep
         .edges
         .into_iter()
-        .map(|e| {
+        .enumerate()
+        .map(|(local, e)| {
             let (id, flipped, new) = welder.edge(
                 model,
                 || EntityName::local(&base, e.name),
-                e.curve,
+                &e.curve,
+                || {
+                    if by_solid {
+                        Carrier::primitive(id, local)
+                    } else {
+                        Carrier::own(e.curve.clone())
+                    }
+                },
                 vertex_ids[e.begin],
                 vertex_ids[e.end],
             );
@@ -349,14 +370,18 @@ fn lower_solid(
         }
     };
     let mut faces = Vec::with_capacity(brep.faces.len());
-    for f in brep.faces {
+    for (local, f) in brep.faces.into_iter().enumerate() {
         let total = f.loops.iter().map(Vec::len).sum();
         let loops =
             Loops::from_nested(f.loops.iter().map(|l| l.iter().copied().map(orient)), total);
         let first = loops.first().and_then(|l| l.first()).copied();
         let face = Face {
             name: EntityName::local(&base, f.name),
-            surface: f.surface,
+            carrier: if by_solid {
+                Carrier::primitive(id, local)
+            } else {
+                Carrier::own(f.surface)
+            },
             reversed: false,
             loops,
         };
@@ -370,15 +395,11 @@ fn lower_solid(
         faces.push(OrientedFace { face: id, outward });
     }
     let boundary_edges = brep.boundary.iter().copied().map(orient).collect();
-    let id = SolidId(model.solids.len() as u32);
-    model.solids.push(Solid {
-        name: name.to_string(),
-        shape: shape.clone(),
-        faces,
-        boundary_edges,
-        edges: edge_ids.iter().map(|&(e, _)| e).collect(),
-        vertices: vertex_ids,
-    });
+    let solid = &mut model.solids[id.index()];
+    solid.faces = faces;
+    solid.boundary_edges = boundary_edges;
+    solid.edges = edge_ids.iter().map(|&(e, _)| e).collect();
+    solid.vertices = vertex_ids;
     source_map.solids.insert(id, origin);
     id
 }
