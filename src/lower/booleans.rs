@@ -47,6 +47,7 @@ struct Built {
     span: crate::span::Span,
 }
 
+#[allow(clippy::too_many_arguments)]
 pub(super) fn lower_subdomains(
     defs: Vec<SubdomainDef>,
     resolved: &Resolved,
@@ -55,6 +56,7 @@ pub(super) fn lower_subdomains(
     entities: &Entities,
     face_samples: &FaceSamples,
     diags: &mut Diagnostics,
+    release: Option<fn()>,
 ) {
     let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(defs.len());
     model.subdomains.reserve(defs.len());
@@ -124,6 +126,10 @@ pub(super) fn lower_subdomains(
             trimmed: trimmed_faces,
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
+    }
+    // The definitions are gone: their pages go back before the checks below.
+    if let Some(release) = release {
+        release();
     }
     let Some(leaf_pairs) = check_relations(model, source_map, &trees, diags) else {
         return;

@@ -212,9 +212,9 @@ fn parallelepiped(frame: &Frame) -> Brep {
     }
     let flip = mirrors(frame);
     let mut faces = Vec::new();
-    for axis in 0..3 {
+    for (axis, names) in FACE_NAMES.iter().enumerate() {
         let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
-        for (side, &face_name) in FACE_NAMES[axis].iter().enumerate() {
+        for (side, &face_name) in names.iter().enumerate() {
             // The four edges of the face axis = side, walked p-then-q, which is
             // counter-clockwise about +axis; reversed on the min side.
             let e = |along: usize, fixed_axis: usize, fixed: usize| {

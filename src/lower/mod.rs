@@ -100,7 +100,14 @@ impl Entities {
 /// Reads the document's subdomains and boundaries; every object comes from
 /// `resolved` (the driver drops the document's objects before lowering). The
 /// subdomain definitions are taken out of `doc` and dropped once lowered.
-pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
+/// `release` (the driver's `Options::release_memory`) is called where much
+/// has just been freed: the welder's tables, the subdomain definitions.
+pub fn lower(
+    doc: &mut Document,
+    resolved: &Resolved,
+    diags: &mut Diagnostics,
+    release: Option<fn()>,
+) -> Lowered {
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
     } else {
@@ -168,6 +175,12 @@ pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -
     // on large files) must not still be alive while subdomains are built.
     let face_samples = std::mem::take(&mut welder.face_samples);
     drop(welder);
+    // Freed memory is otherwise kept by the allocator for reuse (about a
+    // second): the welder's and isolation's tables would stay resident
+    // through the subdomains, the memory peak on files of many solids.
+    if let Some(release) = release {
+        release();
+    }
     explicit::lower_topology(resolved, &mut model, &mut source_map, &mut entities, diags);
     let named_lists =
         !doc.boundaries.is_empty() || doc.subdomains.iter().any(|s| s.faces.is_some());
@@ -182,6 +195,7 @@ pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -
         &entities,
         &face_samples,
         diags,
+        release,
     );
     explicit::lower_boundaries(doc, &mut model, &entities, diags);
     prune::prune_interior(&mut model, &mut source_map);
