@@ -69,7 +69,11 @@ impl Report {
                             .map(|of| {
                                 let face = model.face(of.face);
                                 // Trimmed faces: oriented on the mesh, marked.
-                                if matches!(face.surface, crate::geom::Surface::Parametric(_)) {
+                                // (never a primitive's: their carriers are their own).
+                                if matches!(
+                                    face.carrier.owned(),
+                                    Some(crate::geom::Surface::Parametric(_))
+                                ) {
                                     return format!("{} (trimmed)", face.name);
                                 }
                                 format!("{}{}", if of.outward { "" } else { "-" }, face.name)
@@ -259,12 +263,10 @@ fn point_curves(model: &Model) -> Vec<String> {
     let edges = model
         .edges
         .iter()
-        .map(|e| (&e.name as &dyn Display, &e.curve, "edge"));
+        // Point-calculus curves are never a primitive's: their carriers are their own.
+        .map(|e| (&e.name as &dyn Display, e.carrier.owned(), "edge"));
     let mut out = Vec::new();
-    for (name, curve, role) in lines
-        .map(|(n, c, r)| (n, c.as_ref(), r))
-        .chain(edges.map(|(n, c, r)| (n, Some(c), r)))
-    {
+    for (name, curve, role) in lines.map(|(n, c, r)| (n, c.as_ref(), r)).chain(edges) {
         if let Some(Curve::PointCalculus(c)) = curve {
             out.push(format!("{name} ({role}): {}", c.describe()));
         }

@@ -42,12 +42,12 @@ fn cylinder_bounded_by_conic_arcs_is_watertight() {
     let conics = m
         .edges
         .iter()
-        .filter(|e| matches!(&e.curve, Curve::PointCalculus(c) if matches!(**c, PcCurve::Conic { k, .. } if (k - 2.0 / 3.0).abs() < 1e-15)))
+        .filter(|e| matches!(&*e.curve(&m.solids), Curve::PointCalculus(c) if matches!(**c, PcCurve::Conic { k, .. } if (k - 2.0 / 3.0).abs() < 1e-15)))
         .count();
     assert_eq!(conics, 6);
     // The arcs are exact circles: every point at radius 1.
     for e in &m.edges[..6] {
-        for p in e.curve.samples(50) {
+        for p in e.curve(&m.solids).samples(50) {
             assert!((p.x.hypot(p.y) - 1.0).abs() < 1e-14, "{}: {p}", e.name);
         }
     }
@@ -80,7 +80,8 @@ fn cylinder_bounded_by_conic_arcs_is_watertight() {
 fn patch_lid_meshes_with_its_walls() {
     let m = model(&fixture("pointcalc_patch_pillow.xml"));
     let lid = m.faces.iter().find(|f| f.name == "lid").expect("lid");
-    assert!(matches!(lid.surface, geomc::geom::Surface::Patch9(_)));
+    let lid_surface = lid.surface(&m.solids);
+    assert!(matches!(*lid_surface, geomc::geom::Surface::Patch9(_)));
     // Exact volume: 4 · Σ Wᵢ Wⱼ zᵢⱼ with Simpson weights 1/6, 2/3, 1/6 = 5.6.
     let mut previous = f64::INFINITY;
     for tolerance in [0.02, 0.005] {
@@ -95,7 +96,7 @@ fn patch_lid_meshes_with_its_walls() {
         for t in &lid_mesh.triangles {
             for &n in t {
                 let p = Point3::from(mesh.nodes[n as usize]);
-                assert!(lid.surface.distance(&p) < 1e-9, "{p}");
+                assert!(lid_surface.distance(&p) < 1e-9, "{p}");
             }
         }
         assert!(q.min_angle > 10.0, "{}", q.min_angle);

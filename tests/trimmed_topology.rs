@@ -49,7 +49,7 @@ fn a_bezier_patch_with_a_round_hole_has_four_sides_and_one_trim_loop() {
     assert_eq!(trim.begin, trim.end, "the hole is a closed edge");
     // Every point of the trim chain on the hole's rim: the circle of
     // radius 0.4 about the patch's axis (paper 002's example).
-    let Curve::Chain { points } = &trim.curve else {
+    let Curve::Chain { points } = &*trim.curve(&model.solids) else {
         panic!("a chain")
     };
     for p in points {
@@ -124,7 +124,7 @@ fn the_interstage_holes_are_closed_trim_edges_even_across_the_seam() {
         ("interstage.u_min[1]", 2.0, 0.0),
         ("interstage.u_max[1]", 1.5, 3.0),
     ] {
-        let Curve::Chain { points } = &model.edges[edge(&model, name)].curve else {
+        let Curve::Chain { points } = &*model.edges[edge(&model, name)].curve(&model.solids) else {
             panic!("a chain")
         };
         for p in points {

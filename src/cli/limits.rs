@@ -72,7 +72,10 @@ pub fn estimate_triangles(model: &Model, options: &MeshOptions) -> u64 {
         let Some(area) = measure.map(|m| m.area).filter(|a| a.is_finite()) else {
             continue;
         };
-        let curved = !matches!(face.surface, geomc::geom::Surface::Plane { .. });
+        let curved = !matches!(
+            *face.surface(&model.solids),
+            geomc::geom::Surface::Plane { .. }
+        );
         let mut h = if curved { chordal } else { f64::INFINITY };
         if let Some(edge) = options.max_edge {
             h = h.min(edge);

@@ -16,6 +16,7 @@ pub mod polygon;
 mod sampling;
 mod shape_eval;
 mod solid;
+pub(crate) mod solid_carriers;
 mod surface;
 #[cfg(test)]
 mod tests;

@@ -12,12 +12,14 @@
 //!   the face normal points out of the subdomain;
 //! - entities are welded: two solids that share a face share one `Face`.
 
+mod carrier;
 mod fragments;
 mod incidence;
 mod loops;
 mod name;
 mod source_map;
 
+pub use carrier::Carrier;
 pub use fragments::{Fragment, Side, derive_fragments};
 pub use incidence::{Incidence, IncidenceMatrices};
 pub use loops::Loops;
@@ -52,7 +54,8 @@ pub struct Vertex {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Edge {
     pub name: EntityName,
-    pub curve: Curve,
+    /// Its curve; read it with [`Edge::curve`].
+    pub carrier: Carrier<Curve>,
     pub begin: VertexId,
     pub end: VertexId,
 }
@@ -60,6 +63,11 @@ pub struct Edge {
 impl Edge {
     pub fn is_closed(&self) -> bool {
         self.begin == self.end
+    }
+
+    /// The edge's curve (`solids`: the model's, which primitives' edges need).
+    pub fn curve<'a>(&'a self, solids: &[Solid]) -> std::borrow::Cow<'a, Curve> {
+        self.carrier.curve(solids)
     }
 }
 
@@ -73,10 +81,18 @@ pub struct OrientedEdge {
 #[derive(Debug, Clone, PartialEq)]
 pub struct Face {
     pub name: EntityName,
-    pub surface: Surface,
+    /// Its surface; read it with [`Face::surface`].
+    pub carrier: Carrier<Surface>,
     /// The face normal is −∇S when true.
     pub reversed: bool,
     pub loops: Loops,
+}
+
+impl Face {
+    /// The face's surface (`solids`: the model's, which primitives' faces need).
+    pub fn surface<'a>(&'a self, solids: &[Solid]) -> std::borrow::Cow<'a, Surface> {
+        self.carrier.surface(solids)
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -245,6 +261,21 @@ impl Model {
         &self.faces[id.index()]
     }
 
+    /// The surface of face `id`.
+    pub fn face_surface(&self, id: FaceId) -> std::borrow::Cow<'_, Surface> {
+        self.faces[id.index()].surface(&self.solids)
+    }
+
+    /// The curve of edge `id`.
+    pub fn edge_curve(&self, id: EdgeId) -> std::borrow::Cow<'_, Curve> {
+        self.edges[id.index()].curve(&self.solids)
+    }
+
+    /// The curve of edge `id` for changing (from then on the edge's own).
+    pub fn edge_curve_mut(&mut self, id: EdgeId) -> &mut Curve {
+        self.edges[id.index()].carrier.curve_mut(&self.solids)
+    }
+
     pub fn subdomain(&self, id: SubdomainId) -> &Subdomain {
         &self.subdomains[id.index()]
     }
@@ -266,7 +297,8 @@ impl Model {
         }
         // A patch face bulges beyond its vertices: include its nine points.
         for face in &self.faces {
-            if let crate::geom::Surface::Patch9(patch) = &face.surface {
+            // Patches are never a primitive's: their carriers are their own.
+            if let Some(crate::geom::Surface::Patch9(patch)) = face.carrier.owned() {
                 patch.rows.iter().flatten().for_each(|p| bbox.include(p));
             }
         }

@@ -10,8 +10,8 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::{SolidTree, SubdomainDef};
 use crate::geom::{Point3, Surface, Vec3, boundary_relation};
 use crate::ir::{
-    Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId, SourceMap,
-    Subdomain, SubdomainCells, SubdomainId,
+    Carrier, Dimension, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, SolidId,
+    SourceMap, Subdomain, SubdomainCells, SubdomainId,
 };
 use crate::resolve::{Geometry, Resolved};
 use rayon::slice::ParallelSliceMut;
@@ -47,6 +47,7 @@ struct Built {
     span: crate::span::Span,
 }
 
+#[allow(clippy::too_many_arguments)]
 pub(super) fn lower_subdomains(
     defs: Vec<SubdomainDef>,
     resolved: &Resolved,
@@ -55,6 +56,7 @@ pub(super) fn lower_subdomains(
     entities: &Entities,
     face_samples: &FaceSamples,
     diags: &mut Diagnostics,
+    release: Option<fn()>,
 ) {
     let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(defs.len());
     model.subdomains.reserve(defs.len());
@@ -124,6 +126,10 @@ pub(super) fn lower_subdomains(
             trimmed: trimmed_faces,
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
+    }
+    // The definitions are gone: their pages go back before the checks below.
+    if let Some(release) = release {
+        release();
     }
     let Some(leaf_pairs) = check_relations(model, source_map, &trees, diags) else {
         return;
@@ -637,7 +643,7 @@ fn classify_edges(model: &Model, built: &Built) -> Vec<OrientedEdge> {
             if result.contains_key(&oe.edge) {
                 continue;
             }
-            let sample = model.edge(oe.edge).curve.point(0.5);
+            let sample = model.edge_curve(oe.edge).point(0.5);
             // "left" = the side on the left of the edge's own direction.
             let side = |left: bool| {
                 move |i: usize| -> bool {
@@ -694,10 +700,10 @@ fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<
     let id = FaceId(model.faces.len() as u32);
     model.faces.push(Face {
         name: name.into(),
-        surface: Surface::Plane {
+        carrier: Carrier::own(Surface::Plane {
             origin,
             normal: Vec3::z(),
-        },
+        }),
         reversed: false,
         loops: loops.into(),
     });
@@ -765,7 +771,8 @@ fn check_overlaps(
             for e in model.face(of.face).loops.iter().flatten() {
                 let edge = model.edge(e.edge);
                 bbox.include(&model.vertex(edge.begin).position);
-                edge.curve.samples(8).iter().for_each(|p| bbox.include(p));
+                let curve = edge.curve(&model.solids);
+                curve.samples(8).iter().for_each(|p| bbox.include(p));
             }
             if let Some(p) = super::winding::face_sample(model, of.face) {
                 face_points.insert(of.face, p);
@@ -839,7 +846,7 @@ fn interior_probes(
             .filter_map(|of| {
                 let p = samples.get(&of.face)?;
                 let face = model.face(of.face);
-                let n = face.surface.gradient(p);
+                let n = face.surface(&model.solids).gradient(p);
                 if n.norm() == 0.0 {
                     return None;
                 }
@@ -856,7 +863,7 @@ fn interior_probes(
             .iter()
             .flat_map(|f| model.face(*f).loops.iter().flatten())
             .map(|e| {
-                let curve = &model.edge(e.edge).curve;
+                let curve = model.edge_curve(e.edge);
                 let left = Vec3::z().cross(&curve.tangent(0.5));
                 curve.point(0.5) + left * (if e.forward { step } else { -step })
             })
@@ -979,7 +986,8 @@ pub(super) fn orient_shell(model: &Model, faces: &[FaceId]) -> Vec<OrientedFace>
 /// fanned from a point on the surface (n along the loop orientation).
 fn face_volume(model: &Model, face_id: FaceId) -> f64 {
     let face = model.face(face_id);
-    if let crate::geom::Surface::Parametric(s) = &face.surface {
+    let surface = face.surface(&model.solids);
+    if let crate::geom::Surface::Parametric(s) = &*surface {
         // Its loops run counter-clockwise about R_u × R_v.
         let share = crate::trimmed::volume_share(s);
         return if face.reversed { -share } else { share };
@@ -988,7 +996,7 @@ fn face_volume(model: &Model, face_id: FaceId) -> f64 {
     for l in &face.loops {
         let mut points = Vec::new();
         for e in l {
-            let mut s = model.edge(e.edge).curve.samples(16);
+            let mut s = model.edge_curve(e.edge).samples(16);
             if !e.forward {
                 s.reverse();
             }
@@ -1000,7 +1008,7 @@ fn face_volume(model: &Model, face_id: FaceId) -> f64 {
         }
         let centroid =
             Point3::from(points.iter().map(|p| p.coords).sum::<Vec3>() / points.len() as f64);
-        let apex = face.surface.project(&centroid).unwrap_or(centroid);
+        let apex = surface.project(&centroid).unwrap_or(centroid);
         for i in 0..points.len() {
             let a = points[i];
             let b = points[(i + 1) % points.len()];

@@ -2,9 +2,12 @@
 //! documented entity names users refer to (`box.xmin`, `ball.equator`, …).
 //! Built in local indices; the welder merges them into the model.
 
+use crate::geom::solid_carriers::{
+    box_corner, box_edge_ends, box_face, box_face_center, cone_cap, cone_rim, cone_rims, ellipse,
+    torus_meridian, torus_parallel,
+};
 use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
 use crate::ir::LocalName;
-use std::f64::consts::TAU;
 
 pub struct BrepVertex {
     pub name: LocalName,
@@ -117,16 +120,6 @@ fn mirrors(frame: &Frame) -> bool {
     frame.linear.determinant() < 0.0
 }
 
-fn ellipse(frame: &Frame, center: Vec3, a: Vec3, b: Vec3) -> Curve {
-    Curve::Ellipse {
-        center: frame.to_global(&Point3::from(center)),
-        major: frame.vector_to_global(&a),
-        minor: frame.vector_to_global(&b),
-        t0: 0.0,
-        t1: TAU,
-    }
-}
-
 /// Local names are indices into `LOCAL_NAMES` (`ir/name.rs`), checked at
 /// compile time: `named` fails the build on a name the table lacks.
 const fn named(name: &str) -> LocalName {
@@ -187,11 +180,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
     let vertices = (0..8)
         .map(|n| BrepVertex {
             name: VERTEX_NAMES[n],
-            position: frame.to_global(&Point3::new(
-                (n & 1) as f64,
-                ((n >> 1) & 1) as f64,
-                ((n >> 2) & 1) as f64,
-            )),
+            position: box_corner(frame, n),
         })
         .collect::<Vec<_>>();
     // Edges along axis `a` at fixed values of the other two axes.
@@ -208,6 +197,7 @@ fn parallelepiped(frame: &Frame) -> Brep {
                 let begin = corner(at[0], at[1], at[2]);
                 at[axis] = 1;
                 let end = corner(at[0], at[1], at[2]);
+                debug_assert_eq!(box_edge_ends(edges.len()), (begin, end));
                 edges.push(BrepEdge {
                     name,
                     curve: Curve::Segment {
@@ -222,9 +212,9 @@ fn parallelepiped(frame: &Frame) -> Brep {
     }
     let flip = mirrors(frame);
     let mut faces = Vec::new();
-    for axis in 0..3 {
+    for (axis, names) in FACE_NAMES.iter().enumerate() {
         let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
-        for (side, &face_name) in FACE_NAMES[axis].iter().enumerate() {
+        for (side, &face_name) in names.iter().enumerate() {
             // The four edges of the face axis = side, walked p-then-q, which is
             // counter-clockwise about +axis; reversed on the min side.
             let e = |along: usize, fixed_axis: usize, fixed: usize| {
@@ -248,19 +238,11 @@ fn parallelepiped(frame: &Frame) -> Brep {
                     item.1 = !item.1;
                 }
             }
-            let mut local_normal = Vec3::zeros();
-            local_normal[axis] = if side == 0 { -1.0 } else { 1.0 };
-            let mut center = Point3::new(0.5, 0.5, 0.5);
-            center[axis] = side as f64;
-            let sample = frame.to_global(&center);
             faces.push(BrepFace {
                 name: face_name,
-                surface: Surface::Plane {
-                    origin: sample,
-                    normal: frame.normal_to_global(&local_normal),
-                },
+                surface: box_face(frame, axis, side),
                 loops: vec![ring],
-                sample,
+                sample: box_face_center(frame, axis, side),
             });
         }
     }
@@ -311,14 +293,17 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
     let mut edges = Vec::new();
     let mut faces = Vec::new();
     let mut side_loops = Vec::new();
-    let rims = [
-        (0.0, r0, BOTTOM_SEAM, BOTTOM_RIM, BOTTOM, -1.0),
-        (1.0, r1, TOP_SEAM, TOP_RIM, TOP, 1.0),
-    ];
-    for (z, r, vertex, rim, cap, up) in rims {
-        if r <= 0.0 {
-            continue;
+    // The rims that exist, bottom first: their entities take the carriers'
+    // local indices in this order.
+    let names = |up: f64| {
+        if up < 0.0 {
+            (BOTTOM_SEAM, BOTTOM_RIM, BOTTOM)
+        } else {
+            (TOP_SEAM, TOP_RIM, TOP)
         }
+    };
+    for (z, r, up) in cone_rims(r0, r1) {
+        let (vertex, rim, cap) = names(up);
         let v = vertices.len();
         vertices.push(BrepVertex {
             name: vertex,
@@ -327,7 +312,7 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
         let e = edges.len();
         edges.push(BrepEdge {
             name: rim,
-            curve: ellipse(frame, Vec3::new(0.0, 0.0, z), Vec3::x() * r, Vec3::y() * r),
+            curve: cone_rim(frame, z, r),
             begin: v,
             end: v,
         });
@@ -336,10 +321,7 @@ fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
         let center = frame.to_global(&Point3::new(0.0, 0.0, z));
         faces.push(BrepFace {
             name: cap,
-            surface: Surface::Plane {
-                origin: center,
-                normal: frame.normal_to_global(&Vec3::new(0.0, 0.0, up)),
-            },
+            surface: cone_cap(frame, z, up),
             loops: vec![vec![(e, cap_forward)]],
             sample: center,
         });
@@ -382,18 +364,13 @@ fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
         edges: vec![
             BrepEdge {
                 name: PARALLEL,
-                curve: ellipse(frame, Vec3::zeros(), Vec3::x() * outer, Vec3::y() * outer),
+                curve: torus_parallel(frame, major, minor),
                 begin: 0,
                 end: 0,
             },
             BrepEdge {
                 name: MERIDIAN,
-                curve: ellipse(
-                    frame,
-                    Vec3::new(major, 0.0, 0.0),
-                    Vec3::x() * minor,
-                    Vec3::z() * minor,
-                ),
+                curve: torus_meridian(frame, major, minor),
                 begin: 0,
                 end: 0,
             },
@@ -523,6 +500,68 @@ mod tests {
         vertices
             .chain(brep.faces.iter().map(|f| f.sample))
             .collect()
+    }
+
+    /// The 3D primitives' shapes the tests below build their boundaries of:
+    /// turned and mirroring frames, cones with and without caps.
+    fn solids() -> Vec<SolidShape> {
+        let turned = Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7);
+        let mirrored = Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0));
+        let mut shapes = Vec::new();
+        for linear in [turned, mirrored] {
+            let f = frame(linear);
+            shapes.push(SolidShape::Box { frame: f });
+            shapes.push(SolidShape::Ball { frame: f });
+            for (r0, r1) in [(0.4, 0.2), (0.0, 0.3), (0.5, 0.0), (0.25, 0.25)] {
+                shapes.push(SolidShape::Cone { frame: f, r0, r1 });
+            }
+            shapes.push(SolidShape::Torus {
+                frame: f,
+                major: 0.5,
+                minor: 0.15,
+            });
+        }
+        shapes
+    }
+
+    #[test]
+    fn carriers_by_local_index_are_the_breps() {
+        let mut counts = Vec::new();
+        for shape in solids() {
+            let brep = of(&shape);
+            for (k, face) in brep.faces.iter().enumerate() {
+                // Bit for bit: the model makes these instead of keeping them.
+                assert_eq!(
+                    shape.face_surface(k).as_ref(),
+                    Some(&face.surface),
+                    "{shape:?} face {k}"
+                );
+            }
+            for (k, edge) in brep.edges.iter().enumerate() {
+                assert_eq!(
+                    shape.edge_curve(k).as_ref(),
+                    Some(&edge.curve),
+                    "{shape:?} edge {k}"
+                );
+            }
+            assert_eq!(shape.face_surface(brep.faces.len()), None);
+            assert_eq!(shape.edge_curve(brep.edges.len()), None);
+            counts.push((brep.faces.len(), brep.edges.len()));
+        }
+        // Box, ball, four cones (two caps, top only, bottom only, two), torus.
+        let expected = [(6, 12), (2, 1), (3, 2), (2, 1), (2, 1), (3, 2), (1, 2)];
+        assert_eq!(counts[..7], expected);
+        assert_eq!(counts[7..], expected);
+    }
+
+    #[test]
+    fn regions_keep_their_own_carriers() {
+        let disk = SolidShape::Disk {
+            frame: frame(Mat3::identity()),
+        };
+        assert_eq!(of(&disk).faces.len(), 1);
+        assert_eq!(disk.face_surface(0), None);
+        assert_eq!(disk.edge_curve(0), None);
     }
 
     #[test]

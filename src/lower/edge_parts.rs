@@ -5,7 +5,7 @@
 //! position, added to every `<boundary>` group that named the edge.
 
 use crate::geom::Curve;
-use crate::ir::{Edge, EdgeId, EntityName, Model, SourceMap, VertexId};
+use crate::ir::{Carrier, Edge, EdgeId, EntityName, Model, SourceMap, VertexId};
 
 pub(super) struct EdgeParts {
     edge: EdgeId,
@@ -36,13 +36,13 @@ impl EdgeParts {
         self.count += 1;
         if self.count == 1 {
             let edge = &mut model.edges[self.edge.index()];
-            (edge.curve, edge.begin, edge.end) = (curve, begin, end);
+            (edge.carrier, edge.begin, edge.end) = (Carrier::own(curve), begin, end);
             return self.edge;
         }
         let id = EdgeId(model.edges.len() as u32);
         model.edges.push(Edge {
             name: format!("{}.{}", self.name, self.count).into(),
-            curve,
+            carrier: Carrier::own(curve),
             begin,
             end,
         });

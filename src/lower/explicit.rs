@@ -7,8 +7,8 @@ use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::Document;
 use crate::geom::{Curve, Point3, SolidShape, Surface, Vec3};
 use crate::ir::{
-    Boundary, Dimension, Edge, EdgeId, Face, Model, OrientedEdge, Origin, SourceMap, Vertex,
-    VertexId,
+    Boundary, Carrier, Dimension, Edge, EdgeId, Face, Model, OrientedEdge, Origin, SourceMap,
+    Vertex, VertexId,
 };
 use crate::resolve::{Geometry, LineCarrier, Resolved};
 use crate::span::Span;
@@ -175,7 +175,7 @@ pub(super) fn lower_topology(
         let id = crate::ir::FaceId(model.faces.len() as u32);
         model.faces.push(Face {
             name: object.name.as_str().into(),
-            surface,
+            carrier: Carrier::own(surface),
             reversed,
             loops: chained.into(),
         });
@@ -199,7 +199,7 @@ fn push_edge(
     let id = EdgeId(model.edges.len() as u32);
     model.edges.push(Edge {
         name: object.name.as_str().into(),
-        curve,
+        carrier: Carrier::own(curve),
         begin,
         end,
     });
@@ -408,8 +408,7 @@ fn chain(model: &Model, ids: &[EdgeId]) -> Vec<OrientedEdge> {
 fn loop_points(model: &Model, l: &[OrientedEdge]) -> Vec<Point3> {
     let mut points = Vec::new();
     for e in l {
-        let edge = model.edge(e.edge);
-        let mut samples = edge.curve.samples(8);
+        let mut samples = model.edge_curve(e.edge).samples(8);
         if !e.forward {
             samples.reverse();
         }
@@ -474,8 +473,8 @@ fn check_edges_on_surface(
     for (k, l) in loops.iter().enumerate() {
         for e in l {
             let edge = model.edge(e.edge);
-            let worst = edge
-                .curve
+            let worst = model
+                .edge_curve(e.edge)
                 .samples(8)
                 .iter()
                 .map(|p| surface.distance(p))

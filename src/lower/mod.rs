@@ -25,8 +25,8 @@ use crate::diag::Diagnostics;
 use crate::doc::Document;
 use crate::geom::{Aabb, SolidShape};
 use crate::ir::{
-    Dimension, EntityName, Face, Loops, Model, OrientedEdge, OrientedFace, Origin, PointSet,
-    Polyline, Solid, SolidId, SourceMap,
+    Carrier, Dimension, EntityName, Face, Loops, Model, OrientedEdge, OrientedFace, Origin,
+    PointSet, Polyline, Solid, SolidId, SourceMap,
 };
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
@@ -104,7 +104,14 @@ impl Entities {
 /// Reads the document's subdomains and boundaries; every object comes from
 /// `resolved` (the driver drops the document's objects before lowering). The
 /// subdomain definitions are taken out of `doc` and dropped once lowered.
-pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -> Lowered {
+/// `release` (the driver's `Options::release_memory`) is called where much
+/// has just been freed: the welder's tables, the subdomain definitions.
+pub fn lower(
+    doc: &mut Document,
+    resolved: &Resolved,
+    diags: &mut Diagnostics,
+    release: Option<fn()>,
+) -> Lowered {
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
     } else {
@@ -172,6 +179,12 @@ pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -
     // on large files) must not still be alive while subdomains are built.
     let face_samples = std::mem::take(&mut welder.face_samples);
     drop(welder);
+    // Freed memory is otherwise kept by the allocator for reuse (about a
+    // second): the welder's and isolation's tables would stay resident
+    // through the subdomains, the memory peak on files of many solids.
+    if let Some(release) = release {
+        release();
+    }
     explicit::lower_topology(resolved, &mut model, &mut source_map, &mut entities, diags);
     let named_lists =
         !doc.boundaries.is_empty() || doc.subdomains.iter().any(|s| s.faces.is_some());
@@ -186,6 +199,7 @@ pub fn lower(doc: &mut Document, resolved: &Resolved, diags: &mut Diagnostics) -
         &entities,
         &face_samples,
         diags,
+        release,
     );
     explicit::lower_boundaries(doc, &mut model, &entities, diags);
     prune::prune_interior(&mut model, &mut source_map);
@@ -313,6 +327,19 @@ fn lower_solid(
     let origin = Origin { span };
     let brep = brep::of(shape);
     welder.begin_solid(model);
+    // The solid comes first: its faces and edges make their carriers from its
+    // shape (3D primitives; a 2D region's entities keep their own), and the
+    // welder may read them while the solid is lowered.
+    let id = SolidId(model.solids.len() as u32);
+    model.solids.push(Solid {
+        name: name.to_string(),
+        shape: shape.clone(),
+        faces: Vec::new(),
+        boundary_edges: Vec::new(),
+        edges: Vec::new(),
+        vertices: Vec::new(),
+    });
+    let by_solid = !shape.is_planar();
     // The entities' names share the solid's ("{name}.{local}"); the name
     // tables for faces= and edges= lists are built later, and only when a
     // file has such lists.
@@ -331,11 +358,19 @@ fn lower_solid(
     let edge_ids: Vec<_> = brep
         .edges
         .into_iter()
-        .map(|e| {
+        .enumerate()
+        .map(|(local, e)| {
             let (id, flipped, new) = welder.edge(
                 model,
                 || EntityName::local(&base, e.name),
-                e.curve,
+                &e.curve,
+                || {
+                    if by_solid {
+                        Carrier::primitive(id, local)
+                    } else {
+                        Carrier::own(e.curve.clone())
+                    }
+                },
                 vertex_ids[e.begin],
                 vertex_ids[e.end],
             );
@@ -353,14 +388,18 @@ fn lower_solid(
         }
     };
     let mut faces = Vec::with_capacity(brep.faces.len());
-    for f in brep.faces {
+    for (local, f) in brep.faces.into_iter().enumerate() {
         let total = f.loops.iter().map(Vec::len).sum();
         let loops =
             Loops::from_nested(f.loops.iter().map(|l| l.iter().copied().map(orient)), total);
         let first = loops.first().and_then(|l| l.first()).copied();
         let face = Face {
             name: EntityName::local(&base, f.name),
-            surface: f.surface,
+            carrier: if by_solid {
+                Carrier::primitive(id, local)
+            } else {
+                Carrier::own(f.surface)
+            },
             reversed: false,
             loops,
         };
@@ -374,15 +413,11 @@ fn lower_solid(
         faces.push(OrientedFace { face: id, outward });
     }
     let boundary_edges = brep.boundary.iter().copied().map(orient).collect();
-    let id = SolidId(model.solids.len() as u32);
-    model.solids.push(Solid {
-        name: name.to_string(),
-        shape: shape.clone(),
-        faces,
-        boundary_edges,
-        edges: edge_ids.iter().map(|&(e, _)| e).collect(),
-        vertices: vertex_ids,
-    });
+    let solid = &mut model.solids[id.index()];
+    solid.faces = faces;
+    solid.boundary_edges = boundary_edges;
+    solid.edges = edge_ids.iter().map(|&(e, _)| e).collect();
+    solid.vertices = vertex_ids;
     source_map.solids.insert(id, origin);
     id
 }

@@ -279,7 +279,7 @@ pub(super) fn share_arcs(
             .filter(|e| !region_edges.contains(e))
             .collect::<BTreeSet<EdgeId>>()
             .into_iter()
-            .filter_map(|e| KernelCurve::of(&model.edge(e).curve).map(|a| (e, a)))
+            .filter_map(|e| KernelCurve::of(&model.edge_curve(e)).map(|a| (e, a)))
             .collect();
     if arcs.is_empty() {
         return reported;
@@ -444,7 +444,7 @@ pub(super) fn share_arcs(
             model.vertices[edge.begin.index()].position,
             model.vertices[edge.end.index()].position,
         );
-        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = &mut edge.curve {
+        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = model.edge_curve_mut(*e) {
             (*a, *b) = (pa, pb);
         }
     }
@@ -536,12 +536,12 @@ fn find_runs(
     let on: Vec<bool> = (0..n)
         .map(|k| {
             // Box sides on a straight edge are share_box_sides' to split.
-            let box_side = matches!(model.edge(lp[k].edge).curve, Curve::Segment { .. });
+            let box_side = matches!(*model.edge_curve(lp[k].edge), Curve::Segment { .. });
             on_vertex[k]
                 && on_vertex[(k + 1) % n]
                 && !(arc.is_line() && box_side)
                 && arc
-                    .on(&model.edge(lp[k].edge).curve.point(0.5), tol)
+                    .on(&model.edge_curve(lp[k].edge).point(0.5), tol)
                     .is_some()
         })
         .collect();

@@ -321,7 +321,7 @@ fn share_box_sides(
         .iter()
         .flatten()
         .map(|oe| oe.edge)
-        .filter(|&e| matches!(model.edge(e).curve, Curve::Segment { .. }))
+        .filter(|&e| matches!(*model.edge_curve(e), Curve::Segment { .. }))
         .collect();
     if sides.is_empty() {
         return;
@@ -331,7 +331,7 @@ fn share_box_sides(
         face_edges(model, first_region..model.subdomains.len()).collect();
     let kernel_edges: BTreeSet<EdgeId> = face_edges(model, 0..first_region)
         .filter(|e| !region_edges.contains(e))
-        .filter(|&e| matches!(model.edge(e).curve, Curve::Segment { .. }))
+        .filter(|&e| matches!(*model.edge_curve(e), Curve::Segment { .. }))
         .collect();
     let tol = 16.0 * model.tolerance;
     for ke in kernel_edges {
@@ -526,8 +526,8 @@ impl Outline {
         let mut segments = Vec::new();
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for oe in model.faces[f.index()].loops.iter().flatten() {
-            let curve = &model.edge(oe.edge).curve;
-            let n = match curve {
+            let curve = model.edge_curve(oe.edge);
+            let n = match *curve {
                 Curve::Segment { .. } | Curve::Contour { .. } => 1,
                 _ => 256,
             };
@@ -654,7 +654,7 @@ fn check(
             let same_side = shared
                 .iter()
                 .find(|&&e| forward_in(face_of(model, k), e) == forward_in(Some(fr), e))
-                .map(|&e| (Code::SubdomainsOverlap, model.edge(e).curve.point(0.5)));
+                .map(|&e| (Code::SubdomainsOverlap, model.edge_curve(e).point(0.5)));
             let finding = same_side.or_else(|| {
                 loop_vertices(model, fr)
                     .into_iter()
@@ -745,7 +745,7 @@ fn report(
                 d(a).total_cmp(&d(b))
             })
             .map(|s| s.2);
-        match nearest.map(|e| (model.edge(e), matches!(model.edge(e).curve, Curve::Ellipse { .. }))) {
+        match nearest.map(|e| (model.edge(e), matches!(*model.edge_curve(e), Curve::Ellipse { .. }))) {
             Some((edge, true)) => Diagnostic::new(
                 code,
                 span,

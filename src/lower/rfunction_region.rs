@@ -293,7 +293,7 @@ fn add_region(
             };
             model.edges.push(Edge {
                 name: format!("{}.contour[{}].e{}", sub.name, l + 1, k + 1).into(),
-                curve,
+                carrier: crate::ir::Carrier::own(curve),
                 begin: VertexId(a as u32),
                 end: VertexId(b as u32),
             });
@@ -308,10 +308,10 @@ fn add_region(
     let face = FaceId(model.faces.len() as u32);
     model.faces.push(Face {
         name: format!("{}.region", sub.name).into(),
-        surface: Surface::Plane {
+        carrier: crate::ir::Carrier::own(Surface::Plane {
             origin: Point3::origin(),
             normal: Vec3::z(),
-        },
+        }),
         reversed: false,
         loops: face_loops.into(),
     });

@@ -15,7 +15,8 @@ use crate::diag::{Code, Diagnostics};
 use crate::geom::{Curve, Point3, Surface};
 use crate::ir::SourceMap;
 use crate::ir::{
-    Edge, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex, VertexId,
+    Carrier, Edge, EdgeId, Face, FaceId, Model, OrientedEdge, OrientedFace, SubdomainCells, Vertex,
+    VertexId,
 };
 use crate::trimmed::boundary::{U_MAX, U_MIN, V_MAX, V_MIN};
 use crate::trimmed::shared::{bbox, distance_to_polyline, nearest_point};
@@ -66,9 +67,9 @@ pub fn add(model: &mut Model, source_map: &SourceMap, diags: &mut Diagnostics) {
                 }
                 model.edges.push(Edge {
                     name: name.into(),
-                    curve: Curve::Chain {
+                    carrier: Carrier::own(Curve::Chain {
                         points: piece.points.clone(),
-                    },
+                    }),
                     begin,
                     end,
                 });
@@ -81,7 +82,7 @@ pub fn add(model: &mut Model, source_map: &SourceMap, diags: &mut Diagnostics) {
         }
         faces.push(Face {
             name: s.name.as_str().into(),
-            surface: Surface::Parametric(Box::new(s.clone())),
+            carrier: Carrier::own(Surface::Parametric(Box::new(s.clone()))),
             reversed: false,
             loops: chain_loops(&oriented).into(),
         });
@@ -126,7 +127,7 @@ fn along_other_edge(
     };
     let (lo, hi) = bbox(own);
     for (i, e) in model.edges.iter().enumerate().take(own_edges) {
-        let line = match &e.curve {
+        let line = match &*e.curve(&model.solids) {
             Curve::Chain { points } => points.clone(),
             c => c.samples(1024),
         };
@@ -256,7 +257,7 @@ fn shared_edge(model: &Model, piece: &Piece) -> Option<OrientedEdge> {
         if e.begin != e.end || (piece.side != 0 && !e.name.to_string().contains(".trim[")) {
             continue;
         }
-        let line = match &e.curve {
+        let line = match &*e.curve(&model.solids) {
             Curve::Chain { points } => points.clone(),
             c => c.samples(1024),
         };

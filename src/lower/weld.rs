@@ -8,7 +8,9 @@
 
 use super::booleans::cell_hash;
 use crate::geom::{Curve, Point3};
-use crate::ir::{Edge, EdgeId, EntityName, Face, FaceId, Model, OrientedEdge, Vertex, VertexId};
+use crate::ir::{
+    Carrier, Edge, EdgeId, EntityName, Face, FaceId, Model, OrientedEdge, Vertex, VertexId,
+};
 use std::collections::HashMap;
 use std::hash::{BuildHasher, Hash};
 
@@ -251,7 +253,8 @@ impl Welder {
         &mut self,
         model: &mut Model,
         name: impl FnOnce() -> EntityName,
-        curve: Curve,
+        curve: &Curve,
+        carrier: impl FnOnce() -> Carrier<Curve>,
         begin: VertexId,
         end: VertexId,
     ) -> (EdgeId, bool, bool) {
@@ -267,9 +270,9 @@ impl Welder {
             &self.shared
         };
         for id in tables.edges_by_ends.iter(&key) {
-            let probes = *probes.get_or_insert_with(|| probe_points(&curve));
+            let probes = *probes.get_or_insert_with(|| probe_points(curve));
             let existing = &model.edges[id as usize];
-            let theirs = probe_points(&existing.curve);
+            let theirs = probe_points(&existing.curve(&model.solids));
             let same = probes
                 .iter()
                 .zip(&theirs)
@@ -290,7 +293,7 @@ impl Welder {
         let id = EdgeId(model.edges.len() as u32);
         model.edges.push(Edge {
             name: name(),
-            curve,
+            carrier: carrier(),
             begin,
             end,
         });

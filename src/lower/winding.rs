@@ -59,12 +59,12 @@ fn solid_angle(t: &[Point3; 3], p: &Point3) -> f64 {
 pub fn loop_points(model: &Model, l: &[crate::ir::OrientedEdge]) -> Vec<Point3> {
     let mut points = Vec::new();
     for e in l {
-        let edge = model.edge(e.edge);
-        let n = match edge.curve {
+        let curve = model.edge_curve(e.edge);
+        let n = match *curve {
             crate::geom::Curve::Segment { .. } => 1,
             _ => 16,
         };
-        let mut samples = edge.curve.samples(n);
+        let mut samples = curve.samples(n);
         if !e.forward {
             samples.reverse();
         }
@@ -110,10 +110,15 @@ pub fn face_sample(model: &Model, face: FaceId) -> Option<Point3> {
             .any(|p| *p != a && *p != b && *p != c && inside(p));
         if !blocked {
             let guess = Point3::from((a.coords + b.coords + c.coords) / 3.0);
-            return Some(f.surface.project(&guess).unwrap_or(guess));
+            return Some(model.face_surface(face).project(&guess).unwrap_or(guess));
         }
     }
-    Some(f.surface.project(&centroid).unwrap_or(centroid))
+    Some(
+        model
+            .face_surface(face)
+            .project(&centroid)
+            .unwrap_or(centroid),
+    )
 }
 
 #[cfg(test)]

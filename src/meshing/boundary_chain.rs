@@ -153,7 +153,7 @@ pub(super) fn move_onto_curve(
     model: &Model,
     chain: &mut Chain,
 ) -> Option<()> {
-    let curve = &model.edges.get(chain.edge)?.curve;
+    let curve = model.edges.get(chain.edge)?.curve(&model.solids);
     for (uv, _, _) in &chain.inner {
         let handle = cdt.locate_vertex(*uv)?.fix();
         // Removal moves the last vertex into the freed slot: the checked

@@ -222,6 +222,7 @@ fn tip_on_edge(
     else {
         return *tip;
     };
+    let curve = edge.curve(&model.solids);
     let (lo, hi) = if seg.sa < seg.sb {
         (seg.sa, seg.sb)
     } else {
@@ -229,7 +230,7 @@ fn tip_on_edge(
     };
     // Golden-section search for the nearest curve point over the segment's
     // parameter range (exact for straight edges up to rounding).
-    let distance = |s: f64| (edge.curve.point(s) - tip).norm();
+    let distance = |s: f64| (curve.point(s) - tip).norm();
     let ratio = (5f64.sqrt() - 1.0) / 2.0;
     let (mut a, mut b) = (lo, hi);
     for _ in 0..80 {
@@ -251,7 +252,7 @@ fn tip_on_edge(
     } else {
         searched
     };
-    nodes.insert(&edge.curve, s);
+    nodes.insert(&curve, s);
     // The node there (new, or an existing one within 1e-12 in parameter).
     nodes
         .points

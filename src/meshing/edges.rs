@@ -52,12 +52,13 @@ pub(crate) fn discretise(
         .get(edge.end.index())
         .ok_or_else(|| failed("its end vertex does not exist"))?
         .position;
-    let mut n = match &edge.curve {
+    let curve = edge.curve(&model.solids);
+    let mut n = match &*curve {
         _ if edge.is_closed() => 3,
         Curve::Segment { .. } | Curve::Contour { .. } => 1,
         _ => 2,
     };
-    if let Curve::PointCalculus(curve) = &edge.curve {
+    if let Curve::PointCalculus(curve) = &*curve {
         // Point-calculus curves are sampled adaptively (denser where they bend).
         let (params, points) = adaptive_samples(curve, tolerance, max_edge, n)
             .ok_or_else(|| failed("its curve has points that are not finite"))?;
@@ -69,7 +70,7 @@ pub(crate) fn discretise(
         nodes.params = params;
         return Ok(nodes);
     }
-    if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = &edge.curve {
+    if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = &*curve {
         // A straight edge only needs the length limit (a contour piece is
         // within the tolerance of its chord already).
         let length = (b - a).norm();
@@ -79,13 +80,13 @@ pub(crate) fn discretise(
         if n > MAX_SEGMENTS {
             return Err(failed("it needs too many segments for max_edge"));
         }
-        return Ok(finish(edge.curve.samples(n), n, begin, end));
+        return Ok(finish(curve.samples(n), n, begin, end));
     }
     loop {
         if n > MAX_SEGMENTS {
             return Err(failed("its discretisation did not reach the tolerance"));
         }
-        let fine = edge.curve.samples(2 * n);
+        let fine = curve.samples(2 * n);
         if !fine.iter().all(|p| p.coords.iter().all(|x| x.is_finite())) {
             return Err(failed("its curve has points that are not finite"));
         }

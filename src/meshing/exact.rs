@@ -84,7 +84,7 @@ pub fn subdomain_measures(model: &Model) -> Vec<Option<ExactMeasure>> {
 
 fn face_measure(model: &Model, face: &Face, gauss: &GaussLegendre) -> Option<FaceMeasure> {
     let sign = if face.reversed { -1.0 } else { 1.0 };
-    let measure = match &face.surface {
+    let measure = match &*face.surface(&model.solids) {
         Surface::Plane { origin, normal } => planar(model, face, origin, &(normal * sign))?,
         Surface::Ellipsoid { frame } => {
             let north = hemisphere_is_north(model, face, frame)?;
@@ -158,7 +158,7 @@ fn planar(model: &Model, face: &Face, origin: &Point3, normal: &Vec3) -> Option<
     let mut twice = Vec3::zeros();
     for oriented in face.loops.iter().flatten() {
         let edge = model.edges.get(oriented.edge.index())?;
-        let along = loop_integral(&edge.curve)?;
+        let along = loop_integral(&edge.curve(&model.solids))?;
         twice += if oriented.forward { along } else { -along };
     }
     let area = 0.5 * n.dot(&twice);
@@ -205,7 +205,7 @@ fn hemisphere_is_north(model: &Model, face: &Face, frame: &Frame) -> Option<bool
         minor,
         t0,
         t1,
-    } = &model.edges.get(oriented.edge.index())?.curve
+    } = *model.edges.get(oriented.edge.index())?.curve(&model.solids)
     else {
         return None;
     };
@@ -239,7 +239,8 @@ fn cone_side_is_whole(model: &Model, face: &Face, frame: &Frame, r0: f64, r1: f6
         let [oriented] = lp else {
             return None;
         };
-        let Curve::Ellipse { center, t0, t1, .. } = &model.edges.get(oriented.edge.index())?.curve
+        let Curve::Ellipse { center, t0, t1, .. } =
+            *model.edges.get(oriented.edge.index())?.curve(&model.solids)
         else {
             return None;
         };

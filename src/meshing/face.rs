@@ -129,19 +129,20 @@ pub(crate) fn mesh_face(
     };
     let loops = walk_loops(model, face, edges).map_err(failed)?;
     let boundary: Vec<Point3> = loops.iter().flatten().map(|p| p.point).collect();
-    let chart = Chart::new(&face.surface, &boundary, area_vector(face, &loops)).map_err(failed)?;
+    let surface = face.surface(&model.solids);
+    let chart = Chart::new(&surface, &boundary, area_vector(face, &loops)).map_err(failed)?;
     let uv_loops = unwrap_loops(&chart, &loops).map_err(failed)?;
 
     // Sized up front for the nodes the area limit will ask for: growing
     // spade's tables by doubling copied them and touched twice the memory.
     let expected = expected_vertices(
         &uv_loops,
-        settings.max_area.min(guide_area(&uv_loops, &face.surface)),
+        settings.max_area.min(guide_area(&uv_loops, &surface)),
     )
     .max(curved_vertices(
         &chart,
         &uv_loops,
-        &face.surface,
+        &surface,
         settings.tolerance,
     ));
     let bulk = bulk_load_loops(&uv_loops);
@@ -272,7 +273,7 @@ pub(crate) fn mesh_face(
     // plane face move the hull away; the faces out there are refined for
     // their angles only (the area limit is checked on the face's own
     // triangles, `Coarse`) and dropped with the rest of the outside.
-    let framed = !polyline_segments.is_empty() && matches!(face.surface, Surface::Plane { .. });
+    let framed = !polyline_segments.is_empty() && matches!(*surface, Surface::Plane { .. });
     if framed {
         insert_frame(&mut cdt, &chart, &uv_loops, &mut positions).map_err(failed)?;
     }
@@ -282,7 +283,7 @@ pub(crate) fn mesh_face(
     let guide = if small_angle {
         f64::INFINITY
     } else {
-        guide_area(&uv_loops, &face.surface)
+        guide_area(&uv_loops, &surface)
     };
     // Spade finds the outside by peeling the whole triangulation into hash
     // sets on every call (a tenth of the meshing time); a single loop that is
@@ -320,12 +321,11 @@ pub(crate) fn mesh_face(
     // only check the triangles insertions created or moved.
     let mut fine: Vec<u64> = Vec::new();
     let mut excluded: Vec<bool>;
-    let deviation = Deviation::of(&face.surface);
+    let deviation = Deviation::of(&surface);
     let coarse = Coarse {
         deviation: &deviation,
         settings,
-        area_limited: settings.max_area.is_finite()
-            && matches!(face.surface, Surface::Plane { .. }),
+        area_limited: settings.max_area.is_finite() && matches!(*surface, Surface::Plane { .. }),
     };
     // Vertices from this index on have not been checked for boundary splits.
     let mut unchecked = fixed;
@@ -341,7 +341,7 @@ pub(crate) fn mesh_face(
     // face it rescanned the whole face on each of its 2–3 calls between the
     // chordal passes (95% of meshing), where ours checks the surface on each
     // new triangle in the same loop.
-    let plane = matches!(face.surface, Surface::Plane { .. });
+    let plane = matches!(*surface, Surface::Plane { .. });
     // Periodic charts (a torus) stay with spade: their seam segments, split
     // by our loop, fell between the unwrapped copies of an edge (E502).
     let periodic = chart.periods().iter().any(Option::is_some);
@@ -378,8 +378,8 @@ pub(crate) fn mesh_face(
     // Refinement splits a segment on a curved edge at the curve's point
     // (`refine::Curves`): in the chart, and on the curve for the node.
     let curve_point = |edge: usize, s: f64| -> Option<(Point2<f64>, Point3)> {
-        let curve = &model.edges.get(edge)?.curve;
-        if matches!(curve, crate::geom::Curve::Segment { .. }) {
+        let curve = model.edges.get(edge)?.curve(&model.solids);
+        if matches!(*curve, crate::geom::Curve::Segment { .. }) {
             return None;
         }
         let p = curve.point(s);
@@ -482,10 +482,14 @@ pub(crate) fn mesh_face(
                 )
                 .map_err(failed)?
             };
-            let plane = matches!(face.surface, Surface::Plane { .. });
+            let plane = matches!(*surface, Surface::Plane { .. });
             let straight = |edge: usize| {
                 matches!(
-                    model.edges.get(edge).map(|e| &e.curve),
+                    model
+                        .edges
+                        .get(edge)
+                        .map(|e| e.curve(&model.solids))
+                        .as_deref(),
                     Some(crate::geom::Curve::Segment { .. })
                 )
             };

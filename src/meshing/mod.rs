@@ -204,7 +204,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         edge_nodes.iter().map(|n| n.points.clone()).collect();
     let sizing = size::Sizing::new(model, options.size_field.as_ref(), max_edge, &edge_points)?;
     for (nodes, edge) in edge_nodes.iter_mut().zip(&model.edges) {
-        nodes.refine_to_size(&edge.curve, &sizing);
+        nodes.refine_to_size(&edge.curve(&model.solids), &sizing);
     }
     let lines = model
         .polylines
@@ -392,8 +392,9 @@ fn mesh_faces(
                 continue;
             };
             let mut changed = false;
+            let curve = model_edge.curve(&model.solids);
             for s in params {
-                changed |= nodes.insert(&model_edge.curve, s);
+                changed |= nodes.insert(&curve, s);
             }
             if changed {
                 // One face split the edge and kept its mesh: only the

@@ -28,18 +28,17 @@ pub(crate) fn elevate(
     let mut quadratic = QuadraticNodes::default();
     for (i, edge) in mesh.edges.iter().enumerate() {
         let mut per_segment = Vec::with_capacity(edge.nodes.len().saturating_sub(1));
-        let curve_params = origins
-            .get(i)
-            .copied()
-            .flatten()
-            .and_then(|(m, first)| Some((model.edges.get(m)?, edge_nodes.get(m)?, first)));
+        let curve_params = origins.get(i).copied().flatten().and_then(|(m, first)| {
+            let curve = model.edges.get(m)?.curve(&model.solids);
+            Some((curve, edge_nodes.get(m)?, first))
+        });
         for (j, w) in edge.nodes.windows(2).enumerate() {
             let id = *mids.entry(key(w[0], w[1])).or_insert_with(|| {
                 let point = match curve_params {
-                    Some((model_edge, disc, first)) if first + j + 1 < disc.params.len() => {
+                    Some((ref curve, disc, first)) if first + j + 1 < disc.params.len() => {
                         let k = first + j;
                         let s = 0.5 * (disc.params[k] + disc.params[k + 1]);
-                        let p = model_edge.curve.point(s);
+                        let p = curve.point(s);
                         [p.x, p.y, p.z]
                     }
                     _ => middle(&mesh.nodes, w[0], w[1]),

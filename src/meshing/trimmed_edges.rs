@@ -166,7 +166,8 @@ impl Ring {
 /// one nearest the end, and the way round that passes by the edge's own
 /// points. `None` when the path strays from the edge's points.
 fn cut(model: &Model, edge: &crate::ir::Edge, rings: &[Ring]) -> Option<Vec<u32>> {
-    let Curve::Chain { points } = &edge.curve else {
+    // Chains are never a primitive's: their carriers are their own.
+    let Some(Curve::Chain { points }) = edge.carrier.owned() else {
         return None;
     };
     let begin = model.vertices.get(edge.begin.index())?.position;

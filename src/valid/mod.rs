@@ -119,7 +119,7 @@ pub(crate) mod fixtures {
             let id = EdgeId(self.model.edges.len() as u32);
             self.model.edges.push(Edge {
                 name: format!("e{}", id.0).into(),
-                curve,
+                carrier: crate::ir::Carrier::own(curve),
                 begin,
                 end,
             });
@@ -137,7 +137,7 @@ pub(crate) mod fixtures {
             let id = FaceId(self.model.faces.len() as u32);
             self.model.faces.push(Face {
                 name: name.into(),
-                surface,
+                carrier: crate::ir::Carrier::own(surface),
                 reversed: false,
                 loops: loops.into(),
             });

@@ -83,7 +83,7 @@ fn curve_description(curve: &Curve) -> String {
 pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostics) {
     for (i, edge) in model.edges.iter().enumerate() {
         let id = EdgeId(i as u32);
-        if edge.begin == edge.end && !curve_is_closed(&edge.curve, model.tolerance) {
+        if edge.begin == edge.end && !curve_is_closed(&edge.curve(&model.solids), model.tolerance) {
             diags.push(
                 Diagnostic::new(
                     Code::EdgeEndsCoincide,
@@ -92,7 +92,7 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
                         "edge '{}' begins and ends at vertex '{}' but its curve is open ({})",
                         edge.name,
                         vertex_name(model, edge.begin),
-                        curve_description(&edge.curve)
+                        curve_description(&edge.curve(&model.solids))
                     ),
                 )
                 .with_help(
