@@ -331,7 +331,7 @@ fn a_straight_contour_stretch_is_a_few_graded_pieces() {
     let mut pieces: Vec<(f64, f64)> = model
         .edges
         .iter()
-        .filter(|e| matches!(e.curve, geomc::geom::Curve::Contour { .. }))
+        .filter(|e| matches!(*e.curve(&model.solids), geomc::geom::Curve::Contour { .. }))
         .filter(|e| {
             [at(e.begin), at(e.end)]
                 .iter()

@@ -47,10 +47,11 @@ pub(super) fn split_at_joints(model: &mut Model, source_map: &mut SourceMap, fir
         let tol = ON_ARC_FRACTION * extent(model, fr);
         for oe in model.faces[fr.index()].loops.edges() {
             let edge = model.edge(oe.edge);
-            let Curve::Contour { a, b, .. } = &edge.curve else {
+            let curve = edge.curve(&model.solids);
+            let Curve::Contour { a, b, .. } = &*curve else {
                 continue;
             };
-            let middle = edge.curve.point(0.5);
+            let middle = curve.point(0.5);
             for j in &joints {
                 let off = |p: &Point3| {
                     let d = p - j.at;
@@ -76,7 +77,7 @@ fn joints(model: &Model, kernel_edges: &BTreeSet<EdgeId>) -> Vec<Joint> {
     let mut at_vertex: BTreeMap<VertexId, Vec<Vec3>> = BTreeMap::new();
     for &e in kernel_edges {
         let edge = model.edge(e);
-        if let Curve::Segment { a, b } = edge.curve {
+        if let Curve::Segment { a, b } = *edge.curve(&model.solids) {
             let length = (b - a).norm();
             if length > 0.0 {
                 let d = (b - a) / length;
@@ -104,7 +105,7 @@ fn joints(model: &Model, kernel_edges: &BTreeSet<EdgeId>) -> Vec<Joint> {
 /// a new vertex there.
 fn cut(model: &mut Model, source_map: &mut SourceMap, e: EdgeId, at: Point3) {
     let edge = model.edge(e).clone();
-    let Curve::Contour { a, b, f } = edge.curve else {
+    let Curve::Contour { a, b, f } = edge.curve(&model.solids).into_owned() else {
         return;
     };
     let v = VertexId(model.vertices.len() as u32);
@@ -159,7 +160,7 @@ pub(super) fn continues_past(
         return false;
     };
     model.edges.iter().enumerate().any(|(g, other)| {
-        let Curve::Segment { a, b } = other.curve else {
+        let Curve::Segment { a, b } = *other.curve(&model.solids) else {
             return false;
         };
         let length = (b - a).norm();
@@ -167,7 +168,7 @@ pub(super) fn continues_past(
             return false;
         }
         let d = (b - a) / length;
-        let along = model.edge(edge).curve.tangent(0.0);
+        let along = model.edge_curve(edge).tangent(0.0);
         if (along.x * d.y - along.y * d.x).abs() > PARALLEL {
             return false;
         }

@@ -176,7 +176,9 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
             model.vertices[edge.begin.index()].position,
             model.vertices[edge.end.index()].position,
         );
-        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = &mut edge.curve {
+        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } =
+            edge.carrier.curve_mut(&model.solids)
+        {
             (*a, *b) = (pa, pb);
         }
     }
@@ -305,7 +307,9 @@ fn restore_corners(model: &mut Model, f: FaceId, run: &Run) -> Run {
             model.vertices[edge.begin.index()].position,
             model.vertices[edge.end.index()].position,
         );
-        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = &mut edge.curve {
+        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } =
+            edge.carrier.curve_mut(&model.solids)
+        {
             (*a, *b) = (pa, pb);
         }
     }
@@ -421,7 +425,7 @@ const ON_SET_FRACTION: f64 = 1e-6;
 /// [`ON_SET_FRACTION`] of `other`'s extent.
 fn runs_on(model: &Model, f: FaceId, other: FaceId, tol: f64) -> Vec<Run> {
     let tight = ON_SET_FRACTION * extent(model, other);
-    let segments: Vec<(Point3, Point3, &Curve)> = model.faces[other.index()]
+    let segments: Vec<(Point3, Point3, std::borrow::Cow<Curve>)> = model.faces[other.index()]
         .loops
         .edges()
         .iter()
@@ -430,15 +434,15 @@ fn runs_on(model: &Model, f: FaceId, other: FaceId, tol: f64) -> Vec<Run> {
             (
                 model.vertex(e.begin).position,
                 model.vertex(e.end).position,
-                &e.curve,
+                e.curve(&model.solids),
             )
         })
         .collect();
     let near = |p: Point3| {
-        segments.iter().any(|&(a, b, curve)| {
-            let d = segment_distance(p, a, b);
+        segments.iter().any(|(a, b, curve)| {
+            let d = segment_distance(p, *a, *b);
             d <= tol
-                && match curve {
+                && match &**curve {
                     Curve::Contour { f, .. } => off_zero_set(f, p, tight) <= tight,
                     _ => d <= tight,
                 }
@@ -455,7 +459,7 @@ fn runs_on(model: &Model, f: FaceId, other: FaceId, tol: f64) -> Vec<Run> {
             .map(|k| {
                 on_vertex[k]
                     && on_vertex[(k + 1) % n]
-                    && near(model.edge(lp[k].edge).curve.point(0.5))
+                    && near(model.edge_curve(lp[k].edge).point(0.5))
             })
             .collect();
         if on.iter().all(|&x| x) {

@@ -63,7 +63,7 @@ pub(super) fn share_touch_points(
         .into_iter()
         .filter_map(|(edge, mut subdomains)| {
             subdomains.dedup();
-            KernelCurve::of(&model.edge(edge).curve).map(|curve| KernelEdge {
+            KernelCurve::of(&model.edge_curve(edge)).map(|curve| KernelEdge {
                 edge,
                 curve,
                 subdomains,
@@ -194,7 +194,7 @@ fn land(
         .count();
     let chord_on = run[..run.len() - 1]
         .iter()
-        .any(|&i| nearest(&k.curve, &model.edge(lp[i % n].edge).curve.point(0.5)).1 <= on);
+        .any(|&i| nearest(&k.curve, &model.edge_curve(lp[i % n].edge).point(0.5)).1 <= on);
     if on_edge > 1 || chord_on {
         return None;
     }
@@ -222,7 +222,7 @@ fn land(
     let f =
         [lp[before % n], lp[closest % n]]
             .iter()
-            .find_map(|oe| match &model.edge(oe.edge).curve {
+            .find_map(|oe| match &*model.edge_curve(oe.edge) {
                 Curve::Contour { f, .. } => Some(f.clone()),
                 _ => None,
             });
@@ -350,7 +350,9 @@ fn apply(
             model.vertices[edge.begin.index()].position,
             model.vertices[edge.end.index()].position,
         );
-        if let Curve::Contour { a, b, .. } | Curve::Segment { a, b } = &mut edge.curve {
+        if let Curve::Contour { a, b, .. } | Curve::Segment { a, b } =
+            edge.carrier.curve_mut(&model.solids)
+        {
             (*a, *b) = (pa, pb);
         }
     }
