@@ -6,6 +6,7 @@
 //! chunks' partial sums are added in chunk order.
 
 use super::camera::cross;
+use super::normal_sum::serial_sums;
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -71,14 +72,11 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
         .iter()
         .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
     if !local {
-        let mut sums = vec![[0.0; 3]; n + extra.len()];
-        for (t, s) in tris.iter().zip(corner_slots) {
-            let normal = tri_normal(points, *t);
-            for &k in s {
-                add(&mut sums[k as usize], normal);
-            }
-        }
-        return (own_slots, sums.par_iter().map(|&v| finish(v)).collect());
+        let sums = serial_sums(points, tris, corner_slots, n + extra.len());
+        return (
+            own_slots,
+            sums.par_iter().map(|v| finish(v.xyz())).collect(),
+        );
     }
     // Partial sums per chunk: an array over its node span, and the corners
     // of later faces in order.
