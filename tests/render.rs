@@ -180,7 +180,7 @@ fn bands_no_triangle_reaches_show_the_background_of_either_path() {
             // With an edge overlay the whole sample buffer is built and resolved.
             let overlay = RenderOptions {
                 edges: Edges::Feature,
-                ..options.clone()
+                ..options
             };
             let full = render_image(&mesh, &overlay).expect("renders").image;
             for y in 0..300 {
