@@ -162,6 +162,46 @@ fn cube_from_the_front_covers_exactly_its_square() {
 }
 
 #[test]
+fn bands_no_triangle_reaches_show_the_background_of_either_path() {
+    // A cube from the front in a tall picture: its square spans rows 110..190,
+    // so the 16-row bands above row 96 and from row 192 hold no triangle.
+    let mesh = unit_box();
+    for (background, pixel) in [
+        ([255, 255, 255, 0], [0, 0, 0, 0]),
+        ([32, 48, 64, 255], [32, 48, 64, 255]),
+    ] {
+        for antialias in [1, 2, 3] {
+            let options = RenderOptions {
+                background,
+                antialias,
+                ..bare(100, 300, View::FRONT)
+            };
+            let banded = render_image(&mesh, &options).expect("renders").image;
+            // With an edge overlay the whole sample buffer is built and resolved.
+            let overlay = RenderOptions {
+                edges: Edges::Feature,
+                ..options
+            };
+            let full = render_image(&mesh, &overlay).expect("renders").image;
+            for y in 0..300 {
+                for x in 0..100 {
+                    let inside = (10..90).contains(&x) && (110..190).contains(&y);
+                    let got = banded.pixel(x, y);
+                    if inside {
+                        assert_eq!(got[3], 255, "pixel {x},{y}");
+                    } else {
+                        assert_eq!(got, pixel, "pixel {x},{y} antialias {antialias}");
+                    }
+                    if !(105..195).contains(&y) {
+                        assert_eq!(full.pixel(x, y), pixel, "overlay pixel {x},{y}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
 fn box_in_iso_view_draws_only_its_nine_visible_edges() {
     let mesh = unit_box();
     let drawing = render_svg(&mesh, &bare(400, 400, View::ISO)).expect("draws");

@@ -7,7 +7,7 @@
 //! triangles, so any thread count gives the same picture.
 
 use super::raster::{self, EMPTY, Projected};
-use super::resolve::{Image, Samples, resolve_rows};
+use super::resolve::{Image, Samples, background_pixel, resolve_rows};
 use super::scene::Scene;
 use rayon::prelude::*;
 
@@ -30,6 +30,15 @@ pub fn render(
     rgba.par_chunks_mut(width * 4 * BAND_PIXELS)
         .enumerate()
         .for_each_init(Vec::new, |buf: &mut Vec<u64>, (band, out)| {
+            // A band no triangle reaches is background (the margins above
+            // and below the model): no samples to fill and read back.
+            if bins.iter().all(|chunk| chunk[band].is_empty()) {
+                let bg = background_pixel(background);
+                for pixel in out.chunks_exact_mut(4) {
+                    pixel.copy_from_slice(&bg);
+                }
+                return;
+            }
             let y0 = band * band_rows;
             let y1 = (y0 + band_rows).min(sh);
             buf.clear();

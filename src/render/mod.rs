@@ -9,6 +9,8 @@ mod bands;
 mod camera;
 mod font;
 mod legend;
+mod light;
+mod normal_sum;
 mod png_out;
 mod raster;
 mod resolve;

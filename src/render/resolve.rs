@@ -153,6 +153,16 @@ fn background_only(samples: &Samples, ss: usize, px: usize, py: usize) -> bool {
                 .all(|sy| (px * ss..(px + 1) * ss).all(|sx| !samples.edge(sx, sy))))
 }
 
+/// A pixel all of whose samples show `background`: the average the sums
+/// of [`resolve_rows`] give (a transparent one has no colour: all zeros).
+pub fn background_pixel(background: [u8; 4]) -> [u8; 4] {
+    if background[3] == 0 {
+        [0; 4]
+    } else {
+        background
+    }
+}
+
 /// Samples of sample rows `y0..` (stored from `data[0]`), `width` per row,
 /// and the edge mask of the whole picture (empty: no edges).
 pub struct Samples<'a> {
@@ -219,11 +229,7 @@ pub fn resolve_rows(
         let value = samples.value(px * ss, py * ss);
         (value != EMPTY).then_some(((value & 0xffff_ffff) >> 1) as usize)
     };
-    let bg = if background[3] == 0 {
-        [0; 4]
-    } else {
-        background
-    };
+    let bg = background_pixel(background);
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
         for px in 0..width {

@@ -4,6 +4,7 @@
 //! optional section cut.
 
 use super::camera::{Camera, dot};
+use super::light::{intensities, intensity};
 use super::smooth::{self, tri_normal};
 use super::{ColorBy, RenderOptions, Section, Shading};
 use crate::mesh::Mesh;
@@ -254,18 +255,6 @@ fn light_direction(camera: &Camera) -> [f64; 3] {
     l.map(|v| v / n)
 }
 
-fn intensity(normal: [f64; 3], light: [f64; 3]) -> [f32; 2] {
-    let len = dot(normal, normal).sqrt();
-    if len == 0.0 || !len.is_finite() {
-        return [0.6, 0.6];
-    }
-    let c = dot(normal, light) / len;
-    [
-        (0.25 + 0.75 * c.max(0.0)) as f32,
-        (0.25 + 0.75 * (-c).max(0.0)) as f32,
-    ]
-}
-
 /// The triangles and, per chunk of them, the span of nodes they name.
 type Borrowed<'a> = (
     Cow<'a, [[u32; 3]]>,
@@ -324,10 +313,13 @@ fn shade(scene: &mut Scene, shading: Shading, camera: &Camera, spans: Option<&[(
             );
         }
         Shading::Smooth => {
-            let (slots, light) =
-                smooth::per_slot(&scene.points, &scene.tris, &scene.tri_face, spans, |n| {
-                    intensity(n, light)
-                });
+            let (slots, light) = smooth::per_slot(
+                &scene.points,
+                &scene.tris,
+                &scene.tri_face,
+                spans,
+                |s, o| intensities(s, light, o),
+            );
             scene.corner_slots = match slots {
                 Some(slots) => Cow::Owned(slots),
                 None => scene.tris.clone(),

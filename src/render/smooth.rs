@@ -6,6 +6,7 @@
 //! chunks' partial sums are added in chunk order.
 
 use super::camera::cross;
+use super::normal_sum::{Sum, serial_sums};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
@@ -32,8 +33,15 @@ fn add(sum: &mut [f64; 3], n: [f64; 3]) {
     sum[2] += n[2];
 }
 
+fn add_to(sum: &mut Sum, n: [f64; 3]) {
+    sum.0[0] += n[0];
+    sum.0[1] += n[1];
+    sum.0[2] += n[2];
+}
+
 /// Per triangle corner a slot, and per slot `finish` of the summed normal
-/// (the light, for pictures: the sums themselves are never stored). A node's slot
+/// (the light, for pictures: the sums themselves are never stored; `finish`
+/// maps a run of sums to as many values, so it can take them four at a time). A node's slot
 /// is its own index in the first face (lowest index) that uses it; the
 /// (face, node) pairs of later faces get slots after the nodes, in sorted order.
 /// The slots are `None` when they are the triangles' own nodes (one face).
@@ -45,7 +53,7 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
     tris: &[[u32; 3]],
     tri_face: &[u32],
     spans: Option<&[(usize, usize)]>,
-    finish: impl Fn([f64; 3]) -> T + Sync,
+    finish: impl Fn(&[Sum], &mut [T]) + Sync,
 ) -> (Option<Vec<[u32; 3]>>, Vec<T>) {
     let n = points.len();
     let (own_slots, extra) = if tri_face.first() == tri_face.last() {
@@ -71,14 +79,12 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
         .iter()
         .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
     if !local {
-        let mut sums = vec![[0.0; 3]; n + extra.len()];
-        for (t, s) in tris.iter().zip(corner_slots) {
-            let normal = tri_normal(points, *t);
-            for &k in s {
-                add(&mut sums[k as usize], normal);
-            }
-        }
-        return (own_slots, sums.par_iter().map(|&v| finish(v)).collect());
+        let sums = serial_sums(points, tris, corner_slots, n + extra.len());
+        let mut out = vec![T::default(); sums.len()];
+        (out.par_chunks_mut(BLOCK))
+            .zip(sums.par_chunks(BLOCK))
+            .for_each(|(o, s)| finish(s, o));
+        return (own_slots, out);
     }
     // Partial sums per chunk: an array over its node span, and the corners
     // of later faces in order.
@@ -107,30 +113,26 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
     let (owned, later) = out.split_at_mut(n);
     owned.par_chunks_mut(BLOCK).enumerate().for_each_init(
         Vec::new,
-        |sums: &mut Vec<[f64; 3]>, (b, block)| {
+        |sums: &mut Vec<Sum>, (b, block)| {
             let (b0, b1) = (b * BLOCK, b * BLOCK + block.len());
             sums.clear();
-            sums.resize(block.len(), [0.0; 3]);
+            sums.resize(block.len(), Sum::default());
             for (lo, part, _) in &partials {
                 let (from, to) = (b0.max(*lo), b1.min(lo + part.len()));
                 for node in from..to {
-                    add(&mut sums[node - b0], part[node - lo]);
+                    add_to(&mut sums[node - b0], part[node - lo]);
                 }
             }
-            for (o, &v) in block.iter_mut().zip(sums.iter()) {
-                *o = finish(v);
-            }
+            finish(sums, block);
         },
     );
-    let mut later_sums = vec![[0.0; 3]; later.len()];
+    let mut later_sums = vec![Sum::default(); later.len()];
     for (_, _, extra_corners) in &partials {
         for &(k, normal) in extra_corners {
-            add(&mut later_sums[k as usize - n], normal);
+            add_to(&mut later_sums[k as usize - n], normal);
         }
     }
-    for (o, &v) in later.iter_mut().zip(&later_sums) {
-        *o = finish(v);
-    }
+    finish(&later_sums, later);
     (own_slots, out)
 }
 
@@ -148,8 +150,14 @@ fn span(chunk: &[[u32; 3]], n: usize) -> (usize, usize) {
 /// past `n` exactly when some chunk's `hi > n`. For triangles that name
 /// none, these are the spans [`per_slot`] sums one face over.
 pub fn node_spans(tris: &[[u32; 3]]) -> Vec<(usize, usize)> {
+    // A plain minimum and maximum over the flat ids (no filter: every id
+    // counts), which the compiler turns into vector code.
     tris.par_chunks(CHUNK)
-        .map(|chunk| span(chunk, usize::MAX))
+        .map(|chunk| {
+            let ids = chunk.as_flattened().iter();
+            let (lo, hi) = ids.fold((u32::MAX, 0), |(lo, hi), &s| (lo.min(s), hi.max(s)));
+            (lo as usize, hi as usize + 1)
+        })
         .collect()
 }
 
@@ -239,7 +247,11 @@ mod tests {
     }
 
     fn check(points: &[[f64; 3]], tris: &[[u32; 3]], tri_face: &[u32], (nx, ny): (usize, usize)) {
-        let (slots, sums) = per_slot(points, tris, tri_face, None, |v| v);
+        let (slots, sums) = per_slot(points, tris, tri_face, None, |s, o: &mut [[f64; 3]]| {
+            for (o, s) in o.iter_mut().zip(s) {
+                *o = s.xyz();
+            }
+        });
         let one_face = tri_face.iter().all(|&f| f == 0);
         assert_eq!(slots.is_none(), one_face);
         let slots = slots.unwrap_or_else(|| tris.to_vec());
@@ -271,6 +283,23 @@ mod tests {
         check(&points, &tris, &tri_face, (300, 100));
         // As one face: the triangles are their own slots, no crease.
         check(&points, &tris, &vec![0; tris.len()], (300, 100));
+    }
+
+    #[test]
+    fn node_spans_are_each_chunks_id_range() {
+        let (_, mut tris, _) = field(300, 100);
+        // A stray id far out in the second chunk, and the last chunk short.
+        tris[CHUNK + 5][1] = 4_000_000_000;
+        tris.truncate(2 * CHUNK + 7);
+        let spans = node_spans(&tris);
+        assert_eq!(spans.len(), 3);
+        for (chunk, &got) in tris.chunks(CHUNK).zip(&spans) {
+            let ids = chunk.iter().flatten().map(|&i| i as usize);
+            let want = (ids.clone().min().unwrap_or(0), ids.max().unwrap_or(0) + 1);
+            assert_eq!(got, want);
+            assert_eq!(got, span(chunk, usize::MAX));
+        }
+        assert_eq!(spans[1].1, 4_000_000_001);
     }
 
     #[test]
