@@ -2,8 +2,9 @@
 //! sphere) converted to GLB and to MSH 4.1 binary, and a 2-million-triangle
 //! MSH converted to GLB, by the release `geomc convert` and by peers in the
 //! same run (`benches/peers/convert_peers.py`: meshio 5.3.5, and trimesh
-//! 5.2.0 where meshio has no glTF writer). Targets: at least 10× the peers'
-//! speed, peak memory at most 3× the input file.
+//! 5.2.0 where meshio has no glTF writer, with numpy, scipy and networkx
+//! pinned in `benches/peers/requirements.txt`). Targets: at least 10× the
+//! peers' speed, peak memory at most 3× the input file.
 //!
 //! Times are medians of repeated runs (geomc 5, peers 3; see the peer
 //! script), with the first runs' ratio beside them as before.
@@ -114,13 +115,14 @@ fn main() {
         .arg(env!("CARGO_BIN_EXE_geomc"))
         .arg(&dir)
         .output()
-        .expect("run python3 (pip install meshio==5.3.5 trimesh==5.2.0)");
+        .expect("run python3 (pip install -r benches/peers/requirements.txt)");
     assert!(
         out.status.success(),
         "{}",
         String::from_utf8_lossy(&out.stderr)
     );
     let report: serde_json::Value = serde_json::from_slice(&out.stdout).expect("peer JSON");
+    print_environment(&report["environment"]);
     let inputs = [
         ("stl_to_glb", &big_stl),
         ("stl_to_msh41_binary", &big_stl),
@@ -161,6 +163,34 @@ fn main() {
         }
     }
     let _ = std::fs::remove_dir_all(&dir);
+}
+
+/// The peers' package versions, and a warning when they are not the pinned
+/// ones: the peers' times (and so the ratios) depend on them.
+fn print_environment(env: &serde_json::Value) {
+    let versions: Vec<String> = env["versions"]
+        .as_object()
+        .into_iter()
+        .flatten()
+        .map(|(name, v)| format!("{name} {}", v.as_str().unwrap_or("missing")))
+        .collect();
+    println!(
+        "  peers on Python {}: {}",
+        env["python"].as_str().unwrap_or("?"),
+        versions.join(", ")
+    );
+    if env["pinned"].as_bool() != Some(true) {
+        println!(
+            "  WARNING: not the pinned peer set-up (benches/peers/requirements.txt): {}; the ratios are not comparable with the recorded ones",
+            env["differs"]
+                .as_array()
+                .into_iter()
+                .flatten()
+                .filter_map(|d| d.as_str())
+                .collect::<Vec<_>>()
+                .join(", ")
+        );
+    }
 }
 
 fn verdict(ok: bool) -> &'static str {

@@ -25,19 +25,29 @@ if [ ${#need_apt[@]} -gt 0 ]; then
     DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq "${need_apt[@]}" >/dev/null
 fi
 
+# Every pip install below takes the convert bench's peer set-up as constraints
+# (numpy, scipy, networkx, meshio, trimesh at fixed versions), so the peers'
+# times can be compared from one machine to the next.
+PINS=(-c benches/peers/requirements.txt)
+if ! python3 benches/peers/convert_peers.py --check-pins >/dev/null 2>&1; then
+    echo "installing: the convert bench's pinned peer set-up (pip)" >&2
+    python3 -m pip install -q -r benches/peers/requirements.txt \
+        || python3 -m pip install -q --break-system-packages -r benches/peers/requirements.txt
+fi
+
 # tests/tools/check_mesh.py (tests/writers_external.rs).
 if ! python3 -c "import gmsh, meshio" >/dev/null 2>&1; then
     echo "installing: gmsh meshio (pip)" >&2
     # Debian's own python3 refuses system-wide pip installs without this flag.
-    python3 -m pip install -q gmsh==4.15.2 meshio==5.3.5 \
-        || python3 -m pip install -q --break-system-packages gmsh==4.15.2 meshio==5.3.5
+    python3 -m pip install -q "${PINS[@]}" gmsh==4.15.2 meshio==5.3.5 \
+        || python3 -m pip install -q "${PINS[@]}" --break-system-packages gmsh==4.15.2 meshio==5.3.5
 fi
 
 # tests/tools/make_meshes.py (tests/convert_external.rs): meshes made by trimesh.
 if ! python3 -c "import trimesh" >/dev/null 2>&1; then
     echo "installing: trimesh (pip)" >&2
-    python3 -m pip install -q trimesh==5.2.0 \
-        || python3 -m pip install -q --break-system-packages trimesh==5.2.0
+    python3 -m pip install -q "${PINS[@]}" trimesh==5.2.0 \
+        || python3 -m pip install -q "${PINS[@]}" --break-system-packages trimesh==5.2.0
 fi
 
 # tests/tools/fem_poisson.py (tests/fem_2d.rs, tests/region_2d.rs), fem_crack.py
@@ -46,8 +56,8 @@ fi
 # is the 2D meshing peer.
 if ! python3 -c "import skfem, triangle" >/dev/null 2>&1; then
     echo "installing: scikit-fem triangle (pip)" >&2
-    python3 -m pip install -q scikit-fem==10.0.2 triangle==20250106 \
-        || python3 -m pip install -q --break-system-packages scikit-fem==10.0.2 triangle==20250106
+    python3 -m pip install -q "${PINS[@]}" scikit-fem==10.0.2 triangle==20250106 \
+        || python3 -m pip install -q "${PINS[@]}" --break-system-packages scikit-fem==10.0.2 triangle==20250106
 fi
 
 # tests/tools/validate_gltf.js: the validator pinned by tests/tools/package-lock.json.

@@ -164,6 +164,36 @@ fn a_triangle_on_an_unknown_node_names_its_byte() {
     );
 }
 
+/// With node tags running on (1–4), a triangle's corners are found by
+/// subtracting the first tag: a tag below the run (0, which wraps past every
+/// index) or past it (5) is still refused at its own byte.
+#[test]
+fn a_triangle_below_or_past_the_node_run_names_its_byte() {
+    let past = msh(&[(&[1, 2, 3, 4], &C)], &[[5, 2, 3]]);
+    assert_eq!(
+        error(&past),
+        (
+            Code::MeshIndexOutOfRange,
+            "at byte 308: an element refers to node 5, which `$Nodes` does not define".to_string()
+        )
+    );
+    let below = msh(&[(&[1, 2, 3, 4], &C)], &[[1, 2, 3], [0, 3, 4]]);
+    assert_eq!(
+        error(&below),
+        (
+            Code::MeshIndexOutOfRange,
+            "at byte 340: an element refers to node 0, which `$Nodes` does not define".to_string()
+        )
+    );
+    let loaded = load_bytes(
+        ReadFormat::Msh,
+        &msh(&[(&[1, 2, 3, 4], &C)], &[[4, 1, 2]]),
+        Path::new("."),
+    )
+    .expect("valid MSH");
+    assert_eq!(loaded.mesh.faces[0].triangles, vec![[3, 0, 1]]);
+}
+
 /// Blocks whose tags run on from the block before are read whole (in
 /// parallel pieces); a block that skips a tag, or repeats one from an
 /// earlier block, is read node by node with the same numbering and errors.

@@ -3,7 +3,14 @@ conversion runs as its own process, timed by wall clock, with its peak
 resident memory from os.wait4.
 
 Usage: convert_peers.py GEOMC DIR  (DIR holds big.stl and mid.msh)
-Prints one JSON object: case -> {tool: {"seconds": s, "peak_bytes": b, ...}}.
+Prints one JSON object: case -> {tool: {"seconds": s, "peak_bytes": b, ...}},
+and "environment": the versions of the pinned packages
+(benches/peers/requirements.txt) as installed, with "pinned": whether they
+are the pinned ones (the peers' times depend on them: most of the MSH -> GLB
+peer's time is importing numpy, scipy and networkx).
+
+convert_peers.py --check-pins exits 1, naming them, when an installed
+version differs from its pin (scripts/test.sh then installs the pins).
 
 Each conversion runs several times (geomc 5, peers 3) and "seconds" is the
 median, "first_seconds" the first run alone (what this script reported
@@ -15,11 +22,48 @@ does) for STL -> MSH 4.1 binary; meshio cannot write glTF, so the GLB cases
 use trimesh 5.2.0 (STL -> GLB) and meshio's MSH reader + trimesh's GLB
 export (MSH -> GLB).
 """
+import importlib.metadata
 import json
 import os
 import subprocess
 import sys
 import time
+
+PINS_FILE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "requirements.txt")
+
+
+def pins():
+    """name -> pinned version, from requirements.txt's `name==version` lines."""
+    out = {}
+    with open(PINS_FILE) as f:
+        for line in f:
+            line = line.split("#", 1)[0].strip()
+            if line:
+                name, version = line.split("==")
+                out[name.strip()] = version.strip()
+    return out
+
+
+def installed(name):
+    try:
+        return importlib.metadata.version(name)
+    except importlib.metadata.PackageNotFoundError:
+        return None
+
+
+def environment():
+    """name -> installed version of each pinned package, and the mismatches."""
+    pinned = pins()
+    versions = {name: installed(name) for name in pinned}
+    wrong = [f"{n} {versions[n] or 'missing'} (pinned {v})" for n, v in pinned.items() if versions[n] != v]
+    return versions, wrong
+
+
+if sys.argv[1:] == ["--check-pins"]:
+    _, wrong = environment()
+    if wrong:
+        raise SystemExit("the peer set-up differs from its pins: " + ", ".join(wrong))
+    sys.exit(0)
 
 geomc, d = sys.argv[1], sys.argv[2]
 j = lambda name: os.path.join(d, name)
@@ -69,7 +113,9 @@ def repeated(tool, argv):
             "peak_bytes": max(r["peak_bytes"] for r in runs)}
 
 
-out = {}
+versions, wrong = environment()
+out = {"environment": {"versions": versions, "pinned": not wrong, "differs": wrong,
+                       "python": sys.version.split()[0]}}
 for case, tools in cases.items():
     out[case] = {tool: repeated(tool, argv) for tool, argv in tools.items()}
 print(json.dumps(out))

@@ -152,6 +152,33 @@ impl NodeIndex {
     }
 }
 
+/// [`Reader::binary_triangles`] when the node tags run on from `first`
+/// (`len` nodes): a node's index is its tag less `first`, so the corners
+/// are found by a subtraction and a bound check on every tag at once
+/// (no lookup call per tag: that was a fifth of reading the 2-million-triangle
+/// bench file). `false`, with nothing added, when a tag is not a node's.
+fn run_triangles(block: &[u8], first: u64, len: u64, triangles: &mut Vec<[u32; 3]>) -> bool {
+    let unknown = AtomicBool::new(false);
+    let base = triangles.len();
+    let index = |r: &[u8], at: usize| {
+        let tag = super::bytes_at::<8>(r, at).map_or(0, u64::from_le_bytes);
+        // Below `first` wraps past every index (`first + len` fits in u64).
+        tag.wrapping_sub(first)
+    };
+    triangles.par_extend(block.par_chunks_exact(32).map(|r| {
+        let [a, b, c] = [index(r, 8), index(r, 16), index(r, 24)];
+        if (a >= len) | (b >= len) | (c >= len) {
+            unknown.store(true, Ordering::Relaxed);
+        }
+        [a as u32, b as u32, c as u32]
+    }));
+    if unknown.load(Ordering::Relaxed) {
+        triangles.truncate(base);
+        return false;
+    }
+    true
+}
+
 /// What an element type is, by Gmsh's numbering.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Kind {
@@ -734,6 +761,9 @@ impl<'a> Reader<'a> {
         let Some(g) = self.b.groups.get_mut(group) else {
             return false;
         };
+        if let Some((first, len)) = nodes.run {
+            return run_triangles(block, first, u64::from(len), &mut g.triangles);
+        }
         let tag = |r: &[u8], at: usize| {
             super::bytes_at::<8>(r, at).and_then(|b| nodes.get(u64::from_le_bytes(b)))
         };
