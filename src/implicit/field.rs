@@ -242,8 +242,8 @@ fn classify_region(
 }
 
 /// Samples `ssa` on the grid: blocks classified by interval arithmetic
-/// (`classify_region`), the samples of the mixed blocks evaluated row by row
-/// on their own programs, and of the proven-inside blocks on the box faces
+/// (`classify_region`), the samples of the mixed blocks evaluated on their
+/// own programs, all of a block's rows together (`RowTape::eval_block`), and of the proven-inside blocks on the box faces
 /// (which `close_at_box` caps) stored as 1 capped; nothing else is stored.
 pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
     let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
