@@ -15,6 +15,7 @@
 
 use super::interval::{self, Interval, Sign};
 use super::polygonize::{Grid, Options};
+use super::row_blocks::BlockScratch;
 use super::rows::RowTape;
 use super::signs::SignRows;
 use super::tape::{AxisTape, Ssa, Tape};
@@ -241,8 +242,8 @@ fn classify_region(
 }
 
 /// Samples `ssa` on the grid: blocks classified by interval arithmetic
-/// (`classify_region`), the samples of the mixed blocks evaluated row by row
-/// on their own programs, and of the proven-inside blocks on the box faces
+/// (`classify_region`), the samples of the mixed blocks evaluated on their
+/// own programs, all of a block's rows together (`RowTape::eval_block`), and of the proven-inside blocks on the box faces
 /// (which `close_at_box` caps) stored as 1 capped; nothing else is stored.
 pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
     let coords = [grid.coords(0), grid.coords(1), grid.coords(2)];
@@ -276,7 +277,7 @@ pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
     let mut data = vec![0.0f32; stored.len() * BLOCK_LEN];
     data.par_chunks_mut(BLOCK_LEN)
         .zip(stored.par_iter())
-        .for_each(|(out, &b)| {
+        .for_each_init(BlockScratch::default, |scratch, (out, &b)| {
             let at = [b % nb[0], b / nb[0] % nb[1], b / (nb[0] * nb[1])];
             let lo = at.map(|a| a * BS);
             let owned = [0, 1, 2].map(|a| (lo[a] + BS).min(n1[a]));
@@ -284,14 +285,9 @@ pub(super) fn sample_field(ssa: &Ssa, grid: &Grid, options: &Options) -> Field {
             match &blocks[b] {
                 Block::Mixed(kernel) => {
                     let mut ws = kernel.rows.workspace(&coords[0][lo[0]..owned[0]]);
-                    for k in lo[2]..owned[2] {
-                        for j in lo[1]..owned[1] {
-                            let row = &mut out[local(0, j, k)..][..len];
-                            kernel
-                                .rows
-                                .eval_row(&mut ws, coords[1][j], coords[2][k], row);
-                        }
-                    }
+                    // All the block's rows at once (`row_blocks.rs`).
+                    let [ys, zs] = [1, 2].map(|a| &coords[a][lo[a]..owned[a]]);
+                    kernel.rows.eval_block(&mut ws, scratch, ys, zs, len, out);
                 }
                 _ => out.fill(1.0),
             }

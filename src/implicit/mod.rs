@@ -17,6 +17,7 @@ pub mod library;
 pub mod optimize;
 pub mod polygonize;
 pub mod rfs;
+pub mod row_blocks;
 pub mod rows;
 pub mod section;
 pub mod signs;

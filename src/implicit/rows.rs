@@ -24,7 +24,7 @@ use super::ir::{Binary, Node, Unary, r_and, r_or};
 use super::tape::{Ssa, children};
 
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Src {
+pub(super) enum Src {
     /// A lane slot.
     Lane(u32),
     /// A lane slot plus two per-row offsets added in order, in f32
@@ -36,7 +36,7 @@ enum Src {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
-enum Op {
+pub(super) enum Op {
     Unary(Unary),
     Binary(Binary),
     RvOr,
@@ -46,11 +46,11 @@ enum Op {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct LaneInstr {
-    op: Op,
-    out: u32,
-    a: Src,
-    b: Src,
+pub(super) struct LaneInstr {
+    pub(super) op: Op,
+    pub(super) out: u32,
+    pub(super) a: Src,
+    pub(super) b: Src,
 }
 
 /// One folded per-row term: the scalar node, negated for a subtraction.
@@ -72,13 +72,13 @@ pub struct RowTape {
     y_nodes: Vec<u32>,
     yz_nodes: Vec<u32>,
     /// SSA nodes depending on x only, and the lane slot each is stored in.
-    x_nodes: Vec<(u32, u32)>,
-    lane: Vec<LaneInstr>,
+    pub(super) x_nodes: Vec<(u32, u32)>,
+    pub(super) lane: Vec<LaneInstr>,
     /// The terms of each `Src::Shifted` offset pair (None: −0.0, which adds
     /// exactly nothing, even to −0.0).
     shifts: Vec<[Option<Term>; 2]>,
-    slots: usize,
-    out: Src,
+    pub(super) slots: usize,
+    pub(super) out: Src,
     /// Nodes that depend on no coordinate.
     consts_only: Vec<bool>,
 }
@@ -86,10 +86,10 @@ pub struct RowTape {
 /// Per-thread scratch: the lane slots, the x-only lanes for one set of x
 /// coordinates, the per-row scalars and the per-row offsets.
 pub struct RowWorkspace {
-    width: usize,
-    lanes: Vec<f32>,
-    scalars: Vec<f64>,
-    offs: Vec<f32>,
+    pub(super) width: usize,
+    pub(super) lanes: Vec<f32>,
+    pub(super) scalars: Vec<f64>,
+    pub(super) offs: Vec<f32>,
     /// The bits of the y and z the scalars were last evaluated at (a NaN's
     /// at first, so the first row evaluates everything).
     last_y: u64,
@@ -305,6 +305,26 @@ impl RowTape {
 
     /// f on the row (xs of the workspace, y, z) into `out` (one per x).
     pub fn eval_row(&self, ws: &mut RowWorkspace, y: f64, z: f64, out: &mut [f32]) {
+        self.set_row(ws, y, z);
+        run(&self.lane, ws);
+        let n = out.len();
+        match self.out {
+            Src::Lane(slot) => {
+                out.copy_from_slice(&ws.lanes[slot as usize * ws.width..][..n]);
+            }
+            Src::Shifted(slot, k) => {
+                let (c1, c2) = (ws.offs[2 * k as usize], ws.offs[2 * k as usize + 1]);
+                let lanes = &ws.lanes[slot as usize * ws.width..][..n];
+                for (o, &v) in out.iter_mut().zip(lanes) {
+                    *o = (v + c1) + c2;
+                }
+            }
+            Src::Scalar(i) => out.fill(ws.scalars[i as usize] as f32),
+        }
+    }
+
+    /// The per-row scalars and offsets of row (y, z) into the workspace.
+    pub(super) fn set_row(&self, ws: &mut RowWorkspace, y: f64, z: f64) {
         // Constants were set by `workspace`; z-only and y-only terms only
         // change with z and y (a plane's rows share z).
         let eval = |s: &mut [f64], nodes: &[u32]| {
@@ -348,21 +368,6 @@ impl RowTape {
                     if t.negate { -v } else { v }
                 });
             }
-        }
-        run(&self.lane, ws);
-        let n = out.len();
-        match self.out {
-            Src::Lane(slot) => {
-                out.copy_from_slice(&ws.lanes[slot as usize * ws.width..][..n]);
-            }
-            Src::Shifted(slot, k) => {
-                let (c1, c2) = (ws.offs[2 * k as usize], ws.offs[2 * k as usize + 1]);
-                let lanes = &ws.lanes[slot as usize * ws.width..][..n];
-                for (o, &v) in out.iter_mut().zip(lanes) {
-                    *o = (v + c1) + c2;
-                }
-            }
-            Src::Scalar(i) => out.fill(ws.scalars[i as usize] as f32),
         }
     }
 }
