@@ -14,16 +14,13 @@ mod mesh2d_common;
 
 use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
-use geomc::meshing::mesh_model;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, at_30_degrees, coordinate_range, fragment_segments, gmsh_group,
-    min_angle_degrees, python, triangles_of,
+    area, assert_conforming, compile_msh as compile, coordinate_range, fragment_segments,
+    gmsh_group, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
-use std::path::Path;
-use std::process::Command;
 
 /// The unit disk less the patch x ≥ 0.5 of it, carved: the patch's arc lies
 /// on the disk's rim.
@@ -71,20 +68,6 @@ const SLANT: &str = r#"<geometry version="1" dimension="2">
   <subdomain name="plate"><difference><solid ref="tri"/><solid ref="patch"/></difference></subdomain>
   <subdomain name="patch"><solid ref="patch"/></subdomain>
 </geometry>"#;
-
-fn mesh(xml: &str, max_area: f64) -> Mesh {
-    let checked = check_source(
-        SourceFile::new("t.xml", xml.to_string()),
-        &Options::default(),
-    );
-    assert!(
-        checked.diagnostics.items.is_empty(),
-        "{:#?}",
-        checked.diagnostics.items
-    );
-    let model = checked.lowered.expect("a model").model;
-    mesh_model(&model, &at_30_degrees(Some(max_area))).expect("meshes")
-}
 
 fn fragment_names(m: &Mesh) -> BTreeSet<&str> {
     m.fragments.iter().map(|f| f.name.as_str()).collect()
@@ -251,21 +234,6 @@ fn coating_around_a_kernel_disk_uses_the_disk_rim() {
     assert!((coat - ring).abs() / ring < 2e-3, "coat area {coat}");
     assert!((core + coat - fan_area(&m, &outer)).abs() < 1e-12);
     assert_min_angle(&m);
-}
-
-fn compile(xml: &str, dir: &Path, name: &str, max_area: &str) -> std::path::PathBuf {
-    let input = dir.join(format!("{name}.xml"));
-    std::fs::write(&input, xml).expect("write input");
-    let msh = dir.join(format!("{name}.msh"));
-    let status = Command::new(env!("CARGO_BIN_EXE_geomc"))
-        .args(["compile", "-q"])
-        .arg(&input)
-        .args(["--min-angle", "30", "--max-area", max_area, "-o"])
-        .arg(&msh)
-        .status()
-        .expect("run geomc");
-    assert!(status.success(), "geomc compile {name}");
-    msh
 }
 
 #[test]

@@ -9,12 +9,9 @@
 
 mod mesh2d_common;
 
-use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
-use geomc::meshing::mesh_model;
-use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, at_30_degrees, coordinate_range, fragment_segments, gmsh_group,
+    area, assert_conforming, coordinate_range, fragment_segments, gmsh_group, mesh_clean as mesh,
     min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
@@ -45,20 +42,6 @@ const POLYGON: &str = r#"<geometry version="1" dimension="2">
   <subdomain name="plate"><solid ref="pg"/></subdomain>
   <subdomain name="cap"><solid ref="cap"/></subdomain>
 </geometry>"#;
-
-fn mesh(xml: &str) -> Mesh {
-    let checked = check_source(
-        SourceFile::new("t.xml", xml.to_string()),
-        &Options::default(),
-    );
-    assert!(
-        checked.diagnostics.items.is_empty(),
-        "{:#?}",
-        checked.diagnostics.items
-    );
-    let model = checked.lowered.expect("a model").model;
-    mesh_model(&model, &at_30_degrees(Some(0.01))).expect("meshes")
-}
 
 fn fragment_names(m: &Mesh) -> BTreeSet<&str> {
     m.fragments.iter().map(|f| f.name.as_str()).collect()
@@ -99,7 +82,7 @@ fn node_at(m: &Mesh, p: [f64; 2]) -> u32 {
 
 #[test]
 fn contour_along_two_stacked_squares_follows_onto_the_upper_side() {
-    let m = mesh(STACKED);
+    let m = mesh(STACKED, 0.01);
     assert_eq!(
         fragment_names(&m),
         BTreeSet::from([
@@ -152,7 +135,7 @@ fn contour_along_two_stacked_squares_follows_onto_the_upper_side() {
 
 #[test]
 fn contour_over_a_polygon_vertex_on_a_straight_side_shares_both_sides() {
-    let m = mesh(POLYGON);
+    let m = mesh(POLYGON, 0.01);
     assert_eq!(
         fragment_names(&m),
         BTreeSet::from(["plate|exterior", "plate|cap", "cap|exterior"])
@@ -193,7 +176,7 @@ fn msh_of_the_stacked_squares_keeps_its_groups_for_gmsh_and_meshio() {
         .status()
         .expect("run geomc");
     assert!(status.success());
-    let expected = mesh(STACKED);
+    let expected = mesh(STACKED, 0.01);
     let r = python("check_mesh.py", &[&msh], &[]);
     for group in ["low|cap", "high|cap", "low|high", "cap|exterior"] {
         let lines = fragment_segments(&expected, group).len() as u64;

@@ -11,16 +11,13 @@ mod mesh2d_common;
 use geomc::diag::Code;
 use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
-use geomc::meshing::mesh_model;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, at_30_degrees, coordinate_range, fragment_segments, gmsh_group,
-    min_angle_degrees, python, triangles_of,
+    area, assert_conforming, compile_msh as compile, coordinate_range, fragment_segments,
+    gmsh_group, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
-use std::path::Path;
-use std::process::Command;
 
 /// The unit disk cut along x = 0.5 into two R-function regions on different
 /// grids (40 × 40 over different boxes): the interface is straight.
@@ -50,20 +47,6 @@ const RING: &str = r#"<geometry version="1" dimension="2">
 /// The chordal tolerance of a contour: 0.5e-3 of its box diagonal (the
 /// larger box here, √(1.9² + 2.2²) and √8).
 const CHORD: f64 = 0.5e-3 * 2.83;
-
-fn mesh(xml: &str, max_area: f64) -> Mesh {
-    let checked = check_source(
-        SourceFile::new("t.xml", xml.to_string()),
-        &Options::default(),
-    );
-    assert!(
-        checked.diagnostics.items.is_empty(),
-        "{:#?}",
-        checked.diagnostics.items
-    );
-    let model = checked.lowered.expect("a model").model;
-    mesh_model(&model, &at_30_degrees(Some(max_area))).expect("meshes")
-}
 
 fn radius(m: &Mesh, n: u32) -> f64 {
     let p = m.nodes[n as usize];
@@ -162,21 +145,6 @@ fn a_ring_around_a_disk_shares_the_whole_circle() {
     assert!((coat - ring).abs() / ring < 2e-3, "coat {coat}");
     let least = min_angle_degrees(&m);
     assert!(least >= 30.0 - 1e-9, "min angle {least}");
-}
-
-fn compile(xml: &str, dir: &Path, name: &str, max_area: &str) -> std::path::PathBuf {
-    let input = dir.join(format!("{name}.xml"));
-    std::fs::write(&input, xml).expect("write input");
-    let msh = dir.join(format!("{name}.msh"));
-    let status = Command::new(env!("CARGO_BIN_EXE_geomc"))
-        .args(["compile", "-q"])
-        .arg(&input)
-        .args(["--min-angle", "30", "--max-area", max_area, "-o"])
-        .arg(&msh)
-        .status()
-        .expect("run geomc");
-    assert!(status.success(), "geomc compile {name}");
-    msh
 }
 
 #[test]

@@ -11,15 +11,13 @@ mod mesh2d_common;
 
 use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
-use geomc::meshing::mesh_model;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, at_30_degrees, fragment_segments, gmsh_group, min_angle_degrees, python, triangles_of,
+    area, compile_msh as compile, fragment_segments, gmsh_group, mesh_clean as mesh,
+    min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
-use std::path::{Path, PathBuf};
-use std::process::Command;
 
 /// The bead's centre: 1.3 from the origin at 60°, so that it touches the
 /// unit circle at (0.5, √0.75).
@@ -54,20 +52,6 @@ const ON_SIDE: &str = r#"<geometry version="1" dimension="2">
   <subdomain name="plate"><solid ref="sq"/></subdomain>
   <subdomain name="bead"><solid ref="bead"/></subdomain>
 </geometry>"#;
-
-fn mesh(xml: &str, max_area: f64) -> Mesh {
-    let checked = check_source(
-        SourceFile::new("t.xml", xml.to_string()),
-        &Options::default(),
-    );
-    assert!(
-        checked.diagnostics.items.is_empty(),
-        "{:#?}",
-        checked.diagnostics.items
-    );
-    let model = checked.lowered.expect("a model").model;
-    mesh_model(&model, &at_30_degrees(Some(max_area))).expect("meshes")
-}
 
 fn nodes_of(m: &Mesh, name: &str) -> BTreeSet<u32> {
     triangles_of(m, name).into_iter().flatten().collect()
@@ -231,21 +215,6 @@ fn bead_touching_a_polygon_corner_takes_the_corner() {
     let polygon = fan_area(&m, &fragment_segments(&m, "bead|exterior"), [1.3, 0.0]);
     assert!((bead - polygon).abs() < 1e-12, "{bead} vs {polygon}");
     assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
-}
-
-fn compile(xml: &str, dir: &Path, name: &str, max_area: &str) -> PathBuf {
-    let input = dir.join(format!("{name}.xml"));
-    std::fs::write(&input, xml).expect("write input");
-    let msh = dir.join(format!("{name}.msh"));
-    let status = Command::new(env!("CARGO_BIN_EXE_geomc"))
-        .args(["compile", "-q"])
-        .arg(&input)
-        .args(["--min-angle", "30", "--max-area", max_area, "-o"])
-        .arg(&msh)
-        .status()
-        .expect("run geomc");
-    assert!(status.success(), "geomc compile {name}");
-    msh
 }
 
 #[test]

@@ -62,3 +62,16 @@ impl EdgeParts {
         }
     }
 }
+
+/// A straight or contour piece's curve ends where its vertices are again,
+/// after a vertex was merged into another or moved onto a kernel edge.
+pub(super) fn follow_vertices(model: &mut Model, e: EdgeId) {
+    let edge = model.edge(e);
+    let (pa, pb) = (
+        model.vertex(edge.begin).position,
+        model.vertex(edge.end).position,
+    );
+    if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = model.edge_curve_mut(e) {
+        (*a, *b) = (pa, pb);
+    }
+}

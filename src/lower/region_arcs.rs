@@ -403,31 +403,7 @@ pub(super) fn share_arcs(
     for ((f, l), mut swaps) in by_loop {
         swaps.sort_by_key(|s| s.0);
         let lp: Vec<OrientedEdge> = model.faces[f.index()].loops[l].to_vec();
-        let n = lp.len();
-        let mut covered = vec![None; n];
-        for (k, (start, len, _)) in swaps.iter().enumerate() {
-            for i in 0..*len {
-                covered[(start + i) % n] = Some(k);
-            }
-        }
-        // Start the walk where a run starts (or anywhere if none wraps).
-        let origin = swaps[0].0;
-        let mut out = Vec::with_capacity(n);
-        let mut i = 0;
-        while i < n {
-            let at = (origin + i) % n;
-            match covered[at] {
-                Some(k) if swaps[k].0 == at => {
-                    out.extend(swaps[k].2.iter().copied());
-                    i += swaps[k].1;
-                }
-                Some(_) => i += 1,
-                None => {
-                    out.push(lp[at]);
-                    i += 1;
-                }
-            }
-        }
+        let out = spliced(&lp, &swaps);
         let mut loops = model.faces[f.index()].loops.to_vecs();
         loops[l] = out;
         model.faces[f.index()].loops = loops.into();
@@ -440,13 +416,7 @@ pub(super) fn share_arcs(
                 *v = w;
             }
         }
-        let (pa, pb) = (
-            model.vertices[edge.begin.index()].position,
-            model.vertices[edge.end.index()].position,
-        );
-        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } = model.edge_curve_mut(*e) {
-            (*a, *b) = (pa, pb);
-        }
+        super::edge_parts::follow_vertices(model, *e);
     }
     let keep_edge: Vec<bool> = (0..model.edges.len())
         .map(|e| !dropped_edges.contains(&EdgeId(e as u32)))
@@ -699,4 +669,37 @@ fn report_run(
             "end the region's contour inside the curved edge, or split the kernel shape so that one edge holds the whole run".to_string()
         }),
     );
+}
+
+/// Loop `lp` with each (start, len) stretch replaced by its pieces.
+pub(super) fn spliced(
+    lp: &[OrientedEdge],
+    swaps: &[(usize, usize, Vec<OrientedEdge>)],
+) -> Vec<OrientedEdge> {
+    let n = lp.len();
+    let mut covered = vec![None; n];
+    for (k, (start, len, _)) in swaps.iter().enumerate() {
+        for i in 0..*len {
+            covered[(start + i) % n] = Some(k);
+        }
+    }
+    // Start the walk where a stretch starts, so none wraps past the end.
+    let origin = swaps[0].0;
+    let mut out = Vec::with_capacity(n);
+    let mut i = 0;
+    while i < n {
+        let at = (origin + i) % n;
+        match covered[at] {
+            Some(k) if swaps[k].0 == at => {
+                out.extend(swaps[k].2.iter().copied());
+                i += swaps[k].1;
+            }
+            Some(_) => i += 1,
+            None => {
+                out.push(lp[at]);
+                i += 1;
+            }
+        }
+    }
+    out
 }

@@ -155,7 +155,7 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
     let mut loops = model.faces[fb.index()].loops.to_vecs();
     for (l, mut list) in swaps {
         list.sort_by_key(|s| s.0);
-        loops[l] = spliced(&loops[l], &list);
+        loops[l] = super::region_arcs::spliced(&loops[l], &list);
     }
     model.faces[fb.index()].loops = loops.into();
     // The later region's remaining pieces next to a run end follow it.
@@ -172,46 +172,9 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
                 *v = w;
             }
         }
-        let (pa, pb) = (
-            model.vertices[edge.begin.index()].position,
-            model.vertices[edge.end.index()].position,
-        );
-        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } =
-            edge.carrier.curve_mut(&model.solids)
-        {
-            (*a, *b) = (pa, pb);
-        }
+        super::edge_parts::follow_vertices(model, e);
     }
     Some((dropped_edges, dropped_vertices))
-}
-
-/// Loop `lp` with each (start, len) stretch replaced by its pieces.
-fn spliced(lp: &[OrientedEdge], swaps: &[(usize, usize, Vec<OrientedEdge>)]) -> Vec<OrientedEdge> {
-    let n = lp.len();
-    let mut covered = vec![None; n];
-    for (k, (start, len, _)) in swaps.iter().enumerate() {
-        for i in 0..*len {
-            covered[(start + i) % n] = Some(k);
-        }
-    }
-    let origin = swaps[0].0;
-    let mut out = Vec::with_capacity(n);
-    let mut i = 0;
-    while i < n {
-        let at = (origin + i) % n;
-        match covered[at] {
-            Some(k) if swaps[k].0 == at => {
-                out.extend(swaps[k].2.iter().copied());
-                i += swaps[k].1;
-            }
-            Some(_) => i += 1,
-            None => {
-                out.push(lp[at]);
-                i += 1;
-            }
-        }
-    }
-    out
 }
 
 fn loop_of(model: &Model, f: FaceId, lp: usize) -> &[OrientedEdge] {
@@ -302,16 +265,7 @@ fn restore_corners(model: &mut Model, f: FaceId, run: &Run) -> Run {
     }
     // The run's own pieces and the neighbours follow their vertices.
     for oe in lp {
-        let edge = &mut model.edges[oe.edge.index()];
-        let (pa, pb) = (
-            model.vertices[edge.begin.index()].position,
-            model.vertices[edge.end.index()].position,
-        );
-        if let Curve::Segment { a, b } | Curve::Contour { a, b, .. } =
-            edge.carrier.curve_mut(&model.solids)
-        {
-            (*a, *b) = (pa, pb);
-        }
+        super::edge_parts::follow_vertices(model, oe.edge);
     }
     run
 }

@@ -346,15 +346,7 @@ fn apply(
                 *v = w;
             }
         }
-        let (pa, pb) = (
-            model.vertices[edge.begin.index()].position,
-            model.vertices[edge.end.index()].position,
-        );
-        if let Curve::Contour { a, b, .. } | Curve::Segment { a, b } =
-            edge.carrier.curve_mut(&model.solids)
-        {
-            (*a, *b) = (pa, pb);
-        }
+        super::edge_parts::follow_vertices(model, EdgeId(e as u32));
     }
     let keep_edge = vec![true; model.edges.len()];
     let keep_vertex: Vec<bool> = (0..model.vertices.len())

@@ -2,10 +2,12 @@
 //! triangles use each edge, the smallest angle, and the Python checkers.
 #![allow(dead_code)]
 
+use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
-use geomc::meshing::MeshOptions;
+use geomc::meshing::{MeshOptions, mesh_model};
+use geomc::span::SourceFile;
 use std::collections::{BTreeSet, HashMap};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::Command;
 
 /// The length of a node chain.
@@ -181,4 +183,36 @@ pub fn assert_conforming(m: &Mesh, fragment: &str, a: &str, b: &str) -> usize {
     assert_eq!(shared, nodes.len(), "common nodes of {a} and {b}");
     assert!(nodes.iter().all(|n| na.contains(n) && nb.contains(n)));
     nodes.len()
+}
+
+/// The mesh of a 2D domain that must check clean, at 30° and `max_area`.
+pub fn mesh_clean(xml: &str, max_area: f64) -> Mesh {
+    let checked = check_source(
+        SourceFile::new("t.xml", xml.to_string()),
+        &Options::default(),
+    );
+    assert!(
+        checked.diagnostics.items.is_empty(),
+        "{:#?}",
+        checked.diagnostics.items
+    );
+    let model = checked.lowered.expect("a model").model;
+    mesh_model(&model, &at_30_degrees(Some(max_area))).expect("meshes")
+}
+
+/// `geomc compile` of `xml` (written to `dir/name.xml`) to `dir/name.msh`
+/// at 30° and `max_area`, through the binary as a user runs it.
+pub fn compile_msh(xml: &str, dir: &Path, name: &str, max_area: &str) -> PathBuf {
+    let input = dir.join(format!("{name}.xml"));
+    std::fs::write(&input, xml).expect("write input");
+    let msh = dir.join(format!("{name}.msh"));
+    let status = Command::new(env!("CARGO_BIN_EXE_geomc"))
+        .args(["compile", "-q"])
+        .arg(&input)
+        .args(["--min-angle", "30", "--max-area", max_area, "-o"])
+        .arg(&msh)
+        .status()
+        .expect("run geomc");
+    assert!(status.success(), "geomc compile {name}");
+    msh
 }
