@@ -16,8 +16,9 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, compile_msh as compile, coordinate_range, fragment_segments,
-    gmsh_group, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
+    area, assert_conforming, assert_groups_read, compile_msh as compile, coordinate_range,
+    fan_area, fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python,
+    triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -69,26 +70,10 @@ const SLANT: &str = r#"<geometry version="1" dimension="2">
   <subdomain name="patch"><solid ref="patch"/></subdomain>
 </geometry>"#;
 
-fn fragment_names(m: &Mesh) -> BTreeSet<&str> {
-    m.fragments.iter().map(|f| f.name.as_str()).collect()
-}
-
 /// The distance of node n from the origin.
 fn radius(m: &Mesh, n: u32) -> f64 {
     let p = m.nodes[n as usize];
     p[0].hypot(p[1])
-}
-
-/// The area of the polygon of `segments` seen from the origin (a boundary
-/// star-shaped about it, such as a circle's chords).
-fn fan_area(m: &Mesh, segments: &[[u32; 2]]) -> f64 {
-    segments
-        .iter()
-        .map(|s| {
-            let (p, q) = (m.nodes[s[0] as usize], m.nodes[s[1] as usize]);
-            0.5 * (p[0] * q[1] - p[1] * q[0]).abs()
-        })
-        .sum()
 }
 
 fn assert_min_angle(m: &Mesh) {
@@ -142,7 +127,7 @@ fn patch_against_the_outer_circle_shares_its_line_and_keeps_the_arc_on_the_circl
         "plate area {plate}"
     );
     // Together they fill the disk's inscribed polygon exactly.
-    let domain = fan_area(&m, &rim);
+    let domain = fan_area(&m, &rim, [0.0, 0.0]);
     assert!(
         (patch + plate - domain).abs() < 1e-12,
         "{} vs {domain}",
@@ -185,7 +170,7 @@ fn patch_against_a_hole_splits_the_hole_rim() {
     );
     let exact = PI / 2.0 * (0.36 - 0.09);
     assert!((patch - exact).abs() / exact < 2e-3, "patch area {patch}");
-    let domain = 4.0 - fan_area(&m, &hole);
+    let domain = 4.0 - fan_area(&m, &hole, [0.0, 0.0]);
     assert!(
         (plate - (domain - exact)).abs() / domain < 2e-3,
         "plate area {plate}"
@@ -222,7 +207,7 @@ fn coating_around_a_kernel_disk_uses_the_disk_rim() {
     );
     // The core is exactly the polygon of its rim nodes; the ring is what is
     // left of the outer contour's polygon.
-    let inner = fan_area(&m, &interface);
+    let inner = fan_area(&m, &interface, [0.0, 0.0]);
     assert!((core - inner).abs() < 1e-12, "core area {core} vs {inner}");
     // The rim's chords follow the model's chordal tolerance (1e-3 of the
     // box diagonal, about 48 chords): a regular 48-gon is 2.85e-3 short.
@@ -232,7 +217,7 @@ fn coating_around_a_kernel_disk_uses_the_disk_rim() {
     );
     let ring = PI * (0.64 - 0.25);
     assert!((coat - ring).abs() / ring < 2e-3, "coat area {coat}");
-    assert!((core + coat - fan_area(&m, &outer)).abs() < 1e-12);
+    assert!((core + coat - fan_area(&m, &outer, [0.0, 0.0])).abs() < 1e-12);
     assert_min_angle(&m);
 }
 
@@ -242,17 +227,12 @@ fn msh_of_a_patch_against_a_hole_keeps_its_groups_for_gmsh_and_meshio() {
     let msh = compile(HOLE, dir.path(), "hole", "0.01");
     let expected = mesh(HOLE, 0.01);
     let r = python("check_mesh.py", &[&msh], &[]);
-    for group in ["plate|patch", "patch|exterior", "plate|exterior"] {
-        let lines = fragment_segments(&expected, group).len() as u64;
-        assert_eq!(gmsh_group(&r, group)["elements"]["line"], lines, "{group}");
-        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
-    }
-    for sub in ["plate", "patch"] {
-        assert_eq!(
-            gmsh_group(&r, sub)["elements"]["triangle"],
-            triangles_of(&expected, sub).len() as u64
-        );
-    }
+    assert_groups_read(
+        &r,
+        &expected,
+        &["plate|patch", "patch|exterior", "plate|exterior"],
+        &["plate", "patch"],
+    );
     assert_eq!(r["gmsh"]["nodes"], expected.nodes.len() as u64);
 }
 
@@ -422,18 +402,12 @@ fn msh_of_a_patch_against_a_slanted_side_keeps_its_groups_for_gmsh_and_meshio() 
     let msh = compile(SLANT, dir.path(), "slant", "0.01");
     let expected = mesh(SLANT, 0.01);
     let r = python("check_mesh.py", &[&msh], &[]);
-    for group in ["plate|patch", "patch|exterior", "plate|exterior"] {
-        let lines = fragment_segments(&expected, group).len() as u64;
-        assert!(lines > 0, "{group}");
-        assert_eq!(gmsh_group(&r, group)["elements"]["line"], lines, "{group}");
-        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
-    }
-    for sub in ["plate", "patch"] {
-        assert_eq!(
-            gmsh_group(&r, sub)["elements"]["triangle"],
-            triangles_of(&expected, sub).len() as u64
-        );
-    }
+    assert_groups_read(
+        &r,
+        &expected,
+        &["plate|patch", "patch|exterior", "plate|exterior"],
+        &["plate", "patch"],
+    );
 }
 
 /// The unit square and a half disk of radius 0.3 outside it against its

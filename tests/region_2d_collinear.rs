@@ -11,12 +11,11 @@ mod mesh2d_common;
 
 use geomc::mesh::Mesh;
 use mesh2d_common::{
-    area, assert_conforming, coordinate_range, fragment_segments, gmsh_group, mesh_clean as mesh,
-    min_angle_degrees, python, triangles_of,
+    area, assert_conforming, assert_groups_read, compile_msh, coordinate_range, fan_area,
+    fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
-use std::process::Command;
 
 /// Two unit squares stacked (low below y = 1, high above) and a half disk
 /// of radius 0.31 about (1, 1) right of x = 1: its flat side runs along both
@@ -43,10 +42,6 @@ const POLYGON: &str = r#"<geometry version="1" dimension="2">
   <subdomain name="cap"><solid ref="cap"/></subdomain>
 </geometry>"#;
 
-fn fragment_names(m: &Mesh) -> BTreeSet<&str> {
-    m.fragments.iter().map(|f| f.name.as_str()).collect()
-}
-
 /// The y range of an interface on x = 1, every node on the line exactly.
 fn on_the_side(m: &Mesh, fragment: &str) -> (f64, f64) {
     coordinate_range(m, &fragment_segments(m, fragment), 1, |p| {
@@ -55,18 +50,6 @@ fn on_the_side(m: &Mesh, fragment: &str) -> (f64, f64) {
             "{fragment} node off x = 1: {p:?}"
         )
     })
-}
-
-/// The area inside the segments seen from `c` (a half disk's boundary about
-/// its centre; segments through c add nothing).
-fn fan_area(m: &Mesh, segments: &[[u32; 2]], c: [f64; 2]) -> f64 {
-    segments
-        .iter()
-        .map(|s| {
-            let (p, q) = (m.nodes[s[0] as usize], m.nodes[s[1] as usize]);
-            0.5 * ((p[0] - c[0]) * (q[1] - c[1]) - (p[1] - c[1]) * (q[0] - c[0])).abs()
-        })
-        .sum()
 }
 
 fn node_at(m: &Mesh, p: [f64; 2]) -> u32 {
@@ -165,30 +148,14 @@ fn contour_over_a_polygon_vertex_on_a_straight_side_shares_both_sides() {
 #[test]
 fn msh_of_the_stacked_squares_keeps_its_groups_for_gmsh_and_meshio() {
     let dir = tempfile::tempdir().expect("tempdir");
-    let input = dir.path().join("stacked.xml");
-    std::fs::write(&input, STACKED).expect("write input");
-    let msh = dir.path().join("stacked.msh");
-    let status = Command::new(env!("CARGO_BIN_EXE_geomc"))
-        .args(["compile", "-q"])
-        .arg(&input)
-        .args(["--min-angle", "30", "--max-area", "0.01", "-o"])
-        .arg(&msh)
-        .status()
-        .expect("run geomc");
-    assert!(status.success());
+    let msh = compile_msh(STACKED, dir.path(), "stacked", "0.01");
     let expected = mesh(STACKED, 0.01);
     let r = python("check_mesh.py", &[&msh], &[]);
-    for group in ["low|cap", "high|cap", "low|high", "cap|exterior"] {
-        let lines = fragment_segments(&expected, group).len() as u64;
-        assert!(lines > 0, "{group}");
-        assert_eq!(gmsh_group(&r, group)["elements"]["line"], lines, "{group}");
-        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
-    }
-    for sub in ["low", "high", "cap"] {
-        assert_eq!(
-            gmsh_group(&r, sub)["elements"]["triangle"],
-            triangles_of(&expected, sub).len() as u64
-        );
-    }
+    assert_groups_read(
+        &r,
+        &expected,
+        &["low|cap", "high|cap", "low|high", "cap|exterior"],
+        &["low", "high", "cap"],
+    );
     assert_eq!(r["gmsh"]["nodes"], expected.nodes.len() as u64);
 }

@@ -13,8 +13,8 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, compile_msh as compile, coordinate_range, fragment_segments,
-    gmsh_group, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
+    area, assert_conforming, assert_groups_read, compile_msh as compile, coordinate_range,
+    fan_area, fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -51,18 +51,6 @@ const CHORD: f64 = 0.5e-3 * 2.83;
 fn radius(m: &Mesh, n: u32) -> f64 {
     let p = m.nodes[n as usize];
     p[0].hypot(p[1])
-}
-
-/// The area of the polygon of `segments` seen from the origin (a boundary
-/// star-shaped about it).
-fn fan_area(m: &Mesh, segments: &[[u32; 2]]) -> f64 {
-    segments
-        .iter()
-        .map(|s| {
-            let (p, q) = (m.nodes[s[0] as usize], m.nodes[s[1] as usize]);
-            0.5 * (p[0] * q[1] - p[1] * q[0]).abs()
-        })
-        .sum()
 }
 
 #[test]
@@ -107,7 +95,7 @@ fn two_halves_of_a_disk_share_their_straight_interface() {
     assert!((right - cap).abs() / cap < 2e-3, "right area {right}");
     assert!((left - (PI - cap)).abs() / PI < 2e-3, "left area {left}");
     // No gap and no overlap: together exactly the outer boundary's polygon.
-    let domain = fan_area(&m, &outer);
+    let domain = fan_area(&m, &outer, [0.0, 0.0]);
     assert!(
         (left + right - domain).abs() < 1e-12,
         "{} vs {domain}",
@@ -135,11 +123,11 @@ fn a_ring_around_a_disk_shares_the_whole_circle() {
         area(&m, &triangles_of(&m, "coat")),
     );
     assert!(
-        (core - fan_area(&m, &interface)).abs() < 1e-12,
+        (core - fan_area(&m, &interface, [0.0, 0.0])).abs() < 1e-12,
         "core {core}"
     );
     let outer = fragment_segments(&m, "coat|exterior");
-    assert!((core + coat - fan_area(&m, &outer)).abs() < 1e-12);
+    assert!((core + coat - fan_area(&m, &outer, [0.0, 0.0])).abs() < 1e-12);
     assert!((core - PI * 0.25).abs() / (PI * 0.25) < 2e-3, "core {core}");
     let ring = PI * (0.64 - 0.25);
     assert!((coat - ring).abs() / ring < 2e-3, "coat {coat}");
@@ -153,18 +141,12 @@ fn msh_of_two_regions_keeps_the_interface_group_for_gmsh_and_meshio() {
     let msh = compile(HALVES, dir.path(), "halves", "0.01");
     let expected = mesh(HALVES, 0.01);
     let r = python("check_mesh.py", &[&msh], &[]);
-    for group in ["left|right", "left|exterior", "right|exterior"] {
-        let lines = fragment_segments(&expected, group).len() as u64;
-        assert!(lines > 0, "{group}");
-        assert_eq!(gmsh_group(&r, group)["elements"]["line"], lines, "{group}");
-        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
-    }
-    for sub in ["left", "right"] {
-        assert_eq!(
-            gmsh_group(&r, sub)["elements"]["triangle"],
-            triangles_of(&expected, sub).len() as u64
-        );
-    }
+    assert_groups_read(
+        &r,
+        &expected,
+        &["left|right", "left|exterior", "right|exterior"],
+        &["left", "right"],
+    );
     assert_eq!(r["gmsh"]["nodes"], expected.nodes.len() as u64);
 }
 

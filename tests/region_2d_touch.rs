@@ -13,8 +13,8 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, compile_msh as compile, fragment_segments, gmsh_group, mesh_clean as mesh,
-    min_angle_degrees, python, triangles_of,
+    area, assert_groups_read, compile_msh as compile, fan_area, fragment_names, fragment_segments,
+    mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -74,22 +74,6 @@ fn touch_node(m: &Mesh, a: &str, b: &str) -> [f64; 3] {
         assert_eq!(ends, 2, "{fragment} around the touch node");
     }
     m.nodes[common[0] as usize]
-}
-
-/// The area of the polygon of `segments` seen from `c` (a boundary
-/// star-shaped about it).
-fn fan_area(m: &Mesh, segments: &[[u32; 2]], c: [f64; 2]) -> f64 {
-    segments
-        .iter()
-        .map(|s| {
-            let (p, q) = (m.nodes[s[0] as usize], m.nodes[s[1] as usize]);
-            0.5 * ((p[0] - c[0]) * (q[1] - c[1]) - (p[1] - c[1]) * (q[0] - c[0])).abs()
-        })
-        .sum()
-}
-
-fn fragment_names(m: &Mesh) -> BTreeSet<&str> {
-    m.fragments.iter().map(|f| f.name.as_str()).collect()
 }
 
 #[test]
@@ -223,18 +207,12 @@ fn msh_of_a_tangent_bead_keeps_its_groups_for_gmsh_and_meshio() {
     let msh = compile(TANGENT, dir.path(), "tangent", "0.01");
     let expected = mesh(TANGENT, 0.01);
     let r = python("check_mesh.py", &[&msh], &[]);
-    for group in ["plate|exterior", "bead|exterior"] {
-        let lines = fragment_segments(&expected, group).len() as u64;
-        assert!(lines > 0, "{group}");
-        assert_eq!(gmsh_group(&r, group)["elements"]["line"], lines, "{group}");
-        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
-    }
-    for sub in ["plate", "bead"] {
-        assert_eq!(
-            gmsh_group(&r, sub)["elements"]["triangle"],
-            triangles_of(&expected, sub).len() as u64
-        );
-    }
+    assert_groups_read(
+        &r,
+        &expected,
+        &["plate|exterior", "bead|exterior"],
+        &["plate", "bead"],
+    );
     assert_eq!(r["gmsh"]["nodes"], expected.nodes.len() as u64);
 }
 

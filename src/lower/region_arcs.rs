@@ -428,12 +428,14 @@ pub(super) fn share_arcs(
     reported
 }
 
-fn begin(model: &Model, oe: OrientedEdge) -> VertexId {
+/// The vertex a loop's oriented edge starts at.
+pub(super) fn begin(model: &Model, oe: OrientedEdge) -> VertexId {
     let e = model.edge(oe.edge);
     if oe.forward { e.begin } else { e.end }
 }
 
-fn end(model: &Model, oe: OrientedEdge) -> VertexId {
+/// The vertex a loop's oriented edge ends at.
+pub(super) fn end(model: &Model, oe: OrientedEdge) -> VertexId {
     let e = model.edge(oe.edge);
     if oe.forward { e.end } else { e.begin }
 }

@@ -14,6 +14,7 @@
 //! Anything else (a tangent contact, runs that do not pair up one to one) is
 //! left to the touch check: E543.
 
+use super::region_arcs::{begin, end};
 use crate::geom::{Curve, Point3};
 use crate::ir::{EdgeId, FaceId, Model, OrientedEdge, SourceMap, VertexId};
 use std::collections::{BTreeMap, BTreeSet};
@@ -185,16 +186,6 @@ fn pieces(model: &Model, f: FaceId, run: &Run) -> Vec<OrientedEdge> {
     let lp = loop_of(model, f, run.lp);
     let n = lp.len();
     (0..run.len).map(|i| lp[(run.start + i) % n]).collect()
-}
-
-fn begin(model: &Model, oe: OrientedEdge) -> VertexId {
-    let e = model.edge(oe.edge);
-    if oe.forward { e.begin } else { e.end }
-}
-
-fn end(model: &Model, oe: OrientedEdge) -> VertexId {
-    let e = model.edge(oe.edge);
-    if oe.forward { e.end } else { e.begin }
 }
 
 fn run_end_points(model: &Model, f: FaceId, run: &Run) -> (Point3, Point3) {

@@ -216,3 +216,44 @@ pub fn compile_msh(xml: &str, dir: &Path, name: &str, max_area: &str) -> PathBuf
     assert!(status.success(), "geomc compile {name}");
     msh
 }
+
+/// gmsh and meshio (report `r` of `check_mesh.py`) read every fragment
+/// group of `groups` with the lines `expected` has there (at least one), and
+/// every subdomain of `subdomains` with its triangles.
+pub fn assert_groups_read(
+    r: &serde_json::Value,
+    expected: &Mesh,
+    groups: &[&str],
+    subdomains: &[&str],
+) {
+    for &group in groups {
+        let lines = fragment_segments(expected, group).len() as u64;
+        assert!(lines > 0, "{group}");
+        assert_eq!(gmsh_group(r, group)["elements"]["line"], lines, "{group}");
+        assert_eq!(r["meshio"]["cell_sets"][group], lines, "{group}");
+    }
+    for &sub in subdomains {
+        assert_eq!(
+            gmsh_group(r, sub)["elements"]["triangle"],
+            triangles_of(expected, sub).len() as u64
+        );
+    }
+}
+
+/// The names of a mesh's fragments.
+pub fn fragment_names(m: &Mesh) -> BTreeSet<&str> {
+    m.fragments.iter().map(|f| f.name.as_str()).collect()
+}
+
+/// The area of the polygon of `segments` seen from `c` (a boundary
+/// star-shaped about it, such as a circle's chords about its centre;
+/// segments through `c` add nothing).
+pub fn fan_area(m: &Mesh, segments: &[[u32; 2]], c: [f64; 2]) -> f64 {
+    segments
+        .iter()
+        .map(|s| {
+            let (p, q) = (m.nodes[s[0] as usize], m.nodes[s[1] as usize]);
+            0.5 * ((p[0] - c[0]) * (q[1] - c[1]) - (p[1] - c[1]) * (q[0] - c[0])).abs()
+        })
+        .sum()
+}
