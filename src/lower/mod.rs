@@ -15,6 +15,7 @@ mod region_arcs;
 mod region_collinear;
 pub mod region_interfaces;
 mod region_pairs;
+mod region_stretches;
 mod region_touch;
 pub mod rfunction_region;
 pub mod trimmed_topology;
