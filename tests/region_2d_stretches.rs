@@ -1,7 +1,8 @@
 //! Issue 6: two 2D R-function regions whose contours' runs along each other
 //! do not pair one to one. A notch in one region cuts the stretch it shares
 //! with its neighbour in two (the neighbour's one run lies along two runs),
-//! and a ring around two half disks lies along both with one loop. The
+//! a ring around two half disks lies along both with one loop, and a ring
+//! around a disk with bumps left out meets it in four stretches. The
 //! earlier contour is split where the later one leaves it, so the meshes
 //! share their nodes there. Checked on the shared nodes (on the curves, the
 //! corners found), areas adding up, the minimum angle, and the MSH groups as
@@ -34,6 +35,22 @@ const RING_AROUND_HALVES: &str = r#"<geometry version="1" dimension="2">
   </rfunction>
   <subdomain name="west"><solid ref="west"/></subdomain>
   <subdomain name="east"><solid ref="east"/></subdomain>
+  <subdomain name="coat"><solid ref="coat"/></subdomain>
+</geometry>"#;
+
+/// A disk of radius 0.5 and a ring 0.5 ≤ r ≤ 0.8 around it with four
+/// bumps of radius 0.12 centred on r = 0.5 left out: the two contours run
+/// along each other in four stretches, each broken off by a bump.
+const BUMPED_RING: &str = r#"<geometry version="1" dimension="2">
+  <rfunction name="core" nx="40" ny="40" x_min="-1" x_max="1" y_min="-1" y_max="1">
+    <disk r="0.5" x0="0" y0="0"/> </rfunction>
+  <rfunction name="coat" nx="37" ny="37" x_min="-1" x_max="1" y_min="-1" y_max="1">
+    <difference> <disk r="0.8" x0="0" y0="0"/>
+      <union> <disk r="0.5" x0="0" y0="0"/> <disk r="0.12" x0="0.5" y0="0"/> <disk r="0.12" x0="-0.5" y0="0"/>
+        <disk r="0.12" x0="0" y0="0.5"/> <disk r="0.12" x0="0" y0="-0.5"/> </union>
+    </difference>
+  </rfunction>
+  <subdomain name="core"><solid ref="core"/></subdomain>
   <subdomain name="coat"><solid ref="coat"/></subdomain>
 </geometry>"#;
 
@@ -218,6 +235,65 @@ fn a_ring_around_two_half_disks_shares_its_inner_loop_with_both() {
     assert!((west + east - fan_area(&m, &arcs, [0.0, 0.0])).abs() < 1e-12);
     let outer = fragment_segments(&m, "coat|exterior");
     assert!((west + east + coat - fan_area(&m, &outer, [0.0, 0.0])).abs() < 1e-12);
+    let least = min_angle_degrees(&m);
+    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+}
+
+#[test]
+fn a_ring_with_bumps_shares_four_stretches_ending_at_the_bumps() {
+    let m = mesh(BUMPED_RING, 0.01);
+    assert_eq!(
+        fragment_names(&m),
+        BTreeSet::from(["core|exterior", "core|coat", "coat|exterior"])
+    );
+    // Four open chains on r = 0.5, each ending where a bump meets the circle.
+    let interface = fragment_segments(&m, "core|coat");
+    let nodes = assert_conforming(&m, "core|coat", "core", "coat");
+    assert_eq!(interface.len() + 4, nodes);
+    for &n in interface.iter().flatten() {
+        assert!((radius(&m, n) - 0.5).abs() < 1e-12, "r = {}", radius(&m, n));
+    }
+    let bumps = [[0.5, 0.0], [-0.5, 0.0], [0.0, 0.5], [0.0, -0.5]];
+    let mut count: BTreeMap<u32, usize> = BTreeMap::new();
+    for &n in interface.iter().flatten() {
+        *count.entry(n).or_default() += 1;
+    }
+    let ends: Vec<u32> = count
+        .into_iter()
+        .filter(|&(_, c)| c == 1)
+        .map(|(n, _)| n)
+        .collect();
+    assert_eq!(ends.len(), 8);
+    for n in ends {
+        let p = m.nodes[n as usize];
+        let to_bump = bumps
+            .iter()
+            .map(|c| (p[0] - c[0]).hypot(p[1] - c[1]))
+            .fold(f64::INFINITY, f64::min);
+        assert!((to_bump - 0.12).abs() < 1e-9, "corner {p:?}: {to_bump}");
+    }
+    // The core's rim inside the bumps is its own boundary.
+    for &n in fragment_segments(&m, "core|exterior").iter().flatten() {
+        assert!((radius(&m, n) - 0.5).abs() < 1e-12, "r = {}", radius(&m, n));
+    }
+    let (core, coat) = (
+        area(&m, &triangles_of(&m, "core")),
+        area(&m, &triangles_of(&m, "coat")),
+    );
+    assert!((core - PI * 0.25).abs() / (PI * 0.25) < 2e-3, "core {core}");
+    // Each bump's part outside the core: its disk less the lens they share.
+    let (r, big, d) = (0.12f64, 0.5f64, 0.5f64);
+    let lens = r * r * ((d * d + r * r - big * big) / (2.0 * d * r)).acos()
+        + big * big * ((d * d + big * big - r * r) / (2.0 * d * big)).acos()
+        - 0.5 * ((-d + r + big) * (d + r - big) * (d - r + big) * (d + r + big)).sqrt();
+    let ring = PI * (0.64 - 0.25) - 4.0 * (PI * r * r - lens);
+    assert!((coat - ring).abs() / ring < 2e-3, "coat {coat} vs {ring}");
+    let domain = outline_area(&m, &["core", "coat"], &["core|exterior", "coat|exterior"]);
+    assert!(
+        (core + coat - domain).abs() < 1e-12,
+        "{} vs {domain}",
+        core + coat
+    );
     let least = min_angle_degrees(&m);
     assert!(least >= 30.0 - 1e-9, "min angle {least}");
 }
