@@ -362,17 +362,27 @@ pub(super) fn corner_on_line(
     from: Point3,
     direction: crate::geom::Vec3,
 ) -> Option<Point3> {
-    let d = lp.iter().find_map(|oe| {
+    let d = vertex_after(model, lp, b, c)?;
+    let p = |w: VertexId| model.vertex(w).position;
+    let x = parabola_meets_line([p(b), p(c), p(d)], from, from + direction)?;
+    ((x - p(v)).norm() <= 2.0 * (p(b) - p(v)).norm()).then_some(x)
+}
+
+/// The vertex of loop `lp` after c, coming from b.
+pub(super) fn vertex_after(
+    model: &Model,
+    lp: &[OrientedEdge],
+    b: VertexId,
+    c: VertexId,
+) -> Option<VertexId> {
+    lp.iter().find_map(|oe| {
         let e = model.edge(oe.edge);
         match (e.begin, e.end) {
             (x, y) if x == c && y != b => Some(y),
             (y, x) if x == c && y != b => Some(y),
             _ => None,
         }
-    })?;
-    let p = |w: VertexId| model.vertex(w).position;
-    let x = parabola_meets_line([p(b), p(c), p(d)], from, from + direction)?;
-    ((x - p(v)).norm() <= 2.0 * (p(b) - p(v)).norm()).then_some(x)
+    })
 }
 
 /// Where the parabola through the contour points q[0], q[1], q[2]
