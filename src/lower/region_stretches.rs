@@ -102,7 +102,9 @@ pub(super) fn share_along(
         )?;
         // A's stretch from the end's corner forward to the start's lies
         // along the run: every A vertex inside it near one of its pieces.
-        if start.lp != stop.lp {
+        // One loop, and two distinct corners (the same one would make the
+        // stretch the whole loop).
+        if start.lp != stop.lp || (start.at - stop.at).norm() <= 16.0 * model.tolerance {
             return None;
         }
         let inside = stretch_vertices(model, fa, &stop, &start)?;
@@ -149,6 +151,9 @@ pub(super) fn share_along(
     let mut swaps: BTreeMap<usize, Vec<(usize, usize, Vec<OrientedEdge>)>> = BTreeMap::new();
     for ((rb, [start, stop]), places) in runs_b.iter().zip(&at).zip(&corners) {
         let lp = &model.faces[fa.index()].loops[places[0].lp];
+        if start == stop {
+            return None;
+        }
         let walk = walk_forward(model, lp, *stop, *start)?;
         if walk.iter().any(|oe| !used.insert(oe.edge)) {
             return None;
