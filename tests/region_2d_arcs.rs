@@ -222,6 +222,51 @@ fn coating_around_a_kernel_disk_uses_the_disk_rim() {
 }
 
 #[test]
+fn lens_leaving_the_rim_along_a_circle_ends_at_the_true_corner() {
+    // The unit disk less a lens cut by a circle of radius 0.5 about (1, 0):
+    // the lens leaves the rim along that circle at (0.875, ±√(1 − 0.875²)).
+    // The parabola through the contour's next three points, followed back
+    // to the rim, finds the corner to 1e-8 (the chord through the next two
+    // points, followed back, missed it by 1.3e-5).
+    let xml = r#"<geometry version="1" dimension="2">
+  <circle name="disk"><center x="0" y="0"/><radius value="1"/></circle>
+  <rfunction name="lens" nx="40" ny="40" x_min="0.4" x_max="1.1" y_min="-0.6" y_max="0.6">
+    <intersection> <disk r="1" x0="0" y0="0"/> <disk r="0.5" x0="1" y0="0"/> </intersection>
+  </rfunction>
+  <subdomain name="plate"><difference><solid ref="disk"/><solid ref="lens"/></difference></subdomain>
+  <subdomain name="lens"><solid ref="lens"/></subdomain>
+</geometry>"#;
+    let m = mesh(xml, 0.01);
+    assert_eq!(
+        fragment_names(&m),
+        BTreeSet::from(["plate|exterior", "plate|lens", "lens|exterior"])
+    );
+    let rim = fragment_segments(&m, "lens|exterior");
+    for &n in rim.iter().flatten() {
+        let p = m.nodes[n as usize];
+        assert!((p[0].hypot(p[1]) - 1.0).abs() < 1e-12, "off the rim: {p:?}");
+    }
+    // The rim part's two ends are the corners, where the interface ends too.
+    let mut uses = std::collections::BTreeMap::new();
+    for &n in rim.iter().flatten() {
+        *uses.entry(n).or_insert(0) += 1;
+    }
+    let ends: Vec<[f64; 3]> = uses
+        .into_iter()
+        .filter(|&(_, c)| c == 1)
+        .map(|(n, _)| m.nodes[n as usize])
+        .collect();
+    assert_eq!(ends.len(), 2);
+    let corner = [0.875, (1.0f64 - 0.875 * 0.875).sqrt()];
+    for p in ends {
+        let miss = (p[0] - corner[0]).hypot(p[1].abs() - corner[1]);
+        assert!(miss < 1e-8, "corner {p:?} misses by {miss}");
+    }
+    assert_conforming(&m, "plate|lens", "plate", "lens");
+    assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
+}
+
+#[test]
 fn msh_of_a_patch_against_a_hole_keeps_its_groups_for_gmsh_and_meshio() {
     let dir = tempfile::tempdir().expect("tempdir");
     let msh = compile(HOLE, dir.path(), "hole", "0.01");

@@ -202,6 +202,43 @@ fn bead_touching_a_polygon_corner_takes_the_corner() {
 }
 
 #[test]
+fn bead_passing_a_polygon_corner_between_its_vertices_takes_the_corner() {
+    // The octagon's corner (1, 0) lies inside a chord of the bead's contour
+    // (its grid is shifted off y = 0, so no contour vertex is within the
+    // touch distance of the corner): the touch is found from the bead's
+    // function, zero at the corner and negative along both octagon edges.
+    let xml = r#"<geometry version="1" dimension="2">
+  <regular_polygon name="pg" sides="8"><center x="0" y="0"/><radius value="1"/></regular_polygon>
+  <rfunction name="bead" nx="40" ny="40" x_min="0.95" x_max="1.7" y_min="-0.37" y_max="0.38">
+    <disk r="0.3" x0="1.3" y0="0"/> </rfunction>
+  <subdomain name="plate"><solid ref="pg"/></subdomain>
+  <subdomain name="bead"><solid ref="bead"/></subdomain>
+</geometry>"#;
+    let m = mesh(xml, 0.01);
+    let p = touch_node(&m, "plate", "bead");
+    assert_eq!([p[0], p[1]], [1.0, 0.0]);
+    // The bead's next node is a contour vertex away, not within the touch
+    // distance (0.5e-3 of its box diagonal, 4.2e-4): the case is the chord's.
+    let next = nodes_of(&m, "bead")
+        .into_iter()
+        .map(|n| m.nodes[n as usize])
+        .filter(|q| q[0] != 1.0 || q[1] != 0.0)
+        .map(|q| (q[0] - 1.0).hypot(q[1]))
+        .fold(f64::INFINITY, f64::min);
+    assert!(next > 4e-3, "bead node {next} from the corner");
+    let plate = area(&m, &triangles_of(&m, "plate"));
+    assert!((plate - 8f64.sqrt()).abs() < 1e-12, "plate area {plate}");
+    let bead = area(&m, &triangles_of(&m, "bead"));
+    let polygon = fan_area(&m, &fragment_segments(&m, "bead|exterior"), [1.3, 0.0]);
+    assert!((bead - polygon).abs() < 1e-12, "{bead} vs {polygon}");
+    assert!(
+        (bead - PI * 0.09).abs() / (PI * 0.09) < 2e-3,
+        "bead area {bead}"
+    );
+    assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
+}
+
+#[test]
 fn msh_of_a_tangent_bead_keeps_its_groups_for_gmsh_and_meshio() {
     let dir = tempfile::tempdir().expect("tempdir");
     let msh = compile(TANGENT, dir.path(), "tangent", "0.01");

@@ -204,6 +204,53 @@ impl Arc {
         (u, reach)
     }
 
+    /// Where the parabola through the contour points q[0], q[1], q[2]
+    /// (parameters 0 and their chord lengths), extended back past q[0],
+    /// first meets the curve: the contour's curvature kept, so the corner is
+    /// found to the third order of the piece length (the ray of
+    /// [`Arc::corner`] to the second). None when it does not meet it within
+    /// four of q[0]'s pieces.
+    fn corner_parabola(&self, q: [Point3; 3]) -> Option<Point3> {
+        let s1 = (q[1] - q[0]).norm();
+        let s2 = s1 + (q[2] - q[1]).norm();
+        if s1 <= 0.0 || s2 <= s1 {
+            return None;
+        }
+        // Lagrange's form, each coordinate.
+        let at = |s: f64| {
+            let w0 = (s - s1) * (s - s2) / (s1 * s2);
+            let w1 = s * (s - s2) / (s1 * (s1 - s2));
+            let w2 = s * (s - s1) / (s2 * (s2 - s1));
+            q[0] * w0 + (q[1] * w1).coords + (q[2] * w2).coords
+        };
+        // Outside (+) or inside (−) the curve, in its unit-circle frame.
+        let side = |s: f64| {
+            let [x, y] = self.local(&at(s));
+            x * x + y * y - 1.0
+        };
+        let step = s1 / 8.0;
+        let mut near = (0.0, side(0.0));
+        for i in 1..=32 {
+            let s = -step * f64::from(i);
+            let g = side(s);
+            if g == 0.0 || (g > 0.0) != (near.1 > 0.0) {
+                let (mut inner, mut outer) = (near.0, s);
+                for _ in 0..60 {
+                    let mid = 0.5 * (inner + outer);
+                    if (side(mid) > 0.0) == (near.1 > 0.0) {
+                        inner = mid;
+                    } else {
+                        outer = mid;
+                    }
+                }
+                let x = at(0.5 * (inner + outer));
+                return Some(self.point(self.parameter(&x)));
+            }
+            near = (s, g);
+        }
+        None
+    }
+
     /// The first point of the ray from b away from c on the curve.
     fn corner(&self, b: Point3, c: Point3) -> Option<Point3> {
         let (lb, lc) = (self.local(&b), self.local(&c));
@@ -323,10 +370,27 @@ pub(super) fn share_arcs(
                     super::region_pairs::corner_on_line(model, lp, [v, b, c], l.from, l.direction)
                         .map(|x| arc.point(arc.parameter(&x).clamp(0.0, l.length)))
                 }
-                KernelCurve::Arc(_) => None,
+                // On an arc likewise: the contour leaving it is curved too.
+                KernelCurve::Arc(curve) => {
+                    let lp = &model.faces[run.face.index()].loops[run.lp];
+                    super::region_pairs::vertex_after(model, lp, b, c)
+                        .and_then(|d| curve.corner_parabola([p(b), p(c), p(d)]))
+                        .filter(|x| (x - p(v)).norm() <= 2.0 * (p(b) - p(v)).norm())
+                }
+            };
+            let ray = arc.corner(p(v), p(b), p(c));
+            // A contour leaving straight gives the ray's corner to rounding:
+            // that one is kept (the same point, and the same mesh as before).
+            let on_line = match (on_line, ray) {
+                (Some(x), Some(y))
+                    if !arc.is_line() && (x - y).norm() <= 1e-12 * (p(b) - p(v)).norm() =>
+                {
+                    Some(y)
+                }
+                (x, _) => x,
             };
             let at = on_line
-                .or_else(|| arc.corner(p(v), p(b), p(c)))
+                .or(ray)
                 .unwrap_or_else(|| arc.point(arc.parameter(&p(v))));
             let u = arc.parameter(&at);
             let list = splits.entry(run.arc).or_default();

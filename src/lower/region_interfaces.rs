@@ -61,6 +61,14 @@ pub fn join(
         |m, r| face_of(m, r).map_or(0.0, |f| touch_distance(m, f)),
         &reported,
     );
+    let touched = super::region_corner_touch::share_corner_touches(
+        model,
+        source_map,
+        first_region,
+        |m, r| face_of(m, r).map_or(0.0, |f| touch_distance(m, f)),
+        &reported,
+        touched,
+    );
     check(model, source_map, first_region, &reported, &touched, diags);
 }
 

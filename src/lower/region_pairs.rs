@@ -23,16 +23,16 @@ use std::collections::{BTreeMap, BTreeSet};
 /// fraction of the region's extent: the contours' chordal tolerance (0.5e-3
 /// of the box diagonal), the same as the touch distance of
 /// `region_interfaces`, so anything closer is either shared or a touch.
-const ON_FRACTION: f64 = 0.5e-3;
+pub(super) const ON_FRACTION: f64 = 0.5e-3;
 
 /// A run of pieces of loop `lp` of a face: `len` pieces from `start`
 /// (cyclically), or the whole loop when `closed`.
 #[derive(Clone, Copy, Debug)]
-struct Run {
-    lp: usize,
-    start: usize,
-    len: usize,
-    closed: bool,
+pub(super) struct Run {
+    pub(super) lp: usize,
+    pub(super) start: usize,
+    pub(super) len: usize,
+    pub(super) closed: bool,
 }
 
 /// Shares the interfaces of every pair of regions (subdomains
@@ -54,7 +54,7 @@ pub(super) fn share_region_interfaces(
             ) else {
                 continue;
             };
-            if let Some((edges, vertices)) = share_pair(model, fa, fb) {
+            if let Some((edges, vertices)) = share_pair(model, source_map, fa, fb) {
                 dropped_edges.extend(edges);
                 dropped_vertices.extend(vertices);
             }
@@ -76,7 +76,7 @@ pub(super) fn share_region_interfaces(
 /// None when the two faces share nothing or their runs do not pair up.
 type Shared = Option<(Vec<EdgeId>, Vec<VertexId>)>;
 
-fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
+fn share_pair(model: &mut Model, source_map: &mut SourceMap, fa: FaceId, fb: FaceId) -> Shared {
     let tol_a = ON_FRACTION * extent(model, fa);
     let tol_b = ON_FRACTION * extent(model, fb);
     let runs_b = runs_on(model, fb, fa, tol_a);
@@ -84,14 +84,32 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
         return None;
     }
     let runs_a = runs_on(model, fa, fb, tol_b);
+    match one_to_one(model, fa, fb, &runs_a, &runs_b) {
+        Some(pairs) => Some(share_pairs(model, fa, fb, pairs)),
+        // Runs broken differently on the two contours: the earlier one is
+        // split where the later one leaves it.
+        None => super::region_stretches::share_along(model, source_map, fa, fb, &runs_b),
+    }
+}
+
+/// Each later run with the earlier run whose ends are nearest its ends
+/// (the earlier run goes the other way), when the runs pair up one to one:
+/// as many on each side, closed with closed, and open ones straight on both
+/// contours, ending at the same corners once those are restored. Curved
+/// open runs and anything else go to `region_stretches`.
+fn one_to_one(
+    model: &Model,
+    fa: FaceId,
+    fb: FaceId,
+    runs_a: &[Run],
+    runs_b: &[Run],
+) -> Option<Vec<(Run, Run)>> {
     if runs_a.len() != runs_b.len() {
         return None;
     }
-    // Each later run with the earlier run whose ends are nearest its ends
-    // (the earlier run goes the other way).
     let mut pairs = Vec::with_capacity(runs_b.len());
     let mut used = vec![false; runs_a.len()];
-    for rb in &runs_b {
+    for rb in runs_b {
         if rb.closed {
             let k = (0..runs_a.len()).find(|&k| runs_a[k].closed && !used[k])?;
             used[k] = true;
@@ -112,6 +130,30 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
         used[k] = true;
         pairs.push((runs_a[k], *rb));
     }
+    let agree = |(ra, rb): &(Run, Run)| {
+        let (Some(a), Some(b)) = (
+            planned_corners(model, fa, ra),
+            planned_corners(model, fb, rb),
+        ) else {
+            return false;
+        };
+        let ((sa, ea), (sb, eb)) = (a.ends(model, fa), b.ends(model, fb));
+        let reach = 2.0 * a.end_piece(model, fa).max(b.end_piece(model, fb));
+        (ea - sb).norm() <= reach && (sa - eb).norm() <= reach
+    };
+    pairs
+        .iter()
+        .all(|p| (p.0.closed && p.1.closed) || agree(p))
+        .then_some(pairs)
+}
+
+/// Replaces each later run by its earlier partner's pieces, reversed.
+fn share_pairs(
+    model: &mut Model,
+    fa: FaceId,
+    fb: FaceId,
+    pairs: Vec<(Run, Run)>,
+) -> (Vec<EdgeId>, Vec<VertexId>) {
     let mut dropped_edges = Vec::new();
     let mut dropped_vertices = Vec::new();
     let mut canonical: BTreeMap<VertexId, VertexId> = BTreeMap::new();
@@ -175,14 +217,14 @@ fn share_pair(model: &mut Model, fa: FaceId, fb: FaceId) -> Shared {
         }
         super::edge_parts::follow_vertices(model, e);
     }
-    Some((dropped_edges, dropped_vertices))
+    (dropped_edges, dropped_vertices)
 }
 
 fn loop_of(model: &Model, f: FaceId, lp: usize) -> &[OrientedEdge] {
     &model.faces[f.index()].loops[lp]
 }
 
-fn pieces(model: &Model, f: FaceId, run: &Run) -> Vec<OrientedEdge> {
+pub(super) fn pieces(model: &Model, f: FaceId, run: &Run) -> Vec<OrientedEdge> {
     let lp = loop_of(model, f, run.lp);
     let n = lp.len();
     (0..run.len).map(|i| lp[(run.start + i) % n]).collect()
@@ -196,33 +238,83 @@ fn run_end_points(model: &Model, f: FaceId, run: &Run) -> (Point3, Point3) {
     )
 }
 
+/// A straight run extended along its line, with the positions its two end
+/// vertices move to (see [`restore_corners`]).
+struct Planned {
+    run: Run,
+    moves: Vec<(VertexId, Point3)>,
+}
+
+impl Planned {
+    /// The run's end points once moved.
+    fn ends(&self, model: &Model, f: FaceId) -> (Point3, Point3) {
+        let own = pieces(model, f, &self.run);
+        let at = |v: VertexId| {
+            self.moves
+                .iter()
+                .find(|m| m.0 == v)
+                .map_or(model.vertex(v).position, |m| m.1)
+        };
+        (
+            at(begin(model, own[0])),
+            at(end(model, own[self.run.len - 1])),
+        )
+    }
+
+    /// The longer of the run's two end pieces.
+    fn end_piece(&self, model: &Model, f: FaceId) -> f64 {
+        let own = pieces(model, f, &self.run);
+        let length = |oe: OrientedEdge| {
+            (model.vertex(end(model, oe)).position - model.vertex(begin(model, oe)).position).norm()
+        };
+        length(own[0]).max(length(own[self.run.len - 1]))
+    }
+}
+
 /// Where a straight run's ends really are: marching squares cut the corner
 /// where the contour leaves the interface, so the line through the next two
 /// contour points beyond each end is followed back to the run's line, and
 /// the end vertex moved there when that point is within two of the end's
 /// pieces (else the contour leaves smoothly and the end stays).
 fn restore_corners(model: &mut Model, f: FaceId, run: &Run) -> Run {
-    let lp = loop_of(model, f, run.lp).to_vec();
+    let Some(plan) = planned_corners(model, f, run) else {
+        return *run;
+    };
+    for (v, x) in plan.moves {
+        model.vertices[v.index()].position = x;
+    }
+    // The run's own pieces and the neighbours follow their vertices.
+    for oe in loop_of(model, f, run.lp).to_vec() {
+        super::edge_parts::follow_vertices(model, oe.edge);
+    }
+    plan.run
+}
+
+/// [`restore_corners`] without moving anything; None when the run is not
+/// straight.
+fn planned_corners(model: &Model, f: FaceId, run: &Run) -> Option<Planned> {
+    let lp = loop_of(model, f, run.lp);
     let n = lp.len();
-    let p = |m: &Model, v: VertexId| m.vertex(v).position;
+    let mut moves: Vec<(VertexId, Point3)> = Vec::new();
     let (a, b) = run_end_points(model, f, run);
     // Straight: every vertex of the run on the chord of its ends.
     let tol = ON_SET_FRACTION * extent(model, f);
+    let position = |v: VertexId| model.vertex(v).position;
     if pieces(model, f, run)
         .iter()
-        .any(|oe| off_line(p(model, end(model, *oe)), a, b) > tol)
+        .any(|oe| off_line(position(end(model, *oe)), a, b) > tol)
     {
-        return *run;
+        return None;
     }
     // The contour may go on along the line past the other's cut corner.
     let mut run = *run;
     while run.len + 2 < n
-        && off_line(p(model, end(model, lp[(run.start + run.len) % n])), a, b) <= tol
+        && off_line(position(end(model, lp[(run.start + run.len) % n])), a, b) <= tol
     {
         run.len += 1;
     }
     while run.len + 2 < n
-        && off_line(p(model, begin(model, lp[(run.start + n - 1) % n])), a, b) <= tol
+        && off_line(position(begin(model, lp[(run.start + n - 1) % n])), a, b) <= tol
     {
         run.start = (run.start + n - 1) % n;
         run.len += 1;
@@ -245,20 +337,18 @@ fn restore_corners(model: &mut Model, f: FaceId, run: &Run) -> Run {
         ),
     ];
     for (v, beyond, further, third) in ends {
-        let (pv, pb, pc) = (p(model, v), p(model, beyond), p(model, further));
-        let extended = parabola_meets_line([pb, pc, p(model, third)], a, b)
+        // An end moved already (a run of all but two pieces) counts moved.
+        let p = |w: VertexId| moves.iter().find(|m| m.0 == w).map_or(position(w), |m| m.1);
+        let (pv, pb, pc) = (p(v), p(beyond), p(further));
+        let extended = parabola_meets_line([pb, pc, p(third)], a, b)
             .or_else(|| ray_meets_line(pb, pb - pc, a, b));
         if let Some(x) = extended
             && (x - pv).norm() <= 2.0 * (pb - pv).norm()
         {
-            model.vertices[v.index()].position = x;
+            moves.push((v, x));
         }
     }
-    // The run's own pieces and the neighbours follow their vertices.
-    for oe in lp {
-        super::edge_parts::follow_vertices(model, oe.edge);
-    }
-    run
+    Some(Planned { run, moves })
 }
 
 /// The corner where a contour leaving the line `from + direction·u` at
@@ -272,17 +362,27 @@ pub(super) fn corner_on_line(
     from: Point3,
     direction: crate::geom::Vec3,
 ) -> Option<Point3> {
-    let d = lp.iter().find_map(|oe| {
+    let d = vertex_after(model, lp, b, c)?;
+    let p = |w: VertexId| model.vertex(w).position;
+    let x = parabola_meets_line([p(b), p(c), p(d)], from, from + direction)?;
+    ((x - p(v)).norm() <= 2.0 * (p(b) - p(v)).norm()).then_some(x)
+}
+
+/// The vertex of loop `lp` after c, coming from b.
+pub(super) fn vertex_after(
+    model: &Model,
+    lp: &[OrientedEdge],
+    b: VertexId,
+    c: VertexId,
+) -> Option<VertexId> {
+    lp.iter().find_map(|oe| {
         let e = model.edge(oe.edge);
         match (e.begin, e.end) {
             (x, y) if x == c && y != b => Some(y),
             (y, x) if x == c && y != b => Some(y),
             _ => None,
         }
-    })?;
-    let p = |w: VertexId| model.vertex(w).position;
-    let x = parabola_meets_line([p(b), p(c), p(d)], from, from + direction)?;
-    ((x - p(v)).norm() <= 2.0 * (p(b) - p(v)).norm()).then_some(x)
+    })
 }
 
 /// Where the parabola through the contour points q[0], q[1], q[2]
@@ -362,7 +462,7 @@ fn off_line(p: Point3, a: Point3, b: Point3) -> f64 {
 /// a shared stretch is on both zero sets to root finding's precision, while
 /// two curves that only touch (tangent disks) part quadratically and fail it
 /// within a fraction of a piece.
-const ON_SET_FRACTION: f64 = 1e-6;
+pub(super) const ON_SET_FRACTION: f64 = 1e-6;
 
 /// The maximal runs of face `f`'s loop pieces lying on face `other`'s
 /// contour: both ends and the middle within `tol` of one of its pieces, and
@@ -433,7 +533,7 @@ fn runs_on(model: &Model, f: FaceId, other: FaceId, tol: f64) -> Vec<Run> {
 
 /// |f(p)| / |∇f(p)|: the distance of p from f = 0 to first order (central
 /// differences with step `h`).
-fn off_zero_set(f: &crate::implicit::tape::Ssa, p: Point3, h: f64) -> f64 {
+pub(super) fn off_zero_set(f: &crate::implicit::tape::Ssa, p: Point3, h: f64) -> f64 {
     let at = |x: f64, y: f64| f.eval_point([x, y, p.z]);
     let value = at(p.x, p.y);
     let gx = (at(p.x + h, p.y) - at(p.x - h, p.y)) / (2.0 * h);
@@ -445,7 +545,7 @@ fn off_zero_set(f: &crate::implicit::tape::Ssa, p: Point3, h: f64) -> f64 {
     value.abs() / slope
 }
 
-fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
+pub(super) fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
     let d = b - a;
     let l2 = d.x * d.x + d.y * d.y;
     let t = if l2 > 0.0 {
@@ -457,7 +557,7 @@ fn segment_distance(p: Point3, a: Point3, b: Point3) -> f64 {
 }
 
 /// The diagonal of a face's vertices' box.
-fn extent(model: &Model, f: FaceId) -> f64 {
+pub(super) fn extent(model: &Model, f: FaceId) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for oe in model.faces[f.index()].loops.edges() {
         let p = model.vertex(model.edge(oe.edge).begin).position;
