@@ -171,6 +171,31 @@ impl FileOutput {
         Ok(())
     }
 
+    /// Writes `values` converted to `N` bytes each, converted straight into
+    /// the buffer (no block of their own copied in afterwards).
+    pub(crate) fn write_converted<T: Copy, const N: usize>(
+        &mut self,
+        values: &[T],
+        bytes: impl Fn(T) -> [u8; N],
+    ) -> std::io::Result<()> {
+        let total = N * values.len();
+        let mut from = 0;
+        while from < total {
+            let room = self.room();
+            let n = (room - self.len).min(total - from);
+            let at = self.first() + self.len;
+            if let Some(slot) = self.buffer.get_mut(at..at + n) {
+                super::file_ranges::fill_converted(values, &bytes, from, slot);
+            }
+            self.len += n;
+            from += n;
+            if self.len == room {
+                self.write_buffer()?;
+            }
+        }
+        Ok(())
+    }
+
     /// The file offset the next byte written goes to.
     pub fn position(&self) -> u64 {
         self.at + self.len as u64
@@ -414,5 +439,29 @@ mod tests {
         })
         .expect("written");
         assert_eq!(std::fs::read(&path).expect("read back"), data);
+    }
+
+    /// Values converted straight into the buffer, across several buffers
+    /// and from an offset that is not a value's or a page's, give the bytes
+    /// of their conversion.
+    #[test]
+    fn values_converted_into_the_buffer_are_their_bytes() {
+        let dir = tempfile::tempdir().expect("temporary folder");
+        let path = dir.path().join("converted.bin");
+        let values: Vec<f32> = (0..700_000).map(|i| i as f32 * 0.37 - 5.0).collect();
+        let bytes: Vec<u8> = values.iter().flat_map(|v| v.to_le_bytes()).collect();
+        write_atomic_file(&path, |out| {
+            out.write_all(b"abc")?;
+            out.write_converted(&values[..1_000], f32::to_le_bytes)?;
+            out.write_converted(&values[1_000..], f32::to_le_bytes)?;
+            out.write_all(b"z")?;
+            Ok(())
+        })
+        .expect("written");
+        let read = std::fs::read(&path).expect("read back");
+        assert_eq!(read.len(), 4 + bytes.len());
+        assert_eq!(&read[..3], b"abc");
+        assert_eq!(read[3..3 + bytes.len()], bytes[..]);
+        assert_eq!(read.last(), Some(&b'z'));
     }
 }

@@ -683,13 +683,13 @@ impl InOrder<'_> {
         &self,
         expander: &mut groups::Expander,
         block: &mut Vec<u8>,
-        out: &mut dyn Write,
+        out: &mut FileOutput,
     ) -> std::io::Result<()> {
         match self {
             InOrder::Piece(piece) => piece.write(expander, block, out),
             InOrder::Normals { triangles, used } => {
                 groups::emit_unit_normals(expander.mesh(), triangles, *used, &mut |run| {
-                    write_blocks(run.as_flattened(), block, out, f32::to_le_bytes)
+                    out.write_converted(run.as_flattened(), f32::to_le_bytes)
                 })
             }
         }
