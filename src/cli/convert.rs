@@ -7,7 +7,8 @@ use geomc::convert::{ConvertOptions, apply, inspect::MeshReport};
 use geomc::diag::{Code, Diagnostic, render_human};
 use geomc::formats::read::{ReadFormat, ReadLimits, load_mesh_limited, load_mesh_unchecked};
 use geomc::formats::{
-    Encoding, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic, writer_for_path,
+    Encoding, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic, write_atomic_file,
+    writer_for_path,
 };
 use geomc::span::SourceFile;
 use std::path::{Path, PathBuf};
@@ -334,7 +335,7 @@ fn write(
             write_atomic(&side_path, |w| Ok(w.write_all(&side.bytes)?))?;
             written.push(side_path);
         }
-        write_atomic(path, |w| writer.write(mesh, options, w))
+        write_atomic_file(path, |out| writer.write_file(mesh, options, out))
     })();
     if result.is_err() {
         for side_path in written {

@@ -8,8 +8,11 @@
 //! edges; each node's `extras` say what it is and, for a fragment, its
 //! subdomain pair. Floats are `f32`, as glTF requires.
 
+use super::file_ranges::{self, Range, fill_converted};
 use super::groups::{self, Source};
-use super::{MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning};
+use super::{
+    FileOutput, MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning,
+};
 use crate::mesh::Mesh;
 use serde_json::{Value, json};
 use std::io::Write;
@@ -41,16 +44,7 @@ impl MeshWriter for Gltf {
         options: &WriteOptions,
         out: &mut dyn Write,
     ) -> Result<Vec<Warning>, WriteError> {
-        groups::check(mesh)?;
-        let doc = Document::of(mesh, self.name());
-        let mut warnings = doc.warnings.clone();
-        warnings.extend(groups::dropped_volumes(self.name(), mesh));
-        if options.encoding.is_some() {
-            warnings.push(warning(
-                self.name(),
-                "glTF has one encoding: the encoding option is ignored",
-            ));
-        }
+        let (doc, warnings) = self.document(mesh, options)?;
         if self.glb {
             let json = doc.json(None);
             write_glb(&json, &doc, out)?;
@@ -67,6 +61,20 @@ impl MeshWriter for Gltf {
         Ok(warnings)
     }
 
+    fn write_file(
+        &self,
+        mesh: &Mesh,
+        options: &WriteOptions,
+        out: &mut FileOutput,
+    ) -> Result<Vec<Warning>, WriteError> {
+        if !self.glb {
+            return self.write(mesh, options, out);
+        }
+        let (doc, warnings) = self.document(mesh, options)?;
+        write_glb_file(&doc.json(None), &doc, out, PARALLEL_FROM)?;
+        Ok(warnings)
+    }
+
     fn side_files(&self, mesh: &Mesh, options: &WriteOptions) -> Result<Vec<SideFile>, WriteError> {
         if self.glb {
             return Ok(Vec::new());
@@ -79,6 +87,27 @@ impl MeshWriter for Gltf {
             }],
             None => Vec::new(),
         })
+    }
+}
+
+impl Gltf {
+    /// The checked mesh's document and the warnings of writing it.
+    fn document<'m>(
+        &self,
+        mesh: &'m Mesh,
+        options: &WriteOptions,
+    ) -> Result<(Document<'m>, Vec<Warning>), WriteError> {
+        groups::check(mesh)?;
+        let doc = Document::of(mesh, self.name());
+        let mut warnings = doc.warnings.clone();
+        warnings.extend(groups::dropped_volumes(self.name(), mesh));
+        if options.encoding.is_some() {
+            warnings.push(warning(
+                self.name(),
+                "glTF has one encoding: the encoding option is ignored",
+            ));
+        }
+        Ok((doc, warnings))
     }
 }
 
@@ -550,9 +579,24 @@ fn extras(mesh: &Mesh, source: Source) -> Value {
 /// GLB container: a 12-byte header, the JSON chunk padded with spaces and the
 /// BIN chunk padded with zeros, both to 4 bytes.
 fn write_glb(json: &[u8], doc: &Document, out: &mut dyn Write) -> Result<(), WriteError> {
-    let pad = |n: usize| (4 - n % 4) % 4;
-    let json_len = json.len() + pad(json.len());
+    write_glb_head(json, doc.buffer_len, out)?;
     let bin = doc.buffer_len;
+    if bin > 0 {
+        doc.write_buffer(out)?;
+        out.write_all(&[0u8; 3][..pad(bin)])?;
+    }
+    Ok(())
+}
+
+/// Bytes that pad `n` to a multiple of 4.
+fn pad(n: usize) -> usize {
+    (4 - n % 4) % 4
+}
+
+/// The GLB's bytes before its binary buffer: the header, the JSON chunk
+/// and the BIN chunk's header (when there is a buffer of `bin` bytes).
+fn write_glb_head(json: &[u8], bin: usize, out: &mut dyn Write) -> Result<(), WriteError> {
+    let json_len = json.len() + pad(json.len());
     let bin_len = bin + pad(bin);
     let mut total = 12 + 8 + json_len;
     if bin > 0 {
@@ -571,8 +615,238 @@ fn write_glb(json: &[u8], doc: &Document, out: &mut dyn Write) -> Result<(), Wri
     if bin > 0 {
         out.write_all(&(bin_len as u32).to_le_bytes())?;
         out.write_all(b"BIN\0")?;
-        doc.write_buffer(out)?;
-        out.write_all(&[0u8; 3][..pad(bin)])?;
     }
     Ok(())
+}
+
+/// Binary buffers from this size on are written by [`write_glb_file`]'s
+/// two sides (below it the threads' start costs more than they save).
+const PARALLEL_FROM: usize = 4 << 20;
+
+/// [`write_glb`] into a file, the same bytes: when the buffer has at least
+/// `parallel_from` bytes, the parts that are copies of the mesh's values
+/// (positions and indices of a face as it is, other positions and
+/// indices) are made and written at their offsets by whichever thread is
+/// free, while this one writes the rest in order (normals, expanded
+/// groups) and skips over them. Beside `convert`'s surface checks, the
+/// checks' thread takes them once it is done.
+fn write_glb_file(
+    json: &[u8],
+    doc: &Document,
+    out: &mut FileOutput,
+    parallel_from: usize,
+) -> Result<(), WriteError> {
+    let bin = doc.buffer_len;
+    let parts = if bin > 0 && bin >= parallel_from {
+        out.parts()
+    } else {
+        None
+    };
+    let Some(parts) = parts else {
+        return write_glb(json, doc, out);
+    };
+    write_glb_head(json, bin, out)?;
+    let base = out.position();
+    let (in_order, ranges) = doc.layout(base);
+    let (ordered, ranged) = rayon::join(
+        || -> std::io::Result<()> {
+            let mut block = Vec::with_capacity(BLOCK + 12);
+            let mut expander = groups::Expander::new(doc.mesh);
+            for (offset, part) in &in_order {
+                out.skip_to(*offset)?;
+                part.write(&mut expander, &mut block, out)?;
+            }
+            out.skip_to(base + bin as u64)?;
+            out.write_all(&[0u8; 3][..pad(bin)])
+        },
+        || file_ranges::write_ranges(&parts, &ranges),
+    );
+    drop(parts);
+    ordered?;
+    ranged?;
+    Ok(())
+}
+
+/// What [`write_glb_file`]'s own thread writes, in order.
+enum InOrder<'d> {
+    /// A whole piece.
+    Piece(&'d Piece),
+    /// The normals of a face as it is, nodes `0..used`.
+    Normals {
+        triangles: &'d [[u32; 3]],
+        used: usize,
+    },
+}
+
+impl InOrder<'_> {
+    fn write(
+        &self,
+        expander: &mut groups::Expander,
+        block: &mut Vec<u8>,
+        out: &mut FileOutput,
+    ) -> std::io::Result<()> {
+        match self {
+            InOrder::Piece(piece) => piece.write(expander, block, out),
+            InOrder::Normals { triangles, used } => {
+                groups::emit_unit_normals(expander.mesh(), triangles, *used, &mut |run| {
+                    out.write_converted(run.as_flattened(), f32::to_le_bytes)
+                })
+            }
+        }
+    }
+}
+
+impl Document<'_> {
+    /// The buffer's parts at their file offsets (the buffer starting at
+    /// `base`): what is written in order, and the ranges any thread can make.
+    fn layout(&self, base: u64) -> (Vec<(u64, InOrder<'_>)>, Vec<Range<'_>>) {
+        let mesh = self.mesh;
+        let mut in_order = Vec::new();
+        let mut ranges = Vec::new();
+        let mut offset = base;
+        for piece in &self.pieces {
+            let len = piece.byte_len();
+            match piece {
+                Piece::Vec3F32(v) => {
+                    let values = v.as_flattened();
+                    ranges.push(Range {
+                        offset,
+                        len,
+                        fill: Box::new(move |from, out| {
+                            fill_converted(values, f32::to_le_bytes, from, out)
+                        }),
+                    });
+                }
+                Piece::Indices(values) => ranges.push(Range {
+                    offset,
+                    len,
+                    fill: Box::new(move |from, out| {
+                        fill_converted(values, u32::to_le_bytes, from, out)
+                    }),
+                }),
+                Piece::Group { faces, measured } => match (faces.as_slice(), measured.identity) {
+                    ([(face, false)], Some(used)) => {
+                        let triangles = &mesh.faces[*face as usize].triangles;
+                        let nodes = &mesh.nodes[..used];
+                        ranges.push(Range {
+                            offset,
+                            len: 12 * used,
+                            fill: Box::new(move |from, out| {
+                                fill_converted(nodes, position, from, out)
+                            }),
+                        });
+                        let normals = offset + 12 * used as u64;
+                        in_order.push((normals, InOrder::Normals { triangles, used }));
+                        ranges.push(Range {
+                            offset: normals + 12 * used as u64,
+                            len: 12 * triangles.len(),
+                            fill: Box::new(move |from, out| {
+                                fill_converted(
+                                    triangles.as_flattened(),
+                                    u32::to_le_bytes,
+                                    from,
+                                    out,
+                                )
+                            }),
+                        });
+                    }
+                    _ => in_order.push((offset, InOrder::Piece(piece))),
+                },
+            }
+            offset += len as u64;
+        }
+        (in_order, ranges)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::mesh::{MeshFace, MeshPolyline};
+
+    /// A wavy strip of `n` triangles over nodes numbered in first-use order.
+    fn strip(n: u32) -> (Vec<[f64; 3]>, Vec<[u32; 3]>) {
+        let nodes = (0..n + 2)
+            .map(|i| {
+                let x = f64::from(i / 2) * 0.01;
+                [x, f64::from(i % 2), (x * 3.0).sin()]
+            })
+            .collect();
+        let triangles = (0..n)
+            .map(|i| {
+                if i % 2 == 0 {
+                    [i, i + 1, i + 2]
+                } else {
+                    [i + 1, i, i + 2]
+                }
+            })
+            .collect();
+        (nodes, triangles)
+    }
+
+    fn face(name: &str, triangles: Vec<[u32; 3]>) -> MeshFace {
+        MeshFace {
+            name: name.into(),
+            triangles,
+            boundary: Vec::new(),
+        }
+    }
+
+    /// The GLB written with its copied parts made by offset (threshold 0)
+    /// is the GLB written in order, byte for byte.
+    fn written_by_parts_equals_in_order(mesh: &Mesh, ranges: usize, in_order: usize) {
+        let mut whole = Vec::new();
+        GLB.write(mesh, &WriteOptions::default(), &mut whole)
+            .expect("written in order");
+        let dir = tempfile::tempdir().expect("temporary folder");
+        let path = dir.path().join("parts.glb");
+        super::super::write_atomic_file(&path, |out| {
+            let (doc, _) = GLB.document(mesh, &WriteOptions::default())?;
+            let (order, parts) = doc.layout(0);
+            assert_eq!((parts.len(), order.len()), (ranges, in_order));
+            write_glb_file(&doc.json(None), &doc, out, 0)
+        })
+        .expect("written by parts");
+        assert_eq!(std::fs::read(&path).expect("read back"), whole);
+    }
+
+    #[test]
+    fn a_face_as_it_is_written_by_parts_gives_the_same_bytes() {
+        // 150,000 triangles: 1.8 MB of indices, several pieces each.
+        let (nodes, triangles) = strip(150_000);
+        let mesh = Mesh {
+            dimension: 3,
+            nodes,
+            faces: vec![face("strip", triangles)],
+            ..Mesh::default()
+        };
+        // Positions and indices by offset, the normals in order.
+        written_by_parts_equals_in_order(&mesh, 2, 1);
+    }
+
+    #[test]
+    fn expanded_groups_lines_and_points_written_by_parts_give_the_same_bytes() {
+        let (nodes, triangles) = strip(30_000);
+        let (first, second) = triangles.split_at(12_345);
+        let mut flipped: Vec<[u32; 3]> = second.to_vec();
+        flipped.reverse();
+        let mesh = Mesh {
+            dimension: 3,
+            nodes,
+            faces: vec![face("a", first.to_vec()), face("b", flipped)],
+            polylines: vec![MeshPolyline {
+                name: "rail".into(),
+                nodes: (0..5_000).map(|i| 2 * i).collect(),
+            }],
+            point_sets: vec![MeshPolyline {
+                name: "marks".into(),
+                nodes: vec![7, 3, 30_001],
+            }],
+            ..Mesh::default()
+        };
+        // Face `a` is as it is (positions and indices by offset, normals in
+        // order); face `b` is renumbered (in order); the poly_line's
+        // positions and indices and the point set's positions by offset.
+        written_by_parts_equals_in_order(&mesh, 5, 2);
+    }
 }

@@ -11,6 +11,7 @@
 
 mod atomic;
 mod base64;
+mod file_ranges;
 pub mod frag;
 mod gltf;
 mod groups;
@@ -23,7 +24,7 @@ pub mod read;
 mod stl;
 mod vtu;
 
-pub use atomic::write_atomic;
+pub use atomic::{FileOutput, Parts, write_atomic, write_atomic_file};
 pub use frag::{FragDocument, read_frag_xml};
 
 use crate::mesh::Mesh;
@@ -100,6 +101,17 @@ pub trait MeshWriter: Sync {
         options: &WriteOptions,
         out: &mut dyn Write,
     ) -> Result<Vec<Warning>, WriteError>;
+    /// Writes the main file to an output file: the same bytes as
+    /// [`MeshWriter::write`]. A writer that can have parts of its file
+    /// made and written by other threads at their offsets overrides it.
+    fn write_file(
+        &self,
+        mesh: &Mesh,
+        options: &WriteOptions,
+        out: &mut FileOutput,
+    ) -> Result<Vec<Warning>, WriteError> {
+        self.write(mesh, options, out)
+    }
     /// Files the main file refers to, for the same mesh and options. Most
     /// formats are self-contained.
     fn side_files(
@@ -174,7 +186,7 @@ pub fn write_mesh_file(
             write_atomic(&side_path, |w| Ok(w.write_all(&side.bytes)?))?;
             written.push(side_path);
         }
-        write_atomic(path, |w| writer.write(mesh, &options, w))
+        write_atomic_file(path, |out| writer.write_file(mesh, &options, out))
     })();
     if result.is_err() {
         // A side file without its main file is a partial output too.
