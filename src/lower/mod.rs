@@ -13,6 +13,7 @@ mod point_calculus;
 mod prune;
 mod region_arcs;
 mod region_collinear;
+mod region_crossing;
 pub mod region_interfaces;
 mod region_pairs;
 mod region_touch;
