@@ -14,10 +14,11 @@ mod mesh2d_common;
 use geomc::diag::Code;
 use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
+use geomc::meshing::mesh_model;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, assert_groups_read, compile_msh as compile, fan_area, fragment_names,
-    fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
+    area, assert_conforming, assert_groups_read, at_30_degrees, compile_msh as compile, fan_area,
+    fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -226,6 +227,127 @@ fn disk_across_two_stacked_rectangles_splits_their_common_edge() {
     assert!((high - (0.5 - high_cut)).abs() < 1e-12, "high {high}");
     assert!((bead - (low_cut + high_cut)).abs() < 1e-12, "bead {bead}");
     assert!((bead - PI / 16.0).abs() / (PI / 16.0) < 2e-3, "{bead}");
+    assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
+}
+
+#[test]
+fn band_across_the_square_cuts_the_plate_in_two() {
+    // 0.4 ≤ y ≤ 0.6 over the whole square and beyond (its box's sides at
+    // x = −0.2 and 1.2 bound it): the plate keeps two loops, below and above.
+    let xml = r#"<geometry version="1" dimension="2">
+  <rectangle name="sq"><first_point x="0" y="0"/><second_point x="1" y="1"/></rectangle>
+  <rfunction name="band" nx="40" ny="40" x_min="-0.2" x_max="1.2" y_min="0.3" y_max="0.7">
+    <formula value="0.1 - abs(y - 0.5)"/> </rfunction>
+  <subdomain name="plate"><difference><solid ref="sq"/><solid ref="band"/></difference></subdomain>
+  <subdomain name="band"><solid ref="band"/></subdomain>
+</geometry>"#;
+    let checked = check_source(
+        SourceFile::new("t.xml", xml.to_string()),
+        &Options::default(),
+    );
+    let codes: Vec<Code> = checked.diagnostics.items.iter().map(|d| d.code).collect();
+    assert_eq!(codes, vec![Code::RegionCutByBox]);
+    let model = checked.lowered.expect("a model").model;
+    let m = mesh_model(&model, &at_30_degrees(Some(0.01))).expect("meshes");
+    assert_eq!(
+        fragment_names(&m),
+        BTreeSet::from(["plate|exterior", "plate|band", "band|exterior"])
+    );
+    let mut crossings = meeting_nodes(&m, "plate|band", "band|exterior");
+    crossings.sort_by(|p, q| p[0].total_cmp(&q[0]).then(p[1].total_cmp(&q[1])));
+    assert_eq!(crossings.len(), 4, "{crossings:?}");
+    for (p, q) in crossings
+        .iter()
+        .zip([[0.0, 0.4], [0.0, 0.6], [1.0, 0.4], [1.0, 0.6]])
+    {
+        assert!(
+            (p[0] - q[0]).abs() < 1e-12 && (p[1] - q[1]).abs() < 1e-12,
+            "{p:?} vs {q:?}"
+        );
+    }
+    // Each side is cut in three; the middle part, inside the band, is gone.
+    let outer = m
+        .fragments
+        .iter()
+        .find(|f| f.name == "plate|exterior")
+        .expect("plate|exterior");
+    let names: BTreeSet<&str> = outer
+        .edges
+        .iter()
+        .map(|&e| m.edges[e as usize].name.as_str())
+        .collect();
+    assert_eq!(
+        names,
+        BTreeSet::from(["sq.e1", "sq.e2", "sq.e2.3", "sq.e3", "sq.e4", "sq.e4.3"])
+    );
+    let plate = triangles_of(&m, "plate");
+    let centre_y = |t: &[u32; 3]| t.iter().map(|&n| m.nodes[n as usize][1]).sum::<f64>() / 3.0;
+    let (below, above): (Vec<[u32; 3]>, Vec<[u32; 3]>) =
+        plate.iter().partition(|t| centre_y(t) < 0.5);
+    assert!((area(&m, &below) - 0.4).abs() < 1e-12, "below");
+    assert!((area(&m, &above) - 0.4).abs() < 1e-12, "above");
+    let band = area(&m, &triangles_of(&m, "band"));
+    assert!((band - 0.28).abs() < 1e-12, "band {band}");
+    assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
+}
+
+#[test]
+fn disk_over_a_corner_drops_the_corner() {
+    let xml = ON_SIDE
+        .replace(r#"x0="1" y0="0.5""#, r#"x0="1" y0="1""#)
+        .replace(r#"y_min="0" y_max="1""#, r#"y_min="0.5" y_max="1.5""#);
+    let m = mesh(&xml, 0.01);
+    let crossings = meeting_nodes(&m, "plate|bead", "bead|exterior");
+    assert_eq!(crossings.len(), 2, "{crossings:?}");
+    let [a, b] = [crossings[0], crossings[1]];
+    assert!(
+        (a[0] - 1.0).abs() < 1e-12 && (a[1] - 0.7).abs() < 1e-12,
+        "{a:?}"
+    );
+    assert!(
+        (b[0] - 0.7).abs() < 1e-12 && (b[1] - 1.0).abs() < 1e-12,
+        "{b:?}"
+    );
+    // No plate node inside the bead: the corner (1, 1) went with its parts.
+    for n in triangles_of(&m, "plate").into_iter().flatten() {
+        let p = m.nodes[n as usize];
+        assert!((p[0] - 1.0).hypot(p[1] - 1.0) > 0.3 - 1e-6, "{p:?}");
+    }
+    let plate = area(&m, &triangles_of(&m, "plate"));
+    let quarter = fan_area(&m, &fragment_segments(&m, "plate|bead"), [1.0, 1.0]);
+    assert!((plate - (1.0 - quarter)).abs() < 1e-12, "plate {plate}");
+    assert!(
+        (quarter - 0.0225 * PI).abs() / (0.0225 * PI) < 2e-3,
+        "{quarter}"
+    );
+    assert_conforming(&m, "plate|bead", "plate", "bead");
+    assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
+}
+
+#[test]
+fn small_disk_on_a_long_edge_is_found_between_samples() {
+    // Crossings 0.1 apart on an edge 100 long: the edge is sampled by the
+    // region's extent, not in 512 steps of 0.195 (which step over both).
+    let xml = r#"<geometry version="1" dimension="2">
+  <rectangle name="strip"><first_point x="0" y="0"/><second_point x="100" y="1"/></rectangle>
+  <rfunction name="bead" nx="32" ny="32" x_min="49.8" x_max="50.4" y_min="0.7" y_max="1.3">
+    <disk r="0.05" x0="50.09" y0="1"/> </rfunction>
+  <subdomain name="plate"><difference><solid ref="strip"/><solid ref="bead"/></difference></subdomain>
+  <subdomain name="bead"><solid ref="bead"/></subdomain>
+</geometry>"#;
+    let m = mesh(xml, 10.0);
+    let mut crossings = meeting_nodes(&m, "plate|bead", "bead|exterior");
+    crossings.sort_by(|p, q| p[0].total_cmp(&q[0]));
+    assert_eq!(crossings.len(), 2, "{crossings:?}");
+    for (p, x) in crossings.iter().zip([50.04, 50.14]) {
+        assert!(
+            (p[0] - x).abs() < 1e-12 && (p[1] - 1.0).abs() < 1e-12,
+            "{p:?}"
+        );
+    }
+    let plate = area(&m, &triangles_of(&m, "plate"));
+    let half = fan_area(&m, &fragment_segments(&m, "plate|bead"), [50.09, 1.0]);
+    assert!((plate - (100.0 - half)).abs() < 1e-10, "plate {plate}");
     assert!(min_angle_degrees(&m) >= 30.0 - 1e-9);
 }
 

@@ -26,9 +26,14 @@ use crate::ir::{EdgeId, FaceId, Loops, Model, OrientedEdge, SourceMap, Vertex, V
 use crate::span::Span;
 use std::collections::{BTreeMap, BTreeSet};
 
-/// Samples of the region's function along each kernel edge: two crossings
-/// closer than 1/512 of the edge are missed (and refused, as unmatched).
-const SAMPLES: usize = 512;
+/// Samples of the region's function along each kernel edge: at least
+/// `MIN_SAMPLES`, and one per 1/`PER_EXTENT` of the region's extent (a
+/// small region on a long edge), at most `MAX_SAMPLES`. Two crossings closer
+/// than the spacing are missed: no sign change (the contour then stays
+/// near the edge, and the touch check reports it).
+const MIN_SAMPLES: usize = 512;
+const PER_EXTENT: f64 = 256.0;
+const MAX_SAMPLES: usize = 1 << 16;
 
 /// A contour vertex within this fraction of its piece's length from a
 /// crossing is moved onto it rather than the piece cut (no short piece).
@@ -75,7 +80,7 @@ impl Refusal {
             ),
             Refusal::Unmatched { .. } => (
                 format!(
-                    "subdomain '{kernel}' subtracts region '{region}', whose contour crosses the kernel edge '{edge}' near ({:.6}, {:.6}) where the crossings do not cut both boundaries into simple loops (two crossings closer than 1/512 of the edge, or a tangency)",
+                    "subdomain '{kernel}' subtracts region '{region}', whose contour crosses the kernel edge '{edge}' near ({:.6}, {:.6}) where the crossings found do not cut both boundaries into simple loops (crossings closer than the sampling of the edge, or a crossing at a tangency)",
                     at.x, at.y
                 ),
                 "move the region so that its contour crosses each kernel edge clearly, or clip its R-function to the kernel shape",
@@ -114,7 +119,8 @@ pub(super) fn split_at_crossings(
         return Err(unmatched);
     };
     box_sides_clear(model, fr, fk, touch)?;
-    let crossings = find_crossings(model, fk, region_edges, &f, touch)?;
+    let extent = super::region_arcs::extent(model, fr);
+    let crossings = find_crossings(model, fk, region_edges, &f, (touch, extent))?;
     if crossings.is_empty() {
         return Err(unmatched);
     }
@@ -261,7 +267,7 @@ fn find_crossings(
     fk: FaceId,
     region_edges: &BTreeSet<EdgeId>,
     f: &Ssa,
-    touch: f64,
+    (touch, extent): (f64, f64),
 ) -> Result<Vec<Crossing>, Refusal> {
     let mut seen = BTreeSet::new();
     let mut out = Vec::new();
@@ -274,10 +280,16 @@ fn find_crossings(
             let p = curve.point(s);
             f.eval_point([p.x, p.y, p.z])
         };
+        let per_length = (curve.length() * PER_EXTENT / extent).ceil();
+        let samples = if per_length.is_finite() {
+            (per_length as usize).clamp(MIN_SAMPLES, MAX_SAMPLES)
+        } else {
+            MIN_SAMPLES
+        };
         let mut roots = Vec::new();
         let mut previous = (0.0, g(0.0));
-        for i in 1..=SAMPLES {
-            let s = i as f64 / SAMPLES as f64;
+        for i in 1..=samples {
+            let s = i as f64 / samples as f64;
             let here = (s, g(s));
             if previous.1.is_finite() && here.1.is_finite() && (previous.1 > 0.0) != (here.1 > 0.0)
             {
