@@ -7,6 +7,8 @@
 //! - **carving**: a kernel subdomain's `<difference>` subtracts the
 //!   R-function solid of a region subdomain lying strictly inside it; the
 //!   region's contour loops become holes of the kernel face (an inclusion);
+//!   a carved region whose contour crosses kernel edges is split at the
+//!   crossings instead (`region_crossing`);
 //! - **a box side on a straight kernel edge**: contour pieces along a side of
 //!   the region's box that lie on a straight kernel edge replace that part of
 //!   the edge, which is split around them;
