@@ -120,7 +120,7 @@ pub(super) fn split_at_crossings(
     };
     box_sides_clear(model, fr, fk, touch)?;
     let extent = super::region_arcs::extent(model, fr);
-    let crossings = find_crossings(model, fk, region_edges, &f, (touch, extent))?;
+    let crossings = find_crossings(model, (fk, fr), region_edges, &f, (touch, extent))?;
     if crossings.is_empty() {
         return Err(unmatched);
     }
@@ -264,7 +264,7 @@ fn crossing_on_outline(kernel: &Outline, run: &[Point3], (from, to): (Point3, Po
 /// region's outline (beyond its box f may change sign too), in face order.
 fn find_crossings(
     model: &Model,
-    fk: FaceId,
+    (fk, fr): (FaceId, FaceId),
     region_edges: &BTreeSet<EdgeId>,
     f: &Ssa,
     (touch, extent): (f64, f64),
@@ -303,7 +303,7 @@ fn find_crossings(
         let kernel_curve = KernelCurve::of(&curve);
         for s in roots {
             let at = curve.point(s);
-            if !near_contour(model, at, touch) {
+            if !near_contour(model, fr, at, touch) {
                 continue;
             }
             let Some(kc) = kernel_curve else {
@@ -319,13 +319,17 @@ fn find_crossings(
     Ok(out)
 }
 
-/// Whether `at` lies within `touch` of some region contour piece (a
-/// `Contour` chord): a sign change of f beyond the region's box does not.
-fn near_contour(model: &Model, at: Point3, touch: f64) -> bool {
-    model.edges.iter().any(|e| match &*e.curve(&model.solids) {
-        Curve::Contour { a, b, .. } => chord_distance(at, *a, *b) <= touch,
-        _ => false,
-    })
+/// Whether `at` lies within `touch` of one of the region's contour pieces
+/// (a `Contour` chord): a sign change of f beyond its box does not.
+fn near_contour(model: &Model, fr: FaceId, at: Point3, touch: f64) -> bool {
+    model.faces[fr.index()]
+        .loops
+        .edges()
+        .iter()
+        .any(|oe| match &*model.edge_curve(oe.edge) {
+            Curve::Contour { a, b, .. } => chord_distance(at, *a, *b) <= touch,
+            _ => false,
+        })
 }
 
 fn chord_distance(p: Point3, a: Point3, b: Point3) -> f64 {
