@@ -14,6 +14,7 @@ mod prune;
 mod region_arcs;
 mod region_collinear;
 mod region_corner_touch;
+mod region_crossing;
 pub mod region_interfaces;
 mod region_pairs;
 mod region_stretches;

@@ -7,6 +7,8 @@
 //! - **carving**: a kernel subdomain's `<difference>` subtracts the
 //!   R-function solid of a region subdomain lying strictly inside it; the
 //!   region's contour loops become holes of the kernel face (an inclusion);
+//!   a carved region whose contour crosses kernel edges is split at the
+//!   crossings instead (`region_crossing`);
 //! - **a box side on a straight kernel edge**: contour pieces along a side of
 //!   the region's box that lie on a straight kernel edge replace that part of
 //!   the edge, which is split around them;
@@ -46,7 +48,7 @@ pub fn join(
     // Pairs a refused carve or arc run reported already.
     let mut reported = super::region_arcs::share_arcs(model, source_map, first_region, diags);
     for c in carves {
-        if let Some(pair) = carve(model, first_region, c, region_of, diags) {
+        if let Some(pair) = carve(model, source_map, first_region, c, region_of, diags) {
             reported.insert(pair);
         }
     }
@@ -96,6 +98,7 @@ pub(super) fn face_of(model: &Model, k: usize) -> Option<FaceId> {
 
 fn carve(
     model: &mut Model,
+    source_map: &mut SourceMap,
     first_region: usize,
     c: &Carve,
     region_of: &[(String, String)],
@@ -139,19 +142,24 @@ fn carve(
         .filter(|v| !on_shared.contains(v))
         .map(|v| model.vertex(v).position)
         .collect();
-    if let Some((p, edge)) = crossing(&outline, &points, touch) {
-        diags.push(
-            Diagnostic::new(
-                Code::RegionCarveOutside,
-                c.span,
-                format!(
-                    "subdomain '{}' subtracts region '{}', whose contour crosses the kernel edge '{}' near ({:.6}, {:.6}): a carved region that crosses a kernel edge is not split at the crossings",
-                    c.subdomain, region, model.edge(edge).name, p.x, p.y
-                ),
-            )
-            .with_help("clip the region to the kernel region (intersect its R-function with the kernel shape's disk or half-planes, so that its contour runs along the edge instead of crossing it), or move the region inside, clear of the boundary"),
+    if let Some(near) = crossing(&outline, &points, touch) {
+        let region_edges: BTreeSet<EdgeId> =
+            face_edges(model, first_region..model.subdomains.len()).collect();
+        let split = super::region_crossing::split_at_crossings(
+            model,
+            source_map,
+            (fk, fr),
+            &region_edges,
+            touch,
+            near,
         );
-        return Some((k, r));
+        return match split {
+            Ok(()) => None,
+            Err(refusal) => {
+                diags.push(refusal.diagnostic(model, c.span, &c.subdomain, region));
+                Some((k, r))
+            }
+        };
     }
     let outside = points
         .into_iter()
@@ -271,6 +279,16 @@ fn rejoin(
                 forward: !oe.forward,
             }),
     );
+    chain(model, &pool)
+}
+
+/// Chains oriented edges end to start into closed loops. Err(point) where
+/// two edges leave one vertex (the boundaries touch at a point as well) or a
+/// chain does not close.
+pub(super) fn chain(
+    model: &Model,
+    pool: &[OrientedEdge],
+) -> Result<Vec<Vec<OrientedEdge>>, Point3> {
     let start_of = |oe: &OrientedEdge| {
         let e = model.edge(oe.edge);
         if oe.forward { e.begin } else { e.end }
@@ -511,7 +529,7 @@ fn loop_vertices(model: &Model, f: FaceId) -> Vec<VertexId> {
 }
 
 /// [`TOUCH_FRACTION`] of the diagonal of a region's contour.
-fn touch_distance(model: &Model, f: FaceId) -> f64 {
+pub(super) fn touch_distance(model: &Model, f: FaceId) -> f64 {
     let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
     for v in loop_vertices(model, f) {
         let p = model.vertex(v).position;
@@ -523,14 +541,14 @@ fn touch_distance(model: &Model, f: FaceId) -> f64 {
 
 /// A face's boundary as straight pieces (curved edges sampled finely), each
 /// with its edge.
-struct Outline {
+pub(super) struct Outline {
     segments: Vec<([f64; 2], [f64; 2], EdgeId)>,
     lo: [f64; 2],
     hi: [f64; 2],
 }
 
 impl Outline {
-    fn of(model: &Model, f: FaceId) -> Outline {
+    pub(super) fn of(model: &Model, f: FaceId) -> Outline {
         let mut segments = Vec::new();
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for oe in model.faces[f.index()].loops.iter().flatten() {
@@ -557,15 +575,26 @@ impl Outline {
         (0..2).all(|i| self.lo[i] <= other.hi[i] + gap && other.lo[i] <= self.hi[i] + gap)
     }
 
-    fn distance(&self, p: &Point3) -> f64 {
+    pub(super) fn distance(&self, p: &Point3) -> f64 {
         self.segments
             .iter()
             .map(|(a, b, _)| segment_distance([p.x, p.y], *a, *b))
             .fold(f64::INFINITY, f64::min)
     }
 
+    /// The edge of the outline's piece nearest p.
+    pub(super) fn nearest_edge(&self, p: &Point3) -> Option<EdgeId> {
+        self.segments
+            .iter()
+            .min_by(|a, b| {
+                let d = |s: &([f64; 2], [f64; 2], EdgeId)| segment_distance([p.x, p.y], s.0, s.1);
+                d(a).total_cmp(&d(b))
+            })
+            .map(|s| s.2)
+    }
+
     /// Even–odd: inside the outer loop and outside the holes.
-    fn contains(&self, p: &Point3) -> bool {
+    pub(super) fn contains(&self, p: &Point3) -> bool {
         let mut inside = false;
         for (a, b, _) in &self.segments {
             if (a[1] > p.y) != (b[1] > p.y) {

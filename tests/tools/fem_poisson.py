@@ -6,7 +6,9 @@ CASE: disk (unit disk, exact (1 - r^2)/4), annulus (radii 0.5 and 1),
       twomat (unit square, k = 1 for x < 0.5 and 10 beyond; reports the
       flux jump across the interface line named 'interface'),
       disks:X,Y,R;X,Y,R;... (disjoint or touching disks, k = 1, exact
-      (R^2 - |x - c|^2)/4 in the disk holding the point).
+      (R^2 - |x - c|^2)/4 in the disk holding the point),
+      square (the unit square [0, 1]^2 however it is cut into subdomains,
+      k = 1, exact: the double sine series over odd n, m < 400).
 Prints one JSON object: triangles, nodes, max_u, max_error (nodal, against
 the exact solution where there is one), flux_jump (twomat).
 """
@@ -88,6 +90,13 @@ def main():
         exact = np.max([(R**2 - (x[0] - cx)**2 - (x[1] - cy)**2) / 4 for cx, cy, R in disks],
                        axis=0)
         out["max_error"] = float(np.abs(u - np.maximum(exact, 0.0)).max())
+    elif case == "square":
+        n = np.arange(1, 400, 2, dtype=float)
+        sx = np.sin(np.pi * np.outer(x[0], n)) / n
+        sy = np.sin(np.pi * np.outer(x[1], n)) / n
+        weight = 16.0 / np.pi**4 / (n[:, None] ** 2 + n[None, :] ** 2)
+        exact = np.einsum("pi,ij,pj->p", sx, weight, sy)
+        out["max_error"] = float(np.abs(u - exact).max())
     elif case == "twomat":
         # Normal flux k du/dx on each side of x = 0.5, from the elements that
         # touch the interface, integrated over it: equal for the exact solution.
