@@ -55,6 +55,7 @@ pub(super) fn lower_subdomains(
     source_map: &mut SourceMap,
     entities: &Entities,
     face_samples: &FaceSamples,
+    overlapping: Option<super::isolation::Overlapping>,
     diags: &mut Diagnostics,
     release: Option<fn()>,
 ) {
@@ -131,7 +132,7 @@ pub(super) fn lower_subdomains(
     if let Some(release) = release {
         release();
     }
-    let Some(leaf_pairs) = check_relations(model, source_map, &trees, diags) else {
+    let Some(leaf_pairs) = check_relations(model, source_map, &trees, overlapping, diags) else {
         return;
     };
     for (id, built) in &trees {
@@ -312,27 +313,55 @@ fn build_tree(
 
 /// Checks every pair of leaf solids: crossing boundaries, and touching
 /// without sharing whole faces, are reported (E408). Returns false if any was.
+/// `overlapping`: the pairs of all primitive solids whose boxes overlap, when
+/// the isolation grid found them (the leaves' pairs are taken from there).
 fn check_relations(
     model: &Model,
     source_map: &SourceMap,
     trees: &[(SubdomainId, Built)],
+    overlapping: Option<super::isolation::Overlapping>,
     diags: &mut Diagnostics,
 ) -> Option<LeafPairs> {
-    let leaves: BTreeSet<SolidId> = trees
+    let mut leaves: Vec<SolidId> = trees
         .iter()
         .flat_map(|(_, b)| b.leaves.iter().copied())
         .collect();
-    let leaves: Vec<SolidId> = leaves.into_iter().collect();
-    let boxes: Vec<crate::geom::Aabb> = leaves
-        .iter()
-        .map(|id| model.solids[id.index()].shape.bbox())
-        .collect();
-    let pairs = candidate_pairs(&boxes, model.tolerance);
+    leaves.sort_unstable();
+    leaves.dedup();
+    let pairs = match overlapping {
+        // The solids are the shapes the pairs were found for, in order.
+        Some(all) if all.solids == model.solids.len() => {
+            leaf_pairs(&leaves, &all.pairs, all.solids)
+        }
+        _ => {
+            let boxes: Vec<crate::geom::Aabb> = leaves
+                .iter()
+                .map(|id| model.solids[id.index()].shape.bbox())
+                .collect();
+            candidate_pairs(&boxes, model.tolerance)
+        }
+    };
     let mut ok = true;
     for &(i, j) in &pairs {
         ok &= check_pair(model, source_map, leaves[i], leaves[j], diags);
     }
     ok.then_some(LeafPairs { leaves, pairs })
+}
+
+/// The pairs among `leaves` (sorted solid ids) of the pairs of all `solids`
+/// solids, as indices into `leaves`: sorted, since the indices grow with the ids.
+fn leaf_pairs(leaves: &[SolidId], all: &[(u32, u32)], solids: usize) -> Vec<(usize, usize)> {
+    const NONE: u32 = u32::MAX;
+    let mut leaf_of = vec![NONE; solids];
+    for (k, id) in leaves.iter().enumerate() {
+        leaf_of[id.index()] = k as u32;
+    }
+    all.iter()
+        .filter_map(|&(a, b)| {
+            let (i, j) = (leaf_of[a as usize], leaf_of[b as usize]);
+            (i != NONE && j != NONE).then_some((i as usize, j as usize))
+        })
+        .collect()
 }
 
 /// The candidate pairs of leaf solids (indices into `leaves`, sorted by id)
@@ -398,7 +427,11 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
     let cell = (2.0 * median.unwrap_or(0.5))
         .max(tol * 1e3)
         .max(f64::MIN_POSITIVE);
-    let key = |v: f64| (v / cell).floor() as i64;
+    // The grid is shifted by an irrational part of a cell: files often place
+    // solids on a lattice of round numbers, and a lattice whose boxes are
+    // centred on cell borders put every box in 8 cells (the pairs do not
+    // depend on the grid, only the number of entries to sort does).
+    let key = |v: f64| (v / cell + GRID_SHIFT).floor() as i64;
     // A sorted list of (cell, box) instead of a map of cells: boxes sharing a
     // cell are adjacent after sorting, and nothing is allocated per cell.
     // The cell range (lowest, highest) of a placeable box and how many cells
@@ -473,6 +506,10 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
     pairs.dedup();
     pairs
 }
+
+/// Where the candidate grid's cell borders lie, in cells (1/φ², far from
+/// simple fractions).
+const GRID_SHIFT: f64 = 0.381_966_011_250_105_1;
 
 /// A well-mixed 64-bit hash of a grid cell (fixed, so runs are reproducible).
 pub(super) fn cell_hash(cell: [i64; 3]) -> u64 {

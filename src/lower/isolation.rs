@@ -35,36 +35,106 @@ pub(super) fn solid_shapes<'r>(
     shapes
 }
 
-/// Per shape: whether it is isolated. Entities weld only when their positions
-/// are within `tol` (edges need welded ends, faces welded edges or, without
-/// edges, interior samples within `tol`), so a solid is isolated when the box
-/// of its vertex positions and face samples, widened by twice the tolerance
-/// (a margin for rounding), meets no other solid's. A box that is not finite
-/// (a position the welder cannot place) is never called isolated.
-pub(super) fn isolated(shapes: &[&SolidShape], tol: f64) -> Vec<bool> {
+/// What one candidate grid over the primitive solids gives: which solids are
+/// isolated (for the welder), and which pairs' bounding boxes overlap within
+/// the tolerance (for the crossing check, `booleans::check_relations`, which
+/// otherwise sorts a grid of nearly the same boxes a second time).
+pub(super) struct SolidPairs {
+    /// Per shape: whether it is isolated.
+    pub isolated: Vec<bool>,
+    /// `None` when a box is not finite or inverted (`candidate_pairs` leaves
+    /// such boxes out, so the crossing check makes its own grid then).
+    pub overlapping: Option<Overlapping>,
+}
+
+/// The shapes whose bounding boxes overlap within the tolerance.
+pub(super) struct Overlapping {
+    /// How many shapes there were: the solids lowered from them, in order,
+    /// have these indices as ids.
+    pub solids: usize,
+    /// Pairs (i, j), i < j, sorted: exactly what `candidate_pairs` over the
+    /// shapes' `bbox()`es gives.
+    pub pairs: Vec<(u32, u32)>,
+}
+
+/// Per shape: whether it is isolated, and the overlapping bounding boxes.
+/// Entities weld only when their positions are within `tol` (edges need
+/// welded ends, faces welded edges or, without edges, interior samples within
+/// `tol`), so a solid is isolated when the box of its vertex positions and
+/// face samples (its anchors), widened by twice the tolerance (a margin for
+/// rounding), meets no other solid's. A box that is not finite (a position
+/// the welder cannot place) is never called isolated.
+///
+/// One grid serves both questions: its boxes hold each shape's anchors and
+/// its `bbox()` with the larger margin, so every pair either question
+/// finds is among the grid's pairs, which are then tested exactly.
+pub(super) fn pairs(shapes: &[&SolidShape], tol: f64) -> SolidPairs {
     // Each box is a pure function of its shape: made in parallel, in order.
-    let boxes: Vec<Aabb> = shapes
+    let (hulls, placeable): (Vec<Aabb>, Vec<(bool, bool)>) = shapes
         .par_iter()
         .with_min_len(1024)
         .map(|shape| {
-            let mut bbox = Aabb::empty();
-            brep::anchors(shape, |p| bbox.include(&p));
-            bbox
+            let (anchors, bbox) = (anchor_box(shape), shape.bbox());
+            let placeable = (finite(&anchors), in_order(&anchors) && in_order(&bbox));
+            (anchors.union(&bbox), placeable)
         })
-        .collect();
-    let finite = |b: &Aabb| {
-        [b.min, b.max]
-            .iter()
-            .all(|p| p.iter().all(|c| c.is_finite()))
-            && !b.is_empty()
-    };
-    let mut isolated: Vec<bool> = boxes.iter().map(finite).collect();
-    // Non-finite boxes are left out of the pairs (and not isolated above).
-    for (i, j) in super::booleans::candidate_pairs(&boxes, 2.0 * tol) {
-        isolated[i] = false;
-        isolated[j] = false;
+        .unzip();
+    let mut isolated: Vec<bool> = placeable.iter().map(|&(finite, _)| finite).collect();
+    let margin = 2.0 * tol;
+    if !placeable.iter().all(|&(finite, ordered)| finite && ordered) {
+        // Boxes the grid leaves out: each question on its own boxes, as before.
+        drop(hulls);
+        let anchors: Vec<Aabb> = shapes.par_iter().map(|s| anchor_box(s)).collect();
+        for (i, j) in super::booleans::candidate_pairs(&anchors, margin) {
+            isolated[i] = false;
+            isolated[j] = false;
+        }
+        return SolidPairs {
+            isolated,
+            overlapping: None,
+        };
     }
-    isolated
+    let mut overlapping = Vec::new();
+    // Every pair of either question is here: a hull holds both boxes and the
+    // margin is the larger one (the rounding of `min - margin` is monotone).
+    for (i, j) in super::booleans::candidate_pairs(&hulls, margin) {
+        let (a, b) = (shapes[i], shapes[j]);
+        if anchor_box(a).overlaps(&anchor_box(b), margin) {
+            isolated[i] = false;
+            isolated[j] = false;
+        }
+        if a.bbox().overlaps(&b.bbox(), tol) {
+            overlapping.push((i as u32, j as u32));
+        }
+    }
+    SolidPairs {
+        isolated,
+        overlapping: Some(Overlapping {
+            solids: shapes.len(),
+            pairs: overlapping,
+        }),
+    }
+}
+
+/// The box of a shape's anchors (the points the welder places).
+fn anchor_box(shape: &SolidShape) -> Aabb {
+    let mut bbox = Aabb::empty();
+    brep::anchors(shape, |p| bbox.include(&p));
+    bbox
+}
+
+/// Finite and not empty: a box the welder can place.
+fn finite(b: &Aabb) -> bool {
+    [b.min, b.max]
+        .iter()
+        .all(|p| p.iter().all(|c| c.is_finite()))
+        && !b.is_empty()
+}
+
+/// Finite with min ≤ max on every axis: a box `candidate_pairs` pairs with
+/// every box it overlaps.
+fn in_order(b: &Aabb) -> bool {
+    finite(b) && (0..3).all(|k| b.min[k] <= b.max[k])
 }
 
 #[cfg(test)]
@@ -95,13 +165,55 @@ mod tests {
             unit_box(0.0, 0.0, 1.001),
         ];
         let refs: Vec<&SolidShape> = shapes.iter().collect();
-        assert_eq!(isolated(&refs, tol), vec![false, false, false, false, true]);
+        assert_eq!(
+            pairs(&refs, tol).isolated,
+            vec![false, false, false, false, true]
+        );
     }
 
     #[test]
     fn a_solid_with_a_non_finite_position_is_never_isolated() {
         let shapes = [unit_box(f64::NAN, 0.0, 0.0), unit_box(5.0, 0.0, 0.0)];
         let refs: Vec<&SolidShape> = shapes.iter().collect();
-        assert_eq!(isolated(&refs, 1e-6), vec![false, true]);
+        let found = pairs(&refs, 1e-6);
+        assert_eq!(found.isolated, vec![false, true]);
+        // The grid leaves the NaN box out, so the crossing check makes its own.
+        assert!(found.overlapping.is_none());
+    }
+
+    fn unit_ball(x: f64) -> SolidShape {
+        SolidShape::Ball {
+            frame: Frame {
+                origin: Point3::new(x, 0.0, 0.0),
+                linear: Mat3::identity(),
+            },
+        }
+    }
+
+    #[test]
+    fn overlapping_pairs_are_those_of_a_grid_of_the_bounding_boxes() {
+        let tol = 1e-6;
+        // Two boxes sharing the face x = 1; two balls whose bounding boxes
+        // overlap (x in [4, 6] and [5.5, 7.5]) while their anchors (x from 5
+        // to 6 and from 6.5 to 7.5) are apart, so both stay isolated; a box
+        // far from everything.
+        let shapes = [
+            unit_box(0.0, 0.0, 0.0),
+            unit_box(1.0, 0.0, 0.0),
+            unit_ball(5.0),
+            unit_ball(6.5),
+            unit_box(20.0, 0.0, 0.0),
+        ];
+        let refs: Vec<&SolidShape> = shapes.iter().collect();
+        let found = pairs(&refs, tol);
+        assert_eq!(found.isolated, vec![false, false, true, true, true]);
+        let overlapping = found.overlapping.map(|o| o.pairs);
+        assert_eq!(overlapping, Some(vec![(0, 1), (2, 3)]));
+        let boxes: Vec<Aabb> = shapes.iter().map(SolidShape::bbox).collect();
+        let by_grid: Vec<(u32, u32)> = super::super::booleans::candidate_pairs(&boxes, tol)
+            .into_iter()
+            .map(|(i, j)| (i as u32, j as u32))
+            .collect();
+        assert_eq!(overlapping, Some(by_grid));
     }
 }

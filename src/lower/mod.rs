@@ -133,7 +133,10 @@ pub fn lower(
     // Curves that carry edges are part of the topology, not standalone lines.
     let edge_lines = point_calculus::edge_lines(resolved);
     let shapes = isolation::solid_shapes(resolved, &edge_lines);
-    let isolated = isolation::isolated(&shapes, model.tolerance);
+    let isolation::SolidPairs {
+        isolated,
+        overlapping,
+    } = isolation::pairs(&shapes, model.tolerance);
     entities.solids.reserve(shapes.len());
     let mut shared = Expected::default();
     for (shape, _) in shapes.iter().zip(&isolated).filter(|(_, i)| !**i) {
@@ -201,6 +204,7 @@ pub fn lower(
         &mut source_map,
         &entities,
         &face_samples,
+        overlapping,
         diags,
         release,
     );

@@ -39,10 +39,15 @@ impl FaceSamples {
 /// Chains of entity ids sharing a key: the map holds (first, last) of each
 /// chain, `next` links an id to the following one. Ids are at least `base`
 /// (`next` is indexed from there, so tables restarted per solid stay small).
+/// A table restarted per solid keeps its few entries in a list instead,
+/// scanned in push order: the same ids in the same order, without hashing
+/// into a map for every lookup of every entity of every isolated solid.
 struct Chains<K> {
     heads: FastMap<K, (u32, u32)>,
     next: Vec<u32>,
     base: u32,
+    /// (key, id) in push order, once the table has been restarted.
+    listed: Option<Vec<(K, u32)>>,
 }
 
 impl<K> Default for Chains<K> {
@@ -51,27 +56,35 @@ impl<K> Default for Chains<K> {
             heads: FastMap::default(),
             next: Vec::new(),
             base: 0,
+            listed: None,
         }
     }
 }
 
-impl<K: Hash + Eq> Chains<K> {
+impl<K: Hash + Eq + Copy> Chains<K> {
     fn with_capacity(capacity: usize) -> Self {
         Chains {
             heads: FastMap::with_capacity_and_hasher(capacity, Default::default()),
             next: Vec::with_capacity(capacity),
             base: 0,
+            listed: None,
         }
     }
 
-    /// Empties the chains; later ids are at least `base`.
+    /// Empties the table, which from now on lists its entries; later ids
+    /// are at least `base`.
     fn restart(&mut self, base: usize) {
         self.heads.clear();
         self.next.clear();
         self.base = base as u32;
+        self.listed.get_or_insert_with(Vec::new).clear();
     }
 
     fn push(&mut self, key: K, id: u32) {
+        if let Some(listed) = &mut self.listed {
+            listed.push((key, id));
+            return;
+        }
         let at = (id - self.base) as usize;
         if self.next.len() <= at {
             self.next.resize(at + 1, NONE);
@@ -89,8 +102,15 @@ impl<K: Hash + Eq> Chains<K> {
 
     /// The ids under `key`, in the order they were pushed.
     fn iter(&self, key: &K) -> impl Iterator<Item = u32> + '_ {
-        let mut at = self.heads.get(key).map_or(NONE, |&(first, _)| first);
-        std::iter::from_fn(move || {
+        let key = *key;
+        let listed = (self.listed.iter().flatten())
+            .filter(move |(k, _)| *k == key)
+            .map(|&(_, id)| id);
+        let mut at = match self.listed {
+            Some(_) => NONE,
+            None => self.heads.get(&key).map_or(NONE, |&(first, _)| first),
+        };
+        let chained = std::iter::from_fn(move || {
             if at == NONE {
                 return None;
             }
@@ -101,7 +121,8 @@ impl<K: Hash + Eq> Chains<K> {
                 .copied()
                 .unwrap_or(NONE);
             Some(id)
-        })
+        });
+        listed.chain(chained)
     }
 }
 
@@ -342,4 +363,34 @@ fn sorted_edges(face: &Face, out: &mut Vec<EdgeId>) {
 /// curve when these agree (in order, or reversed for opposite directions).
 fn probe_points(curve: &Curve) -> [Point3; 3] {
     [curve.point(0.25), curve.point(0.5), curve.point(0.75)]
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_listed_table_gives_the_ids_of_the_hashed_chains_in_push_order() {
+        let entries = [(7u64, 10u32), (3, 11), (7, 12), (9, 13), (7, 14), (3, 15)];
+        let mut hashed = Chains::with_capacity(8);
+        let mut listed = Chains::default();
+        listed.restart(10);
+        for (key, id) in entries {
+            hashed.push(key, id);
+            listed.push(key, id);
+        }
+        assert!(hashed.listed.is_none() && listed.listed.is_some());
+        for (key, ids) in [
+            (7, vec![10, 12, 14]),
+            (3, vec![11, 15]),
+            (9, vec![13]),
+            (5, vec![]),
+        ] {
+            assert_eq!(hashed.iter(&key).collect::<Vec<_>>(), ids);
+            assert_eq!(listed.iter(&key).collect::<Vec<_>>(), ids);
+        }
+        // Restarted, it is empty again.
+        listed.restart(16);
+        assert_eq!(listed.iter(&7).count(), 0);
+    }
 }
