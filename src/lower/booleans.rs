@@ -214,28 +214,12 @@ fn build_tree(
                 return None;
             };
             let geometry = object.geometry.as_ref()?;
-            // A plain reference (one per subdomain on large files) borrows its
-            // solids from the table instead of copying them under a new key.
-            let found: Vec<SolidId>;
-            let ids: &[SolidId] = match (geometry, r.index) {
-                (Geometry::Group(members), None) => {
-                    found = (1..=members.len())
-                        .flat_map(|k| {
-                            entities
-                                .solids
-                                .get(&format!("{}[{k}]", r.name))
-                                .cloned()
-                                .unwrap_or_default()
-                        })
-                        .collect();
-                    &found
-                }
-                (_, Some(k)) => {
-                    let key = format!("{}[{k}]", r.name);
-                    entities.solids.get(&key).map_or(&[], Vec::as_slice)
-                }
-                (_, None) => (entities.solids.get(r.name.as_str())).map_or(&[], Vec::as_slice),
+            let group_members = match geometry {
+                Geometry::Group(members) => Some(members.len()),
+                _ => None,
             };
+            let found = (entities.solids).of(resolved, &r.name, r.index, group_members);
+            let ids: &[SolidId] = &found;
             let member_geometry = match (geometry, r.index) {
                 (Geometry::Group(members), Some(k)) => members.get(k.wrapping_sub(1)),
                 (Geometry::Group(members), None) => members.first(),
@@ -1041,17 +1025,17 @@ mod tests {
             of(0, true),
         ];
         model.solids.push(Solid {
-            name: "s".into(),
+            name: std::sync::Arc::new("s".into()),
             shape: SolidShape::Box {
                 frame: Frame {
                     origin: Point3::origin(),
                     linear: Mat3::identity(),
                 },
             },
-            faces,
-            boundary_edges: Vec::new(),
-            edges: Vec::new(),
-            vertices: Vec::new(),
+            faces: faces.into_boxed_slice(),
+            boundary_edges: Box::default(),
+            edges: Box::default(),
+            vertices: Box::default(),
         });
         let mut samples = FaceSamples::default();
         for f in [0, 1, 3] {

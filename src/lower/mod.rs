@@ -9,6 +9,7 @@ mod contour_straight;
 mod edge_parts;
 mod explicit;
 mod isolation;
+mod object_solids;
 mod point_calculus;
 mod prune;
 mod region_arcs;
@@ -46,8 +47,8 @@ pub(crate) struct Entities {
     pub faces: HashMap<String, crate::ir::FaceId>,
     pub edges: HashMap<String, crate::ir::EdgeId>,
     pub vertices: HashMap<String, crate::ir::VertexId>,
-    /// Object name (or member "row[2]") → the solids it lowered to.
-    pub solids: HashMap<String, Vec<SolidId>>,
+    /// The solids each object lowered to.
+    pub solids: object_solids::ObjectSolids,
     /// Objects that failed to resolve (already reported): references to them
     /// are not reported again.
     pub failed: foldhash::HashSet<String>,
@@ -75,7 +76,7 @@ impl Entities {
         );
         for solid in &model.solids {
             let brep = brep::of(&solid.shape);
-            let name = solid.name.as_str();
+            let name: &str = &solid.name;
             add(
                 &mut self.vertices,
                 name,
@@ -131,7 +132,6 @@ pub fn lower(
     let edge_lines = point_calculus::edge_lines(resolved);
     let shapes = isolation::solid_shapes(resolved, &edge_lines);
     let isolated = isolation::isolated(&shapes, model.tolerance);
-    entities.solids.reserve(shapes.len());
     let mut shared = Expected::default();
     for (shape, _) in shapes.iter().zip(&isolated).filter(|(_, i)| !**i) {
         shared.add(shape);
@@ -142,6 +142,7 @@ pub fn lower(
     point_calculus::report_unused_patches(resolved, diags);
 
     for object in &resolved.objects {
+        entities.solids.begin_object(model.solids.len());
         let Some(geometry) = &object.geometry else {
             entities.failed.insert(object.name.clone());
             continue;
@@ -156,7 +157,6 @@ pub fn lower(
                     lower_free(
                         &mut model,
                         &mut source_map,
-                        &mut entities,
                         &mut welder,
                         &name,
                         member,
@@ -167,7 +167,6 @@ pub fn lower(
             g => lower_free(
                 &mut model,
                 &mut source_map,
-                &mut entities,
                 &mut welder,
                 &object.name,
                 g,
@@ -175,6 +174,7 @@ pub fn lower(
             ),
         }
     }
+    entities.solids.begin_object(model.solids.len());
     // Only the face samples outlive the welder: its tables (tens of megabytes
     // on large files) must not still be alive while subdomains are built.
     let face_samples = std::mem::take(&mut welder.face_samples);
@@ -280,7 +280,6 @@ fn tolerance(resolved: &Resolved) -> f64 {
 fn lower_free(
     model: &mut Model,
     source_map: &mut SourceMap,
-    entities: &mut Entities,
     welder: &mut weld::Welder,
     name: &str,
     geometry: &Geometry,
@@ -305,12 +304,7 @@ fn lower_free(
             source_map.trimmed.push(span);
         }
         Geometry::Solid(shape) => {
-            let id = lower_solid(model, source_map, welder, name, shape, span);
-            entities
-                .solids
-                .entry(name.to_string())
-                .or_default()
-                .push(id);
+            lower_solid(model, source_map, welder, name, shape, span);
         }
         _ => {}
     }
@@ -331,19 +325,19 @@ fn lower_solid(
     // shape (3D primitives; a 2D region's entities keep their own), and the
     // welder may read them while the solid is lowered.
     let id = SolidId(model.solids.len() as u32);
-    model.solids.push(Solid {
-        name: name.to_string(),
-        shape: shape.clone(),
-        faces: Vec::new(),
-        boundary_edges: Vec::new(),
-        edges: Vec::new(),
-        vertices: Vec::new(),
-    });
-    let by_solid = !shape.is_planar();
     // The entities' names share the solid's ("{name}.{local}"); the name
     // tables for faces= and edges= lists are built later, and only when a
     // file has such lists.
     let base: std::sync::Arc<Box<str>> = std::sync::Arc::new(name.into());
+    model.solids.push(Solid {
+        name: std::sync::Arc::clone(&base),
+        shape: shape.clone(),
+        faces: Box::default(),
+        boundary_edges: Box::default(),
+        edges: Box::default(),
+        vertices: Box::default(),
+    });
+    let by_solid = !shape.is_planar();
     let vertex_ids: Vec<_> = brep
         .vertices
         .iter()
@@ -414,10 +408,10 @@ fn lower_solid(
     }
     let boundary_edges = brep.boundary.iter().copied().map(orient).collect();
     let solid = &mut model.solids[id.index()];
-    solid.faces = faces;
+    solid.faces = faces.into_boxed_slice();
     solid.boundary_edges = boundary_edges;
     solid.edges = edge_ids.iter().map(|&(e, _)| e).collect();
-    solid.vertices = vertex_ids;
+    solid.vertices = vertex_ids.into_boxed_slice();
     source_map.solids.insert(id, origin);
     id
 }
