@@ -94,3 +94,96 @@ impl ObjectSolids {
         ids
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geom::{Frame, SolidShape};
+    use crate::resolve::{NameIndex, ResolvedObject};
+
+    fn ball() -> Geometry {
+        Geometry::Solid(SolidShape::Ball {
+            frame: Frame::identity(),
+        })
+    }
+
+    fn object(name: &str, geometry: Option<Geometry>) -> ResolvedObject {
+        ResolvedObject {
+            name: name.to_string(),
+            span: crate::span::Span::default(),
+            geometry,
+        }
+    }
+
+    /// Objects and the number of solids each lowered to, as `lower` counts them.
+    fn lowered(objects: Vec<ResolvedObject>, solids: &[usize]) -> (Resolved, ObjectSolids) {
+        let resolved = Resolved {
+            dimension: 3,
+            by_name: NameIndex::build(&objects),
+            objects,
+            parameters: Vec::new(),
+            subdomain_areas: Vec::new(),
+        };
+        let mut table = ObjectSolids::default();
+        let mut total = 0;
+        for n in solids {
+            table.begin_object(total);
+            total += n;
+        }
+        table.begin_object(total);
+        (resolved, table)
+    }
+
+    fn ids(list: &[u32]) -> Vec<SolidId> {
+        list.iter().copied().map(SolidId).collect()
+    }
+
+    #[test]
+    fn objects_and_group_members_find_their_solids() {
+        // a: a ball (solid 0); failed: nothing; row: a group of a ball, a
+        // point set and two balls (solids 1, 2, 3); b: a ball (solid 4).
+        let points = Geometry::Points {
+            points: Vec::new(),
+            partial: Vec::new(),
+        };
+        let row = Geometry::Group(vec![ball(), points, ball(), ball()]);
+        let (resolved, table) = lowered(
+            vec![
+                object("a", Some(ball())),
+                object("failed", None),
+                object("row", Some(row)),
+                object("b", Some(ball())),
+            ],
+            &[1, 0, 3, 1],
+        );
+        assert_eq!(table.of(&resolved, "a", None, None), ids(&[0]));
+        assert_eq!(table.of(&resolved, "b", None, None), ids(&[4]));
+        assert_eq!(table.of(&resolved, "failed", None, None), ids(&[]));
+        assert_eq!(table.of(&resolved, "row", Some(1), None), ids(&[1]));
+        // Member 2 is no solid; members 3 and 4 come after it.
+        assert_eq!(table.of(&resolved, "row", Some(2), None), ids(&[]));
+        assert_eq!(table.of(&resolved, "row", Some(4), None), ids(&[3]));
+        assert_eq!(table.of(&resolved, "row", Some(0), None), ids(&[]));
+        assert_eq!(table.of(&resolved, "row", Some(5), None), ids(&[]));
+        assert_eq!(table.of(&resolved, "row", None, Some(4)), ids(&[1, 2, 3]));
+        // A group's own name (no member) stands for no solid of its own.
+        assert_eq!(table.of(&resolved, "row", None, None), ids(&[]));
+    }
+
+    #[test]
+    fn a_name_given_twice_finds_every_objects_solids_in_order() {
+        let (resolved, table) = lowered(
+            vec![
+                object("a", Some(ball())),
+                object("g", Some(Geometry::Group(vec![ball(), ball()]))),
+                object("a", Some(ball())),
+                object("g[2]", Some(ball())),
+            ],
+            &[1, 2, 1, 1],
+        );
+        assert_eq!(table.of(&resolved, "a", None, None), ids(&[0, 3]));
+        // "g[2]" written as a name is met by member 2 of g, as before.
+        assert_eq!(table.of(&resolved, "g", Some(2), None), ids(&[2, 4]));
+        assert_eq!(table.of(&resolved, "g", None, Some(2)), ids(&[1, 2, 4]));
+    }
+}
