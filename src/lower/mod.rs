@@ -105,14 +105,21 @@ impl Entities {
 /// Reads the document's subdomains and boundaries; every object comes from
 /// `resolved` (the driver drops the document's objects before lowering). The
 /// subdomain definitions are taken out of `doc` and dropped once lowered.
-/// `release` (the driver's `Options::release_memory`) is called where much
-/// has just been freed: the welder's tables, the subdomain definitions.
+/// `resolved` is dropped once the subdomains' solid trees are built, before
+/// the checks of their relations (the memory peak on files of many solids),
+/// unless `keep_resolved` (the driver's implicit lowering reads it after):
+/// then it is returned. `release` (the driver's `Options::release_memory`)
+/// is called where much has just been freed: the isolation's shapes, the
+/// welder's tables, the subdomain definitions and the resolved objects.
 pub fn lower(
     doc: &mut Document,
-    resolved: &Resolved,
+    resolved: Resolved,
+    keep_resolved: bool,
     diags: &mut Diagnostics,
     release: Option<fn()>,
-) -> Lowered {
+) -> (Lowered, Option<Resolved>) {
+    let resolved_objects = resolved;
+    let resolved = &resolved_objects;
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
     } else {
@@ -137,6 +144,11 @@ pub fn lower(
         shared.add(shape);
     }
     drop(shapes);
+    // The shapes' copies (a large block) would stay resident through the
+    // object loop below, beside the model it fills.
+    if let Some(release) = release {
+        release();
+    }
     let mut welder =
         weld::Welder::with_capacity(model.tolerance, &shared, expected.faces, isolated);
     point_calculus::report_unused_patches(resolved, diags);
@@ -191,19 +203,25 @@ pub fn lower(
     if named_lists {
         entities.add_solid_entities(&model);
     }
-    booleans::lower_subdomains(
+    let trees = booleans::build_subdomains(
         std::mem::take(&mut doc.subdomains),
         resolved,
         &mut model,
         &mut source_map,
         &entities,
-        &face_samples,
         diags,
-        release,
     );
+    drop(edge_lines);
+    let kept = keep_resolved.then_some(resolved_objects);
+    // The definitions and (unless kept) the resolved objects are gone: their
+    // pages go back before the checks below.
+    if let Some(release) = release {
+        release();
+    }
+    booleans::check_subdomains(trees, &mut model, &source_map, &face_samples, diags);
     explicit::lower_boundaries(doc, &mut model, &entities, diags);
     prune::prune_interior(&mut model, &mut source_map);
-    Lowered { model, source_map }
+    (Lowered { model, source_map }, kept)
 }
 
 /// How many entities the primitive solids will lower to at most (before
