@@ -133,9 +133,16 @@ fn run(
     // Lowering takes the subdomain definitions (dropped once lowered, before
     // the overlap check at the memory peak); only their count is read later.
     let defined_subdomains = document.subdomains.len();
-    let mut lowered = lower::lower(&mut document, &resolved, diags, options.release_memory);
-    if !extracted.is_empty() {
-        let (subdomains, trims) = lower_implicit(source, options, &extracted, &resolved, diags);
+    let keep_resolved = !extracted.is_empty();
+    let (mut lowered, resolved) = lower::lower(
+        &mut document,
+        resolved,
+        keep_resolved,
+        diags,
+        options.release_memory,
+    );
+    if let Some(resolved) = &resolved {
+        let (subdomains, trims) = lower_implicit(source, options, &extracted, resolved, diags);
         *implicit = subdomains;
         set_trims(&mut lowered.model, trims);
     }

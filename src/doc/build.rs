@@ -95,7 +95,8 @@ pub fn parse_attribute_expr(
         limits: ExprLimits::default(),
     }
     .parse_number(attr)
-    .expr
+    .expr()
+    .map(std::borrow::Cow::into_owned)
 }
 
 struct Builder<'a> {
@@ -152,9 +153,9 @@ impl Builder<'_> {
                     doc.subdomains.push(SubdomainDef {
                         name,
                         material: e.attribute("material").map(|a| a.value.to_string()),
-                        faces: self.ref_list(e, "faces"),
+                        faces: self.ref_list(e, "faces").map(Box::new),
                         tree: e.children.first().and_then(|c| self.solid_tree(c)),
-                        area: self.number(e, "area"),
+                        area: self.number(e, "area").map(Box::new),
                         span: e.name_span,
                     });
                 }
@@ -538,10 +539,7 @@ impl Builder<'_> {
                 if !exact {
                     relocate(&mut expr, attr.value_span);
                 }
-                Number {
-                    expr: Some(expr),
-                    span: attr.value_span,
-                }
+                Number::new(Some(expr), attr.value_span)
             }
             Err(error) => {
                 let d = match error {
@@ -585,10 +583,7 @@ impl Builder<'_> {
                     .with_help("split it into parameters, or raise the limits with --max-expression-nodes N and --max-expression-depth N"),
                 };
                 self.diags.push(d);
-                Number {
-                    expr: None,
-                    span: attr.value_span,
-                }
+                Number::new(None, attr.value_span)
             }
         }
     }
@@ -702,7 +697,7 @@ pub fn parse_ref(text: &str, span: Span) -> Ref {
     let mut entity = None;
     if let Some(dot) = name.rfind('.') {
         if dot > 0 && dot + 1 < name.len() && !name[dot + 1..].contains(']') {
-            entity = Some(name[dot + 1..].to_string());
+            entity = Some(name[dot + 1..].into());
             name.truncate(dot);
         }
     }
@@ -718,7 +713,7 @@ pub fn parse_ref(text: &str, span: Span) -> Ref {
         name,
         index,
         entity,
-        text: text.to_string(),
+        text: text.into(),
         span,
     }
 }
@@ -757,5 +752,24 @@ mod tests {
         );
         let r = parse_ref("point 3D", Span::default());
         assert_eq!((r.name.as_str(), r.index), ("point 3D", None));
+    }
+
+    #[test]
+    fn numbers_give_back_the_expression_they_were_parsed_from() {
+        // A plain number spanning its value, one with spaces around it (its
+        // token's span is not the value's), a name, an expression, a failure.
+        for text in ["2.5", " 2.5 ", "r", "r/2 + 1", "-1"] {
+            let span = Span {
+                start: 10,
+                end: 10 + text.len() as u32,
+            };
+            let expr = crate::expr::parse(text, 10).expect("parses");
+            let number = Number::new(Some(expr.clone()), span);
+            assert_eq!(number.expr().as_deref(), Some(&expr), "{text:?}");
+            assert_eq!(number.span, span);
+        }
+        assert_eq!(Number::new(None, Span::default()).expr(), None);
+        // Plain numbers are the common case of large files: no tree is kept.
+        assert!(std::mem::size_of::<Number>() <= 24);
     }
 }

@@ -18,18 +18,53 @@ pub struct Name {
 pub struct Ref {
     pub name: String,
     pub index: Option<usize>,
-    pub entity: Option<String>,
+    pub entity: Option<Box<str>>,
     /// The reference as written.
-    pub text: String,
+    pub text: Box<str>,
     pub span: Span,
 }
 
-/// A numeric attribute: the parsed expression, or `None` if it did not parse
-/// (already reported).
+/// A numeric attribute: the parsed expression, or none if it did not parse
+/// (already reported). Read it with [`Number::expr`].
 #[derive(Debug, Clone, PartialEq)]
 pub struct Number {
-    pub expr: Option<Expr>,
+    parsed: Parsed,
     pub span: Span,
+}
+
+/// A plain number spanning the whole value (most numbers of large files) is
+/// kept as its value, any other expression as a boxed tree: an `Expr` inline
+/// made every coordinate 48 bytes, and the typed document holds one per
+/// number of the file until resolution is done.
+#[derive(Debug, Clone, PartialEq)]
+enum Parsed {
+    Plain(f64),
+    Expr(Box<Expr>),
+    Invalid,
+}
+
+impl Number {
+    /// `expr`: the parsed value (`None`: it did not parse); `span`: the value's.
+    pub fn new(expr: Option<Expr>, span: Span) -> Number {
+        let parsed = match expr {
+            None => Parsed::Invalid,
+            Some(Expr {
+                kind: crate::expr::ExprKind::Number(value),
+                span: at,
+            }) if at == span => Parsed::Plain(value),
+            Some(expr) => Parsed::Expr(Box::new(expr)),
+        };
+        Number { parsed, span }
+    }
+
+    /// The parsed expression, or `None` if it did not parse.
+    pub fn expr(&self) -> Option<std::borrow::Cow<'_, Expr>> {
+        match &self.parsed {
+            Parsed::Plain(value) => Some(std::borrow::Cow::Owned(Expr::number(*value, self.span))),
+            Parsed::Expr(expr) => Some(std::borrow::Cow::Borrowed(expr)),
+            Parsed::Invalid => None,
+        }
+    }
 }
 
 /// A point-valued child element (`center`, `vertex`, …): coordinates, or a
@@ -373,10 +408,12 @@ pub enum SolidTree {
 pub struct SubdomainDef {
     pub name: Name,
     pub material: Option<String>,
-    pub faces: Option<(Vec<Ref>, Span)>,
+    /// Boxed, as `area`: most subdomains are a solid tree, and a definition
+    /// is kept per subdomain until lowering.
+    pub faces: Option<Box<(Vec<Ref>, Span)>>,
     pub tree: Option<SolidTree>,
     /// 2D: the largest triangle area allowed in its mesh.
-    pub area: Option<Number>,
+    pub area: Option<Box<Number>>,
     pub span: Span,
 }
 

@@ -134,18 +134,21 @@ pub struct Subdomain {
 }
 
 /// A lowered primitive solid: its shape and the entities of its canonical
-/// boundary representation.
+/// boundary representation. The lists are boxed slices, sized once, and the
+/// name is the one its entities' names share: on files of many primitives a
+/// `String` and four vectors per solid were a sixth of the model.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Solid {
-    pub name: String,
+    /// Shared with its entities' [`EntityName`]s ("{name}.{local}").
+    pub name: std::sync::Arc<Box<str>>,
     pub shape: SolidShape,
     /// Faces with `outward` relative to this solid (3D).
-    pub faces: Vec<OrientedFace>,
+    pub faces: Box<[OrientedFace]>,
     /// Boundary edges with `forward` when the region lies on their left, seen
     /// from the region face's normal side (2D regions).
-    pub boundary_edges: Vec<OrientedEdge>,
-    pub edges: Vec<EdgeId>,
-    pub vertices: Vec<VertexId>,
+    pub boundary_edges: Box<[OrientedEdge]>,
+    pub edges: Box<[EdgeId]>,
+    pub vertices: Box<[VertexId]>,
 }
 
 /// A set of points (paper 000's `point` with several values), global coordinates.

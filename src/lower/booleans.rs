@@ -47,18 +47,22 @@ struct Built {
     span: crate::span::Span,
 }
 
-#[allow(clippy::too_many_arguments)]
-pub(super) fn lower_subdomains(
+/// The subdomains' solid trees, built by [`build_subdomains`] and checked
+/// and classified by [`check_subdomains`].
+pub(super) struct Trees(Vec<(SubdomainId, Built)>);
+
+/// Lowers the subdomain definitions: a subdomain given by faces gets its
+/// shell, one given by a solid tree gets an empty boundary until
+/// [`check_subdomains`] classifies its faces. Split in two so the caller can
+/// drop the definitions and the resolved objects before the checks.
+pub(super) fn build_subdomains(
     defs: Vec<SubdomainDef>,
     resolved: &Resolved,
     model: &mut Model,
     source_map: &mut SourceMap,
     entities: &Entities,
-    face_samples: &FaceSamples,
-    overlapping: Option<super::isolation::Overlapping>,
     diags: &mut Diagnostics,
-    release: Option<fn()>,
-) {
+) -> Trees {
     let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(defs.len());
     model.subdomains.reserve(defs.len());
     // Consumed: each definition is dropped once lowered, so none is alive
@@ -66,7 +70,7 @@ pub(super) fn lower_subdomains(
     for (def_index, def) in defs.into_iter().enumerate() {
         let id = SubdomainId(model.subdomains.len() as u32);
         let mut trimmed_faces = Vec::new();
-        let cells = match (&def.faces, &def.tree) {
+        let cells = match (def.faces.as_deref(), &def.tree) {
             (Some(_), Some(_)) => {
                 diags.push(
                     Diagnostic::new(
@@ -128,10 +132,20 @@ pub(super) fn lower_subdomains(
         });
         source_map.subdomains.insert(id, Origin { span: def.span });
     }
-    // The definitions are gone: their pages go back before the checks below.
-    if let Some(release) = release {
-        release();
-    }
+    Trees(trees)
+}
+
+/// Checks the relations of the subdomains' solids (crossing boundaries,
+/// overlaps) and classifies each solid tree's faces into its boundary.
+pub(super) fn check_subdomains(
+    trees: Trees,
+    model: &mut Model,
+    source_map: &SourceMap,
+    face_samples: &FaceSamples,
+    overlapping: Option<super::isolation::Overlapping>,
+    diags: &mut Diagnostics,
+) {
+    let Trees(trees) = trees;
     let Some(leaf_pairs) = check_relations(model, source_map, &trees, overlapping, diags) else {
         return;
     };
@@ -215,28 +229,12 @@ fn build_tree(
                 return None;
             };
             let geometry = object.geometry.as_ref()?;
-            // A plain reference (one per subdomain on large files) borrows its
-            // solids from the table instead of copying them under a new key.
-            let found: Vec<SolidId>;
-            let ids: &[SolidId] = match (geometry, r.index) {
-                (Geometry::Group(members), None) => {
-                    found = (1..=members.len())
-                        .flat_map(|k| {
-                            entities
-                                .solids
-                                .get(&format!("{}[{k}]", r.name))
-                                .cloned()
-                                .unwrap_or_default()
-                        })
-                        .collect();
-                    &found
-                }
-                (_, Some(k)) => {
-                    let key = format!("{}[{k}]", r.name);
-                    entities.solids.get(&key).map_or(&[], Vec::as_slice)
-                }
-                (_, None) => (entities.solids.get(r.name.as_str())).map_or(&[], Vec::as_slice),
+            let group_members = match geometry {
+                Geometry::Group(members) => Some(members.len()),
+                _ => None,
             };
+            let found = (entities.solids).of(resolved, &r.name, r.index, group_members);
+            let ids: &[SolidId] = &found;
             let member_geometry = match (geometry, r.index) {
                 (Geometry::Group(members), Some(k)) => members.get(k.wrapping_sub(1)),
                 (Geometry::Group(members), None) => members.first(),
@@ -752,8 +750,9 @@ fn region_face(model: &mut Model, name: &str, edges: &[OrientedEdge]) -> Option<
 /// solids, or the winding number of its explicit faces.
 enum Member<'a> {
     Tree(&'a Built),
-    /// A shell of explicit faces, with its interior probes.
-    Shell(super::winding::ShellTriangles, Vec<Point3>),
+    /// A shell of explicit faces, with its interior probes (boxed: there is
+    /// a member per subdomain, and most are trees).
+    Shell(Box<(super::winding::ShellTriangles, Vec<Point3>)>),
 }
 
 /// Reports pairs of subdomains that share volume: a point just inside one
@@ -816,14 +815,14 @@ fn check_overlaps(
             }
         }
         let probes = interior_probes(model, id, &face_points, step);
-        members.push((id, Member::Shell(shell, probes)));
+        members.push((id, Member::Shell(Box::new((shell, probes)))));
         boxes.push(bbox);
     }
     let inside = |member: &Member, p: &Point3| match member {
         Member::Tree(built) => built
             .tree
             .eval(&|i| model.solids[built.leaves[i].index()].shape.value(p) > 0.0),
-        Member::Shell(shell, _) => shell.contains(p),
+        Member::Shell(shell) => shell.0.contains(p),
     };
     // Tree probes made so far, by member index (same points as made eagerly).
     let mut tree_probes: HashMap<usize, Vec<Point3>> = HashMap::new();
@@ -841,7 +840,7 @@ fn check_overlaps(
         }
         let probes_of = |k: usize| -> &[Point3] {
             match &members[k] {
-                (_, Member::Shell(_, probes)) => probes,
+                (_, Member::Shell(shell)) => &shell.1,
                 (_, Member::Tree(_)) => tree_probes.get(&k).map_or(&[], Vec::as_slice),
             }
         };
@@ -940,7 +939,7 @@ fn explicit_shell(
                     }
                 }
             }
-            None => match model.trimmed.iter().position(|s| s.name == r.text) {
+            None => match model.trimmed.iter().position(|s| *s.name == *r.text) {
                 Some(k) if trimmed.contains(&k) => diags.push(
                     Diagnostic::new(
                         Code::RepeatedFace,
@@ -1078,17 +1077,17 @@ mod tests {
             of(0, true),
         ];
         model.solids.push(Solid {
-            name: "s".into(),
+            name: std::sync::Arc::new("s".into()),
             shape: SolidShape::Box {
                 frame: Frame {
                     origin: Point3::origin(),
                     linear: Mat3::identity(),
                 },
             },
-            faces,
-            boundary_edges: Vec::new(),
-            edges: Vec::new(),
-            vertices: Vec::new(),
+            faces: faces.into_boxed_slice(),
+            boundary_edges: Box::default(),
+            edges: Box::default(),
+            vertices: Box::default(),
         });
         let mut samples = FaceSamples::default();
         for f in [0, 1, 3] {

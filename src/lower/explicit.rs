@@ -579,14 +579,14 @@ pub(super) fn unknown_entity(
     entities: &Entities,
     diags: &mut Diagnostics,
 ) {
-    if entities.failed.contains(&r.name) || entities.failed.contains(&r.text) {
+    if entities.failed.contains(&r.name) || entities.failed.contains(&*r.text) {
         return;
     }
     let found_as = if kind != "face" && lookup_entities(&entities.faces, &r.text).is_some() {
         Some("a face")
     } else if kind != "edge" && lookup_entities(&entities.edges, &r.text).is_some() {
         Some("an edge")
-    } else if entities.vertices.contains_key(&r.text) {
+    } else if entities.vertices.contains_key(&*r.text) {
         Some("a vertex")
     } else {
         None

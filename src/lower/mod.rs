@@ -9,6 +9,7 @@ mod contour_straight;
 mod edge_parts;
 mod explicit;
 mod isolation;
+mod object_solids;
 mod point_calculus;
 mod prune;
 mod region_arcs;
@@ -49,8 +50,8 @@ pub(crate) struct Entities {
     pub faces: HashMap<String, crate::ir::FaceId>,
     pub edges: HashMap<String, crate::ir::EdgeId>,
     pub vertices: HashMap<String, crate::ir::VertexId>,
-    /// Object name (or member "row[2]") → the solids it lowered to.
-    pub solids: HashMap<String, Vec<SolidId>>,
+    /// The solids each object lowered to.
+    pub solids: object_solids::ObjectSolids,
     /// Objects that failed to resolve (already reported): references to them
     /// are not reported again.
     pub failed: foldhash::HashSet<String>,
@@ -78,7 +79,7 @@ impl Entities {
         );
         for solid in &model.solids {
             let brep = brep::of(&solid.shape);
-            let name = solid.name.as_str();
+            let name: &str = &solid.name;
             add(
                 &mut self.vertices,
                 name,
@@ -107,14 +108,21 @@ impl Entities {
 /// Reads the document's subdomains and boundaries; every object comes from
 /// `resolved` (the driver drops the document's objects before lowering). The
 /// subdomain definitions are taken out of `doc` and dropped once lowered.
-/// `release` (the driver's `Options::release_memory`) is called where much
-/// has just been freed: the welder's tables, the subdomain definitions.
+/// `resolved` is dropped once the subdomains' solid trees are built, before
+/// the checks of their relations (the memory peak on files of many solids),
+/// unless `keep_resolved` (the driver's implicit lowering reads it after):
+/// then it is returned. `release` (the driver's `Options::release_memory`)
+/// is called where much has just been freed: the isolation's shapes, the
+/// welder's tables, the subdomain definitions and the resolved objects.
 pub fn lower(
     doc: &mut Document,
-    resolved: &Resolved,
+    resolved: Resolved,
+    keep_resolved: bool,
     diags: &mut Diagnostics,
     release: Option<fn()>,
-) -> Lowered {
+) -> (Lowered, Option<Resolved>) {
+    let resolved_objects = resolved;
+    let resolved = &resolved_objects;
     let dimension = if resolved.dimension == 2 {
         Dimension::Two
     } else {
@@ -137,17 +145,22 @@ pub fn lower(
         isolated,
         overlapping,
     } = isolation::pairs(&shapes, model.tolerance);
-    entities.solids.reserve(shapes.len());
     let mut shared = Expected::default();
     for (shape, _) in shapes.iter().zip(&isolated).filter(|(_, i)| !**i) {
         shared.add(shape);
     }
     drop(shapes);
+    // The shapes' copies (a large block) would stay resident through the
+    // object loop below, beside the model it fills.
+    if let Some(release) = release {
+        release();
+    }
     let mut welder =
         weld::Welder::with_capacity(model.tolerance, &shared, expected.faces, isolated);
     point_calculus::report_unused_patches(resolved, diags);
 
     for object in &resolved.objects {
+        entities.solids.begin_object(model.solids.len());
         let Some(geometry) = &object.geometry else {
             entities.failed.insert(object.name.clone());
             continue;
@@ -162,7 +175,6 @@ pub fn lower(
                     lower_free(
                         &mut model,
                         &mut source_map,
-                        &mut entities,
                         &mut welder,
                         &name,
                         member,
@@ -173,7 +185,6 @@ pub fn lower(
             g => lower_free(
                 &mut model,
                 &mut source_map,
-                &mut entities,
                 &mut welder,
                 &object.name,
                 g,
@@ -181,6 +192,7 @@ pub fn lower(
             ),
         }
     }
+    entities.solids.begin_object(model.solids.len());
     // Only the face samples outlive the welder: its tables (tens of megabytes
     // on large files) must not still be alive while subdomains are built.
     let face_samples = std::mem::take(&mut welder.face_samples);
@@ -197,20 +209,32 @@ pub fn lower(
     if named_lists {
         entities.add_solid_entities(&model);
     }
-    booleans::lower_subdomains(
+    let trees = booleans::build_subdomains(
         std::mem::take(&mut doc.subdomains),
         resolved,
         &mut model,
         &mut source_map,
         &entities,
+        diags,
+    );
+    drop(edge_lines);
+    let kept = keep_resolved.then_some(resolved_objects);
+    // The definitions and (unless kept) the resolved objects are gone: their
+    // pages go back before the checks below.
+    if let Some(release) = release {
+        release();
+    }
+    booleans::check_subdomains(
+        trees,
+        &mut model,
+        &source_map,
         &face_samples,
         overlapping,
         diags,
-        release,
     );
     explicit::lower_boundaries(doc, &mut model, &entities, diags);
     prune::prune_interior(&mut model, &mut source_map);
-    Lowered { model, source_map }
+    (Lowered { model, source_map }, kept)
 }
 
 /// How many entities the primitive solids will lower to at most (before
@@ -287,7 +311,6 @@ fn tolerance(resolved: &Resolved) -> f64 {
 fn lower_free(
     model: &mut Model,
     source_map: &mut SourceMap,
-    entities: &mut Entities,
     welder: &mut weld::Welder,
     name: &str,
     geometry: &Geometry,
@@ -312,12 +335,7 @@ fn lower_free(
             source_map.trimmed.push(span);
         }
         Geometry::Solid(shape) => {
-            let id = lower_solid(model, source_map, welder, name, shape, span);
-            entities
-                .solids
-                .entry(name.to_string())
-                .or_default()
-                .push(id);
+            lower_solid(model, source_map, welder, name, shape, span);
         }
         _ => {}
     }
@@ -338,19 +356,19 @@ fn lower_solid(
     // shape (3D primitives; a 2D region's entities keep their own), and the
     // welder may read them while the solid is lowered.
     let id = SolidId(model.solids.len() as u32);
-    model.solids.push(Solid {
-        name: name.to_string(),
-        shape: shape.clone(),
-        faces: Vec::new(),
-        boundary_edges: Vec::new(),
-        edges: Vec::new(),
-        vertices: Vec::new(),
-    });
-    let by_solid = !shape.is_planar();
     // The entities' names share the solid's ("{name}.{local}"); the name
     // tables for faces= and edges= lists are built later, and only when a
     // file has such lists.
     let base: std::sync::Arc<Box<str>> = std::sync::Arc::new(name.into());
+    model.solids.push(Solid {
+        name: std::sync::Arc::clone(&base),
+        shape: shape.clone(),
+        faces: Box::default(),
+        boundary_edges: Box::default(),
+        edges: Box::default(),
+        vertices: Box::default(),
+    });
+    let by_solid = !shape.is_planar();
     let vertex_ids: Vec<_> = brep
         .vertices
         .iter()
@@ -421,10 +439,10 @@ fn lower_solid(
     }
     let boundary_edges = brep.boundary.iter().copied().map(orient).collect();
     let solid = &mut model.solids[id.index()];
-    solid.faces = faces;
+    solid.faces = faces.into_boxed_slice();
     solid.boundary_edges = boundary_edges;
     solid.edges = edge_ids.iter().map(|&(e, _)| e).collect();
-    solid.vertices = vertex_ids;
+    solid.vertices = vertex_ids.into_boxed_slice();
     source_map.solids.insert(id, origin);
     id
 }

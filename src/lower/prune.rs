@@ -1,7 +1,9 @@
 //! Removing what the boolean trees made interior: faces of solids used by
 //! subdomains that bound no subdomain, and the edges and vertices only they used.
 
-use crate::ir::{EdgeId, FaceId, Model, SourceMap, SubdomainCells, VertexId};
+use crate::ir::{
+    EdgeId, FaceId, Model, OrientedEdge, OrientedFace, SourceMap, SubdomainCells, VertexId,
+};
 
 pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     // Flag vectors, not sets: these run over every entity of the model.
@@ -177,26 +179,14 @@ fn apply(
         }
     }
     for solid in &mut model.solids {
-        solid.faces.retain(|of| f(of.face).is_some());
-        solid
-            .faces
-            .iter_mut()
-            .for_each(|of| of.face = f(of.face).unwrap_or(of.face));
-        solid.boundary_edges.retain(|oe| e(oe.edge).is_some());
-        solid
-            .boundary_edges
-            .iter_mut()
-            .for_each(|oe| oe.edge = e(oe.edge).unwrap_or(oe.edge));
-        solid.edges.retain(|&x| e(x).is_some());
-        solid
-            .edges
-            .iter_mut()
-            .for_each(|x| *x = e(*x).unwrap_or(*x));
-        solid.vertices.retain(|&x| v(x).is_some());
-        solid
-            .vertices
-            .iter_mut()
-            .for_each(|x| *x = v(*x).unwrap_or(*x));
+        solid.faces = kept(&solid.faces, |of| {
+            f(of.face).map(|face| OrientedFace { face, ..of })
+        });
+        solid.boundary_edges = kept(&solid.boundary_edges, |oe| {
+            e(oe.edge).map(|edge| OrientedEdge { edge, ..oe })
+        });
+        solid.edges = kept(&solid.edges, e);
+        solid.vertices = kept(&solid.vertices, v);
     }
     for b in &mut model.boundaries {
         b.faces.retain(|&x| f(x).is_some());
@@ -207,4 +197,9 @@ fn apply(
     source_map.faces = source_map.faces.remap(f);
     source_map.edges = source_map.edges.remap(e);
     source_map.vertices = source_map.vertices.remap(v);
+}
+
+/// The items `map` keeps, mapped (a solid's lists are boxed slices).
+fn kept<T: Copy>(items: &[T], map: impl Fn(T) -> Option<T>) -> Box<[T]> {
+    items.iter().filter_map(|&x| map(x)).collect()
 }

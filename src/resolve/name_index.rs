@@ -46,6 +46,21 @@ impl NameIndex {
         }
         None
     }
+
+    /// Every object named `name` (a name given twice has several), in
+    /// document order.
+    pub fn all(&self, objects: &[ResolvedObject], name: &str) -> Vec<usize> {
+        let mut found = Vec::new();
+        let mut at = self.last.get(&hash(name)).copied().unwrap_or(NONE);
+        while let Some(object) = objects.get(at as usize) {
+            if object.name == name {
+                found.push(at as usize);
+            }
+            at = self.previous.get(at as usize).copied().unwrap_or(NONE);
+        }
+        found.reverse();
+        found
+    }
 }
 
 #[cfg(test)]
@@ -70,5 +85,14 @@ mod tests {
         assert_eq!(index.get(&objects, ""), Some(4));
         assert_eq!(index.get(&objects, "d"), None);
         assert_eq!(index.get(&objects, "ab"), None);
+    }
+
+    #[test]
+    fn finds_every_object_of_a_name_in_order() {
+        let objects: Vec<ResolvedObject> = ["a", "b", "a", "c", "a"].map(object).into();
+        let index = NameIndex::build(&objects);
+        assert_eq!(index.all(&objects, "a"), [0, 2, 4]);
+        assert_eq!(index.all(&objects, "c"), [3]);
+        assert!(index.all(&objects, "d").is_empty());
     }
 }

@@ -77,7 +77,7 @@ impl<'a> Resolver<'a> {
                 name: cs.name.text.clone(),
                 index: None,
                 entity: None,
-                text: cs.name.text.clone(),
+                text: cs.name.text.as_str().into(),
                 span: cs.name.span,
             };
             self.frame_of(&reference);

@@ -651,7 +651,7 @@ fn surface(
                 return None;
             }
             Surface::Implicit {
-                expr: fold_parameters(r, eq.expr.as_ref()?)?,
+                expr: fold_parameters(r, &*eq.expr()?)?,
             }
         }
     };
@@ -1184,10 +1184,7 @@ fn fold_parameters(r: &mut Resolver, expr: &Expr) -> Option<Expr> {
     Some(match &expr.kind {
         ExprKind::Name(n) if matches!(n.as_str(), "x" | "y" | "z" | "pi") => expr.clone(),
         ExprKind::Name(_) => {
-            let number = Number {
-                expr: Some(expr.clone()),
-                span: expr.span,
-            };
+            let number = Number::new(Some(expr.clone()), expr.span);
             Expr::number(r.number(&number)?, expr.span)
         }
         ExprKind::Number(_) => expr.clone(),

@@ -249,7 +249,7 @@ fn trim(r: &mut Resolver, t: &TrimSpec, name: &str) -> Option<Trim> {
         return None;
     };
     let mut ctx = Ctx::new();
-    let folded = fold(r, equation.expr.as_ref()?, &["x", "y", "z"])?;
+    let folded = fold(r, &*equation.expr()?, &["x", "y", "z"])?;
     match program::build(&mut ctx, &folded, &["x", "y", "z"]) {
         Ok(root) => Some(Trim::new(&ctx, root, t.negative)),
         Err(var) => {
@@ -260,7 +260,7 @@ fn trim(r: &mut Resolver, t: &TrimSpec, name: &str) -> Option<Trim> {
 }
 
 fn compile(r: &mut Resolver, n: &Number, vars: &[&str], name: &str, what: &str) -> Option<Ssa> {
-    let folded = fold(r, n.expr.as_ref()?, vars)?;
+    let folded = fold(r, &*n.expr()?, vars)?;
     let mut ctx = Ctx::new();
     match program::build(&mut ctx, &folded, vars) {
         Ok(root) => Some(Ssa::from_ctx(&ctx, root)),
@@ -296,10 +296,7 @@ fn fold(r: &mut Resolver, expr: &Expr, vars: &[&str]) -> Option<Expr> {
                 // Left for `program::build` to report with the variables it expects.
                 return Some(expr.clone());
             }
-            let number = Number {
-                expr: Some(expr.clone()),
-                span: expr.span,
-            };
+            let number = Number::new(Some(expr.clone()), expr.span);
             Expr::number(r.number(&number)?, expr.span)
         }
         ExprKind::Number(_) => expr.clone(),

@@ -64,7 +64,7 @@ impl<'d> Values<'d> {
             sources.insert(
                 p.name.text.clone(),
                 Source::Parameter {
-                    expr: p.value.expr.clone(),
+                    expr: p.value.expr().map(std::borrow::Cow::into_owned),
                     span: p.name.span,
                 },
             );
@@ -72,7 +72,7 @@ impl<'d> Values<'d> {
         for b in &doc.basis {
             sources.entry(b.name.text.clone()).or_insert(Source::Basis {
                 axis: b.axis,
-                expr: b.value.expr.clone(),
+                expr: b.value.expr().map(std::borrow::Cow::into_owned),
                 span: b.name.span,
             });
         }
@@ -106,8 +106,8 @@ impl<'d> Values<'d> {
 
     /// The value of a numeric attribute, or `None` after reporting why not.
     pub fn eval(&mut self, number: &Number, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
-        let expr = number.expr.as_ref()?;
-        self.eval_expr(expr, ctx, diags)
+        let expr = number.expr()?;
+        self.eval_expr(&expr, ctx, diags)
     }
 
     pub fn eval_opt(

@@ -1272,14 +1272,14 @@ mod tests {
         b.segment(u, w);
         let generated = b.vertex([9.0, 9.0, 9.0]);
         b.model.solids.push(Solid {
-            name: "ball".into(),
+            name: std::sync::Arc::new("ball".into()),
             shape: SolidShape::Ball {
                 frame: Frame::identity(),
             },
-            faces: Vec::new(),
-            boundary_edges: Vec::new(),
-            edges: Vec::new(),
-            vertices: vec![generated],
+            faces: Box::default(),
+            boundary_edges: Box::default(),
+            edges: Box::default(),
+            vertices: Box::new([generated]),
         });
         // Not in the source map: not explicit, so not reported either.
         b.model.vertices.push(crate::ir::Vertex {
