@@ -64,73 +64,90 @@ pub(super) fn build_subdomains(
     diags: &mut Diagnostics,
 ) -> Trees {
     let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(defs.len());
-    model.subdomains.reserve(defs.len());
+    let first = model.subdomains.len();
+    let mut made = 0;
+    let shared: &Model = model;
     // Consumed: each definition is dropped once lowered, so none is alive
-    // during the overlap check (the memory peak on large files).
-    for (def_index, def) in defs.into_iter().enumerate() {
-        let id = SubdomainId(model.subdomains.len() as u32);
-        let mut trimmed_faces = Vec::new();
-        let cells = match (def.faces.as_deref(), &def.tree) {
-            (Some(_), Some(_)) => {
-                diags.push(
-                    Diagnostic::new(
-                        Code::ConflictingForms,
-                        def.span,
-                        format!("subdomain '{}' has both faces= and a solid", def.name.text),
-                    )
-                    .with_help("give either the faces that bound it or a solid tree"),
-                );
-                continue;
-            }
-            (Some((refs, _)), None) => match explicit_shell(model, entities, refs, diags) {
-                Some((boundary, trimmed)) => {
-                    trimmed_faces = trimmed;
-                    SubdomainCells::Volume { boundary }
+    // during the overlap check (the memory peak on large files). Collected
+    // from the consumed definitions, so the standard library builds the
+    // subdomains in the definitions' own allocation (a `Subdomain` is no
+    // larger than a `SubdomainDef`, test `subdomains_fit_in_their_definitions`):
+    // the two vectors, tens of megabytes on large files, are never allocated
+    // side by side at the end of this loop, the lowering's memory peak.
+    let subdomains: Vec<Subdomain> = (defs.into_iter().enumerate())
+        .filter_map(|(def_index, def)| {
+            let model = shared;
+            let id = SubdomainId((first + made) as u32);
+            let mut trimmed_faces = Vec::new();
+            let cells = match (def.faces.as_deref(), &def.tree) {
+                (Some(_), Some(_)) => {
+                    diags.push(
+                        Diagnostic::new(
+                            Code::ConflictingForms,
+                            def.span,
+                            format!("subdomain '{}' has both faces= and a solid", def.name.text),
+                        )
+                        .with_help("give either the faces that bound it or a solid tree"),
+                    );
+                    return None;
                 }
-                None => continue,
-            },
-            (None, Some(tree)) => {
-                let mut leaves = Vec::new();
-                let Some(tree) = build_tree(tree, resolved, model, entities, &mut leaves, diags)
-                else {
-                    continue;
-                };
-                trees.push((
-                    id,
-                    Built {
-                        tree,
-                        leaves,
-                        span: def.span,
-                    },
-                ));
-                SubdomainCells::Volume {
-                    boundary: Vec::new(),
+                (Some((refs, _)), None) => match explicit_shell(model, entities, refs, diags) {
+                    Some((boundary, trimmed)) => {
+                        trimmed_faces = trimmed;
+                        SubdomainCells::Volume { boundary }
+                    }
+                    None => return None,
+                },
+                (None, Some(tree)) => {
+                    let mut leaves = Vec::new();
+                    let Some(tree) =
+                        build_tree(tree, resolved, model, entities, &mut leaves, diags)
+                    else {
+                        return None;
+                    };
+                    trees.push((
+                        id,
+                        Built {
+                            tree,
+                            leaves,
+                            span: def.span,
+                        },
+                    ));
+                    SubdomainCells::Volume {
+                        boundary: Vec::new(),
+                    }
                 }
-            }
-            (None, None) => {
-                diags.push(
-                    Diagnostic::new(
-                        Code::MissingElement,
-                        def.span,
-                        format!(
-                            "subdomain '{}' has neither faces= nor a solid",
-                            def.name.text
-                        ),
-                    )
-                    .with_help("add faces=\"…\" or a child such as <solid ref=\"…\"/>"),
-                );
-                continue;
-            }
-        };
-        model.subdomains.push(Subdomain {
-            name: def.name.text,
-            material: def.material,
-            cells,
-            solids: Vec::new(),
-            max_area: resolved.subdomain_areas.get(def_index).copied().flatten(),
-            trimmed: trimmed_faces,
-        });
-        source_map.subdomains.insert(id, Origin { span: def.span });
+                (None, None) => {
+                    diags.push(
+                        Diagnostic::new(
+                            Code::MissingElement,
+                            def.span,
+                            format!(
+                                "subdomain '{}' has neither faces= nor a solid",
+                                def.name.text
+                            ),
+                        )
+                        .with_help("add faces=\"…\" or a child such as <solid ref=\"…\"/>"),
+                    );
+                    return None;
+                }
+            };
+            source_map.subdomains.insert(id, Origin { span: def.span });
+            made += 1;
+            Some(Subdomain {
+                name: def.name.text,
+                material: def.material,
+                cells,
+                solids: Vec::new(),
+                max_area: resolved.subdomain_areas.get(def_index).copied().flatten(),
+                trimmed: trimmed_faces,
+            })
+        })
+        .collect();
+    if model.subdomains.is_empty() {
+        model.subdomains = subdomains;
+    } else {
+        model.subdomains.extend(subdomains);
     }
     Trees(trees)
 }
@@ -1102,5 +1119,24 @@ mod tests {
         let general = classify_faces(&model, &built(Tree::Union(vec![Tree::Leaf(0)])), &samples);
         assert_eq!(fast, vec![of(0, true), of(1, false), of(3, true)]);
         assert_eq!(fast, general);
+    }
+
+    /// `build_subdomains` collects the subdomains from the consumed
+    /// definitions so they reuse the definitions' allocation; the standard
+    /// library does that only when a subdomain fits in a definition with the
+    /// same alignment.
+    #[test]
+    fn subdomains_fit_in_their_definitions() {
+        use std::mem::{align_of, size_of};
+        assert!(
+            size_of::<crate::ir::Subdomain>() <= size_of::<SubdomainDef>(),
+            "Subdomain {} bytes, SubdomainDef {} bytes",
+            size_of::<crate::ir::Subdomain>(),
+            size_of::<SubdomainDef>()
+        );
+        assert_eq!(
+            align_of::<crate::ir::Subdomain>(),
+            align_of::<SubdomainDef>()
+        );
     }
 }
