@@ -31,18 +31,25 @@ pub fn render(
         .enumerate()
         .for_each_init(Vec::new, |buf: &mut Vec<u64>, (band, out)| {
             // A band no triangle reaches is background (the margins above
-            // and below the model): no samples to fill and read back.
-            if bins.iter().all(|chunk| chunk[band].is_empty()) {
-                let bg = background_pixel(background);
+            // and below the model): no samples to fill and read back. Of
+            // the others only the pixel columns its triangles reach are
+            // filled and resolved (the margins left and right of the model).
+            let bg = background_pixel(background);
+            let Some((first, last)) = raster::band_columns(&bins, band) else {
                 for pixel in out.chunks_exact_mut(4) {
                     pixel.copy_from_slice(&bg);
                 }
                 return;
-            }
+            };
+            let cols = first / ss..last / ss + 1;
             let y0 = band * band_rows;
             let y1 = (y0 + band_rows).min(sh);
-            buf.clear();
+            // Samples outside the filled columns are left as the last band
+            // had them: nothing draws or reads there.
             buf.resize(sw * (y1 - y0), EMPTY);
+            for row in buf[..sw * (y1 - y0)].chunks_exact_mut(sw) {
+                row[cols.start * ss..cols.end * ss].fill(EMPTY);
+            }
             raster::draw_band(scene, proj, &bins, band, buf, sw, y0..y1);
             let samples = Samples {
                 data: buf,
@@ -50,6 +57,13 @@ pub fn render(
                 y0,
                 edges: &[],
             };
+            for row in out.chunks_exact_mut(width * 4) {
+                let (left, rest) = row.split_at_mut(cols.start * 4);
+                let right = &mut rest[(cols.end - cols.start) * 4..];
+                for pixel in left.chunks_exact_mut(4).chain(right.chunks_exact_mut(4)) {
+                    pixel.copy_from_slice(&bg);
+                }
+            }
             resolve_rows(
                 scene,
                 proj,
@@ -57,6 +71,7 @@ pub fn render(
                 ss,
                 background,
                 band * BAND_PIXELS,
+                cols,
                 out,
             );
         });

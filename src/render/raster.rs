@@ -97,16 +97,40 @@ fn sample_span(lo: i64, hi: i64, size: usize) -> Option<(usize, usize)> {
     (first <= last).then_some((first as usize, last as usize))
 }
 
-/// Sample rows a triangle may cover, clamped to the image; none when its
-/// bounding box holds no sample centre of the image.
+/// Sample columns and rows a triangle may cover (`x0..=x1`, `y0..=y1`),
+/// clamped to the image; none when its bounding box holds no sample centre
+/// of the image.
 #[inline]
-fn row_range(v: &[[i64; 2]; 3], width: usize, height: usize) -> Option<(usize, usize)> {
+fn sample_box(
+    v: &[[i64; 2]; 3],
+    width: usize,
+    height: usize,
+) -> Option<(usize, usize, usize, usize)> {
     let min_x = v[0][0].min(v[1][0]).min(v[2][0]);
     let max_x = v[0][0].max(v[1][0]).max(v[2][0]);
-    sample_span(min_x, max_x, width)?;
+    let (x0, x1) = sample_span(min_x, max_x, width)?;
     let lo = v[0][1].min(v[1][1]).min(v[2][1]);
     let hi = v[0][1].max(v[1][1]).max(v[2][1]);
-    sample_span(lo, hi, height)
+    let (y0, y1) = sample_span(lo, hi, height)?;
+    Some((x0, x1, y0, y1))
+}
+
+/// One chunk's binned triangles: per band, the ids it must draw and the
+/// sample columns their boxes reach (`first..=last`; empty when `first >
+/// last`), so a band fills and resolves only the columns drawn on.
+pub struct ChunkBins {
+    pub ids: Vec<Vec<u32>>,
+    pub cols: Vec<(u32, u32)>,
+}
+
+/// The sample columns the triangles of band `band` reach over every chunk
+/// (`first..=last`), or `None` when no triangle reaches the band.
+pub fn band_columns(bins: &[ChunkBins], band: usize) -> Option<(usize, usize)> {
+    let (first, last) = bins.iter().fold((u32::MAX, 0), |(f, l), chunk| {
+        let (cf, cl) = chunk.cols[band];
+        (f.min(cf), l.max(cl))
+    });
+    (first <= last).then_some((first as usize, last as usize))
 }
 
 /// For each chunk of triangles, the ids each band of `band_rows` sample rows
@@ -117,7 +141,7 @@ pub fn bin(
     width: usize,
     height: usize,
     band_rows: usize,
-) -> Vec<Vec<Vec<u32>>> {
+) -> Vec<ChunkBins> {
     let n_bands = height.div_ceil(band_rows);
     // Each sample row's band, looked up: two divisions by a band height
     // that is not always a power of two cost a fifth of binning.
@@ -125,7 +149,8 @@ pub fn bin(
     (0..scene.tris.len().div_ceil(CHUNK))
         .into_par_iter()
         .map(|c| {
-            let mut bands: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
+            let mut ids: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
+            let mut cols = vec![(u32::MAX, 0u32); n_bands];
             let end = ((c + 1) * CHUNK).min(scene.tris.len());
             for tri in c * CHUNK..end {
                 let Some((v, back)) = facing(proj, scene.tris[tri]) else {
@@ -134,14 +159,15 @@ pub fn bin(
                 if !visible_side(scene, tri, back) {
                     continue;
                 }
-                if let Some((first, last)) = row_range(&v, width, height) {
+                if let Some((x0, x1, first, last)) = sample_box(&v, width, height) {
                     let (from, to) = (band_of[first] as usize, band_of[last] as usize);
-                    for band in &mut bands[from..=to] {
+                    for (band, reach) in ids[from..=to].iter_mut().zip(&mut cols[from..=to]) {
                         band.push(tri as u32);
+                        *reach = (reach.0.min(x0 as u32), reach.1.max(x1 as u32));
                     }
                 }
             }
-            bands
+            ChunkBins { ids, cols }
         })
         .collect()
 }
@@ -150,7 +176,7 @@ pub fn bin(
 pub fn draw_band(
     scene: &Scene,
     proj: &Projected,
-    bins: &[Vec<Vec<u32>>],
+    bins: &[ChunkBins],
     band: usize,
     rows: &mut [u64],
     width: usize,
@@ -158,7 +184,7 @@ pub fn draw_band(
 ) {
     let (y0, y1) = (ys.start, ys.end);
     for chunk in bins {
-        let ids = &chunk[band];
+        let ids = &chunk.ids[band];
         for (i, &tri) in ids.iter().enumerate() {
             // A band's triangles lie scattered over the mesh, and a corner
             // is two dependent loads (the triangle, then its node): fetch the
@@ -223,6 +249,13 @@ fn draw(
     if x_first > sx1 || y_first > sy1 {
         return;
     }
+    // The depth plane's one division, issued before the edge set-up so its
+    // latency overlaps it (waiting for it at the first covered sample was a
+    // tenth of drawing); the rest of the plane is made only once a sample is
+    // found inside (most tiny triangles of a large mesh cover none).
+    let area =
+        (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0]);
+    let inv = 1.0 / area as f64;
     // Edge k runs from v[k] to v[k+1]; E_k(p) = (b−a)×(p−a) is positive inside.
     let mut e_row = [0i64; 3];
     let mut step_x = [0i64; 3];
@@ -241,12 +274,8 @@ fn draw(
         step_y[k] = dx * SUB;
     }
     // Depth as a plane over sample coordinates, referenced at the triangle's
-    // own first sample so bands agree exactly: one division per triangle,
-    // made only once a sample is found inside (most tiny triangles of a
-    // large mesh cover none).
+    // own first sample so bands agree exactly.
     let plane = || {
-        let area = ((v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
-            - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0])) as f64;
         let (x1, y1_, x2, y2) = (
             (v[1][0] - v[0][0]) as f64,
             (v[1][1] - v[0][1]) as f64,
@@ -254,7 +283,6 @@ fn draw(
             (v[2][1] - v[0][1]) as f64,
         );
         let (z1, z2) = ((z[1] - z[0]) as f64, (z[2] - z[0]) as f64);
-        let inv = 1.0 / area;
         // dz per snapped unit, then per sample.
         let gx = (z1 * y2 - z2 * y1_) * inv;
         let gy = (z2 * x1 - z1 * x2) * inv;
@@ -333,5 +361,41 @@ pub fn mark_edges(
                 }
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn chunk(cols: &[(u32, u32)]) -> ChunkBins {
+        ChunkBins {
+            ids: vec![Vec::new(); cols.len()],
+            cols: cols.to_vec(),
+        }
+    }
+
+    #[test]
+    fn band_columns_join_the_chunks_reach() {
+        let none = (u32::MAX, 0);
+        let bins = [
+            chunk(&[none, (10, 20), (7, 9)]),
+            chunk(&[none, (4, 12), none]),
+        ];
+        assert_eq!(band_columns(&bins, 0), None);
+        assert_eq!(band_columns(&bins, 1), Some((4, 20)));
+        assert_eq!(band_columns(&bins, 2), Some((7, 9)));
+    }
+
+    #[test]
+    fn sample_box_holds_the_covered_sample_centres() {
+        // Corners in 1/16 sample steps: x 20..70 holds the centres of
+        // samples 1..=3 (24, 40, 56), y 0..30 those of rows 0..=1 (8, 24).
+        let v = [[20, 0], [70, 10], [30, 30]];
+        assert_eq!(sample_box(&v, 100, 100), Some((1, 3, 0, 1)));
+        // Clamped to a picture of 3 columns and 1 row.
+        assert_eq!(sample_box(&v, 3, 1), Some((1, 2, 0, 0)));
+        // Between two sample centres: nothing to draw.
+        assert_eq!(sample_box(&[[9, 9], [20, 9], [9, 20]], 100, 100), None);
     }
 }

@@ -204,7 +204,9 @@ pub fn resolve(
     let mut rgba = vec![0u8; width * height * 4];
     rgba.par_chunks_mut(width * 4)
         .enumerate()
-        .for_each(|(py, row)| resolve_rows(scene, proj, &samples, ss, background, py, row));
+        .for_each(|(py, row)| {
+            resolve_rows(scene, proj, &samples, ss, background, py, 0..width, row)
+        });
     Image {
         width: width as u32,
         height: height as u32,
@@ -212,8 +214,10 @@ pub fn resolve(
     }
 }
 
-/// Resolves the pixel rows from `py0` that `out` holds (RGBA, the picture's
-/// width); their samples must be in `samples`.
+/// Resolves the pixel columns `cols` of the pixel rows from `py0` that `out`
+/// holds (RGBA, the picture's width); their samples must be in `samples`
+/// (those of other columns are not read).
+#[allow(clippy::too_many_arguments)]
 pub fn resolve_rows(
     scene: &Scene,
     proj: &Projected,
@@ -221,6 +225,7 @@ pub fn resolve_rows(
     ss: usize,
     background: [u8; 4],
     py0: usize,
+    cols: std::ops::Range<usize>,
     out: &mut [u8],
 ) {
     let width = samples.width / ss;
@@ -232,7 +237,7 @@ pub fn resolve_rows(
     let bg = background_pixel(background);
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
-        for px in 0..width {
+        for px in cols.clone() {
             // Background first: such a pixel shows no triangle (`uniform`
             // would find none), so it skips the look-ahead fetches too.
             if background_only(samples, ss, px, py) {
@@ -243,14 +248,14 @@ pub fn resolve_rows(
             // Shading gathers a triangle, then its corners' positions and
             // light: fetch the triangle of the pixel 16 ahead and the
             // corners of the one 8 ahead, so the loads overlap.
-            if let Some(tri) = (px + 2 * AHEAD < width)
+            if let Some(tri) = (px + 2 * AHEAD < cols.end)
                 .then(|| first_tri(px + 2 * AHEAD, py))
                 .flatten()
             {
                 prefetch(&scene.tris[tri]);
                 prefetch(&scene.corner_slots[tri]);
             }
-            if let Some(tri) = (px + AHEAD < width)
+            if let Some(tri) = (px + AHEAD < cols.end)
                 .then(|| first_tri(px + AHEAD, py))
                 .flatten()
             {
