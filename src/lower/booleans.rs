@@ -100,11 +100,7 @@ pub(super) fn build_subdomains(
                 },
                 (None, Some(tree)) => {
                     let mut leaves = Vec::new();
-                    let Some(tree) =
-                        build_tree(tree, resolved, model, entities, &mut leaves, diags)
-                    else {
-                        return None;
-                    };
+                    let tree = build_tree(tree, resolved, model, entities, &mut leaves, diags)?;
                     trees.push((
                         id,
                         Built {
