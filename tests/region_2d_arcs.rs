@@ -17,8 +17,8 @@ use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use mesh2d_common::{
     area, assert_conforming, assert_groups_read, compile_msh as compile, coordinate_range,
-    fan_area, fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python,
-    triangles_of,
+    diagnostics, fan_area, fragment_names, fragment_segments, mesh_clean as mesh,
+    min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -352,15 +352,6 @@ fn a_straight_contour_stretch_is_a_few_graded_pieces() {
     }
     let longest = pieces.iter().map(|p| p.1 - p.0).fold(0.0, f64::max);
     assert!(longest > 0.15, "longest piece {longest}");
-}
-
-fn diagnostics(xml: &str) -> Vec<geomc::diag::Diagnostic> {
-    check_source(
-        SourceFile::new("t.xml", xml.to_string()),
-        &Options::default(),
-    )
-    .diagnostics
-    .items
 }
 
 #[test]

@@ -11,8 +11,9 @@ mod mesh2d_common;
 
 use geomc::mesh::Mesh;
 use mesh2d_common::{
-    area, assert_conforming, assert_groups_read, compile_msh, coordinate_range, fan_area,
-    fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
+    area, assert_conforming, assert_groups_read, assert_min_angle_30, compile_msh,
+    coordinate_range, fan_area, fragment_names, fragment_segments, mesh_clean as mesh,
+    min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -112,8 +113,7 @@ fn contour_along_two_stacked_squares_follows_onto_the_upper_side() {
     assert!((cap - polygon).abs() < 1e-12, "{cap} vs {polygon}");
     let exact = PI * 0.31 * 0.31 / 2.0;
     assert!((cap - exact).abs() / exact < 2e-3, "cap area {cap}");
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]

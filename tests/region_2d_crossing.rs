@@ -17,8 +17,9 @@ use geomc::mesh::Mesh;
 use geomc::meshing::mesh_model;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, assert_groups_read, at_30_degrees, compile_msh as compile, fan_area,
-    fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
+    area, assert_conforming, assert_groups_read, assert_min_angle_30, at_30_degrees,
+    compile_msh as compile, diagnostics, fan_area, fragment_names, fragment_segments,
+    mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -120,8 +121,7 @@ fn disk_across_a_square_side_is_split_at_the_crossings() {
         "{inside}"
     );
     assert!((bead - 0.09 * PI).abs() / (0.09 * PI) < 2e-3, "{bead}");
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]
@@ -404,15 +404,6 @@ fn poisson_over_the_stacked_square_matches_the_series() {
         errors.push(error);
     }
     assert!(errors[1] < errors[0] / 3.0, "{errors:?}");
-}
-
-fn diagnostics(xml: &str) -> Vec<geomc::diag::Diagnostic> {
-    check_source(
-        SourceFile::new("t.xml", xml.to_string()),
-        &Options::default(),
-    )
-    .diagnostics
-    .items
 }
 
 #[test]

@@ -13,8 +13,8 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_conforming, assert_groups_read, compile_msh as compile, coordinate_range,
-    fan_area, fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
+    area, assert_conforming, assert_groups_read, assert_min_angle_30, compile_msh as compile,
+    coordinate_range, fan_area, fragment_segments, mesh_clean as mesh, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -101,8 +101,7 @@ fn two_halves_of_a_disk_share_their_straight_interface() {
         "{} vs {domain}",
         left + right
     );
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]
@@ -131,8 +130,7 @@ fn a_ring_around_a_disk_shares_the_whole_circle() {
     assert!((core - PI * 0.25).abs() / (PI * 0.25) < 2e-3, "core {core}");
     let ring = PI * (0.64 - 0.25);
     assert!((coat - ring).abs() / ring < 2e-3, "coat {coat}");
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]

@@ -12,8 +12,8 @@ mod mesh2d_common;
 
 use geomc::mesh::Mesh;
 use mesh2d_common::{
-    area, assert_conforming, assert_groups_read, compile_msh as compile, coordinate_range,
-    fan_area, fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python,
+    area, assert_conforming, assert_groups_read, assert_min_angle_30, compile_msh as compile,
+    coordinate_range, fan_area, fragment_names, fragment_segments, mesh_clean as mesh, python,
     sides, triangles_of,
 };
 use std::collections::{BTreeMap, BTreeSet};
@@ -162,8 +162,7 @@ fn a_notch_splits_the_shared_stretch_at_its_corners() {
         "{} vs {domain}",
         left + right
     );
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]
@@ -235,8 +234,7 @@ fn a_ring_around_two_half_disks_shares_its_inner_loop_with_both() {
     assert!((west + east - fan_area(&m, &arcs, [0.0, 0.0])).abs() < 1e-12);
     let outer = fragment_segments(&m, "coat|exterior");
     assert!((west + east + coat - fan_area(&m, &outer, [0.0, 0.0])).abs() < 1e-12);
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]
@@ -294,8 +292,7 @@ fn a_ring_with_bumps_shares_four_stretches_ending_at_the_bumps() {
         "{} vs {domain}",
         core + coat
     );
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]

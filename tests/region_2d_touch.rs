@@ -13,8 +13,8 @@ use geomc::driver::{Options, check_source};
 use geomc::mesh::Mesh;
 use geomc::span::SourceFile;
 use mesh2d_common::{
-    area, assert_groups_read, compile_msh as compile, fan_area, fragment_names, fragment_segments,
-    mesh_clean as mesh, min_angle_degrees, python, triangles_of,
+    area, assert_groups_read, assert_min_angle_30, compile_msh as compile, fan_area,
+    fragment_names, fragment_segments, mesh_clean as mesh, min_angle_degrees, python, triangles_of,
 };
 use std::collections::BTreeSet;
 use std::f64::consts::PI;
@@ -123,8 +123,7 @@ fn bead_tangent_to_a_kernel_circle_shares_the_touch_point() {
         (bead - 0.09 * PI).abs() / (0.09 * PI) < 2e-3,
         "bead area {bead}"
     );
-    let least = min_angle_degrees(&m);
-    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+    assert_min_angle_30(&m);
 }
 
 #[test]

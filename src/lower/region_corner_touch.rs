@@ -54,12 +54,7 @@ pub(super) fn share_corner_touches(
         let Some(fr) = super::region_interfaces::face_of(model, r) else {
             continue;
         };
-        let own: BTreeSet<VertexId> = model.faces[fr.index()]
-            .loops
-            .edges()
-            .iter()
-            .flat_map(|oe| [model.edge(oe.edge).begin, model.edge(oe.edge).end])
-            .collect();
+        let own = super::region_interfaces::face_vertex_set(model, fr);
         let touch = touch_of(model, r);
         for (&w, (edges, users)) in &at_vertex {
             if own.contains(&w) || users.iter().any(|&k| reported.contains(&(k, r))) {

@@ -374,12 +374,7 @@ fn place_crossings(
 ) {
     let merge = 16.0 * model.tolerance;
     // Vertices of the kernel face (shared arcs' ends included) stay put.
-    let fixed: BTreeSet<VertexId> = model.faces[fk.index()]
-        .loops
-        .edges()
-        .iter()
-        .flat_map(|oe| [model.edge(oe.edge).begin, model.edge(oe.edge).end])
-        .collect();
+    let fixed = super::region_interfaces::face_vertex_set(model, fk);
     let mut moved = BTreeSet::new();
     let mut kernel_cuts: BTreeMap<EdgeId, Vec<(f64, VertexId)>> = BTreeMap::new();
     let mut contour_cuts: Vec<VertexId> = Vec::new();

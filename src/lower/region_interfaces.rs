@@ -56,18 +56,19 @@ pub fn join(
         share_box_sides(model, source_map, first_region, r, diags);
     }
     super::region_pairs::share_region_interfaces(model, source_map, first_region);
+    let touch_of = |m: &Model, r: usize| face_of(m, r).map_or(0.0, |f| touch_distance(m, f));
     let touched = super::region_touch::share_touch_points(
         model,
         source_map,
         first_region,
-        |m, r| face_of(m, r).map_or(0.0, |f| touch_distance(m, f)),
+        touch_of,
         &reported,
     );
     let touched = super::region_corner_touch::share_corner_touches(
         model,
         source_map,
         first_region,
-        |m, r| face_of(m, r).map_or(0.0, |f| touch_distance(m, f)),
+        touch_of,
         &reported,
         touched,
     );
@@ -526,6 +527,11 @@ fn loop_vertices(model: &Model, f: FaceId) -> Vec<VertexId> {
         })
         .filter(|v| seen.insert(*v))
         .collect()
+}
+
+/// The vertices of a face's loops as a set (lookups, not order).
+pub(super) fn face_vertex_set(model: &Model, f: FaceId) -> BTreeSet<VertexId> {
+    loop_vertices(model, f).into_iter().collect()
 }
 
 /// [`TOUCH_FRACTION`] of the diagonal of a region's contour.

@@ -181,27 +181,32 @@ fn share_pairs(
                 dropped_vertices.push(begin(model, *oe));
             }
         }
-        let replacement: Vec<OrientedEdge> = own_a
-            .iter()
-            .rev()
-            .map(|oe| OrientedEdge {
-                edge: oe.edge,
-                forward: !oe.forward,
-            })
-            .collect();
+        let replacement = reversed(&own_a);
         swaps
             .entry(rb.lp)
             .or_default()
             .push((rb.start, rb.len, replacement));
     }
     dropped_vertices.extend(canonical.keys().copied());
+    swap_runs(model, fb, swaps, &canonical);
+    (dropped_edges, dropped_vertices)
+}
+
+/// The later region's runs replaced by the earlier region's pieces
+/// (`swaps`: per loop, the runs' start, length and replacement), and its
+/// remaining pieces next to a run end moved onto the run's corner vertices.
+pub(super) fn swap_runs(
+    model: &mut Model,
+    fb: FaceId,
+    swaps: BTreeMap<usize, Vec<(usize, usize, Vec<OrientedEdge>)>>,
+    canonical: &BTreeMap<VertexId, VertexId>,
+) {
     let mut loops = model.faces[fb.index()].loops.to_vecs();
     for (l, mut list) in swaps {
         list.sort_by_key(|s| s.0);
         loops[l] = super::region_arcs::spliced(&loops[l], &list);
     }
     model.faces[fb.index()].loops = loops.into();
-    // The later region's remaining pieces next to a run end follow it.
     let remaining: BTreeSet<EdgeId> = model.faces[fb.index()]
         .loops
         .edges()
@@ -217,7 +222,19 @@ fn share_pairs(
         }
         super::edge_parts::follow_vertices(model, e);
     }
-    (dropped_edges, dropped_vertices)
+}
+
+/// Pieces walked the other way: the earlier region's run as the later one
+/// goes along it.
+pub(super) fn reversed(pieces: &[OrientedEdge]) -> Vec<OrientedEdge> {
+    pieces
+        .iter()
+        .rev()
+        .map(|oe| OrientedEdge {
+            edge: oe.edge,
+            forward: !oe.forward,
+        })
+        .collect()
 }
 
 fn loop_of(model: &Model, f: FaceId, lp: usize) -> &[OrientedEdge] {

@@ -14,7 +14,8 @@
 use super::edge_parts::EdgeParts;
 use super::region_arcs::{begin, end};
 use super::region_pairs::{
-    ON_FRACTION, ON_SET_FRACTION, Run, extent, off_zero_set, pieces, segment_distance,
+    ON_FRACTION, ON_SET_FRACTION, Run, extent, off_zero_set, pieces, reversed, segment_distance,
+    swap_runs,
 };
 use crate::geom::{Curve, Point3};
 use crate::implicit::tape::Ssa;
@@ -138,12 +139,7 @@ pub(super) fn share_along(
     let at = split_at_corners(model, source_map, fa, &corners);
     // Each run replaced by A's pieces from its end's corner to its start's,
     // reversed.
-    let a_vertices: BTreeSet<VertexId> = model.faces[fa.index()]
-        .loops
-        .edges()
-        .iter()
-        .flat_map(|oe| [model.edge(oe.edge).begin, model.edge(oe.edge).end])
-        .collect();
+    let a_vertices = super::region_interfaces::face_vertex_set(model, fa);
     let mut used = BTreeSet::new();
     let mut canonical: BTreeMap<VertexId, VertexId> = BTreeMap::new();
     let mut dropped_edges = Vec::new();
@@ -174,42 +170,14 @@ pub(super) fn share_along(
                 dropped_vertices.push(v);
             }
         }
-        let replacement = walk
-            .iter()
-            .rev()
-            .map(|oe| OrientedEdge {
-                edge: oe.edge,
-                forward: !oe.forward,
-            })
-            .collect();
+        let replacement = reversed(&walk);
         swaps
             .entry(rb.lp)
             .or_default()
             .push((rb.start, rb.len, replacement));
     }
     dropped_vertices.extend(canonical.keys().copied());
-    let mut loops = model.faces[fb.index()].loops.to_vecs();
-    for (l, mut list) in swaps {
-        list.sort_by_key(|s| s.0);
-        loops[l] = super::region_arcs::spliced(&loops[l], &list);
-    }
-    model.faces[fb.index()].loops = loops.into();
-    // B's remaining pieces at a run's end start or end at its corner.
-    let remaining: BTreeSet<EdgeId> = model.faces[fb.index()]
-        .loops
-        .edges()
-        .iter()
-        .map(|oe| oe.edge)
-        .collect();
-    for e in remaining {
-        let edge = &mut model.edges[e.index()];
-        for v in [&mut edge.begin, &mut edge.end] {
-            if let Some(&w) = canonical.get(v) {
-                *v = w;
-            }
-        }
-        super::edge_parts::follow_vertices(model, e);
-    }
+    swap_runs(model, fb, swaps, &canonical);
     Some((dropped_edges, dropped_vertices))
 }
 

@@ -257,3 +257,19 @@ pub fn fan_area(m: &Mesh, segments: &[[u32; 2]], c: [f64; 2]) -> f64 {
         })
         .sum()
 }
+
+/// The diagnostics of checking a file, without meshing it.
+pub fn diagnostics(xml: &str) -> Vec<geomc::diag::Diagnostic> {
+    check_source(
+        SourceFile::new("t.xml", xml.to_string()),
+        &Options::default(),
+    )
+    .diagnostics
+    .items
+}
+
+/// Every triangle's angles are at least the 30° the 2D tests mesh at.
+pub fn assert_min_angle_30(m: &Mesh) {
+    let least = min_angle_degrees(m);
+    assert!(least >= 30.0 - 1e-9, "min angle {least}");
+}
