@@ -1,7 +1,7 @@
 """The 2D meshing peer of benches/mesh2d.rs: Shewchuk's Triangle (PyPI
 `triangle`) on the same boundary (a PSLG of geomc's boundary nodes) at the
-same minimum angle and area limit. Prints {"seconds": best of RUNS single
-runs, "cpu_seconds": CPU time per run, the best of RUNS samples of REPS
+same minimum angle and area limit. Prints {"seconds": best of RUNS × REPS
+single runs (as geomc's), "cpu_seconds": CPU time per run, the best of RUNS samples of REPS
 back-to-back runs (process CPU time: every thread), "threads": threads in
 the process, "triangles": n}.
 
@@ -34,7 +34,7 @@ def main():
     if d.get("max_area"):
         opts += "a%s" % np.format_float_positional(d["max_area"], trim="-")  # Triangle reads no exponents
     best, best_cpu, count = float("inf"), float("inf"), 0
-    for _ in range(runs):
+    for _ in range(runs * reps):
         start, cpu = time.perf_counter(), time.process_time()
         out = triangle.triangulate(pslg, opts)
         best = min(best, time.perf_counter() - start)
