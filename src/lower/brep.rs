@@ -505,11 +505,8 @@ mod tests {
     /// The 3D primitives' shapes the tests below build their boundaries of:
     /// turned and mirroring frames, cones with and without caps.
     fn solids() -> Vec<SolidShape> {
-        let turned = Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7);
-        let mirrored = Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0));
         let mut shapes = Vec::new();
-        for linear in [turned, mirrored] {
-            let f = frame(linear);
+        for f in frames() {
             shapes.push(SolidShape::Box { frame: f });
             shapes.push(SolidShape::Ball { frame: f });
             for (r0, r1) in [(0.4, 0.2), (0.0, 0.3), (0.5, 0.0), (0.25, 0.25)] {
@@ -564,35 +561,17 @@ mod tests {
         assert_eq!(disk.edge_curve(0), None);
     }
 
-    #[test]
-    fn anchors_are_the_brep_points() {
+    /// A turned and a mirroring frame.
+    fn frames() -> [Frame; 2] {
         let turned = Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7);
         let mirrored = Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0));
-        let mut shapes = Vec::new();
-        for linear in [turned, mirrored] {
-            let f = frame(linear);
-            shapes.push(SolidShape::Box { frame: f });
-            shapes.push(SolidShape::Ball { frame: f });
-            shapes.push(SolidShape::Cone {
-                frame: f,
-                r0: 0.4,
-                r1: 0.2,
-            });
-            shapes.push(SolidShape::Cone {
-                frame: f,
-                r0: 0.0,
-                r1: 0.3,
-            });
-            shapes.push(SolidShape::Cone {
-                frame: f,
-                r0: 0.5,
-                r1: 0.0,
-            });
-            shapes.push(SolidShape::Torus {
-                frame: f,
-                major: 0.5,
-                minor: 0.15,
-            });
+        [frame(turned), frame(mirrored)]
+    }
+
+    #[test]
+    fn anchors_are_the_brep_points() {
+        let mut shapes = solids();
+        for f in frames() {
             shapes.push(SolidShape::Disk { frame: f });
             shapes.push(SolidShape::Polygon {
                 frame: f,
