@@ -82,6 +82,14 @@ impl KernelCurve {
         }
     }
 
+    /// The centre of a circle or ellipse; None for a line.
+    pub(super) fn center(&self) -> Option<Point3> {
+        match self {
+            KernelCurve::Arc(a) => Some(a.center),
+            KernelCurve::Line(_) => None,
+        }
+    }
+
     pub(super) fn is_line(&self) -> bool {
         matches!(self, KernelCurve::Line(_))
     }

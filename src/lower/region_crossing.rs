@@ -159,7 +159,7 @@ pub(super) fn split_at_crossings(
     let kept = pool.len();
     for oe in model.faces[fr.index()].loops.edges() {
         if !kernel_edges.contains(&oe.edge)
-            && kernel.contains(&model.edge_curve(oe.edge).point(0.5))
+            && kernel.contains(&piece_middle(&model.edge_curve(oe.edge)))
         {
             pool.push(OrientedEdge {
                 edge: oe.edge,
@@ -174,6 +174,18 @@ pub(super) fn split_at_crossings(
     model.faces[fk.index()].loops = Loops::from(loops);
     drop_unused(model, source_map, &dropped);
     Ok(())
+}
+
+/// A point in the middle of a region piece, to tell which side of the
+/// kernel outline it is on: a contour piece's chord middle (its curve
+/// middle costs a root finding, and lies within the chordal tolerance of
+/// it, far closer than a piece ending at a crossing comes to the outline
+/// elsewhere).
+fn piece_middle(curve: &Curve) -> Point3 {
+    match *curve {
+        Curve::Contour { a, b, .. } => a + (b - a) * 0.5,
+        _ => curve.point(0.5),
+    }
 }
 
 /// The region's function, from any of its contour pieces.

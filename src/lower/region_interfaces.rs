@@ -162,10 +162,30 @@ fn carve(
             }
         };
     }
-    let outside = points
-        .into_iter()
-        .find(|p| outline.distance(p) <= touch || !outline.contains(p));
-    if let Some(p) = outside {
+    // Clear of the outline and outside it: the region lies outside.
+    let beyond = points
+        .iter()
+        .find(|p| outline.distance(p) > touch && !outline.contains(p));
+    let near = points.iter().find(|p| outline.distance(p) <= touch);
+    if let (None, Some(_), true) = (beyond, near, shared.is_empty()) {
+        // Inside, touching the outline: shared where it is a tangency.
+        let region_edges: BTreeSet<EdgeId> =
+            face_edges(model, first_region..model.subdomains.len()).collect();
+        let touched = super::region_touch_inside::share_inside_touches(
+            model,
+            source_map,
+            (fk, fr),
+            &region_edges,
+            touch,
+        );
+        if let Err(refusal) = touched {
+            diags.push(refusal.diagnostic(model, c.span, &c.subdomain, region));
+            return Some((k, r));
+        }
+    } else if let Some(p) = points
+        .iter()
+        .find(|p| outline.distance(p) <= touch || !outline.contains(p))
+    {
         diags.push(
             Diagnostic::new(
                 Code::RegionCarveOutside,

@@ -24,15 +24,15 @@ use std::f64::consts::TAU;
 const SEARCH_STEPS: usize = 80;
 
 /// A kernel edge a region may touch, with the kernel subdomains using it.
-struct KernelEdge {
-    edge: EdgeId,
-    curve: KernelCurve,
-    subdomains: Vec<usize>,
+pub(super) struct KernelEdge {
+    pub(super) edge: EdgeId,
+    pub(super) curve: KernelCurve,
+    pub(super) subdomains: Vec<usize>,
 }
 
 /// Where a region vertex goes: onto the kernel edge at parameter `u`, or
 /// onto an existing kernel vertex.
-enum Landing {
+pub(super) enum Landing {
     Split { edge: EdgeId, u: f64, at: Point3 },
     Merge(VertexId),
 }
@@ -117,18 +117,25 @@ pub(super) fn share_touch_points(
     if landings.is_empty() {
         return touched;
     }
-    apply(model, source_map, &kernel, landings, touched)
+    apply(
+        model,
+        source_map,
+        &kernel,
+        landings,
+        BTreeMap::new(),
+        touched,
+    )
 }
 
 /// The loop's vertex i (the start of its piece i).
-fn vertex_at(model: &Model, lp: &[OrientedEdge], i: usize) -> VertexId {
+pub(super) fn vertex_at(model: &Model, lp: &[OrientedEdge], i: usize) -> VertexId {
     let oe = lp[i % lp.len()];
     let e = model.edge(oe.edge);
     if oe.forward { e.begin } else { e.end }
 }
 
 /// The nearest point of the kernel edge to p: (parameter, distance).
-fn nearest(curve: &KernelCurve, p: &Point3) -> (f64, f64) {
+pub(super) fn nearest(curve: &KernelCurve, p: &Point3) -> (f64, f64) {
     let span = curve.span();
     let u = curve.parameter(p);
     let u = if (0.0..=span).contains(&u) {
@@ -143,7 +150,7 @@ fn nearest(curve: &KernelCurve, p: &Point3) -> (f64, f64) {
 
 /// The maximal cyclic runs of loop vertices (as indices) within `touch` of
 /// the kernel edge, none of them and neither neighbour a kernel vertex.
-fn near_runs(
+pub(super) fn near_runs(
     model: &Model,
     lp: &[OrientedEdge],
     curve: &KernelCurve,
@@ -178,7 +185,7 @@ fn near_runs(
 /// Where a touch run meets the kernel edge and which of its vertices goes
 /// there; None when the run is no single touch (more than one vertex or any
 /// chord on the edge) or the touch point lies away from the run.
-fn land(
+pub(super) fn land(
     model: &Model,
     lp: &[OrientedEdge],
     run: &[usize],
@@ -306,15 +313,16 @@ fn peak(g: &dyn Fn(f64) -> f64, mut a: f64, mut b: f64) -> f64 {
 }
 
 /// Moves or merges the touching vertices, splits the kernel edges at the
-/// moved ones and drops the merged ones. Returns `touched` renumbered.
-fn apply(
+/// moved ones (and at the further `cuts`, new vertices) and drops the
+/// merged ones. Returns `touched` renumbered.
+pub(super) fn apply(
     model: &mut Model,
     source_map: &mut SourceMap,
     kernel: &[KernelEdge],
     landings: BTreeMap<VertexId, Landing>,
+    mut cuts: BTreeMap<EdgeId, Vec<(f64, VertexId)>>,
     touched: BTreeSet<VertexId>,
 ) -> BTreeSet<VertexId> {
-    let mut cuts: BTreeMap<EdgeId, Vec<(f64, VertexId)>> = BTreeMap::new();
     let mut merged: BTreeMap<VertexId, VertexId> = BTreeMap::new();
     let moved: BTreeSet<VertexId> = landings.keys().copied().collect();
     for (v, landing) in landings {
