@@ -296,28 +296,175 @@ fn read_document<'s>(
     diags: &mut Diagnostics,
 ) -> Result<(doc::Document, crate::implicit::xml::Extracted<'s>), syntax::Reparse> {
     let heads = parsed.heads();
-    // The root's check reports unknown elements; only known ones go deeper.
-    doc::structure::check_element_heads(&root, &heads, &grammar::GEOMETRY, diags);
     let extractor = crate::implicit::xml::Extractor::new(&root, &heads);
     let mut builder = doc::DocumentBuilder::new(source, &root, &options.expressions);
     let subdomains = heads.iter().filter(|h| h.name == "subdomain").count();
     builder.reserve(heads.len() - subdomains, subdomains);
-    drop(heads);
     let mut extracted = crate::implicit::xml::Extracted::default();
+    // The root's check reports unknown elements; only known ones go deeper.
+    let check_root = |found: &mut Diagnostics| {
+        doc::structure::check_element_heads(&root, &heads, &grammar::GEOMETRY, found);
+    };
+    if let Some(runs) = parsed.runs() {
+        let read = Reading {
+            extractor: &extractor,
+            builder: &mut builder,
+            extracted: &mut extracted,
+            diags,
+        };
+        read_runs(&runs, check_root, read)?;
+        return Ok((builder.finish(), extracted));
+    }
+    check_root(diags);
+    drop(heads);
     for element in parsed.top_level() {
-        let element = element?;
-        if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
-            doc::structure::check(&element, rule, diags);
-        }
-        if let Some(element) = extractor.take(element, &mut extracted) {
-            builder.add(&element, diags);
-        }
+        read_element(element?, &extractor, &mut builder, &mut extracted, diags);
     }
     Ok((builder.finish(), extracted))
 }
 
+/// Checks one top-level element and adds it to the document (or to what the
+/// implicit path takes); [`read_runs`] does the same in two steps.
+fn read_element<'s>(
+    element: syntax::Element<'s>,
+    extractor: &crate::implicit::xml::Extractor,
+    builder: &mut doc::DocumentBuilder,
+    extracted: &mut crate::implicit::xml::Extracted<'s>,
+    diags: &mut Diagnostics,
+) {
+    if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
+        doc::structure::check(&element, rule, diags);
+    }
+    if let Some(element) = extractor.take(element, extracted) {
+        builder.add(&element, diags);
+    }
+}
+
+/// Runs parsed ahead of the one being added to the document: enough to keep
+/// the rayon threads busy while the main thread adds, few enough that their
+/// element trees stay small (about 64 kB of text each).
+const RUNS_AHEAD: usize = 8;
+
+/// Where [`read_runs`] puts what it reads.
+struct Reading<'r, 'b, 's> {
+    extractor: &'r crate::implicit::xml::Extractor,
+    builder: &'r mut doc::DocumentBuilder<'b>,
+    extracted: &'r mut crate::implicit::xml::Extracted<'s>,
+    diags: &'r mut Diagnostics,
+}
+
+/// [`read_element`] for every element of a split file, as a pipeline: the
+/// rayon threads parse the runs and check their elements' structure (the
+/// larger part of reading), the main thread takes them in file order and
+/// builds the typed document. Everything the document keeps is allocated on
+/// the main thread, which frees it later (memory freed from another thread's
+/// heap waits there, and raised the peak); the elements it is done with go
+/// back to a rayon thread to be freed. The root's check (`check_root`) runs
+/// beside them, its findings put first. The findings come in the order of
+/// reading the file serially, for any number of threads.
+fn read_runs<'s>(
+    runs: &syntax::Runs<'_, 's>,
+    check_root: impl FnOnce(&mut Diagnostics) + Send,
+    read: Reading<'_, '_, 's>,
+) -> Result<(), syntax::Reparse> {
+    type Checked<'s> = Result<Vec<(syntax::Element<'s>, Diagnostics)>, syntax::Reparse>;
+    let checked = |i: usize| -> Checked<'s> {
+        let elements = runs.elements(i)?;
+        Ok(elements
+            .into_iter()
+            .map(|element| {
+                let mut found = Diagnostics::default();
+                if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
+                    doc::structure::check(&element, rule, &mut found);
+                }
+                (element, found)
+            })
+            .collect())
+    };
+    let Reading {
+        extractor,
+        builder,
+        extracted,
+        diags,
+    } = read;
+    let root_findings_at = diags.items.len();
+    // A job's panic travels to this thread, which is waiting for its result.
+    let (root_sender, root_receiver) = std::sync::mpsc::channel();
+    let (sender, receiver) =
+        std::sync::mpsc::channel::<(usize, std::thread::Result<Checked<'s>>)>();
+    rayon::in_place_scope(|scope| {
+        scope.spawn(move |_| {
+            let found = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                let mut found = Diagnostics::default();
+                check_root(&mut found);
+                found
+            }));
+            drop(root_sender.send(found));
+        });
+        let spawn = |i: usize| {
+            let (sender, checked) = (sender.clone(), &checked);
+            scope.spawn(move |_| {
+                let run = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| checked(i)));
+                // The receiver is gone only when reading stopped at a Reparse.
+                drop(sender.send((i, run)));
+            });
+        };
+        (0..runs.len().min(RUNS_AHEAD)).for_each(spawn);
+        let mut arrived = std::collections::BTreeMap::new();
+        for next in 0..runs.len() {
+            let run = loop {
+                if let Some(run) = arrived.remove(&next) {
+                    break run;
+                }
+                let (i, run) = wait_for(&receiver)?;
+                arrived.insert(i, run);
+            };
+            if next + RUNS_AHEAD < runs.len() {
+                spawn(next + RUNS_AHEAD);
+            }
+            let run = run.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
+            let mut done = Vec::with_capacity(run.len());
+            for (element, found) in run {
+                diags.extend(found);
+                if let Some(element) = extractor.take(element, extracted) {
+                    builder.add(&element, diags);
+                    done.push(element);
+                }
+            }
+            scope.spawn(move |_| drop(done));
+        }
+        let root = wait_for(&root_receiver)?;
+        let root = root.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
+        diags
+            .items
+            .splice(root_findings_at..root_findings_at, root.items);
+        Ok(())
+    })
+}
+
+/// The next message of a job of [`read_runs`]. On a rayon thread (the driver
+/// called inside a caller's pool) it runs the pool's pending jobs, its own
+/// among them, instead of blocking: a pool of one thread would wait forever.
+fn wait_for<T>(receiver: &std::sync::mpsc::Receiver<T>) -> Result<T, syntax::Reparse> {
+    loop {
+        match receiver.try_recv() {
+            Ok(message) => return Ok(message),
+            Err(std::sync::mpsc::TryRecvError::Empty) => {
+                if !matches!(rayon::yield_now(), Some(rayon::Yield::Executed)) {
+                    // Nothing pending: the job is running on another thread.
+                    return receiver.recv().map_err(|_| syntax::Reparse);
+                }
+            }
+            Err(std::sync::mpsc::TryRecvError::Disconnected) => return Err(syntax::Reparse),
+        }
+    }
+}
+
 fn release(options: &Options) {
     if let Some(release) = options.release_memory {
+        // The runs are read on the rayon threads, so much of what was just
+        // freed lies in their heaps, which only they can hand back.
+        rayon::broadcast(|_| release());
         release();
     }
 }
@@ -431,5 +578,68 @@ fn check_domain(
                     .with_help("name faces on the boundary of a subdomain; faces made interior by a union bound nothing"),
             );
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// `count` spheres, each a subdomain; every 7th has an unknown attribute
+    /// (E111, a structure finding), every 11th a malformed radius (a document
+    /// finding) and every 13th repeats an earlier name (E201, resolution); an
+    /// unknown element halfway is the root's finding.
+    /// `tail` goes right before the root's end tag.
+    fn spheres(count: usize, tail: &str) -> String {
+        let mut xml = String::from("<geometry version=\"1\">\n");
+        for i in 0..count {
+            let name = if i % 13 == 12 { i - 1 } else { i };
+            let extra = if i % 7 == 0 { " colour=\"red\"" } else { "" };
+            let radius = if i % 11 == 0 { "0.3x" } else { "0.3" };
+            if i == count / 2 {
+                // The root's own check reports it (E110).
+                xml.push_str("  <spere name=\"typo\"/>\n");
+            }
+            xml.push_str(&format!(
+                "  <sphere name=\"s{name}\"{extra}><center x=\"{i}\" y=\"0\" z=\"0\"/><radius value=\"{radius}\"/></sphere>\n  <subdomain name=\"d{i}\"><solid ref=\"s{name}\"/></subdomain>\n"
+            ));
+        }
+        xml.push_str(tail);
+        xml.push_str("</geometry>\n");
+        xml
+    }
+
+    fn checked_with(threads: usize, text: &str) -> Diagnostics {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        let source = SourceFile::new("many.xml".to_string(), text.to_string());
+        pool.install(|| check_source(source, &Options::default()).diagnostics)
+    }
+
+    #[test]
+    fn runs_read_on_threads_give_the_whole_reads_diagnostics() {
+        let split = spheres(5_000, "");
+        let source = SourceFile::new("many.xml".to_string(), split.clone());
+        let parsed = syntax::parse_document(&source, &Limits::default()).expect("parses");
+        let runs = parsed.runs().expect("the file is read in runs").len();
+        assert!(runs > RUNS_AHEAD, "{runs} runs");
+        // A comment at the top level makes the file parse whole and read
+        // serially, with every span before it the same.
+        let whole = spheres(5_000, "  <!-- parsed whole -->\n");
+        let source = SourceFile::new("many.xml".to_string(), whole.clone());
+        let parsed = syntax::parse_document(&source, &Limits::default()).expect("parses");
+        assert!(parsed.runs().is_none());
+
+        let one = checked_with(1, &split);
+        let count = |code: Code| one.items.iter().filter(|d| d.code == code).count();
+        assert_eq!(count(Code::UnknownAttribute), 715);
+        assert_eq!(count(Code::DuplicateName), 384);
+        assert_eq!(count(Code::BadExpression), 455);
+        assert_eq!(count(Code::UnknownElement), 1);
+        assert_eq!(one.items, checked_with(3, &split).items);
+        assert_eq!(one.items, checked_with(1, &whole).items);
+        assert_eq!(one.items, checked_with(2, &whole).items);
     }
 }

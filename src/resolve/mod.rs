@@ -103,7 +103,17 @@ pub fn resolve(
     overrides: &[Override],
     diags: &mut Diagnostics,
 ) -> Resolved {
-    let names = std::rc::Rc::new(NameTable::build(source, doc, diags));
+    // The name table (with its findings) and the resolver's own tables side
+    // by side; the findings are reported first, as when built alone.
+    let ((names, found), tables) = rayon::join(
+        || {
+            let mut found = Diagnostics::default();
+            (NameTable::build(source, doc, &mut found), found)
+        },
+        || objects::Tables::build(doc),
+    );
+    diags.extend(found);
+    let names = std::rc::Rc::new(names);
     let pairs: Vec<(String, Expr)> = overrides
         .iter()
         .map(|o| (o.name.clone(), o.value.clone()))
@@ -133,7 +143,7 @@ pub fn resolve(
     values.other_names = std::rc::Rc::clone(&names);
     let parameters = values.evaluate_all(diags);
     check_basis_order(doc, &values, diags);
-    let mut resolver = objects::Resolver::new(doc, &names, values, diags);
+    let mut resolver = objects::Resolver::new(doc, &names, tables, values, diags);
     let objects = resolver.resolve_all();
     let subdomain_areas = doc
         .subdomains

@@ -34,14 +34,18 @@ pub(super) struct Resolver<'a> {
     state: Vec<Option<State>>,
 }
 
-impl<'a> Resolver<'a> {
-    pub fn new(
-        doc: &'a Document,
-        names: &'a NameTable<'a>,
-        values: Values<'a>,
-        diags: &'a mut Diagnostics,
-    ) -> Self {
-        let mut by_name = HashMap::new();
+/// The resolver's lookup tables of a document's objects and coordinate
+/// systems (the first of a repeated name), built apart from the name table:
+/// on large files both are hundreds of thousands of inserts, so the driver
+/// builds them side by side.
+pub(super) struct Tables<'a> {
+    by_name: HashMap<&'a str, usize>,
+    systems: HashMap<String, &'a CoordinateSystem>,
+}
+
+impl<'a> Tables<'a> {
+    pub fn build(doc: &'a Document) -> Tables<'a> {
+        let mut by_name = HashMap::with_capacity(doc.objects.len());
         for (i, o) in doc.objects.iter().enumerate() {
             by_name.entry(o.name.text.as_str()).or_insert(i);
         }
@@ -49,13 +53,25 @@ impl<'a> Resolver<'a> {
         for cs in &doc.coordinate_systems {
             systems.entry(cs.name.text.clone()).or_insert(cs);
         }
+        Tables { by_name, systems }
+    }
+}
+
+impl<'a> Resolver<'a> {
+    pub fn new(
+        doc: &'a Document,
+        names: &'a NameTable<'a>,
+        tables: Tables<'a>,
+        values: Values<'a>,
+        diags: &'a mut Diagnostics,
+    ) -> Self {
         Resolver {
             doc,
             names,
             values,
             diags,
-            by_name,
-            systems,
+            by_name: tables.by_name,
+            systems: tables.systems,
             frames: HashMap::new(),
             state: vec![None; doc.objects.len()],
         }

@@ -58,22 +58,7 @@ impl<'s> Split<'s> {
         }
         let root_name = name_at(text, root_start + 1)?;
         let root = parse_root(text, tag_end, root_name, limits)?;
-        let mut heads = Vec::new();
-        let mut children = Vec::new();
-        let mut pos = tag_end;
-        loop {
-            pos = skip_whitespace(bytes, pos);
-            match bytes.get(pos..pos + 2)? {
-                b"</" => break,
-                [b'<', c] if !matches!(c, b'!' | b'?') => {
-                    let end = element_end(bytes, pos)?;
-                    heads.push(scan_head(text, pos)?);
-                    children.push(pos..end);
-                    pos = end;
-                }
-                _ => return None,
-            }
-        }
+        let (heads, children, pos) = scan_children(text, tag_end, HALVES_FROM)?;
         let end = root_end(text, pos, root_name)?;
         let mut root = root;
         root.span = Span::new(root_start, end);
@@ -102,10 +87,24 @@ impl<'s> Split<'s> {
         }
     }
 
-    /// Parses the run of children starting at `first`; returns the index
-    /// after its last child.
-    fn parse_run(&self, first: usize, out: &mut VecDeque<Element<'s>>) -> Result<usize, Reparse> {
-        let start = self.children.get(first).ok_or(Reparse)?.start;
+    /// The index of the first child of every run, in order: the runs
+    /// [`Split::top_level`] parses one after another, so they can be parsed
+    /// apart (on other threads) and joined in this order.
+    pub fn run_starts(&self) -> Vec<usize> {
+        let mut starts = Vec::with_capacity(self.text.len() / RUN_BYTES + 1);
+        let mut first = 0;
+        while first < self.children.len() {
+            starts.push(first);
+            first = self.run_end(first);
+        }
+        starts
+    }
+
+    /// The index after the last child of the run starting at `first`.
+    fn run_end(&self, first: usize) -> usize {
+        let Some(start) = self.children.get(first).map(|c| c.start) else {
+            return first;
+        };
         let mut last = first;
         while let Some(next) = self.children.get(last + 1) {
             if next.end - start > RUN_BYTES {
@@ -113,6 +112,26 @@ impl<'s> Split<'s> {
             }
             last += 1;
         }
+        last + 1
+    }
+
+    /// The elements of the run starting at `first` (one of
+    /// [`Split::run_starts`]).
+    pub fn run(&self, first: usize) -> Result<Vec<Element<'s>>, Reparse> {
+        let mut elements = Vec::with_capacity(self.run_end(first) - first);
+        self.parse_run(first, &mut elements)?;
+        Ok(elements)
+    }
+
+    /// Parses the run of children starting at `first`; returns the index
+    /// after its last child.
+    fn parse_run(
+        &self,
+        first: usize,
+        out: &mut impl Extend<Element<'s>>,
+    ) -> Result<usize, Reparse> {
+        let start = self.children.get(first).ok_or(Reparse)?.start;
+        let last = self.run_end(first) - 1;
         let end = self.children.get(last).ok_or(Reparse)?.end;
         let piece = self.text.get(start..end).ok_or(Reparse)?;
         let mut buffer = String::with_capacity(OPEN.len() + piece.len() + CLOSE.len());
@@ -134,7 +153,7 @@ impl<'s> Split<'s> {
                 if self.heads.get(index) != Some(&element.head()) {
                     return Err(Reparse);
                 }
-                out.push_back(element);
+                out.extend(Some(element));
                 index += 1;
             } else if !node.text().is_some_and(|t| t.trim().is_empty()) {
                 return Err(Reparse);
@@ -145,6 +164,116 @@ impl<'s> Split<'s> {
         }
         Ok(index)
     }
+}
+
+/// Root contents from which the scan of the children runs in two halves
+/// side by side (below it a thread costs more than it saves).
+const HALVES_FROM: usize = 1 << 20;
+
+/// What a scan of the root's children found: their heads and extents, and
+/// where it stopped.
+struct Scanned<'s> {
+    heads: Vec<Head<'s>>,
+    children: Vec<Range<usize>>,
+    /// At the root's end tag (`</`), or at `stop` when the scan was told to.
+    at: usize,
+    ended: bool,
+}
+
+/// The heads and extents of the root's children from `from` (where a child
+/// may start) up to the root's end tag, and that tag's position. Between two
+/// children the scan's only state is its position, so when the contents are
+/// at least `halves_from` bytes long a second scan starts at a child's start
+/// guessed in the middle, beside the first: if the first arrives exactly
+/// there, the halves join; if it passes it (the guess was inside a child), it
+/// goes on alone. The result is that of one scan from `from` either way.
+fn scan_children(
+    text: &str,
+    from: usize,
+    halves_from: usize,
+) -> Option<(Vec<Head<'_>>, Vec<Range<usize>>, usize)> {
+    let guess = (text.len() - from >= halves_from)
+        .then(|| guess_child_start(text.as_bytes(), from + (text.len() - from) / 2))
+        .flatten();
+    match guess {
+        Some(middle) => scan_halves(text, from, middle),
+        None => {
+            let whole = scan_from(text, from, usize::MAX)?;
+            Some((whole.heads, whole.children, whole.at))
+        }
+    }
+}
+
+/// [`scan_children`] in two halves, the second from `middle`.
+fn scan_halves(
+    text: &str,
+    from: usize,
+    middle: usize,
+) -> Option<(Vec<Head<'_>>, Vec<Range<usize>>, usize)> {
+    let (first, second) = rayon::join(
+        || scan_from(text, from, middle),
+        || scan_from(text, middle, usize::MAX),
+    );
+    let mut first = first?;
+    let rest = match second {
+        _ if first.ended => return Some((first.heads, first.children, first.at)),
+        Some(second) if first.at == middle => second,
+        _ => scan_from(text, first.at, usize::MAX)?,
+    };
+    first.heads.extend(rest.heads);
+    first.children.extend(rest.children);
+    Some((first.heads, first.children, rest.at))
+}
+
+/// The first `<` at or after `pos` that follows whitespace and starts a name:
+/// maybe a child of the root (checked by the scan arriving there).
+fn guess_child_start(bytes: &[u8], mut pos: usize) -> Option<usize> {
+    loop {
+        pos += memchr::memchr(b'<', bytes.get(pos..)?)?;
+        let before = bytes.get(pos.checked_sub(1)?)?;
+        let after = bytes.get(pos + 1)?;
+        if before.is_ascii_whitespace() && (after.is_ascii_alphabetic() || *after == b'_') {
+            return Some(pos);
+        }
+        pos += 1;
+    }
+}
+
+/// Scans children from `pos` until the root's end tag, or until a child
+/// would start at or after `stop`; `None` where the file must be parsed whole.
+fn scan_from(text: &str, mut pos: usize, stop: usize) -> Option<Scanned<'_>> {
+    let bytes = text.as_bytes();
+    let mut heads = Vec::new();
+    let mut children = Vec::new();
+    loop {
+        pos = skip_whitespace(bytes, pos);
+        if pos >= stop {
+            break;
+        }
+        match bytes.get(pos..pos + 2)? {
+            b"</" => {
+                return Some(Scanned {
+                    heads,
+                    children,
+                    at: pos,
+                    ended: true,
+                });
+            }
+            [b'<', c] if !matches!(c, b'!' | b'?') => {
+                let end = element_end(bytes, pos)?;
+                heads.push(scan_head(text, pos)?);
+                children.push(pos..end);
+                pos = end;
+            }
+            _ => return None,
+        }
+    }
+    Some(Scanned {
+        heads,
+        children,
+        at: pos,
+        ended: false,
+    })
 }
 
 /// The root's children, each built whole when the iterator reaches it (a run
@@ -425,6 +554,36 @@ mod tests {
         assert_eq!(children.len(), 5000);
         assert_eq!(children, whole_children(&text));
         assert_eq!(children[4999].attributes[0].value, "s4999");
+    }
+
+    #[test]
+    fn scans_in_halves_find_what_one_scan_finds() {
+        // Children with nested elements on lines of their own: a guessed
+        // middle may be a child's start or lie inside a child.
+        let mut text = String::from("<geometry>");
+        for i in 0..300 {
+            text.push_str(&format!("\n <transform name=\"t{i}\">"));
+            for j in 0..i % 4 {
+                text.push_str(&format!("\n  <shift x=\"{j}\"/>"));
+            }
+            text.push_str("\n </transform>");
+        }
+        text.push_str("\n</geometry>");
+        let from = "<geometry>".len();
+        let one = scan_children(&text, from, usize::MAX).expect("scans");
+        assert_eq!(one.0.len(), 300);
+        assert_eq!(one.0[299].name_attribute, Some("t299"));
+        assert_eq!(one.2, text.len() - "</geometry>".len());
+        let mut kinds = std::collections::BTreeSet::new();
+        for at in from..text.len() {
+            let Some(middle) = guess_child_start(text.as_bytes(), at) else {
+                continue;
+            };
+            kinds.insert(one.1.iter().any(|c| c.start == middle));
+            assert_eq!(scan_halves(&text, from, middle).as_ref(), Some(&one));
+        }
+        assert_eq!(kinds, [false, true].into());
+        assert_eq!(scan_children(&text, from, 0), Some(one));
     }
 
     #[test]
