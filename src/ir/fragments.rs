@@ -3,7 +3,7 @@
 //! belong to its outer boundary Γ_{k,0}.
 
 use super::{Dimension, EdgeId, FaceId, Model, SubdomainCells, SubdomainId};
-use std::collections::{BTreeMap, BTreeSet};
+use std::collections::BTreeMap;
 
 /// The other side of a fragment.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, serde::Serialize)]
@@ -62,10 +62,10 @@ pub fn derive_fragments(model: &Model) -> Vec<Fragment> {
     // Grouped first by the user's name, or none for the default name: a
     // name string per face (edge) was most of this on a 10,000-edge polygon.
     let mut by_pair: BTreeMap<(SubdomainId, Side, Option<&str>), Vec<u32>> = BTreeMap::new();
-    for (id, subdomains) in sides {
-        let (k, other) = match subdomains[..] {
-            [k] => (k, Side::Exterior),
-            [k, k2] => (k, Side::Subdomain(k2)),
+    for (id, sides) in (0u32..).zip(&sides) {
+        let (k, other) = match sides.pair() {
+            Some(&[k]) => (k, Side::Exterior),
+            Some(&[k, k2]) => (k, Side::Subdomain(k2)),
             _ => continue,
         };
         let name = names.get(&id).copied();
@@ -108,59 +108,97 @@ pub fn derive_fragments(model: &Model) -> Vec<Fragment> {
         .collect()
 }
 
-/// Adds subdomain k to a face's (edge's) sides: subdomains come in
-/// ascending order, so the list stays sorted and without repeats (a `Vec`
-/// rather than a set: one allocation fewer per face or edge).
-fn push_side(sides: &mut Vec<SubdomainId>, k: SubdomainId) {
-    if sides.last() != Some(&k) {
-        sides.push(k);
+/// The subdomains on the sides of one face (edge): the first two, in
+/// ascending order, and how many there are. Fixed size, kept in a table
+/// indexed by face (edge): a map with a list per edge was a third of this
+/// function on a 10,000-edge polygon.
+#[derive(Clone, Copy)]
+struct Sides {
+    first: [SubdomainId; 2],
+    count: usize,
+}
+
+impl Sides {
+    const NONE: Sides = Sides {
+        first: [SubdomainId(0); 2],
+        count: 0,
+    };
+
+    /// Adds subdomain k: subdomains come in ascending order, so a repeat is
+    /// the last one added.
+    fn push(&mut self, k: SubdomainId) {
+        if self.count > 0 && self.first[(self.count - 1).min(1)] == k {
+            return;
+        }
+        if let Some(slot) = self.first.get_mut(self.count) {
+            *slot = k;
+        }
+        self.count += 1;
+    }
+
+    /// The lone subdomain or the pair; `None` for no side or more than two.
+    fn pair(&self) -> Option<&[SubdomainId]> {
+        self.first.get(..self.count)
     }
 }
 
-/// For every face, the subdomains whose Volume boundary lists it (sorted).
-fn face_sides(model: &Model) -> BTreeMap<u32, Vec<SubdomainId>> {
-    let mut sides: BTreeMap<u32, Vec<SubdomainId>> = BTreeMap::new();
+/// For every face (by index), the subdomains whose Volume boundary lists it.
+fn face_sides(model: &Model) -> Vec<Sides> {
+    let mut sides = vec![Sides::NONE; model.faces.len()];
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         if let SubdomainCells::Volume { boundary } = &subdomain.cells {
-            for of in boundary
-                .iter()
-                .filter(|of| of.face.index() < model.faces.len())
-            {
-                push_side(sides.entry(of.face.0).or_default(), SubdomainId(k as u32));
+            for of in boundary {
+                if let Some(slot) = sides.get_mut(of.face.index()) {
+                    slot.push(SubdomainId(k as u32));
+                }
             }
         }
     }
     sides
 }
 
-/// For every edge, the region subdomains it bounds (sorted). An edge lies on region
-/// k's boundary when exactly one face of k uses it; one shared by two faces
-/// of k is inside k and bounds nothing.
-fn edge_sides(model: &Model) -> BTreeMap<u32, Vec<SubdomainId>> {
-    let mut sides: BTreeMap<u32, Vec<SubdomainId>> = BTreeMap::new();
+/// For every edge (by index), the region subdomains it bounds. An edge lies
+/// on region k's boundary when exactly one face of k uses it; one shared by
+/// two faces of k is inside k and bounds nothing.
+fn edge_sides(model: &Model) -> Vec<Sides> {
+    let mut sides = vec![Sides::NONE; model.edges.len()];
+    // Per edge: the faces of the current subdomain using it, and the last
+    // face that counted it (a face using an edge twice counts once).
+    let mut uses = vec![0usize; model.edges.len()];
+    let mut counted_by = vec![usize::MAX; model.edges.len()];
+    let mut touched: Vec<usize> = Vec::new();
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         let SubdomainCells::Region { faces } = &subdomain.cells else {
             continue;
         };
-        let mut uses: BTreeMap<u32, usize> = BTreeMap::new();
-        let distinct: BTreeSet<FaceId> = faces.iter().copied().collect();
-        for face in distinct.iter().filter_map(|f| model.faces.get(f.index())) {
-            let edges: BTreeSet<u32> = face
-                .loops
-                .iter()
-                .flatten()
-                .map(|oe| oe.edge.0)
-                .filter(|&e| (e as usize) < model.edges.len())
-                .collect();
-            for e in edges {
-                *uses.entry(e).or_default() += 1;
+        let mut distinct: Vec<usize> = faces.iter().map(|f| f.index()).collect();
+        distinct.sort_unstable();
+        distinct.dedup();
+        for f in distinct {
+            let Some(face) = model.faces.get(f) else {
+                continue;
+            };
+            for oe in face.loops.iter().flatten() {
+                let e = oe.edge.index();
+                if e < model.edges.len() && counted_by[e] != f {
+                    counted_by[e] = f;
+                    if uses[e] == 0 {
+                        touched.push(e);
+                    }
+                    uses[e] += 1;
+                }
             }
         }
-        for (e, n) in uses {
-            if n == 1 {
-                push_side(sides.entry(e).or_default(), SubdomainId(k as u32));
+        // In edge order, as the sides of each edge come in subdomain order.
+        touched.sort_unstable();
+        for &e in &touched {
+            if uses[e] == 1 {
+                sides[e].push(SubdomainId(k as u32));
             }
+            uses[e] = 0;
+            counted_by[e] = usize::MAX;
         }
+        touched.clear();
     }
     sides
 }

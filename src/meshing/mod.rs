@@ -200,9 +200,7 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
             )
         })
         .collect::<Result<Vec<EdgeNodes>, MeshError>>()?;
-    let edge_points: Vec<Vec<crate::geom::Point3>> =
-        edge_nodes.iter().map(|n| n.points.clone()).collect();
-    let sizing = size::Sizing::new(model, options.size_field.as_ref(), max_edge, &edge_points)?;
+    let sizing = size::Sizing::new(model, options.size_field.as_ref(), max_edge, &edge_nodes)?;
     for (nodes, edge) in edge_nodes.iter_mut().zip(&model.edges) {
         nodes.refine_to_size(&edge.curve(&model.solids), &sizing);
     }
@@ -230,7 +228,12 @@ pub fn mesh_model(model: &Model, options: &MeshOptions) -> Result<Mesh, MeshErro
         || {
             let mut mesh = assemble(model, &edge_nodes, face_meshes, &lines);
             // The face meshes are gone: the writers can have their pages.
-            crate::allocator::release_freed_memory();
+            // A small mesh freed too little to pay for a collection (a
+            // forced one was 3% of meshing a 10,000-sided polygon).
+            let triangles: usize = mesh.faces.iter().map(|f| f.triangles.len()).sum();
+            if triangles >= LARGE_FACE_TRIANGLES {
+                crate::allocator::release_freed_memory();
+            }
             refuse_collapsed(&mesh, tolerance)?;
             let first_trimmed = mesh.faces.len();
             trimmed::append(full, &mut mesh, tolerance, min_angle, max_edge)?;
@@ -291,12 +294,22 @@ fn mesh_faces(
     face_areas: &[f64],
     constraints: &constraints::Constraints,
 ) -> Result<Vec<Option<FaceMesh>>, MeshError> {
-    let mut faces_of_edge: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
-    for (f, face) in model.faces.iter().enumerate() {
-        for oe in face.loops.iter().flatten() {
-            faces_of_edge.entry(oe.edge.index()).or_default().push(f);
-        }
-    }
+    // The faces using each edge, found when a split first needs them (a
+    // map of lists built up front was 2% of meshing a 10,000-sided
+    // polygon, which never splits an edge).
+    let mut faces_of_edge: Option<BTreeMap<usize, Vec<usize>>> = None;
+    let faces_using = |faces_of_edge: &mut Option<BTreeMap<usize, Vec<usize>>>, edge: usize| {
+        let map = faces_of_edge.get_or_insert_with(|| {
+            let mut map: BTreeMap<usize, Vec<usize>> = BTreeMap::new();
+            for (f, face) in model.faces.iter().enumerate() {
+                for oe in face.loops.iter().flatten() {
+                    map.entry(oe.edge.index()).or_default().push(f);
+                }
+            }
+            map
+        });
+        map.get(&edge).cloned().unwrap_or_default()
+    };
     // A face without loops (an unbounded surface) gets no triangles, which
     // would leave a hole in any subdomain it bounds.
     for sub in &model.subdomains {
@@ -404,11 +417,8 @@ fn mesh_faces(
                     _ => None,
                 };
                 todo.extend(
-                    faces_of_edge
-                        .get(&edge)
+                    faces_using(&mut faces_of_edge, edge)
                         .into_iter()
-                        .flatten()
-                        .copied()
                         .filter(|&g| Some(g) != keeper),
                 );
             }

@@ -229,8 +229,11 @@ pub(super) fn refine(cdt: &mut Cdt, params: Params<'_>) -> Refined {
         // Unchanged since it was found bad (same slot generation): its
         // point is computed without checking it again (the surface check
         // is the costly half of that).
-        if let Some(point) = r.bad_triangle_point(r.cdt.face(face).positions()) {
-            r.split_triangle(face, point);
+        // One walk of the face for both its corners and their positions.
+        let vertices = r.cdt.face(face).vertices();
+        let corners = vertices.map(|v| v.fix());
+        if let Some(point) = r.bad_triangle_point(vertices.map(|v| v.position())) {
+            r.split_triangle(face, corners, point);
         }
     }
     Refined {
@@ -419,9 +422,10 @@ impl Refiner<'_, '_> {
         Some(Point2::new(o.x + dx, o.y + dy))
     }
 
-    /// Inserts `x` for the bad triangle `face`, unless it encroaches a
-    /// segment or lies beyond one: then those segments are split and the
-    /// triangle is tried again later.
+    /// Inserts `x` for the bad triangle `face` (corners `corners`,
+    /// counter-clockwise), unless it encroaches a segment or lies beyond
+    /// one: then those segments are split and the triangle is tried again
+    /// later.
     ///
     /// Triangle's way: `x` is inserted, and taken out again when its star
     /// has an encroached segment opposite it, does not hold `face` (a
@@ -429,10 +433,14 @@ impl Refiner<'_, '_> {
     /// first (`split_triangle_by_cavity`) and then letting spade insert
     /// found it twice: a third of the refinement's time on a
     /// 10,000-vertex polygon.
-    fn split_triangle(&mut self, face: FixedFaceHandle<InnerTag>, x: Point2<f64>) {
+    fn split_triangle(
+        &mut self,
+        face: FixedFaceHandle<InnerTag>,
+        corners: [FixedVertexHandle; 3],
+        x: Point2<f64>,
+    ) {
         let faces_before = self.cdt.num_all_faces();
         let before = self.cdt.num_vertices();
-        let corners = self.cdt.face(face).vertices().map(|v| v.fix());
         let v = match self.cdt.insert_with_hint(x, corners[0]) {
             Ok(v) if v.index() >= before => v,
             _ => {
@@ -448,6 +456,11 @@ impl Refiner<'_, '_> {
         // visible from it); slots it reuses were all in x's region.
         let (mut holds_face, mut outside, mut on_hull, mut on_segment) =
             (false, false, false, false);
+        // The star's triangles with their corners (x, then the edge
+        // opposite it), for queueing them when x stays: the walk around x
+        // is not made a second time (`after_insertion`).
+        let mut around = std::mem::take(&mut self.around);
+        around.clear();
         for e in self.cdt.vertex(v).out_edges() {
             on_segment |= e.is_constraint_edge();
             let Some(f) = e.face().as_inner() else {
@@ -459,19 +472,27 @@ impl Refiner<'_, '_> {
             outside |= slot < faces_before && self.outside[slot];
             star.push(f.fix());
             let next = e.next();
-            if next.is_constraint_edge() {
-                let (a, b) = (next.from(), next.to());
-                if self.encroaches(a.position(), b.position(), x) {
-                    self.encroached.push((a.fix(), b.fix()));
-                }
+            let (a, b) = (next.from(), next.to());
+            let (pa, pb) = (a.position(), b.position());
+            around.push((f.fix(), [x, pa, pb], false));
+            if next.is_constraint_edge() && self.encroaches(pa, pb, x) {
+                self.encroached.push((a.fix(), b.fix()));
             }
         }
         if holds_face && !outside && !on_hull && !on_segment && self.encroached.is_empty() {
             self.star = star;
-            // The segments opposite x were just checked against it.
-            self.after_insertion(v, Side::Inside { checked: true });
+            // Inside: the star's triangles are queued when bad, and the
+            // segments opposite x were just checked against it (what
+            // `after_insertion` does for `Side::Inside { checked: true }`).
+            for &(f, corners, _) in &around {
+                self.outside[f.index()] = false;
+                self.generation[f.index()] = self.generation[f.index()].wrapping_add(1);
+                self.push_triangle_at(f, corners);
+            }
+            self.around = around;
             return;
         }
+        self.around = around;
         // Take x out again: removing the last vertex moves no vertex, and
         // the face slots it frees or moves are all in its star (the two
         // slots the insertion added are the last ones).

@@ -20,6 +20,13 @@ pub(super) fn run_bounded<T: Send>(
     budget: u64,
     job: impl Fn(usize) -> T + Sync,
 ) -> Vec<(usize, T)> {
+    // One worker (a single face, or a one-thread pool): run on the calling
+    // thread. Handing a lone job to the pool cost a thread switch, woke the
+    // idle workers, and left the face's memory to be freed from another
+    // thread's heap during assembly.
+    if items.len() <= 1 || rayon::current_num_threads() <= 1 {
+        return items.iter().map(|&(key, _)| (key, job(key))).collect();
+    }
     // Heaviest first (ties by position: a fixed order, though only memory
     // depends on it).
     let mut order: Vec<usize> = (0..items.len()).collect();
@@ -120,6 +127,13 @@ mod tests {
             "{}",
             worst.load(Ordering::SeqCst)
         );
+    }
+
+    #[test]
+    fn a_lone_job_runs_on_the_calling_thread() {
+        let caller = std::thread::current().id();
+        let out = run_bounded(&[(7, 5)], 1, |key| (key * 3, std::thread::current().id()));
+        assert_eq!(out, vec![(7, (21, caller))]);
     }
 
     #[test]

@@ -68,7 +68,7 @@ impl Sizing {
         model: &Model,
         field: Option<&SizeField>,
         max_edge: f64,
-        edge_points: &[Vec<Point3>],
+        edge_nodes: &[super::edges::EdgeNodes],
     ) -> Result<Sizing, MeshError> {
         let Some(field) = field else {
             return Ok(Sizing::uniform(max_edge));
@@ -100,8 +100,8 @@ impl Sizing {
             edges.sort_unstable();
             edges.dedup();
             for e in edges {
-                if let Some(points) = edge_points.get(e) {
-                    segments.extend(points.windows(2).map(|w| (w[0], w[1])));
+                if let Some(nodes) = edge_nodes.get(e) {
+                    segments.extend(nodes.points.windows(2).map(|w| (w[0], w[1])));
                 }
             }
         }
