@@ -74,6 +74,27 @@ impl<K: DenseId, V: Copy + PartialEq> IdMap<K, V> {
         old
     }
 
+    /// Sets the value of ids `first..first + n`: the same as inserting each
+    /// in order, in one step when they are past every id set so far.
+    pub fn insert_range(&mut self, first: usize, n: usize, value: V) {
+        if n == 0 {
+            return;
+        }
+        if self.slots.len() > first {
+            for i in first..first + n {
+                self.insert(K::from_index(i), value);
+            }
+            return;
+        }
+        self.slots.resize(first, EMPTY);
+        if self.values.last() != Some(&value) {
+            self.values.push(value);
+        }
+        let slot = (self.values.len() - 1) as u32;
+        self.slots.resize(first + n, slot);
+        self.len += n;
+    }
+
     pub fn get(&self, id: &K) -> Option<&V> {
         match self.slots.get(id.index()) {
             Some(&slot) if slot != EMPTY => self.values.get(slot as usize),
