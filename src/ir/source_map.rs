@@ -74,6 +74,27 @@ impl<K: DenseId, V: Copy + PartialEq> IdMap<K, V> {
         old
     }
 
+    /// Sets the value of ids `first..first + n`: the same as inserting each
+    /// in order, in one step when they are past every id set so far.
+    pub fn insert_range(&mut self, first: usize, n: usize, value: V) {
+        if n == 0 {
+            return;
+        }
+        if self.slots.len() > first {
+            for i in first..first + n {
+                self.insert(K::from_index(i), value);
+            }
+            return;
+        }
+        self.slots.resize(first, EMPTY);
+        if self.values.last() != Some(&value) {
+            self.values.push(value);
+        }
+        let slot = (self.values.len() - 1) as u32;
+        self.slots.resize(first + n, slot);
+        self.len += n;
+    }
+
     pub fn get(&self, id: &K) -> Option<&V> {
         match self.slots.get(id.index()) {
             Some(&slot) if slot != EMPTY => self.values.get(slot as usize),
@@ -140,5 +161,43 @@ impl SourceMap {
     }
     pub fn solid(&self, id: SolidId) -> Option<Span> {
         self.solids.get(&id).map(|o| o.span)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn origin(k: usize) -> Origin {
+        Origin {
+            span: Span::new(k, k + 1),
+        }
+    }
+
+    /// `insert_range` against one `insert` per id, fresh ids and not.
+    #[test]
+    fn a_range_is_the_inserts_of_its_ids_in_order() {
+        let steps = [
+            (0, 3, 1),
+            (3, 0, 2),
+            (3, 2, 2),
+            (7, 1, 3),
+            (8, 4, 3),
+            (2, 3, 4),
+        ];
+        let (mut ranged, mut one_by_one) = (IdMap::default(), IdMap::default());
+        for (first, n, value) in steps {
+            ranged.insert_range(first, n, origin(value));
+            for id in first..first + n {
+                one_by_one.insert(VertexId(id as u32), origin(value));
+            }
+        }
+        let list = |m: &IdMap<VertexId, Origin>| m.iter().map(|(k, v)| (k, *v)).collect::<Vec<_>>();
+        assert_eq!(list(&ranged), list(&one_by_one));
+        assert_eq!((ranged.len(), ranged.values.len()), (10, 4));
+        assert_eq!(ranged.values, one_by_one.values);
+        assert_eq!(ranged.slots, one_by_one.slots);
+        assert_eq!(ranged.get(&VertexId(5)), None);
+        assert_eq!(ranged.get(&VertexId(3)), Some(&origin(4)));
     }
 }

@@ -24,9 +24,9 @@ pub struct BrepEdge {
 pub struct BrepFace {
     pub name: LocalName,
     pub surface: Surface,
-    /// Loops of (local edge index, forward), counter-clockwise about the
-    /// outward normal.
-    pub loops: Vec<Vec<(usize, bool)>>,
+    /// Its loops, as indices into `Brep::loop_ends` (read through
+    /// [`Brep::loops`]).
+    loops: std::ops::Range<usize>,
     /// A canonical point inside the face (its centre), for welding and classification.
     pub sample: Point3,
 }
@@ -34,25 +34,83 @@ pub struct BrepFace {
 /// A primitive's boundary. For 2D regions `faces` holds the single region
 /// face (normal along the frame's third column) and `boundary` lists the rim
 /// edges with `forward` = region on the left about that normal.
+///
+/// One `Brep` can be rebuilt for solid after solid ([`Brep::rebuild`]): its
+/// vectors keep their capacity and every face's loops share one list, so
+/// lowering a solid allocates nothing here (a fresh boundary took 5 to 15
+/// small vectors per solid).
+#[derive(Default)]
 pub struct Brep {
     pub vertices: Vec<BrepVertex>,
     pub edges: Vec<BrepEdge>,
     pub faces: Vec<BrepFace>,
     pub boundary: Vec<(usize, bool)>,
+    /// Every face's loops end to end: (local edge index, forward),
+    /// counter-clockwise about the outward normal.
+    loop_edges: Vec<(usize, bool)>,
+    /// The end of each loop in `loop_edges`.
+    loop_ends: Vec<usize>,
 }
 
 pub fn of(shape: &SolidShape) -> Brep {
-    match shape {
-        SolidShape::Box { frame } => parallelepiped(frame),
-        SolidShape::Ball { frame } => ball(frame),
-        SolidShape::Cone { frame, r0, r1 } => cone(frame, *r0, *r1),
-        SolidShape::Torus {
-            frame,
-            major,
-            minor,
-        } => torus(frame, *major, *minor),
-        SolidShape::Disk { frame } => disk(frame),
-        SolidShape::Polygon { frame, vertices } => polygon(frame, vertices),
+    let mut brep = Brep::default();
+    brep.rebuild(shape);
+    brep
+}
+
+impl Brep {
+    /// Makes this the boundary of `shape`, reusing the vectors.
+    pub fn rebuild(&mut self, shape: &SolidShape) {
+        self.vertices.clear();
+        self.edges.clear();
+        self.faces.clear();
+        self.boundary.clear();
+        self.loop_edges.clear();
+        self.loop_ends.clear();
+        match shape {
+            SolidShape::Box { frame } => self.parallelepiped(frame),
+            SolidShape::Ball { frame } => self.ball(frame),
+            SolidShape::Cone { frame, r0, r1 } => self.cone(frame, *r0, *r1),
+            SolidShape::Torus {
+                frame,
+                major,
+                minor,
+            } => self.torus(frame, *major, *minor),
+            SolidShape::Disk { frame } => self.disk(frame),
+            SolidShape::Polygon { frame, vertices } => self.polygon(frame, vertices, shape),
+        }
+    }
+
+    /// The loops of `face` (one of `self.faces`), in order.
+    pub fn loops<'b>(
+        &'b self,
+        face: &BrepFace,
+    ) -> impl ExactSizeIterator<Item = &'b [(usize, bool)]> + Clone + 'b {
+        face.loops.clone().map(move |i| {
+            let start = if i == 0 { 0 } else { self.loop_ends[i - 1] };
+            &self.loop_edges[start..self.loop_ends[i]]
+        })
+    }
+
+    /// Adds a face whose loops are `loops`.
+    fn add_face<L: IntoIterator<Item = (usize, bool)>>(
+        &mut self,
+        name: LocalName,
+        surface: Surface,
+        sample: Point3,
+        loops: impl IntoIterator<Item = L>,
+    ) {
+        let first = self.loop_ends.len();
+        for lp in loops {
+            self.loop_edges.extend(lp);
+            self.loop_ends.push(self.loop_edges.len());
+        }
+        self.faces.push(BrepFace {
+            name,
+            surface,
+            loops: first..self.loop_ends.len(),
+            sample,
+        });
     }
 }
 
@@ -175,217 +233,241 @@ const TOP: LocalName = named("top");
 const TOP_RIM: LocalName = named("top_rim");
 const TOP_SEAM: LocalName = named("top_seam");
 
-fn parallelepiped(frame: &Frame) -> Brep {
-    let corner = |i: usize, j: usize, k: usize| i + 2 * j + 4 * k;
-    let vertices = (0..8)
-        .map(|n| BrepVertex {
+/// The builders of each primitive's boundary, into an emptied `Brep`.
+impl Brep {
+    fn parallelepiped(&mut self, frame: &Frame) {
+        let corner = |i: usize, j: usize, k: usize| i + 2 * j + 4 * k;
+        self.vertices.extend((0..8).map(|n| BrepVertex {
             name: VERTEX_NAMES[n],
             position: box_corner(frame, n),
-        })
-        .collect::<Vec<_>>();
-    // Edges along axis `a` at fixed values of the other two axes.
-    // Edge (axis, s, t) is edges[4 * axis + 2 * s + t].
-    let mut edges = Vec::with_capacity(12);
-    for axis in 0..3 {
-        let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
-        let (lo, hi) = (p.min(q), p.max(q));
-        for (s, names) in EDGE_NAMES[axis].iter().enumerate() {
-            for (t, &name) in names.iter().enumerate() {
-                let mut at = [0usize; 3];
-                at[lo] = s;
-                at[hi] = t;
-                let begin = corner(at[0], at[1], at[2]);
-                at[axis] = 1;
-                let end = corner(at[0], at[1], at[2]);
-                debug_assert_eq!(box_edge_ends(edges.len()), (begin, end));
-                edges.push(BrepEdge {
-                    name,
-                    curve: Curve::Segment {
-                        a: vertices[begin].position,
-                        b: vertices[end].position,
-                    },
-                    begin,
-                    end,
-                });
-            }
-        }
-    }
-    let flip = mirrors(frame);
-    let mut faces = Vec::new();
-    for (axis, names) in FACE_NAMES.iter().enumerate() {
-        let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
-        for (side, &face_name) in names.iter().enumerate() {
-            // The four edges of the face axis = side, walked p-then-q, which is
-            // counter-clockwise about +axis; reversed on the min side.
-            let e = |along: usize, fixed_axis: usize, fixed: usize| {
-                // s belongs to the lower of the two fixed axes, t to the higher.
-                let (s, t) = if axis < fixed_axis {
-                    (side, fixed)
-                } else {
-                    (fixed, side)
-                };
-                4 * along + 2 * s + t
-            };
-            let mut ring = vec![
-                (e(p, q, 0), true),
-                (e(q, p, 1), true),
-                (e(p, q, 1), false),
-                (e(q, p, 0), false),
-            ];
-            if (side == 0) != flip {
-                ring.reverse();
-                for item in &mut ring {
-                    item.1 = !item.1;
+        }));
+        // Edges along axis `a` at fixed values of the other two axes.
+        // Edge (axis, s, t) is edges[4 * axis + 2 * s + t].
+        for axis in 0..3 {
+            let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
+            let (lo, hi) = (p.min(q), p.max(q));
+            for (s, names) in EDGE_NAMES[axis].iter().enumerate() {
+                for (t, &name) in names.iter().enumerate() {
+                    let mut at = [0usize; 3];
+                    at[lo] = s;
+                    at[hi] = t;
+                    let begin = corner(at[0], at[1], at[2]);
+                    at[axis] = 1;
+                    let end = corner(at[0], at[1], at[2]);
+                    debug_assert_eq!(box_edge_ends(self.edges.len()), (begin, end));
+                    let curve = Curve::Segment {
+                        a: self.vertices[begin].position,
+                        b: self.vertices[end].position,
+                    };
+                    self.edges.push(BrepEdge {
+                        name,
+                        curve,
+                        begin,
+                        end,
+                    });
                 }
             }
-            faces.push(BrepFace {
-                name: face_name,
-                surface: box_face(frame, axis, side),
-                loops: vec![ring],
-                sample: box_face_center(frame, axis, side),
-            });
+        }
+        let flip = mirrors(frame);
+        for (axis, names) in FACE_NAMES.iter().enumerate() {
+            let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
+            for (side, &face_name) in names.iter().enumerate() {
+                // The four edges of the face axis = side, walked p-then-q, which is
+                // counter-clockwise about +axis; reversed on the min side.
+                let e = |along: usize, fixed_axis: usize, fixed: usize| {
+                    // s belongs to the lower of the two fixed axes, t to the higher.
+                    let (s, t) = if axis < fixed_axis {
+                        (side, fixed)
+                    } else {
+                        (fixed, side)
+                    };
+                    4 * along + 2 * s + t
+                };
+                let mut ring = [
+                    (e(p, q, 0), true),
+                    (e(q, p, 1), true),
+                    (e(p, q, 1), false),
+                    (e(q, p, 0), false),
+                ];
+                if (side == 0) != flip {
+                    reverse(&mut ring);
+                }
+                self.add_face(
+                    face_name,
+                    box_face(frame, axis, side),
+                    box_face_center(frame, axis, side),
+                    [ring],
+                );
+            }
         }
     }
-    Brep {
-        vertices,
-        edges,
-        faces,
-        boundary: Vec::new(),
-    }
-}
 
-fn ball(frame: &Frame) -> Brep {
-    let flip = mirrors(frame);
-    let seam = frame.to_global(&Point3::new(1.0, 0.0, 0.0));
-    let surface = Surface::Ellipsoid { frame: *frame };
-    Brep {
-        vertices: vec![BrepVertex {
+    fn ball(&mut self, frame: &Frame) {
+        let flip = mirrors(frame);
+        self.vertices.push(BrepVertex {
             name: SEAM,
-            position: seam,
-        }],
-        edges: vec![BrepEdge {
+            position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)),
+        });
+        self.edges.push(BrepEdge {
             name: EQUATOR,
             curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
             begin: 0,
             end: 0,
-        }],
-        faces: vec![
-            BrepFace {
-                name: NORTH,
-                surface: surface.clone(),
-                loops: vec![vec![(0, !flip)]],
-                sample: frame.to_global(&Point3::new(0.0, 0.0, 1.0)),
-            },
-            BrepFace {
-                name: SOUTH,
-                surface,
-                loops: vec![vec![(0, flip)]],
-                sample: frame.to_global(&Point3::new(0.0, 0.0, -1.0)),
-            },
-        ],
-        boundary: Vec::new(),
+        });
+        let surface = Surface::Ellipsoid { frame: *frame };
+        let north = frame.to_global(&Point3::new(0.0, 0.0, 1.0));
+        self.add_face(NORTH, surface.clone(), north, [[(0, !flip)]]);
+        let south = frame.to_global(&Point3::new(0.0, 0.0, -1.0));
+        self.add_face(SOUTH, surface, south, [[(0, flip)]]);
     }
-}
 
-fn cone(frame: &Frame, r0: f64, r1: f64) -> Brep {
-    let flip = mirrors(frame);
-    let mut vertices = Vec::new();
-    let mut edges = Vec::new();
-    let mut faces = Vec::new();
-    let mut side_loops = Vec::new();
-    // The rims that exist, bottom first: their entities take the carriers'
-    // local indices in this order.
-    let names = |up: f64| {
-        if up < 0.0 {
-            (BOTTOM_SEAM, BOTTOM_RIM, BOTTOM)
-        } else {
-            (TOP_SEAM, TOP_RIM, TOP)
+    fn cone(&mut self, frame: &Frame, r0: f64, r1: f64) {
+        let flip = mirrors(frame);
+        // The side's loops: one per rim, at most two.
+        let mut side_loops = [(0, false); 2];
+        let mut rims = 0;
+        // The rims that exist, bottom first: their entities take the carriers'
+        // local indices in this order.
+        let names = |up: f64| {
+            if up < 0.0 {
+                (BOTTOM_SEAM, BOTTOM_RIM, BOTTOM)
+            } else {
+                (TOP_SEAM, TOP_RIM, TOP)
+            }
+        };
+        for (z, r, up) in cone_rims(r0, r1) {
+            let (vertex, rim, cap) = names(up);
+            let v = self.vertices.len();
+            self.vertices.push(BrepVertex {
+                name: vertex,
+                position: frame.to_global(&Point3::new(r, 0.0, z)),
+            });
+            let e = self.edges.len();
+            self.edges.push(BrepEdge {
+                name: rim,
+                curve: cone_rim(frame, z, r),
+                begin: v,
+                end: v,
+            });
+            // The cap's outward normal is ∓axis; the side meets the rim from the other side.
+            let cap_forward = (up > 0.0) != flip;
+            let center = frame.to_global(&Point3::new(0.0, 0.0, z));
+            self.add_face(cap, cone_cap(frame, z, up), center, [[(e, cap_forward)]]);
+            side_loops[rims] = (e, !cap_forward);
+            rims += 1;
         }
-    };
-    for (z, r, up) in cone_rims(r0, r1) {
-        let (vertex, rim, cap) = names(up);
-        let v = vertices.len();
-        vertices.push(BrepVertex {
-            name: vertex,
-            position: frame.to_global(&Point3::new(r, 0.0, z)),
-        });
-        let e = edges.len();
-        edges.push(BrepEdge {
-            name: rim,
-            curve: cone_rim(frame, z, r),
-            begin: v,
-            end: v,
-        });
-        // The cap's outward normal is ∓axis; the side meets the rim from the other side.
-        let cap_forward = (up > 0.0) != flip;
-        let center = frame.to_global(&Point3::new(0.0, 0.0, z));
-        faces.push(BrepFace {
-            name: cap,
-            surface: cone_cap(frame, z, up),
-            loops: vec![vec![(e, cap_forward)]],
-            sample: center,
-        });
-        side_loops.push(vec![(e, !cap_forward)]);
-    }
-    let mid_r = 0.5 * (r0 + r1);
-    faces.push(BrepFace {
-        name: SIDE,
-        surface: Surface::Cone {
+        let mid_r = 0.5 * (r0 + r1);
+        let surface = Surface::Cone {
             frame: *frame,
             r0,
             r1,
-        },
-        loops: side_loops,
-        sample: frame.to_global(&Point3::new(-mid_r, 0.0, 0.5)),
-    });
-    Brep {
-        vertices,
-        edges,
-        faces,
-        boundary: Vec::new(),
+        };
+        let sample = frame.to_global(&Point3::new(-mid_r, 0.0, 0.5));
+        let loops = side_loops[..rims].iter().map(|&item| [item]);
+        self.add_face(SIDE, surface, sample, loops);
+    }
+
+    fn torus(&mut self, frame: &Frame, major: f64, minor: f64) {
+        let flip = mirrors(frame);
+        let outer = major + minor;
+        let mut ring = [(0, true), (1, true), (0, false), (1, false)];
+        if flip {
+            reverse(&mut ring);
+        }
+        self.vertices.push(BrepVertex {
+            name: SEAM,
+            position: frame.to_global(&Point3::new(outer, 0.0, 0.0)),
+        });
+        self.edges.push(BrepEdge {
+            name: PARALLEL,
+            curve: torus_parallel(frame, major, minor),
+            begin: 0,
+            end: 0,
+        });
+        self.edges.push(BrepEdge {
+            name: MERIDIAN,
+            curve: torus_meridian(frame, major, minor),
+            begin: 0,
+            end: 0,
+        });
+        let surface = Surface::Torus {
+            frame: *frame,
+            major,
+            minor,
+        };
+        let sample = frame.to_global(&Point3::new(-(major + minor), 0.0, 0.0));
+        self.add_face(SURFACE, surface, sample, [ring]);
+    }
+
+    fn disk(&mut self, frame: &Frame) {
+        let center = frame.origin;
+        self.vertices.push(BrepVertex {
+            name: SEAM,
+            position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)),
+        });
+        self.edges.push(BrepEdge {
+            name: RIM,
+            curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
+            begin: 0,
+            end: 0,
+        });
+        let surface = Surface::Plane {
+            origin: center,
+            normal: region_normal(frame),
+        };
+        self.add_face(REGION, surface, center, [[(0, true)]]);
+        self.boundary.push((0, true));
+    }
+
+    /// A polygon's boundary: vertices v1…vn in the given order, edge ei from vi
+    /// to the next vertex, the loop counter-clockwise in local coordinates
+    /// (a clockwise vertex list is walked backwards). `shape` is the polygon.
+    fn polygon(&mut self, frame: &Frame, local: &[Point3], shape: &SolidShape) {
+        let n = local.len();
+        self.vertices.extend((0..n).map(|i| BrepVertex {
+            name: LocalName::Vertex(i as u32 + 1),
+            position: frame.to_global(&local[i]),
+        }));
+        for i in 0..n {
+            let j = (i + 1) % n;
+            let curve = Curve::Segment {
+                a: self.vertices[i].position,
+                b: self.vertices[j].position,
+            };
+            self.edges.push(BrepEdge {
+                name: LocalName::Edge(i as u32 + 1),
+                curve,
+                begin: i,
+                end: j,
+            });
+        }
+        let twice_area: f64 = (0..n)
+            .map(|i| {
+                let (v, w) = (local[i], local[(i + 1) % n]);
+                v.x * w.y - w.x * v.y
+            })
+            .sum();
+        if twice_area >= 0.0 {
+            self.boundary.extend((0..n).map(|i| (i, true)));
+        } else {
+            self.boundary.extend((0..n).rev().map(|i| (i, false)));
+        }
+        let sample = shape.interior_point();
+        let surface = Surface::Plane {
+            origin: sample,
+            normal: region_normal(frame),
+        };
+        let ring = std::mem::take(&mut self.boundary);
+        self.add_face(REGION, surface, sample, [ring.iter().copied()]);
+        self.boundary = ring;
     }
 }
 
-fn torus(frame: &Frame, major: f64, minor: f64) -> Brep {
-    let flip = mirrors(frame);
-    let outer = major + minor;
-    let mut ring = vec![(0, true), (1, true), (0, false), (1, false)];
-    if flip {
-        ring.reverse();
-        for item in &mut ring {
-            item.1 = !item.1;
-        }
-    }
-    Brep {
-        vertices: vec![BrepVertex {
-            name: SEAM,
-            position: frame.to_global(&Point3::new(outer, 0.0, 0.0)),
-        }],
-        edges: vec![
-            BrepEdge {
-                name: PARALLEL,
-                curve: torus_parallel(frame, major, minor),
-                begin: 0,
-                end: 0,
-            },
-            BrepEdge {
-                name: MERIDIAN,
-                curve: torus_meridian(frame, major, minor),
-                begin: 0,
-                end: 0,
-            },
-        ],
-        faces: vec![BrepFace {
-            name: SURFACE,
-            surface: Surface::Torus {
-                frame: *frame,
-                major,
-                minor,
-            },
-            loops: vec![ring],
-            sample: frame.to_global(&Point3::new(-(major + minor), 0.0, 0.0)),
-        }],
-        boundary: Vec::new(),
+/// A loop walked the other way: its edges in reverse order, each reversed.
+fn reverse(ring: &mut [(usize, bool)]) {
+    ring.reverse();
+    for item in ring {
+        item.1 = !item.1;
     }
 }
 
@@ -395,89 +477,6 @@ fn region_normal(frame: &Frame) -> Vec3 {
         n.normalize()
     } else {
         Vec3::z()
-    }
-}
-
-fn disk(frame: &Frame) -> Brep {
-    let center = frame.origin;
-    Brep {
-        vertices: vec![BrepVertex {
-            name: SEAM,
-            position: frame.to_global(&Point3::new(1.0, 0.0, 0.0)),
-        }],
-        edges: vec![BrepEdge {
-            name: RIM,
-            curve: ellipse(frame, Vec3::zeros(), Vec3::x(), Vec3::y()),
-            begin: 0,
-            end: 0,
-        }],
-        faces: vec![BrepFace {
-            name: REGION,
-            surface: Surface::Plane {
-                origin: center,
-                normal: region_normal(frame),
-            },
-            loops: vec![vec![(0, true)]],
-            sample: center,
-        }],
-        boundary: vec![(0, true)],
-    }
-}
-
-/// A polygon's boundary: vertices v1…vn in the given order, edge ei from vi
-/// to the next vertex, the loop counter-clockwise in local coordinates
-/// (a clockwise vertex list is walked backwards).
-fn polygon(frame: &Frame, local: &[Point3]) -> Brep {
-    let n = local.len();
-    let vertices: Vec<BrepVertex> = (0..n)
-        .map(|i| BrepVertex {
-            name: LocalName::Vertex(i as u32 + 1),
-            position: frame.to_global(&local[i]),
-        })
-        .collect();
-    let edges: Vec<BrepEdge> = (0..n)
-        .map(|i| {
-            let j = (i + 1) % n;
-            BrepEdge {
-                name: LocalName::Edge(i as u32 + 1),
-                curve: Curve::Segment {
-                    a: vertices[i].position,
-                    b: vertices[j].position,
-                },
-                begin: i,
-                end: j,
-            }
-        })
-        .collect();
-    let twice_area: f64 = (0..n)
-        .map(|i| {
-            let (v, w) = (local[i], local[(i + 1) % n]);
-            v.x * w.y - w.x * v.y
-        })
-        .sum();
-    let ring: Vec<(usize, bool)> = if twice_area >= 0.0 {
-        (0..n).map(|i| (i, true)).collect()
-    } else {
-        (0..n).rev().map(|i| (i, false)).collect()
-    };
-    let shape = SolidShape::Polygon {
-        frame: *frame,
-        vertices: local.to_vec(),
-    };
-    let sample = shape.interior_point();
-    Brep {
-        vertices,
-        edges,
-        faces: vec![BrepFace {
-            name: REGION,
-            surface: Surface::Plane {
-                origin: sample,
-                normal: region_normal(frame),
-            },
-            loops: vec![ring.clone()],
-            sample,
-        }],
-        boundary: ring,
     }
 }
 

@@ -8,6 +8,7 @@ mod brep;
 mod contour_straight;
 mod edge_parts;
 mod explicit;
+mod isolated;
 mod isolation;
 mod object_solids;
 mod point_calculus;
@@ -22,6 +23,7 @@ mod region_pairs;
 mod region_stretches;
 mod region_touch;
 mod region_touch_inside;
+mod reserved;
 pub mod rfunction_region;
 pub mod trimmed_topology;
 mod weld;
@@ -37,6 +39,7 @@ use crate::ir::{
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
 use foldhash::HashMap;
+use std::borrow::Cow;
 
 /// The model and its side table of source positions.
 #[derive(Debug, Clone)]
@@ -157,12 +160,16 @@ pub fn lower(
     if let Some(release) = release {
         release();
     }
-    let mut welder =
-        weld::Welder::with_capacity(model.tolerance, &shared, expected.faces, isolated);
+    let mut welder = weld::Welder::with_capacity(model.tolerance, &shared, expected.faces);
     point_calculus::report_unused_patches(resolved, diags);
 
+    // The primitive solids in lowering order (`isolation::solid_shapes`'s);
+    // everything else is lowered on the way.
+    let mut jobs = Vec::with_capacity(expected.solids);
     for object in &resolved.objects {
-        entities.solids.begin_object(model.solids.len());
+        entities
+            .solids
+            .begin_object(model.solids.len() + jobs.len());
         let Some(geometry) = &object.geometry else {
             entities.failed.insert(object.name.clone());
             continue;
@@ -170,31 +177,29 @@ pub fn lower(
         if edge_lines.contains(object.name.as_str()) {
             continue;
         }
+        let (map, span) = (&mut source_map, object.span);
         match geometry {
             Geometry::Group(members) => {
                 for (k, member) in members.iter().enumerate() {
-                    let name = format!("{}[{}]", object.name, k + 1);
-                    lower_free(
-                        &mut model,
-                        &mut source_map,
-                        &mut welder,
-                        &name,
-                        member,
-                        object.span,
-                    );
+                    let name = Cow::Owned(format!("{}[{}]", object.name, k + 1));
+                    add_object(&mut model, map, &mut jobs, name, member, span);
                 }
             }
-            g => lower_free(
+            g => add_object(
                 &mut model,
-                &mut source_map,
-                &mut welder,
-                &object.name,
+                map,
+                &mut jobs,
+                Cow::Borrowed(&object.name),
                 g,
-                object.span,
+                span,
             ),
         }
     }
-    entities.solids.begin_object(model.solids.len());
+    entities
+        .solids
+        .begin_object(model.solids.len() + jobs.len());
+    lower_solids(&mut model, &mut source_map, &mut welder, &jobs, &isolated);
+    drop((jobs, isolated));
     // Only the face samples outlive the welder: its tables (tens of megabytes
     // on large files) must not still be alive while subdomains are built.
     let face_samples = std::mem::take(&mut welder.face_samples);
@@ -202,8 +207,10 @@ pub fn lower(
     // Freed memory is otherwise kept by the allocator for reuse (about a
     // second): the welder's and isolation's tables would stay resident
     // through the subdomains, the memory peak on files of many solids.
+    // The workers, which lowered the isolated solids, free theirs too.
     if let Some(release) = release {
         release();
+        rayon::broadcast(|_| release());
     }
     explicit::lower_topology(resolved, &mut model, &mut source_map, &mut entities, diags);
     let named_lists =
@@ -310,10 +317,53 @@ fn tolerance(resolved: &Resolved) -> f64 {
     (1e-6 * bbox.diagonal()).max(1e-12)
 }
 
-fn lower_free(
+/// Queues a primitive solid for [`lower_solids`], or lowers anything else.
+fn add_object<'r>(
+    model: &mut Model,
+    source_map: &mut SourceMap,
+    jobs: &mut Vec<isolated::SolidJob<'r>>,
+    name: Cow<'r, str>,
+    geometry: &'r Geometry,
+    span: Span,
+) {
+    match geometry {
+        Geometry::Solid(shape) => jobs.push(isolated::SolidJob { name, shape, span }),
+        g => lower_free(model, source_map, &name, g, span),
+    }
+}
+
+/// Lowers the primitive solids in order: runs of isolated ones on the
+/// workers (`isolated.rs`), the others one by one through the welder.
+/// `isolated` holds, per job, whether its solid is isolated.
+fn lower_solids(
     model: &mut Model,
     source_map: &mut SourceMap,
     welder: &mut weld::Welder,
+    jobs: &[isolated::SolidJob],
+    isolated: &[bool],
+) {
+    debug_assert_eq!(jobs.len(), isolated.len());
+    let mut brep = brep::Brep::default();
+    let mut k = 0;
+    while k < jobs.len() {
+        let run = isolated[k..].iter().take_while(|&&i| i).count();
+        if run > 0 {
+            let grid = welder.grid();
+            let (samples, run_jobs) = (&mut welder.face_samples, &jobs[k..k + run]);
+            isolated::lower_run(model, source_map, samples, grid, run_jobs);
+            k += run;
+        } else {
+            let job = &jobs[k];
+            brep.rebuild(job.shape);
+            lower_solid(model, source_map, welder, &brep, job);
+            k += 1;
+        }
+    }
+}
+
+fn lower_free(
+    model: &mut Model,
+    source_map: &mut SourceMap,
     name: &str,
     geometry: &Geometry,
     span: Span,
@@ -336,24 +386,20 @@ fn lower_free(
             model.trimmed.push((**surface).clone());
             source_map.trimmed.push(span);
         }
-        Geometry::Solid(shape) => {
-            lower_solid(model, source_map, welder, name, shape, span);
-        }
         _ => {}
     }
 }
 
+/// Lowers a solid that may weld with others: `brep` is its boundary.
 fn lower_solid(
     model: &mut Model,
     source_map: &mut SourceMap,
     welder: &mut weld::Welder,
-    name: &str,
-    shape: &SolidShape,
-    span: Span,
+    brep: &brep::Brep,
+    job: &isolated::SolidJob,
 ) -> SolidId {
-    let origin = Origin { span };
-    let brep = brep::of(shape);
-    welder.begin_solid(model);
+    let (name, shape) = (job.name.as_ref(), job.shape);
+    let origin = Origin { span: job.span };
     // The solid comes first: its faces and edges make their carriers from its
     // shape (3D primitives; a 2D region's entities keep their own), and the
     // welder may read them while the solid is lowered.
@@ -384,7 +430,7 @@ fn lower_solid(
         .collect();
     let edge_ids: Vec<_> = brep
         .edges
-        .into_iter()
+        .iter()
         .enumerate()
         .map(|(local, e)| {
             let (id, flipped, new) = welder.edge(
@@ -415,17 +461,16 @@ fn lower_solid(
         }
     };
     let mut faces = Vec::with_capacity(brep.faces.len());
-    for (local, f) in brep.faces.into_iter().enumerate() {
-        let total = f.loops.iter().map(Vec::len).sum();
-        let loops =
-            Loops::from_nested(f.loops.iter().map(|l| l.iter().copied().map(orient)), total);
+    for (local, f) in brep.faces.iter().enumerate() {
+        let total = brep.loops(f).map(<[_]>::len).sum();
+        let loops = Loops::from_nested(brep.loops(f).map(|l| l.iter().copied().map(orient)), total);
         let first = loops.first().and_then(|l| l.first()).copied();
         let face = Face {
             name: EntityName::local(&base, f.name),
             carrier: if by_solid {
                 Carrier::primitive(id, local)
             } else {
-                Carrier::own(f.surface)
+                Carrier::own(f.surface.clone())
             },
             reversed: false,
             loops,

@@ -41,6 +41,16 @@ impl FaceSamples {
         (self.present.get(k) == Some(&true)).then(|| &self.points[k])
     }
 
+    /// The points of faces `first..first + n`, all present, for their
+    /// lowering to write (in parallel).
+    pub fn run(&mut self, first: usize, n: usize) -> &mut [Point3] {
+        self.points.resize(first, Point3::origin());
+        self.present.resize(first, false);
+        self.points.resize(first + n, Point3::origin());
+        self.present.resize(first + n, true);
+        &mut self.points[first..]
+    }
+
     pub fn insert(&mut self, face: FaceId, point: Point3) {
         let k = face.index();
         if self.points.len() <= k {
@@ -53,17 +63,10 @@ impl FaceSamples {
 }
 
 /// Chains of entity ids sharing a key: the map holds (first, last) of each
-/// chain, `next` links an id to the following one. Ids are at least `base`
-/// (`next` is indexed from there, so tables restarted per solid stay small).
-/// A table restarted per solid keeps its few entries in a list instead,
-/// scanned in push order: the same ids in the same order, without hashing
-/// into a map for every lookup of every entity of every isolated solid.
+/// chain, `next` links an id to the following one.
 struct Chains<K> {
     heads: FastMap<K, (u32, u32)>,
     next: Vec<u32>,
-    base: u32,
-    /// (key, id) in push order, once the table has been restarted.
-    listed: Option<Vec<(K, u32)>>,
 }
 
 impl<K> Default for Chains<K> {
@@ -71,8 +74,6 @@ impl<K> Default for Chains<K> {
         Chains {
             heads: FastMap::default(),
             next: Vec::new(),
-            base: 0,
-            listed: None,
         }
     }
 }
@@ -82,32 +83,17 @@ impl<K: Hash + Eq + Copy> Chains<K> {
         Chains {
             heads: FastMap::with_capacity_and_hasher(capacity, Default::default()),
             next: Vec::with_capacity(capacity),
-            base: 0,
-            listed: None,
         }
-    }
-
-    /// Empties the table, which from now on lists its entries; later ids
-    /// are at least `base`.
-    fn restart(&mut self, base: usize) {
-        self.heads.clear();
-        self.next.clear();
-        self.base = base as u32;
-        self.listed.get_or_insert_with(Vec::new).clear();
     }
 
     fn push(&mut self, key: K, id: u32) {
-        if let Some(listed) = &mut self.listed {
-            listed.push((key, id));
-            return;
-        }
-        let at = (id - self.base) as usize;
+        let at = id as usize;
         if self.next.len() <= at {
             self.next.resize(at + 1, NONE);
         }
         match self.heads.get_mut(&key) {
             Some((_, last)) => {
-                self.next[(*last - self.base) as usize] = id;
+                self.next[*last as usize] = id;
                 *last = id;
             }
             None => {
@@ -118,27 +104,15 @@ impl<K: Hash + Eq + Copy> Chains<K> {
 
     /// The ids under `key`, in the order they were pushed.
     fn iter(&self, key: &K) -> impl Iterator<Item = u32> + '_ {
-        let key = *key;
-        let listed = (self.listed.iter().flatten())
-            .filter(move |(k, _)| *k == key)
-            .map(|&(_, id)| id);
-        let mut at = match self.listed {
-            Some(_) => NONE,
-            None => self.heads.get(&key).map_or(NONE, |&(first, _)| first),
-        };
-        let chained = std::iter::from_fn(move || {
+        let mut at = self.heads.get(key).map_or(NONE, |&(first, _)| first);
+        std::iter::from_fn(move || {
             if at == NONE {
                 return None;
             }
             let id = at;
-            at = self
-                .next
-                .get((id - self.base) as usize)
-                .copied()
-                .unwrap_or(NONE);
+            at = self.next.get(id as usize).copied().unwrap_or(NONE);
             Some(id)
-        });
-        listed.chain(chained)
+        })
     }
 }
 
@@ -164,24 +138,15 @@ impl Tables {
     }
 }
 
+/// Welds the entities of solids that may weld with another solid's. An
+/// isolated solid (no other solid's entities within the tolerance) is welded
+/// on its own by `isolated::LocalWeld`, with the same rules: its entities
+/// can only match each other, so the tables here hold only the solids that
+/// can weld across (on large files of separate primitives, none).
 pub struct Welder {
     tol: f64,
     cell: f64,
-    /// Entities of solids that may weld with another solid's.
     shared: Tables,
-    /// Entities of the current solid when it is isolated (no other solid's
-    /// entities within the tolerance): restarted per solid, so the large
-    /// tables hold only the solids that can weld across (on large files of
-    /// separate primitives, none) and lookups stay in cache. The result is
-    /// the same as with one table set: an isolated solid's entities can only
-    /// match each other.
-    local: Tables,
-    /// Per solid, in lowering order: whether it is isolated.
-    isolated: Vec<bool>,
-    /// The next solid's index in `isolated`.
-    solid: usize,
-    /// Whether the current solid uses `local`.
-    in_local: bool,
     /// Canonical interior point of every face (welded faces: the first's).
     pub face_samples: FaceSamples,
     scratch: Vec<EdgeId>,
@@ -193,53 +158,27 @@ impl Welder {
             tol,
             cell: (tol * 4.0).max(f64::MIN_POSITIVE),
             shared: Tables::default(),
-            local: Tables::default(),
-            isolated: Vec::new(),
-            solid: 0,
-            in_local: false,
             face_samples: FaceSamples::default(),
             scratch: Vec::new(),
         }
     }
 
-    /// A welder whose shared tables are sized for `shared` entities (those
-    /// of solids that are not isolated), with `faces` faces expected in all.
-    /// `isolated`: per solid in lowering order, whether it is isolated.
-    pub(crate) fn with_capacity(
-        tol: f64,
-        shared: &super::Expected,
-        faces: usize,
-        isolated: Vec<bool>,
-    ) -> Welder {
+    /// A welder whose tables are sized for `shared` entities (those of
+    /// solids that are not isolated), with `faces` faces expected in all.
+    pub(crate) fn with_capacity(tol: f64, shared: &super::Expected, faces: usize) -> Welder {
         Welder {
             shared: Tables::with_capacity(shared),
             face_samples: FaceSamples::with_capacity(faces),
-            isolated,
             ..Welder::new(tol)
         }
     }
 
-    /// Called before each solid's entities are welded, in lowering order.
-    pub fn begin_solid(&mut self, model: &Model) {
-        self.in_local = self.isolated.get(self.solid).copied().unwrap_or(false);
-        self.solid += 1;
-        if self.in_local {
-            self.local.vertex_grid.restart(model.vertices.len());
-            self.local.edges_by_ends.restart(model.edges.len());
-            self.local.faces_by_edges.restart(model.faces.len());
+    /// The welding tolerance and grid cell.
+    pub(super) fn grid(&self) -> Grid {
+        Grid {
+            tol: self.tol,
+            cell: self.cell,
         }
-    }
-
-    fn tables(&mut self) -> &mut Tables {
-        if self.in_local {
-            &mut self.local
-        } else {
-            &mut self.shared
-        }
-    }
-
-    fn key(&self, p: &Point3) -> [i64; 3] {
-        [p.x, p.y, p.z].map(|c| (c / self.cell).floor() as i64)
     }
 
     /// The existing vertex within the tolerance of `position`, or a new one
@@ -250,36 +189,20 @@ impl Welder {
         name: impl FnOnce() -> EntityName,
         position: Point3,
     ) -> (VertexId, bool) {
-        let key = self.key(&position);
-        // Only cells that the tolerance ball around `position` reaches can
-        // hold a match; they are visited in the same order as the full 3×3×3
-        // neighbourhood, so the first match is the same.
-        let lo = self.key(&(position - crate::geom::Vec3::repeat(self.tol)));
-        let hi = self.key(&(position + crate::geom::Vec3::repeat(self.tol)));
-        let range =
-            |k: usize| lo[k].max(key[k].saturating_sub(1))..=hi[k].min(key[k].saturating_add(1));
-        let tables = if self.in_local {
-            &self.local
-        } else {
-            &self.shared
-        };
-        for x in range(0) {
-            for y in range(1) {
-                for z in range(2) {
-                    for id in tables.vertex_grid.iter(&cell_hash([x, y, z])) {
-                        if (model.vertices[id as usize].position - position).norm() <= self.tol {
-                            return (VertexId(id), false);
-                        }
-                    }
-                }
-            }
+        let grid = self.grid();
+        let found = grid.probe_cells(&position).find_map(|cell| {
+            (self.shared.vertex_grid.iter(&cell))
+                .find(|&id| (model.vertices[id as usize].position - position).norm() <= self.tol)
+        });
+        if let Some(id) = found {
+            return (VertexId(id), false);
         }
         let id = VertexId(model.vertices.len() as u32);
         model.vertices.push(Vertex {
             name: name(),
             position,
         });
-        self.tables().vertex_grid.push(cell_hash(key), id.0);
+        self.shared.vertex_grid.push(grid.cell_of(&position), id.0);
         (id, true)
     }
 
@@ -301,30 +224,13 @@ impl Welder {
             (end, begin)
         };
         let mut probes = None;
-        let tables = if self.in_local {
-            &self.local
-        } else {
-            &self.shared
-        };
-        for id in tables.edges_by_ends.iter(&key) {
+        for id in self.shared.edges_by_ends.iter(&key) {
             let probes = *probes.get_or_insert_with(|| probe_points(curve));
             let existing = &model.edges[id as usize];
             let theirs = probe_points(&existing.curve(&model.solids));
-            let same = probes
-                .iter()
-                .zip(&theirs)
-                .all(|(a, b)| (a - b).norm() <= self.tol);
-            let mut reversed_probes = probes;
-            reversed_probes.reverse();
-            let opposite = reversed_probes
-                .iter()
-                .zip(&theirs)
-                .all(|(a, b)| (a - b).norm() <= self.tol);
-            if same && (existing.begin == begin || begin == end) {
-                return (EdgeId(id), false, false);
-            }
-            if opposite && (existing.begin == end || begin == end) {
-                return (EdgeId(id), true, false);
+            let ends = (existing.begin, begin, end);
+            if let Some(flipped) = same_edge(&probes, &theirs, ends, self.tol) {
+                return (EdgeId(id), flipped, false);
             }
         }
         let id = EdgeId(model.edges.len() as u32);
@@ -334,7 +240,7 @@ impl Welder {
             begin,
             end,
         });
-        self.tables().edges_by_ends.push(key, id.0);
+        self.shared.edges_by_ends.push(key, id.0);
         (id, false, true)
     }
 
@@ -344,12 +250,7 @@ impl Welder {
 
         let key = foldhash::fast::FixedState::default().hash_one(&self.scratch);
         let mut theirs = Vec::new();
-        let tables = if self.in_local {
-            &self.local
-        } else {
-            &self.shared
-        };
-        for id in tables.faces_by_edges.iter(&key) {
+        for id in self.shared.faces_by_edges.iter(&key) {
             sorted_edges(&model.faces[id as usize], &mut theirs);
             if theirs != self.scratch {
                 continue;
@@ -362,7 +263,7 @@ impl Welder {
         }
         let id = FaceId(model.faces.len() as u32);
         model.faces.push(face);
-        self.tables().faces_by_edges.push(key, id.0);
+        self.shared.faces_by_edges.push(key, id.0);
         self.face_samples.insert(id, sample);
         (id, true)
     }
@@ -377,36 +278,68 @@ fn sorted_edges(face: &Face, out: &mut Vec<EdgeId>) {
 
 /// Points at s = 1/4, 1/2, 3/4: two curves with the same ends are the same
 /// curve when these agree (in order, or reversed for opposite directions).
-fn probe_points(curve: &Curve) -> [Point3; 3] {
+pub(super) fn probe_points(curve: &Curve) -> [Point3; 3] {
     [curve.point(0.25), curve.point(0.5), curve.point(0.75)]
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
+/// Whether a new edge from `begin` to `end` with probe points `probes` is an
+/// existing edge (starting at `existing_begin`, probe points `theirs`), and
+/// if so whether that edge runs the other way.
+pub(super) fn same_edge<V: PartialEq>(
+    probes: &[Point3; 3],
+    theirs: &[Point3; 3],
+    (existing_begin, begin, end): (V, V, V),
+    tol: f64,
+) -> Option<bool> {
+    let same = probes
+        .iter()
+        .zip(theirs)
+        .all(|(a, b)| (a - b).norm() <= tol);
+    let mut reversed_probes = *probes;
+    reversed_probes.reverse();
+    let opposite = reversed_probes
+        .iter()
+        .zip(theirs)
+        .all(|(a, b)| (a - b).norm() <= tol);
+    if same && (existing_begin == begin || begin == end) {
+        return Some(false);
+    }
+    if opposite && (existing_begin == end || begin == end) {
+        return Some(true);
+    }
+    None
+}
 
-    #[test]
-    fn a_listed_table_gives_the_ids_of_the_hashed_chains_in_push_order() {
-        let entries = [(7u64, 10u32), (3, 11), (7, 12), (9, 13), (7, 14), (3, 15)];
-        let mut hashed = Chains::with_capacity(8);
-        let mut listed = Chains::default();
-        listed.restart(10);
-        for (key, id) in entries {
-            hashed.push(key, id);
-            listed.push(key, id);
-        }
-        assert!(hashed.listed.is_none() && listed.listed.is_some());
-        for (key, ids) in [
-            (7, vec![10, 12, 14]),
-            (3, vec![11, 15]),
-            (9, vec![13]),
-            (5, vec![]),
-        ] {
-            assert_eq!(hashed.iter(&key).collect::<Vec<_>>(), ids);
-            assert_eq!(listed.iter(&key).collect::<Vec<_>>(), ids);
-        }
-        // Restarted, it is empty again.
-        listed.restart(16);
-        assert_eq!(listed.iter(&7).count(), 0);
+/// The vertex grid: cells of four tolerances, keyed by a hash of their
+/// integer coordinates.
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Grid {
+    pub tol: f64,
+    cell: f64,
+}
+
+impl Grid {
+    fn key(&self, p: &Point3) -> [i64; 3] {
+        [p.x, p.y, p.z].map(|c| (c / self.cell).floor() as i64)
+    }
+
+    /// The hashed cell of `p`.
+    pub fn cell_of(&self, p: &Point3) -> u64 {
+        cell_hash(self.key(p))
+    }
+
+    /// The hashed cells that can hold a vertex within the tolerance of
+    /// `position`: only those the tolerance ball reaches, visited in the same
+    /// order as the full 3×3×3 neighbourhood, so the first match is the same.
+    pub fn probe_cells(&self, position: &Point3) -> impl Iterator<Item = u64> {
+        let key = self.key(position);
+        let lo = self.key(&(position - crate::geom::Vec3::repeat(self.tol)));
+        let hi = self.key(&(position + crate::geom::Vec3::repeat(self.tol)));
+        let range = move |k: usize| {
+            lo[k].max(key[k].saturating_sub(1))..=hi[k].min(key[k].saturating_add(1))
+        };
+        range(0).flat_map(move |x| {
+            range(1).flat_map(move |y| range(2).map(move |z| cell_hash([x, y, z])))
+        })
     }
 }
