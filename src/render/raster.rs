@@ -296,16 +296,26 @@ fn draw(
     };
     let mut depth_plane: Option<(f32, f32, f32)> = None;
     let id = id as u64;
-    for sy in y_first..=sy1 {
-        let row = &mut rows[(sy as usize - y0) * width..][..width];
+    // The box lies in the band's rows (`sy1 < y1`) and the picture's columns
+    // (`sx1 < width`), so the sample loop indexes without a bounds check per
+    // sample, and with `while` loops instead of `RangeInclusive`: callgrind
+    // counted them at about 37 M of a render's 752 M instructions.
+    assert!((sy1 as usize - y0 + 1) * width <= rows.len() && (sx1 as usize) < width);
+    let mut sy = y_first;
+    while sy <= sy1 {
+        let base = (sy as usize - y0) * width;
         let mut e = e_row;
-        for sx in x_first..=sx1 {
+        let mut sx = x_first;
+        while sx <= sx1 {
             if (e[0] | e[1] | e[2]) >= 0 {
                 let (z_ref, dzdx, dzdy) = *depth_plane.get_or_insert_with(plane);
                 let zy = z_ref + dzdy * (sy - sy0) as f32;
                 let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
                 let value = ((depth.to_bits() as u64) << 32) | id;
-                let slot = &mut row[sx as usize];
+                // SAFETY: y_first <= sy <= sy1 and 0 <= x_first <= sx <= sx1,
+                // so the index is below (sy1 - y0 + 1) × width <= rows.len(),
+                // asserted above.
+                let slot = unsafe { rows.get_unchecked_mut(base + sx as usize) };
                 if value < *slot {
                     *slot = value;
                 }
@@ -313,7 +323,9 @@ fn draw(
             e[0] += step_x[0];
             e[1] += step_x[1];
             e[2] += step_x[2];
+            sx += 1;
         }
+        sy += 1;
         e_row[0] += step_y[0];
         e_row[1] += step_y[1];
         e_row[2] += step_y[2];
