@@ -1,7 +1,9 @@
-//! Byte ranges of an output file made and written by whichever threads are
-//! free: each range's bytes can be made from any offset in it (a converted
-//! copy of some values), so a range is cut into pieces at fixed file
-//! offsets, each made in a page-aligned buffer and written at its offset.
+//! Byte ranges of an output file made and written apart from the bytes
+//! written in order: each range's bytes can be made from any offset in it
+//! (a converted copy of some values), so a range is cut into pieces at
+//! fixed file offsets, each made in a page-aligned buffer and written at
+//! its offset, by the in-order writer's thread in step with its own writes
+//! or by a thread that is free ([`Pieces`]).
 //! A writer leaves these ranges out of what it writes in order
 //! ([`FileOutput::skip_to`](super::atomic::FileOutput::skip_to)).
 

@@ -21,8 +21,11 @@ pub(crate) struct Scanned {
     /// Per face: [`identity_prefix`] of its triangles.
     pub identity: Vec<Option<usize>>,
     /// The bounds of all nodes (`None` without nodes).
-    pub bounds: Option<([f64; 3], [f64; 3])>,
+    pub bounds: Option<Bounds>,
 }
+
+/// The smallest and the largest coordinates of some nodes.
+pub(crate) type Bounds = ([f64; 3], [f64; 3]);
 
 /// [`check`]; with `scan`, also each face's [`identity_prefix`] (from the
 /// pass that finds its largest index) and the nodes' bounds (from the pass
@@ -639,7 +642,7 @@ impl FirstUse {
 
 /// [`first_non_finite`] and the nodes' bounds, in one pass of parallel
 /// pieces (no bounds when a coordinate is not finite, or without nodes).
-fn nodes_scan(nodes: &[[f64; 3]]) -> (Option<usize>, Option<([f64; 3], [f64; 3])>) {
+fn nodes_scan(nodes: &[[f64; 3]]) -> (Option<usize>, Option<Bounds>) {
     const RUN: usize = 1024;
     type Run = (bool, [f64; 3], [f64; 3]);
     let empty: Run = (false, [f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
