@@ -5,7 +5,7 @@
 use super::{EXIT_INVALID, EXIT_OK, EXIT_USAGE, Format, out};
 use geomc::convert::{ConvertOptions, apply, inspect::MeshReport};
 use geomc::diag::{Code, Diagnostic, render_human};
-use geomc::formats::read::{ReadFormat, ReadLimits, load_mesh_limited, load_mesh_unchecked};
+use geomc::formats::read::{ReadFormat, ReadLimits, load_mesh_keeping_input, load_mesh_limited};
 use geomc::formats::{
     Encoding, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic, write_atomic_file,
     writer_for_path,
@@ -190,7 +190,7 @@ pub fn run(args: &Args) -> i32 {
         max_file_size: args.max_file_size,
         max_elements: args.max_mesh_elements,
     };
-    let (mut loaded, checked) = match load_mesh_unchecked(&args.input, from, &limits) {
+    let (mut loaded, checked, input) = match load_mesh_keeping_input(&args.input, from, &limits) {
         Ok(l) => l,
         Err(d) => return read_failed(&args.input, &d),
     };
@@ -221,6 +221,10 @@ pub fn run(args: &Args) -> i32 {
         && !loaded.mesh.volumes.is_empty()
         && loaded.mesh.faces.iter().all(|f| f.triangles.is_empty());
     let check_while_writing = !checked && options == ConvertOptions::default() && !volumes_only;
+    // The input's bytes: unmapped at once, or by the checks' thread once its
+    // counting is done (while the writer finishes; unmapping 96 MB took
+    // about 5 ms with both threads waiting).
+    let input = check_while_writing.then_some(input);
     if !checked && !check_while_writing {
         loaded.check();
     }
@@ -278,7 +282,11 @@ pub fn run(args: &Args) -> i32 {
     };
     let written = if check_while_writing {
         let (checks, written) = rayon::join(
-            || geomc::formats::read::clean::check_whole(&loaded.mesh),
+            || {
+                let counts = geomc::formats::read::clean::check_whole(&loaded.mesh);
+                drop(input);
+                counts
+            },
             || write(&args.output, writer, &loaded.mesh, &write_options),
         );
         report(&args.input, &checks.warnings());

@@ -79,11 +79,11 @@ impl MeshWriter for Gltf {
         if self.glb {
             return Ok(Vec::new());
         }
-        groups::check(mesh)?;
+        let scanned = groups::check_scanned(mesh, true)?;
         Ok(match bin_name(options) {
             Some(name) => vec![SideFile {
                 name,
-                bytes: Document::of(mesh, self.name()).buffer_bytes(),
+                bytes: Document::of(mesh, self.name(), &scanned).buffer_bytes(),
             }],
             None => Vec::new(),
         })
@@ -97,8 +97,8 @@ impl Gltf {
         mesh: &'m Mesh,
         options: &WriteOptions,
     ) -> Result<(Document<'m>, Vec<Warning>), WriteError> {
-        groups::check(mesh)?;
-        let doc = Document::of(mesh, self.name());
+        let scanned = groups::check_scanned(mesh, true)?;
+        let doc = Document::of(mesh, self.name(), &scanned);
         let mut warnings = doc.warnings.clone();
         warnings.extend(groups::dropped_volumes(self.name(), mesh));
         if options.encoding.is_some() {
@@ -290,7 +290,7 @@ struct Document<'a> {
 }
 
 impl<'a> Document<'a> {
-    fn of(mesh: &'a Mesh, format: &'static str) -> Document<'a> {
+    fn of(mesh: &'a Mesh, format: &'static str, scanned: &groups::Scanned) -> Document<'a> {
         let mut d = Document {
             mesh,
             nodes: Vec::new(),
@@ -303,7 +303,7 @@ impl<'a> Document<'a> {
             warnings: Vec::new(),
         };
         let mut empty = Vec::new();
-        let mut expander = groups::Expander::new(mesh);
+        let mut expander = groups::Expander::scanned(mesh, scanned);
 
         let mut children = Vec::new();
         for g in groups::surface_groups(mesh) {
@@ -626,10 +626,15 @@ const PARALLEL_FROM: usize = 4 << 20;
 /// [`write_glb`] into a file, the same bytes: when the buffer has at least
 /// `parallel_from` bytes, the parts that are copies of the mesh's values
 /// (positions and indices of a face as it is, other positions and
-/// indices) are made and written at their offsets by whichever thread is
-/// free, while this one writes the rest in order (normals, expanded
-/// groups) and skips over them. Beside `convert`'s surface checks, the
-/// checks' thread takes them once it is done.
+/// indices) are cut into pieces written at their offsets, while this
+/// thread writes the rest in order (normals, expanded groups) and skips
+/// over them. This thread takes the pieces in step with its own progress
+/// (a share of them after each run of normals), so they reach the file
+/// early and mostly from one thread at a time: written last by two threads
+/// at once, they waited on each other for the file (ext4 takes one write
+/// into a file at a time) and left most of the file to the final sync.
+/// A thread that is free (beside `convert`'s surface checks, the checks'
+/// thread once done) takes the pieces left.
 fn write_glb_file(
     json: &[u8],
     doc: &Document,
@@ -648,23 +653,58 @@ fn write_glb_file(
     write_glb_head(json, bin, out)?;
     let base = out.position();
     let (in_order, ranges) = doc.layout(base);
+    let pieces = file_ranges::Pieces::of(&ranges);
     let (ordered, ranged) = rayon::join(
         || -> std::io::Result<()> {
+            let mut pace = Pace {
+                pieces: &pieces,
+                parts: &parts,
+                total: in_order.iter().map(|(_, part)| part.byte_len()).sum(),
+                done: 0,
+                buffer: file_ranges::piece_buffer(),
+            };
             let mut block = Vec::with_capacity(BLOCK + 12);
             let mut expander = groups::Expander::new(doc.mesh);
             for (offset, part) in &in_order {
                 out.skip_to(*offset)?;
-                part.write(&mut expander, &mut block, out)?;
+                part.write(&mut expander, &mut block, out, &mut pace)?;
             }
+            pace.finish()?;
             out.skip_to(base + bin as u64)?;
             out.write_all(&[0u8; 3][..pad(bin)])
         },
-        || file_ranges::write_ranges(&parts, &ranges),
+        || pieces.write_rest(&parts),
     );
     drop(parts);
     ordered?;
     ranged?;
     Ok(())
+}
+
+/// [`write_glb_file`]'s share of the pieces for its own thread: after `n`
+/// of the `total` in-order bytes, the same fraction of the pieces.
+struct Pace<'p, 'r, 'a> {
+    pieces: &'p file_ranges::Pieces<'r, 'a>,
+    parts: &'p super::atomic::Parts,
+    total: usize,
+    done: usize,
+    buffer: Vec<u8>,
+}
+
+impl Pace<'_, '_, '_> {
+    /// `n` more in-order bytes are written: takes the pieces due by now.
+    fn wrote(&mut self, n: usize) -> std::io::Result<()> {
+        self.done += n;
+        let share = self.pieces.len() as u64 * self.done as u64 / self.total.max(1) as u64;
+        let due = usize::try_from(share).unwrap_or(usize::MAX);
+        self.pieces.write_until(self.parts, due, &mut self.buffer)
+    }
+
+    /// Takes every piece left.
+    fn finish(&mut self) -> std::io::Result<()> {
+        self.pieces
+            .write_until(self.parts, self.pieces.len(), &mut self.buffer)
+    }
 }
 
 /// What [`write_glb_file`]'s own thread writes, in order.
@@ -679,17 +719,29 @@ enum InOrder<'d> {
 }
 
 impl InOrder<'_> {
+    fn byte_len(&self) -> usize {
+        match self {
+            InOrder::Piece(piece) => piece.byte_len(),
+            InOrder::Normals { used, .. } => 12 * used,
+        }
+    }
+
     fn write(
         &self,
         expander: &mut groups::Expander,
         block: &mut Vec<u8>,
         out: &mut FileOutput,
+        pace: &mut Pace,
     ) -> std::io::Result<()> {
         match self {
-            InOrder::Piece(piece) => piece.write(expander, block, out),
+            InOrder::Piece(piece) => {
+                piece.write(expander, block, out)?;
+                pace.wrote(piece.byte_len())
+            }
             InOrder::Normals { triangles, used } => {
                 groups::emit_unit_normals(expander.mesh(), triangles, *used, &mut |run| {
-                    out.write_converted(run.as_flattened(), f32::to_le_bytes)
+                    out.write_converted(run.as_flattened(), f32::to_le_bytes)?;
+                    pace.wrote(12 * run.len())
                 })
             }
         }

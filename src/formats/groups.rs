@@ -11,6 +11,27 @@ use std::borrow::Cow;
 /// Rejects a mesh whose indices leave their tables or whose coordinates are
 /// not finite. After it, writers may index the mesh's tables directly.
 pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
+    check_scanned(mesh, false).map(|_| ())
+}
+
+/// What [`check_scanned`] learned on its way, for a writer that needs it:
+/// found in the same passes over the nodes and triangles as the checks.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub(crate) struct Scanned {
+    /// Per face: [`identity_prefix`] of its triangles.
+    pub identity: Vec<Option<usize>>,
+    /// The bounds of all nodes (`None` without nodes).
+    pub bounds: Option<Bounds>,
+}
+
+/// The smallest and the largest coordinates of some nodes.
+pub(crate) type Bounds = ([f64; 3], [f64; 3]);
+
+/// [`check`]; with `scan`, also each face's [`identity_prefix`] (from the
+/// pass that finds its largest index) and the nodes' bounds (from the pass
+/// that looks for a coordinate that is not finite), which the glTF writer
+/// needs: two passes over the mesh fewer than finding them after it.
+pub(crate) fn check_scanned(mesh: &Mesh, scan: bool) -> Result<Scanned, WriteError> {
     let bad = |what: String| Err(WriteError::InvalidMesh(what));
     if mesh.dimension != 2 && mesh.dimension != 3 {
         return bad(format!("dimension {} (2 or 3 expected)", mesh.dimension));
@@ -21,7 +42,15 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
             mesh.nodes.len()
         ));
     }
-    if let Some(i) = first_non_finite(&mesh.nodes) {
+    let mut scanned = Scanned::default();
+    let non_finite = if scan {
+        let (first, bounds) = nodes_scan(&mesh.nodes);
+        scanned.bounds = bounds;
+        first
+    } else {
+        first_non_finite(&mesh.nodes)
+    };
+    if let Some(i) = non_finite {
         return bad(format!("node {i} has a coordinate that is not finite"));
     }
     let n = mesh.nodes.len();
@@ -40,7 +69,13 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
         }
     }
     for f in &mesh.faces {
-        let largest = largest_index(&f.triangles);
+        let largest = if scan {
+            let order = FirstUse::of(&f.triangles);
+            scanned.identity.push(order.identity());
+            order.largest()
+        } else {
+            largest_index(&f.triangles)
+        };
         if !f.triangles.is_empty() && !node_ok(&largest) {
             return bad(format!("face `{}` refers to a node out of range", f.name));
         }
@@ -85,7 +120,7 @@ pub(crate) fn check(mesh: &Mesh) -> Result<(), WriteError> {
             return bad(format!("`{}` refers to a node out of range", p.name));
         }
     }
-    Ok(())
+    Ok(scanned)
 }
 
 /// What a group stands for.
@@ -290,6 +325,8 @@ pub(crate) struct Expander<'a> {
     /// Made on first use: the common single-face case needs none.
     slot: Vec<(u32, u32)>,
     stamp: u32,
+    /// What the mesh's check found, if it scanned ([`check_scanned`]).
+    scanned: Option<&'a Scanned>,
 }
 
 impl<'a> Expander<'a> {
@@ -298,6 +335,16 @@ impl<'a> Expander<'a> {
             mesh,
             slot: Vec::new(),
             stamp: 0,
+            scanned: None,
+        }
+    }
+
+    /// An expander that measures with what [`check_scanned`] found on
+    /// `mesh` instead of scanning again.
+    pub(crate) fn scanned(mesh: &'a Mesh, scanned: &'a Scanned) -> Expander<'a> {
+        Expander {
+            scanned: Some(scanned),
+            ..Expander::new(mesh)
         }
     }
 
@@ -340,21 +387,32 @@ impl<'a> Expander<'a> {
         };
         if let [(face, false)] = faces {
             let triangles = &mesh.faces[*face as usize].triangles;
-            if let Some(used) = identity_prefix(triangles) {
+            let identity = match self.scanned {
+                Some(s) => s.identity.get(*face as usize).copied().flatten(),
+                None => identity_prefix(triangles),
+            };
+            if let Some(used) = identity {
                 m.identity = Some(used);
                 m.vertices = used;
                 m.triangles = triangles.len();
                 // Bounds in `f64`, converted once: rounding to `f32` never
                 // changes the order of two values, so the converted bounds
                 // are the bounds of the converted values.
-                let mut lo = [f64::INFINITY; 3];
-                let mut hi = [f64::NEG_INFINITY; 3];
-                for p in &mesh.nodes[..used] {
-                    for k in 0..3 {
-                        lo[k] = lo[k].min(p[k]);
-                        hi[k] = hi[k].max(p[k]);
+                let all = self
+                    .scanned
+                    .and_then(|s| s.bounds)
+                    .filter(|_| used == mesh.nodes.len());
+                let (lo, hi) = all.unwrap_or_else(|| {
+                    let mut lo = [f64::INFINITY; 3];
+                    let mut hi = [f64::NEG_INFINITY; 3];
+                    for p in &mesh.nodes[..used] {
+                        for k in 0..3 {
+                            lo[k] = lo[k].min(p[k]);
+                            hi[k] = hi[k].max(p[k]);
+                        }
                     }
-                }
+                    (lo, hi)
+                });
                 if used > 0 {
                     m.lo = lo.map(|c| c as f32);
                     m.hi = hi.map(|c| c as f32);
@@ -492,55 +550,87 @@ impl<'a> Expander<'a> {
 
 /// `Some(k)` when the triangles use nodes `0..k` and each first appears after
 /// all smaller ones (the order the expansion would number them in): every
-/// index is at most one more than the largest before it. The indices are
-/// cut into [`LANES`] parts scanned side by side, each with its own largest
-/// index so far (one chain of dependent steps per part instead of one for
-/// all: the single chain was 80% of the writer's measuring pass); a part
-/// passes when its indices beyond its own largest so far are covered by
-/// the largest of the parts before it.
+/// index is at most one more than the largest before it. Parts of the
+/// indices are summed up on their own ([`FirstUse`]); a part passes when
+/// its indices beyond its own largest so far are covered by the largest
+/// of the parts before it.
 fn identity_prefix(triangles: &[[u32; 3]]) -> Option<usize> {
-    let values = triangles.as_flattened();
-    let part = values.len().div_ceil(LANES).max(1);
-    let mut lanes = [Lane::default(); LANES];
-    let mut parts = values.chunks(part);
-    let heads: [&[u32]; LANES] = std::array::from_fn(|_| parts.next().unwrap_or_default());
-    let together = heads.iter().map(|h| h.len()).min().unwrap_or(0);
-    let [a, b, c, d] = heads.map(|h| h.get(..together).unwrap_or_default());
-    for (((&a, &b), &c), &d) in a.iter().zip(b).zip(c).zip(d) {
-        for (lane, v) in lanes.iter_mut().zip([a, b, c, d]) {
-            lane.step(v);
-        }
-    }
-    for (lane, head) in lanes.iter_mut().zip(&heads) {
-        for &v in head.get(together..).unwrap_or_default() {
-            lane.step(v);
-        }
-    }
-    // `seen`: one more than the largest index before the part.
-    let mut seen = 0u64;
-    for lane in &lanes {
-        if lane.need > seen {
-            return None;
-        }
-        seen = seen.max(lane.top);
-    }
-    usize::try_from(seen).ok()
+    FirstUse::of(triangles).identity()
 }
 
-/// Parts [`identity_prefix`] scans side by side.
+/// Indices per parallel piece of [`FirstUse::of`].
+const FIRST_USE_PIECE: usize = 1 << 16;
+
+/// Parts [`FirstUse::piece`] scans side by side.
 const LANES: usize = 4;
 
-/// One part of [`identity_prefix`]'s scan.
+/// How some indices follow first-use order, summed up so that the
+/// summaries of consecutive parts combine ([`FirstUse::then`]).
 #[derive(Clone, Copy, Default)]
-struct Lane {
-    /// One more than the part's largest index so far (0: none yet).
+struct FirstUse {
+    /// One more than the largest index (0: none).
     top: u64,
-    /// The largest index that came before its turn within the part: the
-    /// parts before must reach it (0: none).
+    /// The largest index that came before its turn: the parts before must
+    /// reach it (0: none).
     need: u64,
 }
 
-impl Lane {
+impl FirstUse {
+    /// The summary of the triangles' indices, from parallel pieces.
+    fn of(triangles: &[[u32; 3]]) -> FirstUse {
+        triangles
+            .as_flattened()
+            .par_chunks(FIRST_USE_PIECE)
+            .map(FirstUse::piece)
+            .reduce(FirstUse::default, FirstUse::then)
+    }
+
+    /// The indices follow first-use order: `Some(k)`, they are `0..k`.
+    fn identity(self) -> Option<usize> {
+        if self.need > 0 {
+            return None;
+        }
+        usize::try_from(self.top).ok()
+    }
+
+    /// The largest index (0 when there is none).
+    fn largest(self) -> u32 {
+        u32::try_from(self.top.saturating_sub(1)).unwrap_or(u32::MAX)
+    }
+
+    /// This part, then `later`.
+    fn then(self, later: FirstUse) -> FirstUse {
+        let early = if later.need > self.top { later.need } else { 0 };
+        FirstUse {
+            top: self.top.max(later.top),
+            need: self.need.max(early),
+        }
+    }
+
+    /// One piece, cut into [`LANES`] parts scanned side by side, each with
+    /// its own largest index so far (one chain of dependent steps per part
+    /// instead of one for all: the single chain was 80% of the writer's
+    /// measuring pass).
+    fn piece(values: &[u32]) -> FirstUse {
+        let part = values.len().div_ceil(LANES).max(1);
+        let mut lanes = [FirstUse::default(); LANES];
+        let mut parts = values.chunks(part);
+        let heads: [&[u32]; LANES] = std::array::from_fn(|_| parts.next().unwrap_or_default());
+        let together = heads.iter().map(|h| h.len()).min().unwrap_or(0);
+        let [a, b, c, d] = heads.map(|h| h.get(..together).unwrap_or_default());
+        for (((&a, &b), &c), &d) in a.iter().zip(b).zip(c).zip(d) {
+            for (lane, v) in lanes.iter_mut().zip([a, b, c, d]) {
+                lane.step(v);
+            }
+        }
+        for (lane, head) in lanes.iter_mut().zip(&heads) {
+            for &v in head.get(together..).unwrap_or_default() {
+                lane.step(v);
+            }
+        }
+        lanes.into_iter().fold(FirstUse::default(), FirstUse::then)
+    }
+
     #[inline(always)]
     fn step(&mut self, v: u32) {
         let v = u64::from(v);
@@ -548,6 +638,40 @@ impl Lane {
         self.need = self.need.max(early);
         self.top = self.top.max(v + 1);
     }
+}
+
+/// [`first_non_finite`] and the nodes' bounds, in one pass of parallel
+/// pieces (no bounds when a coordinate is not finite, or without nodes).
+fn nodes_scan(nodes: &[[f64; 3]]) -> (Option<usize>, Option<Bounds>) {
+    const RUN: usize = 1024;
+    type Run = (bool, [f64; 3], [f64; 3]);
+    let empty: Run = (false, [f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let (bad, lo, hi) = nodes
+        .par_chunks(RUN)
+        .with_min_len(64)
+        .map(|run| {
+            run.iter().fold(empty, |(bad, lo, hi), p| {
+                (
+                    bad | !(p[0].is_finite() & p[1].is_finite() & p[2].is_finite()),
+                    std::array::from_fn(|k| lo[k].min(p[k])),
+                    std::array::from_fn(|k| hi[k].max(p[k])),
+                )
+            })
+        })
+        .reduce(
+            || empty,
+            |a, b| {
+                (
+                    a.0 | b.0,
+                    std::array::from_fn(|k| a.1[k].min(b.1[k])),
+                    std::array::from_fn(|k| a.2[k].max(b.2[k])),
+                )
+            },
+        );
+    if bad {
+        return (first_non_finite(nodes), None);
+    }
+    (None, (!nodes.is_empty()).then_some((lo, hi)))
 }
 
 /// The first node with a coordinate that is not finite. Runs of nodes are
@@ -984,6 +1108,104 @@ mod tests {
         late.push([0, 1, 2]);
         assert!(!windowed(&late));
         assert_eq!(check(&late).len(), ring.len());
+    }
+
+    /// The index-by-index first-use rule [`identity_prefix`] must agree with.
+    fn first_use_one_by_one(t: &[[u32; 3]]) -> Option<usize> {
+        let mut next = 0u32;
+        for &n in t.as_flattened() {
+            if n > next {
+                return None;
+            }
+            next += u32::from(n == next);
+        }
+        Some(next as usize)
+    }
+
+    /// Over several parallel pieces, an index moved at a piece's edge or
+    /// inside one gives the one-by-one answer, and the summary's largest
+    /// index is [`largest_index`]'s.
+    #[test]
+    fn first_use_over_many_pieces_is_the_one_by_one_rule() {
+        let n = FIRST_USE_PIECE as u32 + 5_000;
+        let strip: Vec<[u32; 3]> = (0..n).map(|i| [i, i + 1, i + 2]).collect();
+        assert_eq!(identity_prefix(&strip), Some(n as usize + 2));
+        assert_eq!(FirstUse::of(&strip).largest(), n + 1);
+        let values = 3 * n as usize;
+        let piece = FIRST_USE_PIECE;
+        for at in [piece - 1, piece, piece + 1, 2 * piece + 7, values - 1] {
+            for delta in [-3i64, 2, 3, 50_000] {
+                let mut t = strip.clone();
+                let slot = &mut t.as_flattened_mut()[at];
+                *slot = (i64::from(*slot) + delta).max(0) as u32;
+                let want = first_use_one_by_one(&t);
+                assert_eq!(identity_prefix(&t), want, "index {at} moved by {delta}");
+                assert_eq!(FirstUse::of(&t).largest(), largest_index(&t));
+            }
+        }
+        assert_eq!(FirstUse::of(&[]).largest(), 0);
+    }
+
+    /// One pass gives the first bad node as [`first_non_finite`] does, or
+    /// the nodes' bounds.
+    #[test]
+    fn nodes_scan_gives_the_bounds_or_the_first_bad_node() {
+        let mut nodes: Vec<[f64; 3]> = (0..5_000)
+            .map(|i| {
+                let x = f64::from(i);
+                [x.sin(), 2.0 * (0.3 * x).cos(), 1e-3 * x - 1.0]
+            })
+            .collect();
+        let (bad, bounds) = nodes_scan(&nodes);
+        assert_eq!(bad, None);
+        let (lo, hi) = bounds.expect("bounds");
+        for k in 0..3 {
+            let c = nodes.iter().map(|p| p[k]);
+            assert_eq!(lo[k], c.clone().fold(f64::INFINITY, f64::min));
+            assert_eq!(hi[k], c.fold(f64::NEG_INFINITY, f64::max));
+        }
+        assert_eq!(lo[2], -1.0);
+        assert_eq!(hi[2], 1e-3 * 4_999.0 - 1.0);
+        nodes[4_000][0] = f64::INFINITY;
+        nodes[3_100][2] = f64::NAN;
+        assert_eq!(nodes_scan(&nodes), (Some(3_100), None));
+        assert_eq!(nodes_scan(&[]), (None, None));
+    }
+
+    /// The scanning check finds each face's first-use prefix and the same
+    /// errors as the plain one.
+    #[test]
+    fn the_scanning_check_finds_each_faces_order() {
+        let face = |name: &str, triangles: Vec<[u32; 3]>| crate::mesh::MeshFace {
+            name: name.into(),
+            triangles,
+            boundary: Vec::new(),
+        };
+        let mut mesh = Mesh {
+            dimension: 3,
+            nodes: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, 0.0, 0.0],
+                [0.0, 1.0, 2.0],
+                [1.0, 1.0, 0.5],
+            ],
+            faces: vec![
+                face("in order", vec![[0, 1, 2], [2, 1, 3]]),
+                face("out of order", vec![[0, 2, 1]]),
+            ],
+            ..Mesh::default()
+        };
+        let scanned = check_scanned(&mesh, true).expect("a valid mesh");
+        assert_eq!(scanned.identity, vec![Some(4), None]);
+        assert_eq!(scanned.bounds, Some(([0.0, 0.0, 0.0], [1.0, 1.0, 2.0])));
+        mesh.faces[1].triangles.push([0, 1, 4]);
+        let plain = check(&mesh).map_err(|e| e.to_string());
+        let scanning = check_scanned(&mesh, true).map_err(|e| e.to_string());
+        assert_eq!(scanning, plain.clone().map(|_| Scanned::default()));
+        assert_eq!(
+            plain,
+            Err("invalid mesh: face `out of order` refers to a node out of range".into())
+        );
     }
 
     #[test]

@@ -189,12 +189,41 @@ pub fn load_mesh_unchecked(
     format: Option<ReadFormat>,
     limits: &ReadLimits,
 ) -> Result<(Loaded, bool), Vec<Diagnostic>> {
+    load_unchecked(path, format, limits, false).map(|(loaded, checked, _)| (loaded, checked))
+}
+
+/// The input file's bytes after reading, still mapped: unmapping a large
+/// file takes the kernel a while (about 5 ms for 96 MB, on the thread that
+/// drops it, while the others wait for it at the next join), so a caller
+/// may drop this where a thread would otherwise be idle.
+pub struct InputBytes {
+    /// Held only to be dropped.
+    _bytes: Option<mapped::FileBytes>,
+}
+
+/// [`load_mesh_unchecked`] that hands back the input's bytes instead of
+/// freeing them (`convert` frees them on the checks' thread once its
+/// counting is done).
+pub fn load_mesh_keeping_input(
+    path: &Path,
+    format: Option<ReadFormat>,
+    limits: &ReadLimits,
+) -> Result<(Loaded, bool, InputBytes), Vec<Diagnostic>> {
+    load_unchecked(path, format, limits, true)
+}
+
+fn load_unchecked(
+    path: &Path,
+    format: Option<ReadFormat>,
+    limits: &ReadLimits,
+    keep_input: bool,
+) -> Result<(Loaded, bool, InputBytes), Vec<Diagnostic>> {
     if matches!(format, None | Some(ReadFormat::Stl))
         && let Some(read) = stl::read_binary_file(path, format.is_some())
     {
         let mut loaded = read?.finish_unchecked()?;
         loaded.binary = Some(true);
-        return Ok((loaded, false));
+        return Ok((loaded, false, InputBytes { _bytes: None }));
     }
     let file = mapped::FileBytes::open(path).map_err(|e| {
         vec![Diagnostic::new(
@@ -221,15 +250,21 @@ pub fn load_mesh_unchecked(
         }
     };
     if format == ReadFormat::FragXml {
-        return frag::load(path, bytes, limits).map(|l| (l, true));
+        return frag::load(path, bytes, limits).map(|l| (l, true, InputBytes { _bytes: None }));
     }
     let folder = path.parent().unwrap_or(Path::new(""));
     let (builder, binary) = parse(format, bytes, folder, limits)?;
-    // The file's bytes are not needed for the checks: free them first.
-    drop(file);
+    // The file's bytes are not needed for the checks: free them first,
+    // unless the caller frees them later.
+    let input = if keep_input {
+        InputBytes { _bytes: Some(file) }
+    } else {
+        drop(file);
+        InputBytes { _bytes: None }
+    };
     let mut loaded = builder.finish_unchecked()?;
     loaded.binary = binary;
-    Ok((loaded, false))
+    Ok((loaded, false, input))
 }
 
 /// Reads a mesh from bytes already in memory. `folder` is where relative
