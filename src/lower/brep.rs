@@ -7,7 +7,8 @@ use crate::geom::solid_carriers::{
     torus_meridian, torus_parallel,
 };
 use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
-use crate::ir::LocalName;
+use crate::ir::{Carrier, EntityName, Face, LocalName, Loops, OrientedEdge, SolidId};
+use std::sync::Arc;
 
 pub struct BrepVertex {
     pub name: LocalName,
@@ -58,6 +59,21 @@ pub fn of(shape: &SolidShape) -> Brep {
     brep
 }
 
+/// A lowered entity's carrier: the primitive's own (solid and local index)
+/// when the solid is curved, else a copy of the planar curve or surface.
+pub(super) fn carrier<T: Clone>(
+    by_solid: bool,
+    solid: SolidId,
+    local: usize,
+    own: &T,
+) -> Carrier<T> {
+    if by_solid {
+        Carrier::primitive(solid, local)
+    } else {
+        Carrier::own(own.clone())
+    }
+}
+
 impl Brep {
     /// Makes this the boundary of `shape`, reusing the vectors.
     pub fn rebuild(&mut self, shape: &SolidShape) {
@@ -90,6 +106,29 @@ impl Brep {
             let start = if i == 0 { 0 } else { self.loop_ends[i - 1] };
             &self.loop_edges[start..self.loop_ends[i]]
         })
+    }
+
+    /// The model face of `self.faces[local]`, of solid `solid` named `base`,
+    /// its loop items oriented by `orient`. The serial welder and the
+    /// isolated runs (`isolated.rs`) both build faces here, so the two paths
+    /// give the same model.
+    pub(super) fn model_face(
+        &self,
+        local: usize,
+        base: &Arc<Box<str>>,
+        (solid, by_solid): (SolidId, bool),
+        orient: impl Fn((usize, bool)) -> OrientedEdge,
+    ) -> Face {
+        let f = &self.faces[local];
+        let total = self.loops(f).map(<[_]>::len).sum();
+        let loops =
+            Loops::from_nested(self.loops(f).map(|l| l.iter().copied().map(&orient)), total);
+        Face {
+            name: EntityName::local(base, f.name),
+            carrier: carrier(by_solid, solid, local, &f.surface),
+            reversed: false,
+            loops,
+        }
     }
 
     /// Adds a face whose loops are `loops`.

@@ -11,8 +11,8 @@ use super::reserved::{Part, Tail};
 use super::weld::{FaceSamples, Grid, probe_points, same_edge};
 use crate::geom::{Point3, SolidShape};
 use crate::ir::{
-    Carrier, Edge, EdgeId, EntityName, Face, FaceId, Loops, Model, OrientedEdge, OrientedFace,
-    Origin, Solid, SourceMap, Vertex, VertexId,
+    Edge, EdgeId, EntityName, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, Solid,
+    SourceMap, Vertex, VertexId,
 };
 use crate::span::Span;
 use rayon::prelude::*;
@@ -352,11 +352,7 @@ impl LocalWeld {
             let e = &brep.edges[src];
             out.edges.push(Edge {
                 name: EntityName::local(&base, e.name),
-                carrier: if by_solid {
-                    Carrier::primitive(id, src)
-                } else {
-                    Carrier::own(e.curve.clone())
-                },
+                carrier: super::brep::carrier(by_solid, id, src, &e.curve),
                 begin: vertex(begin),
                 end: vertex(end),
             });
@@ -364,21 +360,9 @@ impl LocalWeld {
         let (samples, rest) = std::mem::take(&mut out.samples).split_at_mut(self.faces.len());
         out.samples = rest;
         for (&(src, _), sample) in self.faces.iter().zip(samples) {
-            let f = &brep.faces[src];
-            let total = brep.loops(f).map(<[_]>::len).sum();
-            let loops =
-                Loops::from_nested(brep.loops(f).map(|l| l.iter().copied().map(orient)), total);
-            out.faces.push(Face {
-                name: EntityName::local(&base, f.name),
-                carrier: if by_solid {
-                    Carrier::primitive(id, src)
-                } else {
-                    Carrier::own(f.surface.clone())
-                },
-                reversed: false,
-                loops,
-            });
-            *sample = f.sample;
+            out.faces
+                .push(brep.model_face(src, &base, (id, by_solid), orient));
+            *sample = brep.faces[src].sample;
         }
         out.solids.push(Solid {
             name: base,

@@ -33,8 +33,8 @@ use crate::diag::Diagnostics;
 use crate::doc::Document;
 use crate::geom::{Aabb, SolidShape};
 use crate::ir::{
-    Carrier, Dimension, EntityName, Face, Loops, Model, OrientedEdge, OrientedFace, Origin,
-    PointSet, Polyline, Solid, SolidId, SourceMap,
+    Dimension, EntityName, Face, Model, OrientedEdge, OrientedFace, Origin, PointSet, Polyline,
+    Solid, SolidId, SourceMap,
 };
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
@@ -437,13 +437,7 @@ fn lower_solid(
                 model,
                 || EntityName::local(&base, e.name),
                 &e.curve,
-                || {
-                    if by_solid {
-                        Carrier::primitive(id, local)
-                    } else {
-                        Carrier::own(e.curve.clone())
-                    }
-                },
+                || brep::carrier(by_solid, id, local, &e.curve),
                 vertex_ids[e.begin],
                 vertex_ids[e.end],
             );
@@ -462,19 +456,8 @@ fn lower_solid(
     };
     let mut faces = Vec::with_capacity(brep.faces.len());
     for (local, f) in brep.faces.iter().enumerate() {
-        let total = brep.loops(f).map(<[_]>::len).sum();
-        let loops = Loops::from_nested(brep.loops(f).map(|l| l.iter().copied().map(orient)), total);
-        let first = loops.first().and_then(|l| l.first()).copied();
-        let face = Face {
-            name: EntityName::local(&base, f.name),
-            carrier: if by_solid {
-                Carrier::primitive(id, local)
-            } else {
-                Carrier::own(f.surface.clone())
-            },
-            reversed: false,
-            loops,
-        };
+        let face = brep.model_face(local, &base, (id, by_solid), orient);
+        let first = face.loops.first().and_then(|l| l.first()).copied();
         let (id, new) = welder.face(model, face, f.sample);
         if new {
             source_map.faces.insert(id, origin);
