@@ -13,6 +13,10 @@ pub(super) struct Tail<'v, T> {
     len: usize,
     /// How many values the dropped parts wrote.
     written: AtomicUsize,
+    /// Whether [`Tail::parts`] was called: a second split would hand out
+    /// the same slots again, and its counts could then add up to `len`
+    /// with slots left unwritten.
+    split: bool,
 }
 
 /// Consecutive slots of a [`Tail`], filled front to back by [`Part::push`].
@@ -29,12 +33,18 @@ impl<'v, T> Tail<'v, T> {
             vec,
             len,
             written: AtomicUsize::new(0),
+            split: false,
         }
     }
 
     /// The slots split into consecutive parts of the given lengths (which
     /// add up to at most the tail's).
+    ///
+    /// # Panics
+    /// When called a second time, or when the lengths add up to more.
     pub fn parts(&mut self, lens: impl IntoIterator<Item = usize>) -> Vec<Part<'_, T>> {
+        assert!(!self.split, "a tail is split into parts once");
+        self.split = true;
         let written = &self.written;
         let mut rest = &mut self.vec.spare_capacity_mut()[..self.len];
         lens.into_iter()
@@ -59,10 +69,12 @@ impl<'v, T> Tail<'v, T> {
         let written = *self.written.get_mut();
         assert_eq!(written, self.len, "every reserved slot is written");
         let len = self.vec.len() + self.len;
-        // SAFETY: the capacity was reserved in `new`. Each part writes its
-        // slots front to back and counts them when dropped; a part cannot
-        // write past its end (`push` indexes its slice), so the counts add
-        // up to `self.len` only when every part was full, that is, when
+        // SAFETY: the capacity was reserved in `new`. The one split (`parts`
+        // refuses a second) hands out disjoint parts whose lengths add up to
+        // at most `self.len`; each part writes its slots front to back and
+        // counts them when dropped, and cannot write past its end (`push`
+        // indexes its slice), so the counts add up to `self.len` only when
+        // every part was full and the parts cover the tail, that is, when
         // every slot in `len - self.len..len` holds a value.
         unsafe { self.vec.set_len(len) };
     }
@@ -117,6 +129,19 @@ mod tests {
         parts[0].push("only one".into());
         drop(parts);
         tail.commit();
+    }
+
+    #[test]
+    #[should_panic(expected = "a tail is split into parts once")]
+    fn a_tail_is_split_once() {
+        let mut v: Vec<u32> = Vec::new();
+        let mut tail = Tail::new(&mut v, 2);
+        let mut first = tail.parts([1]);
+        first[0].push(1);
+        drop(first);
+        // The same slot again: its count would make the two slots look full.
+        let mut again = tail.parts([1]);
+        again[0].push(2);
     }
 
     #[test]
