@@ -312,8 +312,9 @@ fn draw(
                 let zy = z_ref + dzdy * (sy - sy0) as f32;
                 let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
                 let value = ((depth.to_bits() as u64) << 32) | id;
-                // SAFETY: y_first <= sy <= sy1 and 0 <= x_first <= sx <= sx1,
-                // so the index is below (sy1 - y0 + 1) × width <= rows.len(),
+                // SAFETY: y0 <= y_first <= sy <= sy1 and 0 <= x_first <= sx
+                // <= sx1 (the clamps and the early return above), so the
+                // index is below (sy1 - y0 + 1) × width <= rows.len(),
                 // asserted above.
                 let slot = unsafe { rows.get_unchecked_mut(base + sx as usize) };
                 if value < *slot {
