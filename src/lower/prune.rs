@@ -72,13 +72,7 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     for b in &model.boundaries {
         b.edges.iter().for_each(|e| keep_edge[e.index()] = true);
     }
-    let mut keep_vertex = vec![false; model.vertices.len()];
-    for (k, edge) in model.edges.iter().enumerate() {
-        if keep_edge[k] {
-            keep_vertex[edge.begin.index()] = true;
-            keep_vertex[edge.end.index()] = true;
-        }
-    }
+    let mut keep_vertex = ends_of_kept(model, &keep_edge);
     let mut primitive_vertices = vec![false; model.vertices.len()];
     for v in model.solids.iter().flat_map(|s| &s.vertices) {
         if let Some(flag) = primitive_vertices.get_mut(v.index()) {
@@ -103,6 +97,18 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     let vertex_map = compact(&keep_vertex);
     drop((keep_face, keep_edge, keep_vertex));
     apply(model, source_map, &face_map, &edge_map, &vertex_map);
+}
+
+/// Which vertices end an edge that `keep_edge` keeps.
+pub(super) fn ends_of_kept(model: &Model, keep_edge: &[bool]) -> Vec<bool> {
+    let mut ends = vec![false; model.vertices.len()];
+    for (edge, &keep) in model.edges.iter().zip(keep_edge) {
+        if keep {
+            ends[edge.begin.index()] = true;
+            ends[edge.end.index()] = true;
+        }
+    }
+    ends
 }
 
 /// Drops the edges and vertices whose flag is false (faces stay), renumbering

@@ -519,13 +519,7 @@ fn drop_unused(model: &mut Model, source_map: &mut SourceMap, dropped: &[EdgeId]
             keep_edge[e.index()] = false;
         }
     }
-    let mut needed = vec![false; model.vertices.len()];
-    for (e, edge) in model.edges.iter().enumerate() {
-        if keep_edge[e] {
-            needed[edge.begin.index()] = true;
-            needed[edge.end.index()] = true;
-        }
-    }
+    let needed = super::prune::ends_of_kept(model, &keep_edge);
     let mut keep_vertex = vec![true; model.vertices.len()];
     for &e in dropped {
         let edge = model.edge(e);
