@@ -8,7 +8,7 @@
 
 use super::brep::Brep;
 use super::reserved::{Part, Tail};
-use super::weld::{FaceSamples, Grid, probe_points, same_edge};
+use super::weld::{Chains, FaceSamples, Grid, probe_points, same_edge};
 use crate::geom::{Point3, SolidShape};
 use crate::ir::{
     Edge, EdgeId, EntityName, Face, FaceId, Model, OrientedEdge, OrientedFace, Origin, Solid,
@@ -183,6 +183,50 @@ struct LocalWeld {
     sorted: Vec<u32>,
     /// Per brep face: its distinct face, and whether it faces outward.
     face_of: Vec<(u32, bool)>,
+    /// The candidates of a solid with more than `SCANNED` vertices.
+    index: Index,
+}
+
+/// Vertices up to which a solid's candidates are scanned, not looked up:
+/// every primitive but a large polygon (a scan of a few is cheaper than
+/// hashing them).
+const SCANNED: usize = 32;
+
+/// Candidates by key, each chain in creation order (local ids), as the
+/// welder keeps them.
+#[derive(Default)]
+struct Index {
+    vertices: Chains<u64>,
+    edges: Chains<(u32, u32)>,
+    faces: Chains<u64>,
+}
+
+impl Index {
+    fn clear(&mut self) {
+        self.vertices.clear();
+        self.edges.clear();
+        self.faces.clear();
+    }
+}
+
+/// The candidates' ids in creation order: all `count` of them, or a chain's.
+fn scanned_or_chained<I: Iterator<Item = u32>>(
+    chained: bool,
+    count: usize,
+    chain: impl FnOnce() -> I,
+) -> impl Iterator<Item = u32> {
+    let (all, chain) = if chained {
+        (None, Some(chain()))
+    } else {
+        (Some(0..count as u32), None)
+    };
+    all.into_iter().flatten().chain(chain.into_iter().flatten())
+}
+
+/// The key of a face's sorted edge list (lists are compared exactly on a hit).
+fn edge_list_hash(edges: &[u32]) -> u64 {
+    use std::hash::BuildHasher;
+    foldhash::fast::FixedState::default().hash_one(edges)
 }
 
 impl LocalWeld {
@@ -236,10 +280,15 @@ impl LocalWeld {
     /// Welds the boundary of `shape`. The welder looks up candidates in
     /// hashed chains; here the few entities of one solid are scanned in the
     /// same order (cells in the welder's order, then creation order), so
-    /// each lookup finds what the welder's would.
+    /// each lookup finds what the welder's would. A solid with more than
+    /// `SCANNED` vertices (a polygon of thousands) looks its candidates up
+    /// in chains as the welder does: scanning them all is quadratic.
     fn weld(&mut self, shape: &SolidShape, grid: Grid) {
         self.brep.rebuild(shape);
         let brep = &self.brep;
+        let chained = brep.vertices.len() > SCANNED;
+        let mut index = std::mem::take(&mut self.index);
+        index.clear();
         self.vertices.clear();
         self.vertex_of.clear();
         for (k, v) in brep.vertices.iter().enumerate() {
@@ -247,18 +296,33 @@ impl LocalWeld {
             let near = |&src: &usize| (brep.vertices[src].position - v.position).norm() <= grid.tol;
             // The welder finds only vertices within the tolerance; when there
             // is one (a degenerate solid), the first in its order.
-            let found = vertices.iter().any(near).then(|| {
+            let found = if chained {
                 grid.probe_cells(&v.position).find_map(|cell| {
-                    (vertices.iter()).position(|src| {
-                        grid.cell_of(&brep.vertices[*src].position) == cell && near(src)
-                    })
+                    (index.vertices.iter(&cell)).find(|&id| near(&vertices[id as usize]))
                 })
-            });
-            let id = found.flatten().unwrap_or_else(|| {
+            } else {
+                vertices
+                    .iter()
+                    .any(near)
+                    .then(|| {
+                        grid.probe_cells(&v.position).find_map(|cell| {
+                            (0..vertices.len() as u32).find(|&id| {
+                                let src = &vertices[id as usize];
+                                grid.cell_of(&brep.vertices[*src].position) == cell && near(src)
+                            })
+                        })
+                    })
+                    .flatten()
+            };
+            let id = found.unwrap_or_else(|| {
                 self.vertices.push(k);
-                self.vertices.len() - 1
+                let id = (self.vertices.len() - 1) as u32;
+                if chained {
+                    index.vertices.push(grid.cell_of(&v.position), id);
+                }
+                id
             });
-            self.vertex_of.push(id as u32);
+            self.vertex_of.push(id);
         }
         self.edges.clear();
         self.edge_of.clear();
@@ -266,21 +330,24 @@ impl LocalWeld {
             let (begin, end) = (self.vertex_of[e.begin], self.vertex_of[e.end]);
             let key = (begin.min(end), begin.max(end));
             let mut probes = None;
-            let found = self
-                .edges
-                .iter()
-                .enumerate()
-                .find_map(|(id, &(src, b, en))| {
-                    if (b.min(en), b.max(en)) != key {
-                        return None;
-                    }
-                    let probes = *probes.get_or_insert_with(|| probe_points(&e.curve));
-                    let theirs = probe_points(&brep.edges[src].curve);
-                    same_edge(&probes, &theirs, (b, begin, end), grid.tol).map(|f| (id as u32, f))
-                });
+            let edges = &self.edges;
+            let candidates = scanned_or_chained(chained, edges.len(), || index.edges.iter(&key));
+            let found = candidates.into_iter().find_map(|id| {
+                let (src, b, en) = edges[id as usize];
+                if (b.min(en), b.max(en)) != key {
+                    return None;
+                }
+                let probes = *probes.get_or_insert_with(|| probe_points(&e.curve));
+                let theirs = probe_points(&brep.edges[src].curve);
+                same_edge(&probes, &theirs, (b, begin, end), grid.tol).map(|f| (id, f))
+            });
             let found = found.unwrap_or_else(|| {
                 self.edges.push((k, begin, end));
-                ((self.edges.len() - 1) as u32, false)
+                let id = (self.edges.len() - 1) as u32;
+                if chained {
+                    index.edges.push(key, id);
+                }
+                (id, false)
             });
             self.edge_of.push(found);
         }
@@ -295,19 +362,30 @@ impl LocalWeld {
                 }
             }
             self.sorted[start..].sort_unstable();
-            let mut from = 0;
-            let found = self.faces.iter().position(|&(src, end)| {
-                let theirs = &self.sorted[from..end];
-                from = end;
-                theirs == &self.sorted[start..]
+            let mine = &self.sorted[start..];
+            let key = if chained { edge_list_hash(mine) } else { 0 };
+            let faces = &self.faces;
+            let candidates = scanned_or_chained(chained, faces.len(), || index.faces.iter(&key));
+            // Face `id`'s sorted edges end where the face before it ends.
+            let found = candidates.into_iter().find(|&id| {
+                let (src, end) = faces[id as usize];
+                let from = id
+                    .checked_sub(1)
+                    .map_or(0, |before| faces[before as usize].1);
+                &self.sorted[from..end] == mine
                     && (brep.faces[src].sample - f.sample).norm() <= grid.tol
             });
             let found = match found {
                 None => {
                     self.faces.push((k, self.sorted.len()));
-                    ((self.faces.len() - 1) as u32, true)
+                    let id = (self.faces.len() - 1) as u32;
+                    if chained {
+                        index.faces.push(key, id);
+                    }
+                    (id, true)
                 }
                 Some(id) => {
+                    let id = id as usize;
                     self.sorted.truncate(start);
                     // A welded face keeps the first's orientation; this one's
                     // outward side agrees when its loop runs the same way.
@@ -325,6 +403,7 @@ impl LocalWeld {
             };
             self.face_of.push(found);
         }
+        self.index = index;
     }
 
     /// Writes the welded solid as solid `solid` with its entities from `at`.
@@ -432,8 +511,29 @@ mod tests {
                     .map(|&(x, y)| Point3::new(x, y, 0.0))
                     .collect(),
             });
+            shapes.push(SolidShape::Polygon {
+                frame: f(11.0),
+                vertices: large_polygon(),
+            });
         }
         shapes
+    }
+
+    /// A polygon whose welding looks its candidates up (more than `SCANNED`
+    /// vertices), with a repeated vertex and a stretch out and back along
+    /// one line, so that even its regular frame welds vertices and edges.
+    fn large_polygon() -> Vec<Point3> {
+        let n = 3 * SCANNED;
+        let mut vertices: Vec<Point3> = (0..n)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / n as f64;
+                Point3::new(0.4 * t.cos(), 0.4 * t.sin(), 0.0)
+            })
+            .collect();
+        vertices.insert(5, vertices[5]);
+        let spike = [Point3::new(0.9, 0.0, 0.0), vertices[0]];
+        vertices.splice(1..1, spike);
+        vertices
     }
 
     /// The model, source map and face samples of lowering `shapes` with
@@ -498,6 +598,26 @@ mod tests {
             })
             .collect();
         assert_eq!(vertex_counts, [8, 8, 4, 1]);
+        // The large polygon welded its repeats: 3 · SCANNED + 1 distinct
+        // vertices (the spike's tip), and the spike's way out and back is
+        // one edge (the repeated vertex's zero-length edge stays one of its own).
+        let large = (serial.0.solids.iter())
+            .find(|s| matches!(&s.shape, SolidShape::Polygon { vertices, .. } if vertices.len() > SCANNED))
+            .expect("the large polygon");
+        let distinct = |ids: Vec<u32>| {
+            ids.into_iter()
+                .collect::<std::collections::BTreeSet<_>>()
+                .len()
+        };
+        assert_eq!(
+            distinct(large.vertices.iter().map(|v| v.0).collect()),
+            3 * SCANNED + 1
+        );
+        assert_eq!(large.edges.len(), large_polygon().len());
+        assert_eq!(
+            distinct(large.edges.iter().map(|e| e.0).collect()),
+            large_polygon().len() - 1
+        );
         let alternating: Vec<bool> = (0..shapes.len()).map(|k| k % 7 != 3).collect();
         for threads in [1, 2, 3] {
             for isolated in [vec![true; shapes.len()], alternating.clone()] {

@@ -64,7 +64,7 @@ impl FaceSamples {
 
 /// Chains of entity ids sharing a key: the map holds (first, last) of each
 /// chain, `next` links an id to the following one.
-struct Chains<K> {
+pub(super) struct Chains<K> {
     heads: FastMap<K, (u32, u32)>,
     next: Vec<u32>,
 }
@@ -86,7 +86,12 @@ impl<K: Hash + Eq + Copy> Chains<K> {
         }
     }
 
-    fn push(&mut self, key: K, id: u32) {
+    pub(super) fn clear(&mut self) {
+        self.heads.clear();
+        self.next.clear();
+    }
+
+    pub(super) fn push(&mut self, key: K, id: u32) {
         let at = id as usize;
         if self.next.len() <= at {
             self.next.resize(at + 1, NONE);
@@ -103,7 +108,7 @@ impl<K: Hash + Eq + Copy> Chains<K> {
     }
 
     /// The ids under `key`, in the order they were pushed.
-    fn iter(&self, key: &K) -> impl Iterator<Item = u32> + '_ {
+    pub(super) fn iter(&self, key: &K) -> impl Iterator<Item = u32> + '_ {
         let mut at = self.heads.get(key).map_or(NONE, |&(first, _)| first);
         std::iter::from_fn(move || {
             if at == NONE {
