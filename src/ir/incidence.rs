@@ -170,9 +170,13 @@ impl Incidence {
     /// line per row, headed by the column names; cells `+` / `-` (signed), `±`
     /// (both ways), `1` (unsigned), `.` (absent). Trailing spaces are trimmed
     /// so the output is stable under editors; missing names become `#index`.
+    ///
+    /// A matrix of more than `TABLE_COLUMNS` columns lists each row's entries
+    /// instead (`row: -col +col`): as a table, a polygon of 10,000 edges
+    /// printed 1.2 GB.
     pub fn render(&self, row_names: &[String], col_names: &[String]) -> String {
-        fn name(names: &[String], i: usize) -> String {
-            names.get(i).cloned().unwrap_or_else(|| format!("#{i}"))
+        if self.cols > TABLE_COLUMNS {
+            return self.render_rows(row_names, col_names);
         }
         fn width(s: &str) -> usize {
             s.chars().count()
@@ -210,14 +214,7 @@ impl Incidence {
                 let value = next
                     .next_if(|&&(r, c, _)| (r as usize, c as usize) == (i, j))
                     .map_or(0, |&(_, _, v)| v);
-                let cell = match value {
-                    0 => ".",
-                    1 if self.signed => "+",
-                    1 => "1",
-                    -1 => "-",
-                    2 => "±",
-                    _ => "?",
-                };
+                let cell = self.cell(value);
                 line.push_str("  ");
                 pad(&mut line, cell, *w);
             }
@@ -226,6 +223,54 @@ impl Incidence {
         }
         out
     }
+
+    /// One line per row: its name, then its entries in column order, each
+    /// the column's name after the cell's sign (`+`, `-`, `±`; none when
+    /// unsigned).
+    fn render_rows(&self, row_names: &[String], col_names: &[String]) -> String {
+        let mut out = format!(
+            "{} × {}, {} entries, by row:\n",
+            self.rows,
+            self.cols,
+            self.entries.len()
+        );
+        let mut next = self.entries.iter().peekable();
+        for i in 0..self.rows {
+            out.push_str(&name(row_names, i));
+            out.push(':');
+            while next.next_if(|&&(r, _, _)| (r as usize) < i).is_some() {}
+            while let Some(&(_, c, v)) = next.next_if(|&&(r, _, _)| r as usize == i) {
+                out.push(' ');
+                out.push_str(match self.cell(v) {
+                    "1" => "",
+                    sign => sign,
+                });
+                out.push_str(&name(col_names, c as usize));
+            }
+            out.push('\n');
+        }
+        out
+    }
+
+    /// How an entry value prints in a table.
+    fn cell(&self, value: i8) -> &'static str {
+        match value {
+            0 => ".",
+            1 if self.signed => "+",
+            1 => "1",
+            -1 => "-",
+            2 => "±",
+            _ => "?",
+        }
+    }
+}
+
+/// Columns up to which a matrix prints as a table.
+const TABLE_COLUMNS: usize = 64;
+
+/// The name of row or column `i`, or `#i` when it has none.
+fn name(names: &[String], i: usize) -> String {
+    names.get(i).cloned().unwrap_or_else(|| format!("#{i}"))
 }
 
 #[cfg(test)]
@@ -346,5 +391,50 @@ mod tests {
         );
         let empty = IncidenceMatrices::of(&crate::ir::Model::empty(Dimension::Two));
         assert_eq!(empty.ve.render(&[], &[]), "\n");
+    }
+
+    #[test]
+    fn a_matrix_wider_than_a_table_lists_each_rows_entries() {
+        let n = TABLE_COLUMNS + 1;
+        let corners: Vec<[f64; 3]> = (0..n)
+            .map(|k| {
+                let t = std::f64::consts::TAU * k as f64 / n as f64;
+                [t.cos(), t.sin(), 0.0]
+            })
+            .collect();
+        let mut b = Builder::new(Dimension::Two);
+        let face = b.polygon("P", &corners).face;
+        b.push_subdomain("D", crate::ir::SubdomainCells::Region { faces: vec![face] });
+        let m = IncidenceMatrices::of(&b.model);
+        let vertices = names(&b.model.vertices, |v| &v.name);
+        let edges = names(&b.model.edges, |e| &e.name);
+        let faces = names(&b.model.faces, |f| &f.name);
+        let text = m.ve.render(&vertices, &edges);
+        let lines: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), n + 1);
+        assert_eq!(lines[0], format!("{n} × {n}, {} entries, by row:", 2 * n));
+        assert_eq!(lines[1], format!("v0: -e0 +e{}", n - 1));
+        assert_eq!(lines[2], "v1: +e0 -e1");
+        // Unsigned entries print the column alone; a narrow matrix stays a table.
+        let vf = m.vf.render(&vertices, &faces);
+        assert!(vf.starts_with("     P\nv0   1\n"), "{vf}");
+        let transposed = Incidence {
+            rows: 1,
+            cols: n,
+            signed: false,
+            entries: (0..n as u32).step_by(2).map(|c| (0, c, 1)).collect(),
+        };
+        let text = transposed.render(&faces, &edges);
+        assert_eq!(
+            text.lines().nth(1),
+            Some(&*format!(
+                "P: {}",
+                (0..n)
+                    .step_by(2)
+                    .map(|c| format!("e{c}"))
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            ))
+        );
     }
 }
