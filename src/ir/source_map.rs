@@ -57,6 +57,15 @@ impl<K, V> Default for IdMap<K, V> {
 }
 
 impl<K: DenseId, V: Copy + PartialEq> IdMap<K, V> {
+    /// Makes room for ids below `ids` and `values` more distinct values, so
+    /// a table filled to a known size is allocated once, at that size
+    /// (growth by doubling left up to half of it unused, and copied it).
+    pub fn reserve(&mut self, ids: usize, values: usize) {
+        self.slots
+            .reserve_exact(ids.saturating_sub(self.slots.len()));
+        self.values.reserve_exact(values);
+    }
+
     /// Sets the value of `id`, returning the previous one.
     pub fn insert(&mut self, id: K, value: V) -> Option<V> {
         let i = id.index();

@@ -5,6 +5,7 @@
 
 use super::Entities;
 use super::explicit::{lookup_entities, unknown_entity};
+use super::leaves::Leaves;
 use super::weld::FaceSamples;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::{SolidTree, SubdomainDef};
@@ -14,7 +15,7 @@ use crate::ir::{
     SourceMap, Subdomain, SubdomainCells, SubdomainId,
 };
 use crate::resolve::{Geometry, Resolved};
-use rayon::slice::ParallelSliceMut;
+use rayon::prelude::*;
 use std::collections::{BTreeMap, BTreeSet, HashMap};
 
 /// A boolean tree over leaf solids (indices into `leaves`).
@@ -42,7 +43,7 @@ impl Tree {
 
 struct Built {
     tree: Tree,
-    leaves: Vec<SolidId>,
+    leaves: Leaves,
     /// The subdomain element, for messages.
     span: crate::span::Span,
 }
@@ -63,10 +64,19 @@ pub(super) fn build_subdomains(
     entities: &Entities,
     diags: &mut Diagnostics,
 ) -> Trees {
-    let mut trees: Vec<(SubdomainId, Built)> = Vec::with_capacity(defs.len());
     let first = model.subdomains.len();
     let mut made = 0;
     let shared: &Model = model;
+    // The solid trees are looked up on the workers (names, each object's
+    // solids: hash lookups and cache misses per subdomain), a slot per
+    // definition, in order. The slots' vector becomes the trees' (in place),
+    // so it costs what the trees' own vector did. Their findings are put
+    // back below where the definition's lowering reports them.
+    let (mut looked_up, found) = look_up_trees(&defs, resolved, shared, entities);
+    source_map
+        .subdomains
+        .reserve(first + defs.len(), defs.len());
+    let mut found = found.into_iter().peekable();
     // Consumed: each definition is dropped once lowered, so none is alive
     // during the overlap check (the memory peak on large files). Collected
     // from the consumed definitions, so the standard library builds the
@@ -78,6 +88,9 @@ pub(super) fn build_subdomains(
         .filter_map(|(def_index, def)| {
             let model = shared;
             let id = SubdomainId((first + made) as u32);
+            while let Some((_, d)) = found.next_if(|(k, _)| *k == def_index) {
+                diags.push(d);
+            }
             let mut trimmed_faces = Vec::new();
             let cells = match (def.faces.as_deref(), &def.tree) {
                 (Some(_), Some(_)) => {
@@ -98,17 +111,9 @@ pub(super) fn build_subdomains(
                     }
                     None => return None,
                 },
-                (None, Some(tree)) => {
-                    let mut leaves = Vec::new();
-                    let tree = build_tree(tree, resolved, model, entities, &mut leaves, diags)?;
-                    trees.push((
-                        id,
-                        Built {
-                            tree,
-                            leaves,
-                            span: def.span,
-                        },
-                    ));
+                (None, Some(_)) => {
+                    // Empty when the lookup failed (already reported).
+                    looked_up[def_index].as_mut()?.0 = id;
                     SubdomainCells::Volume {
                         boundary: Vec::new(),
                     }
@@ -145,7 +150,52 @@ pub(super) fn build_subdomains(
     } else {
         model.subdomains.extend(subdomains);
     }
+    // In place (`flatten` would collect into a new vector): every filled
+    // slot is a tree-form definition that became a subdomain and has its id.
+    #[allow(clippy::filter_map_identity)]
+    let trees = looked_up.into_iter().filter_map(|slot| slot).collect();
     Trees(trees)
+}
+
+/// Definitions per task of [`look_up_trees`].
+pub(super) const DEFINITIONS_PER_TASK: usize = 256;
+
+/// The solid trees of the tree-form definitions (neither `faces=` nor a
+/// missing form), a slot per definition (`None` also when the lookup failed;
+/// the ids are set by the caller), and the lookups' diagnostics by definition
+/// index, in the order one definition after another reports them.
+#[allow(clippy::type_complexity)]
+fn look_up_trees(
+    defs: &[SubdomainDef],
+    resolved: &Resolved,
+    model: &Model,
+    entities: &Entities,
+) -> (Vec<Option<(SubdomainId, Built)>>, Vec<(usize, Diagnostic)>) {
+    let found = std::sync::Mutex::new(Vec::new());
+    let looked_up = (defs.par_iter().enumerate())
+        .with_min_len(DEFINITIONS_PER_TASK)
+        .map(|(k, def)| {
+            let (None, Some(tree)) = (&def.faces, &def.tree) else {
+                return None;
+            };
+            let (mut leaves, mut local) = (Leaves::default(), Diagnostics::default());
+            let tree = build_tree(tree, resolved, model, entities, &mut leaves, &mut local);
+            if !local.items.is_empty() {
+                let mut all = found.lock().unwrap_or_else(|e| e.into_inner());
+                all.extend(local.items.into_iter().map(|d| (k, d)));
+            }
+            let built = Built {
+                tree: tree?,
+                leaves,
+                span: def.span,
+            };
+            Some((SubdomainId(u32::MAX), built))
+        })
+        .collect();
+    let mut found = found.into_inner().unwrap_or_else(|e| e.into_inner());
+    // Stable: one definition's findings were added together, in order.
+    found.sort_by_key(|(k, _)| *k);
+    (looked_up, found)
 }
 
 /// Checks the relations of the subdomains' solids (crossing boundaries,
@@ -162,10 +212,21 @@ pub(super) fn check_subdomains(
     let Some(leaf_pairs) = check_relations(model, source_map, &trees, overlapping, diags) else {
         return;
     };
+    // 3D: every tree's faces classified on the workers (reading the model
+    // only), in order; 2D regions add faces to the model, one by one below.
+    let shared: &Model = model;
+    let mut boundaries = match model.dimension {
+        Dimension::Three => (trees.par_iter())
+            .with_min_len(DEFINITIONS_PER_TASK)
+            .map(|(_, built)| classify_faces(shared, built, face_samples))
+            .collect(),
+        Dimension::Two => Vec::new(),
+    }
+    .into_iter();
     for (id, built) in &trees {
         let cells = match model.dimension {
             Dimension::Three => SubdomainCells::Volume {
-                boundary: classify_faces(model, built, face_samples),
+                boundary: boundaries.next().unwrap_or_default(),
             },
             Dimension::Two => {
                 let edges = classify_edges(model, built);
@@ -188,7 +249,7 @@ pub(super) fn check_subdomains(
         }
         let subdomain = &mut model.subdomains[id.index()];
         subdomain.cells = cells;
-        subdomain.solids = built.leaves.clone();
+        subdomain.solids = built.leaves.to_vec();
     }
     check_overlaps(model, source_map, &trees, face_samples, leaf_pairs, diags);
 }
@@ -198,19 +259,17 @@ fn build_tree(
     resolved: &Resolved,
     model: &Model,
     entities: &Entities,
-    leaves: &mut Vec<SolidId>,
+    leaves: &mut Leaves,
     diags: &mut Diagnostics,
 ) -> Option<Tree> {
-    let operands = |ops: &[SolidTree],
-                    leaves: &mut Vec<SolidId>,
-                    diags: &mut Diagnostics|
-     -> Option<Vec<Tree>> {
-        let built: Vec<Option<Tree>> = ops
-            .iter()
-            .map(|t| build_tree(t, resolved, model, entities, leaves, diags))
-            .collect();
-        built.into_iter().collect()
-    };
+    let operands =
+        |ops: &[SolidTree], leaves: &mut Leaves, diags: &mut Diagnostics| -> Option<Vec<Tree>> {
+            let built: Vec<Option<Tree>> = ops
+                .iter()
+                .map(|t| build_tree(t, resolved, model, entities, leaves, diags))
+                .collect();
+            built.into_iter().collect()
+        };
     Some(match tree {
         SolidTree::Union(ops, _) => Tree::Union(operands(ops, leaves, diags)?),
         SolidTree::Intersection(ops, _) => Tree::Intersection(operands(ops, leaves, diags)?),
@@ -305,25 +364,20 @@ fn build_tree(
                 );
                 return None;
             }
-            let mut members = Vec::new();
-            for &id in ids {
-                let index = leaves.iter().position(|&l| l == id).unwrap_or_else(|| {
-                    leaves.push(id);
-                    leaves.len() - 1
-                });
-                members.push(Tree::Leaf(index));
-            }
-            if members.len() == 1 {
-                members.remove(0)
-            } else {
-                Tree::Union(members)
+            match ids {
+                [id] => Tree::Leaf(leaves.index_of(*id)),
+                _ => Tree::Union(
+                    ids.iter()
+                        .map(|&id| Tree::Leaf(leaves.index_of(id)))
+                        .collect(),
+                ),
             }
         }
     })
 }
 
 /// Checks every pair of leaf solids: crossing boundaries, and touching
-/// without sharing whole faces, are reported (E408). Returns false if any was.
+/// without sharing whole faces, are reported (E408). Returns `None` if any was.
 /// `overlapping`: the pairs of all primitive solids whose boxes overlap, when
 /// the isolation grid found them (the leaves' pairs are taken from there).
 fn check_relations(
@@ -352,10 +406,18 @@ fn check_relations(
             candidate_pairs(&boxes, model.tolerance)
         }
     };
-    let mut ok = true;
-    for &(i, j) in &pairs {
-        ok &= check_pair(model, source_map, leaves[i], leaves[j], diags);
-    }
+    // On the workers; the findings are reported in pair order.
+    let found = std::sync::Mutex::new(Vec::new());
+    (pairs.par_iter().enumerate()).for_each(|(k, &(i, j))| {
+        if let Some(d) = check_pair(model, source_map, leaves[i], leaves[j]) {
+            let mut all = found.lock().unwrap_or_else(|e| e.into_inner());
+            all.push((k, d));
+        }
+    });
+    let mut found = found.into_inner().unwrap_or_else(|e| e.into_inner());
+    found.sort_unstable_by_key(|(k, _)| *k);
+    let ok = found.is_empty();
+    diags.items.extend(found.into_iter().map(|(_, d)| d));
     ok.then_some(LeafPairs { leaves, pairs })
 }
 
@@ -399,12 +461,12 @@ impl LeafPairs {
         }
         // Members are distinct leaves when there are as many as leaves, since
         // `leaves` is the set of all the trees' leaves.
-        let mut member_of = vec![0usize; self.leaves.len()];
-        for (m, ((_, member), bbox)) in members.iter().zip(boxes).enumerate() {
+        // Each member's leaf (its index in `leaves`), on the workers.
+        let leaf_of = |((_, member), bbox): (&(SubdomainId, Member), &crate::geom::Aabb)| {
             let Member::Tree(Built { leaves, .. }) = member else {
                 return None;
             };
-            let [leaf] = leaves.as_slice() else {
+            let [leaf] = &**leaves else {
                 return None;
             };
             // Equal unless a coordinate is NaN (the union with the empty box
@@ -412,7 +474,15 @@ impl LeafPairs {
             if *bbox != model.solids[leaf.index()].shape.bbox() {
                 return None;
             }
-            member_of[self.leaves.binary_search(leaf).ok()?] = m;
+            self.leaves.binary_search(leaf).ok()
+        };
+        let leaf_of: Vec<usize> = (members.par_iter().zip(boxes))
+            .with_min_len(DEFINITIONS_PER_TASK)
+            .map(leaf_of)
+            .collect::<Option<_>>()?;
+        let mut member_of = vec![0usize; self.leaves.len()];
+        for (m, leaf) in leaf_of.into_iter().enumerate() {
+            member_of[leaf] = m;
         }
         let mut pairs: Vec<(usize, usize)> = (self.pairs.iter())
             .map(|&(i, j)| {
@@ -431,7 +501,10 @@ impl LeafPairs {
 /// and the pairs do not depend on the cell); boxes spanning many cells are
 /// compared with all.
 pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usize, usize)> {
-    let mut sizes: Vec<f64> = boxes.iter().map(|b| (b.max - b.min).max()).collect();
+    let mut sizes: Vec<f64> = (boxes.par_iter())
+        .with_min_len(BOXES_PER_TASK)
+        .map(|b| (b.max - b.min).max())
+        .collect();
     let middle = sizes.len() / 2;
     let median =
         (middle < sizes.len()).then(|| *sizes.select_nth_unstable_by(middle, f64::total_cmp).1);
@@ -464,33 +537,37 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
         Some((lo, hi, count))
     };
     // Sized exactly: on large models the list has millions of entries.
-    let total: usize = boxes
-        .iter()
+    let total: usize = (boxes.par_iter())
+        .with_min_len(BOXES_PER_TASK)
         .filter_map(range)
         .filter(|r| r.2 <= 64)
         .map(|r| r.2 as usize)
         .sum();
     // A cell is kept as a 64-bit hash of its coordinates (16 bytes an entry
     // instead of 32): cells that collide only add candidates, which the box
-    // test below discards, and the pairs are sorted at the end.
+    // test below discards, and the pairs are sorted at the end. Filled on the
+    // workers, in box order (the order does not matter: the list is sorted).
     let mut cells: Vec<(u64, u32)> = Vec::with_capacity(total);
-    let mut big = Vec::new();
-    for (i, b) in boxes.iter().enumerate() {
-        let Some((lo, hi, count)) = range(b) else {
-            continue;
-        };
-        if count > 64 {
-            big.push(i);
-            continue;
-        }
-        for x in lo[0]..=hi[0] {
-            for y in lo[1]..=hi[1] {
-                for z in lo[2]..=hi[2] {
-                    cells.push((cell_hash([x, y, z]), i as u32));
-                }
-            }
-        }
-    }
+    let placed = (boxes.par_iter().enumerate())
+        .with_min_len(BOXES_PER_TASK)
+        .filter_map(|(i, b)| {
+            range(b)
+                .filter(|r| r.2 <= 64)
+                .map(|(lo, hi, _)| (i, lo, hi))
+        })
+        .flat_map_iter(|(i, lo, hi)| {
+            (lo[0]..=hi[0]).flat_map(move |x| {
+                (lo[1]..=hi[1]).flat_map(move |y| {
+                    (lo[2]..=hi[2]).map(move |z| (cell_hash([x, y, z]), i as u32))
+                })
+            })
+        });
+    cells.par_extend(placed);
+    let big: Vec<usize> = (boxes.par_iter().enumerate())
+        .with_min_len(BOXES_PER_TASK)
+        .filter(|(_, b)| range(b).is_some_and(|r| r.2 > 64))
+        .map(|(i, _)| i)
+        .collect();
     // In parallel: entries equal under the order are identical, so the sorted
     // list does not depend on the threads.
     cells.par_sort_unstable();
@@ -518,6 +595,9 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
     pairs
 }
 
+/// Boxes per task of [`candidate_pairs`]' parallel passes.
+const BOXES_PER_TASK: usize = 4096;
+
 /// Where the candidate grid's cell borders lie, in cells (1/φ², far from
 /// simple fractions).
 const GRID_SHIFT: f64 = 0.381_966_011_250_105_1;
@@ -528,17 +608,12 @@ pub(super) fn cell_hash(cell: [i64; 3]) -> u64 {
     foldhash::quality::FixedState::with_seed(0x5eed).hash_one(cell)
 }
 
-fn check_pair(
-    model: &Model,
-    source_map: &SourceMap,
-    a: SolidId,
-    b: SolidId,
-    diags: &mut Diagnostics,
-) -> bool {
+/// What is wrong with a pair of leaf solids (E408), if anything.
+fn check_pair(model: &Model, source_map: &SourceMap, a: SolidId, b: SolidId) -> Option<Diagnostic> {
     let sa = &model.solids[a.index()];
     let sb = &model.solids[b.index()];
     if !sa.shape.bbox().overlaps(&sb.shape.bbox(), model.tolerance) {
-        return true;
+        return None;
     }
     let relation = boundary_relation(&sa.shape, &sb.shape, model.tolerance * 10.0);
     let span = source_map.solid(b).or(source_map.solid(a));
@@ -547,7 +622,7 @@ fn check_pair(
         .crossing_near
         .or(relation.b_in_a.crossing_near)
     {
-        diags.push(
+        return Some(
             Diagnostic::new(
                 Code::BoundariesIntersect,
                 span,
@@ -555,14 +630,12 @@ fn check_pair(
             )
             .with_help("move the solids apart, nest one inside the other, or make touching faces coincide exactly"),
         );
-        return false;
     }
     if relation.a_in_b.crosses() || relation.b_in_a.crosses() {
-        diags.push(
+        return Some(
             Diagnostic::new(Code::BoundariesIntersect, span, format!("the boundaries of '{}' and '{}' cross", sa.name, sb.name))
                 .with_help("move the solids apart, nest one inside the other, or make touching faces coincide exactly"),
         );
-        return false;
     }
     let touching = relation.a_in_b.on > 0 || relation.b_in_a.on > 0;
     let shares_face = match model.dimension {
@@ -576,7 +649,7 @@ fn check_pair(
             .any(|e| sb.boundary_edges.iter().any(|g| g.edge == e.edge)),
     };
     if touching && !shares_face {
-        diags.push(
+        return Some(
             Diagnostic::new(
                 Code::BoundariesIntersect,
                 span,
@@ -589,14 +662,13 @@ fn check_pair(
                 "make the touching faces coincide exactly (same corners), or move the solids apart",
             ),
         );
-        return false;
     }
-    true
+    None
 }
 
 /// The faces of the subdomain's boundary, with `outward` set.
 fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<OrientedFace> {
-    if let (Tree::Leaf(0), [leaf]) = (&built.tree, built.leaves.as_slice()) {
+    if let (Tree::Leaf(0), [leaf]) = (&built.tree, &*built.leaves) {
         return single_solid_faces(&model.solids[leaf.index()].faces, samples);
     }
     let mut result: BTreeMap<FaceId, bool> = BTreeMap::new();
@@ -611,7 +683,7 @@ fn classify_faces(model: &Model, built: &Built, samples: &FaceSamples) -> Vec<Or
         })
         .collect();
     let sides = &sides;
-    for &leaf in &built.leaves {
+    for &leaf in built.leaves.iter() {
         for of in &model.solids[leaf.index()].faces {
             if result.contains_key(&of.face) {
                 continue;
@@ -686,7 +758,7 @@ fn classify_edges(model: &Model, built: &Built) -> Vec<OrientedEdge> {
         })
         .collect();
     let sides = &sides;
-    for &leaf in &built.leaves {
+    for &leaf in built.leaves.iter() {
         for oe in &model.solids[leaf.index()].boundary_edges {
             if result.contains_key(&oe.edge) {
                 continue;
@@ -795,16 +867,16 @@ fn check_overlaps(
     // probe vector per subdomain was megabytes at the memory peak.
     let mut members: Vec<(SubdomainId, Member)> = Vec::with_capacity(trees.len() + shells);
     let mut boxes: Vec<crate::geom::Aabb> = Vec::with_capacity(trees.len() + shells);
-    for (id, built) in trees {
-        let bbox = built
-            .leaves
-            .iter()
-            .fold(crate::geom::Aabb::empty(), |acc, l| {
+    members.extend(trees.iter().map(|(id, built)| (*id, Member::Tree(built))));
+    // Each tree's box on the workers (a pure function of its leaves' shapes).
+    let tree_boxes = (trees.par_iter())
+        .with_min_len(DEFINITIONS_PER_TASK)
+        .map(|(_, built)| {
+            (built.leaves.iter()).fold(crate::geom::Aabb::empty(), |acc, l| {
                 acc.union(&model.solids[l.index()].shape.bbox())
-            });
-        members.push((*id, Member::Tree(built)));
-        boxes.push(bbox);
-    }
+            })
+        });
+    boxes.par_extend(tree_boxes);
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         let id = SubdomainId(k as u32);
         if !is_shell(k, subdomain) {
@@ -1108,7 +1180,7 @@ mod tests {
         }
         let built = |tree| Built {
             tree,
-            leaves: vec![SolidId(0)],
+            leaves: Leaves::One(SolidId(0)),
             span: crate::span::Span::default(),
         };
         let fast = classify_faces(&model, &built(Tree::Leaf(0)), &samples);

@@ -94,28 +94,44 @@ pub(super) fn lower_run(
         .zip(out)
         .map(|(((k, jobs), start), out)| (first_solid + k * TASK, jobs, start, out))
         .collect();
-    tasks.into_par_iter().for_each_init(
-        LocalWeld::default,
-        |weld, (solid, (jobs, counts), start, mut out)| {
-            let mut at = start;
-            for (k, (job, count)) in jobs.iter().zip(counts).enumerate() {
-                // Welded again only when the first pass merged something.
-                weld.unwelded(job.shape);
-                if !weld.unmerged(count) {
-                    weld.weld(job.shape, grid);
+    // The source map is filled beside the writing, on a worker too: the
+    // main thread only waits.
+    let write = || {
+        tasks.into_par_iter().for_each_init(
+            LocalWeld::default,
+            |weld, (solid, (jobs, counts), start, mut out)| {
+                let mut at = start;
+                for (k, (job, count)) in jobs.iter().zip(counts).enumerate() {
+                    // Welded again only when the first pass merged something.
+                    weld.unwelded(job.shape);
+                    if !weld.unmerged(count) {
+                        weld.weld(job.shape, grid);
+                    }
+                    weld.write(job, solid + k, at, &mut out);
+                    at = at.plus(count);
                 }
-                weld.write(job, solid + k, at, &mut out);
-                at = at.plus(count);
-            }
-        },
-    );
+            },
+        )
+    };
+    rayon::join(write, || {
+        map_origins(source_map, jobs, &counts, first, first_solid)
+    });
     vertices.commit();
     edges.commit();
     faces.commit();
     solids.commit();
-    // The source map, in order (a slot per entity, a value per solid).
+}
+
+/// The source map of a run, in order (a slot per entity, a value per solid).
+fn map_origins(
+    source_map: &mut SourceMap,
+    jobs: &[SolidJob],
+    counts: &[Counts],
+    first: Counts,
+    first_solid: usize,
+) {
     let mut at = first;
-    for (k, (job, count)) in jobs.iter().zip(&counts).enumerate() {
+    for (k, (job, count)) in jobs.iter().zip(counts).enumerate() {
         let origin = Origin { span: job.span };
         let map = &mut *source_map;
         map.vertices

@@ -10,6 +10,7 @@ mod edge_parts;
 mod explicit;
 mod isolated;
 mod isolation;
+mod leaves;
 mod object_solids;
 mod point_calculus;
 mod prune;
@@ -25,6 +26,8 @@ mod region_touch;
 mod region_touch_inside;
 mod reserved;
 pub mod rfunction_region;
+#[cfg(test)]
+mod subdomain_threads_tests;
 pub mod trimmed_topology;
 mod weld;
 mod winding;
@@ -143,6 +146,13 @@ pub fn lower(
     model.edges.reserve(expected.edges);
     model.faces.reserve(expected.faces);
     model.solids.reserve(expected.solids);
+    // The source map's tables too: grown by doubling, they left megabytes
+    // unused at the memory peak, and copied them at every growth.
+    let map = &mut source_map;
+    map.vertices.reserve(expected.vertices, expected.solids);
+    map.edges.reserve(expected.edges, expected.solids);
+    map.faces.reserve(expected.faces, expected.solids);
+    map.solids.reserve(expected.solids, expected.solids);
     // Curves that carry edges are part of the topology, not standalone lines.
     let edge_lines = point_calculus::edge_lines(resolved);
     let shapes = isolation::solid_shapes(resolved, &edge_lines);

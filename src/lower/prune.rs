@@ -4,86 +4,100 @@
 use crate::ir::{
     EdgeId, FaceId, Model, OrientedEdge, OrientedFace, SourceMap, SubdomainCells, VertexId,
 };
+use rayon::prelude::*;
+use std::sync::atomic::{AtomicBool, Ordering};
 
 pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
-    // Flag vectors, not sets: these run over every entity of the model.
-    let mut used_by_subdomains = vec![false; model.solids.len()];
-    for id in model.subdomains.iter().flat_map(|s| &s.solids) {
-        if let Some(flag) = used_by_subdomains.get_mut(id.index()) {
-            *flag = true;
+    // Flag vectors, not sets: these run over every entity of the model, each
+    // pass on the workers (a pass writes one value only, so its flags do not
+    // depend on the order).
+    let used_by_subdomains = Flags::new(model.solids.len(), false);
+    (model.subdomains.par_iter())
+        .flat_map_iter(|s| &s.solids)
+        .for_each(|id| used_by_subdomains.set(id.index(), true));
+    let solids = || {
+        model
+            .solids
+            .par_iter()
+            .enumerate()
+            .with_min_len(ITEMS_PER_TASK)
+    };
+    let keep_face = Flags::new(model.faces.len(), true);
+    // A used 2D region's own face is replaced by its subdomain's face.
+    solids()
+        .filter(|(k, _)| used_by_subdomains.get(*k))
+        .for_each(|(_, solid)| {
+            (solid.faces.iter()).for_each(|of| keep_face.set(of.face.index(), false))
+        });
+    solids()
+        .filter(|(k, _)| !used_by_subdomains.get(*k))
+        .for_each(|(_, solid)| {
+            (solid.faces.iter()).for_each(|of| keep_face.set(of.face.index(), true))
+        });
+    model.subdomains.par_iter().for_each(|s| match &s.cells {
+        SubdomainCells::Volume { boundary } => boundary
+            .iter()
+            .for_each(|of| keep_face.set(of.face.index(), true)),
+        SubdomainCells::Region { faces } => {
+            faces.iter().for_each(|f| keep_face.set(f.index(), true))
         }
+    });
+    for b in &model.boundaries {
+        b.faces.iter().for_each(|f| keep_face.set(f.index(), true));
     }
-    let mut keep_face = vec![true; model.faces.len()];
-    for (k, solid) in model.solids.iter().enumerate() {
-        if used_by_subdomains[k] {
-            for of in &solid.faces {
-                keep_face[of.face.index()] = false;
-            }
-            // A used 2D region's own face is replaced by its subdomain's face.
-        }
-    }
-    for (k, solid) in model.solids.iter().enumerate() {
-        if !used_by_subdomains[k] {
+    let keep_edge = Flags::new(model.edges.len(), false);
+    (model.faces.par_iter().enumerate())
+        .with_min_len(ITEMS_PER_TASK)
+        .filter(|(k, _)| keep_face.get(*k))
+        .for_each(|(_, face)| {
+            (face.loops.iter().flatten()).for_each(|e| keep_edge.set(e.edge.index(), true))
+        });
+    // Explicit edges and edges of free-standing solids always stay.
+    let primitive_edges = Flags::new(model.edges.len(), false);
+    solids().for_each(|(_, s)| {
+        s.edges
+            .iter()
+            .for_each(|e| primitive_edges.set(e.index(), true))
+    });
+    (0..model.edges.len())
+        .into_par_iter()
+        .with_min_len(ITEMS_PER_TASK)
+        .filter(|&k| !primitive_edges.get(k))
+        .for_each(|k| keep_edge.set(k, true));
+    solids()
+        .filter(|(k, _)| !used_by_subdomains.get(*k))
+        .for_each(|(_, solid)| {
             solid
-                .faces
+                .edges
                 .iter()
-                .for_each(|of| keep_face[of.face.index()] = true);
-        }
-    }
-    for s in &model.subdomains {
-        match &s.cells {
-            SubdomainCells::Volume { boundary } => boundary
-                .iter()
-                .for_each(|of| keep_face[of.face.index()] = true),
-            SubdomainCells::Region { faces } => {
-                faces.iter().for_each(|f| keep_face[f.index()] = true)
-            }
-        }
-    }
+                .for_each(|e| keep_edge.set(e.index(), true))
+        });
     for b in &model.boundaries {
-        b.faces.iter().for_each(|f| keep_face[f.index()] = true);
+        b.edges.iter().for_each(|e| keep_edge.set(e.index(), true));
     }
-    let mut keep_edge = vec![false; model.edges.len()];
-    for (k, face) in model.faces.iter().enumerate() {
-        if keep_face[k] {
-            face.loops
-                .iter()
-                .flatten()
-                .for_each(|e| keep_edge[e.edge.index()] = true);
-        }
-    }
-    let mut primitive_edges = vec![false; model.edges.len()];
-    for e in model.solids.iter().flat_map(|s| &s.edges) {
-        if let Some(flag) = primitive_edges.get_mut(e.index()) {
-            *flag = true;
-        }
-    }
-    for (k, keep) in keep_edge.iter_mut().enumerate() {
-        // Explicit edges and edges of free-standing solids always stay.
-        if !primitive_edges[k] {
-            *keep = true;
-        }
-    }
-    for (k, solid) in model.solids.iter().enumerate() {
-        if !used_by_subdomains[k] {
-            solid.edges.iter().for_each(|e| keep_edge[e.index()] = true);
-        }
-    }
-    for b in &model.boundaries {
-        b.edges.iter().for_each(|e| keep_edge[e.index()] = true);
-    }
-    let mut keep_vertex = ends_of_kept(model, &keep_edge);
-    let mut primitive_vertices = vec![false; model.vertices.len()];
-    for v in model.solids.iter().flat_map(|s| &s.vertices) {
-        if let Some(flag) = primitive_vertices.get_mut(v.index()) {
-            *flag = true;
-        }
-    }
-    for (k, keep) in keep_vertex.iter_mut().enumerate() {
-        if !primitive_vertices[k] {
-            *keep = true;
-        }
-    }
+    let keep_vertex = Flags::new(model.vertices.len(), false);
+    (model.edges.par_iter().enumerate())
+        .with_min_len(ITEMS_PER_TASK)
+        .filter(|(k, _)| keep_edge.get(*k))
+        .for_each(|(_, edge)| {
+            keep_vertex.set(edge.begin.index(), true);
+            keep_vertex.set(edge.end.index(), true);
+        });
+    let primitive_vertices = Flags::new(model.vertices.len(), false);
+    solids().for_each(|(_, s)| {
+        (s.vertices.iter()).for_each(|v| primitive_vertices.set(v.index(), true))
+    });
+    (0..model.vertices.len())
+        .into_par_iter()
+        .with_min_len(ITEMS_PER_TASK)
+        .filter(|&k| !primitive_vertices.get(k))
+        .for_each(|k| keep_vertex.set(k, true));
+    drop((used_by_subdomains, primitive_edges, primitive_vertices));
+    let (keep_face, keep_edge, keep_vertex) = (
+        keep_face.into_vec(),
+        keep_edge.into_vec(),
+        keep_vertex.into_vec(),
+    );
     if keep_face.iter().all(|&k| k)
         && keep_edge.iter().all(|&k| k)
         && keep_vertex.iter().all(|&k| k)
@@ -97,6 +111,33 @@ pub(super) fn prune_interior(model: &mut Model, source_map: &mut SourceMap) {
     let vertex_map = compact(&keep_vertex);
     drop((keep_face, keep_edge, keep_vertex));
     apply(model, source_map, &face_map, &edge_map, &vertex_map);
+}
+
+/// Entities per task of the flag passes.
+const ITEMS_PER_TASK: usize = 4096;
+
+/// Flags written by the workers; an index out of range is ignored on
+/// writing and reads false.
+struct Flags(Vec<AtomicBool>);
+
+impl Flags {
+    fn new(len: usize, value: bool) -> Flags {
+        Flags((0..len).map(|_| AtomicBool::new(value)).collect())
+    }
+
+    fn set(&self, index: usize, value: bool) {
+        if let Some(flag) = self.0.get(index) {
+            flag.store(value, Ordering::Relaxed);
+        }
+    }
+
+    fn get(&self, index: usize) -> bool {
+        self.0.get(index).is_some_and(|f| f.load(Ordering::Relaxed))
+    }
+
+    fn into_vec(self) -> Vec<bool> {
+        self.0.into_iter().map(AtomicBool::into_inner).collect()
+    }
 }
 
 /// Which vertices end an edge that `keep_edge` keeps.
