@@ -142,3 +142,106 @@ pub(super) fn unmarked_rows<const SS: usize>(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::super::resolve::{Samples, resolve_rows};
+    use super::super::scene::{Group, Scene};
+    use super::*;
+    use std::borrow::Cow;
+
+    /// Two triangles on two faces (a surface and a section cap), with
+    /// distinct light per node, so pixels can be background, one group,
+    /// mixed, or hatched.
+    fn scene_and_projection(ss: usize) -> (Scene<'static>, Projected) {
+        let tris = vec![[0, 1, 2], [1, 3, 2]];
+        let scene = Scene {
+            points: Cow::Owned(vec![[0.0; 3]; 4]),
+            tris: Cow::Owned(tris.clone()),
+            tri_face: vec![0, 1],
+            one_face: None,
+            face_sides: vec![[0, 1], [2, 2]],
+            same_sides: None,
+            corner_slots: Cow::Owned(tris),
+            light: vec![[0.9, 0.3], [0.5, 0.7], [0.25, 1.0], [0.6, 0.4]],
+            groups: (0..3)
+                .map(|g| Group {
+                    name: format!("g{g}"),
+                    color: [40 + 70 * g as u8, 200 - 50 * g as u8, 90],
+                    cap: g == 2,
+                })
+                .collect(),
+        };
+        let s = ss as f32;
+        let proj = Projected {
+            snapped: Vec::new(),
+            xy_f: vec![
+                [0.0, 0.0],
+                [9.0 * s, 0.5],
+                [0.5, 7.0 * s],
+                [8.5 * s, 6.5 * s],
+            ],
+        };
+        (scene, proj)
+    }
+
+    #[test]
+    fn one_read_per_pixel_resolves_as_the_general_resolver() {
+        for ss in 1..=4 {
+            let (scene, proj) = scene_and_projection(ss);
+            let (width, height) = (9, 7);
+            let (sw, sh) = (width * ss, height * ss);
+            // Samples drawn from empty, either side of either triangle, by a
+            // fixed scramble: every kind of pixel shows up.
+            let data: Vec<u64> = (0..sw * sh)
+                .map(|i| match (i * 7919 + i / sw * 31) % 11 {
+                    // The first pixel column is background.
+                    _ if i % sw < ss => EMPTY,
+                    // The second shows one triangle's front.
+                    _ if i % sw < 2 * ss => 5 << 32,
+                    0..=2 => EMPTY,
+                    k => ((k as u64) << 32) | (k as u64 % 4),
+                })
+                .collect();
+            let no_marks = vec![false; sw * sh];
+            let resolve = |edges: &[bool], background: [u8; 4]| {
+                let samples = Samples {
+                    data: &data,
+                    width: sw,
+                    y0: 0,
+                    edges,
+                };
+                let mut out = vec![0u8; width * height * 4];
+                resolve_rows(
+                    &scene,
+                    &proj,
+                    &samples,
+                    ss,
+                    background,
+                    0,
+                    0..width,
+                    &mut out,
+                );
+                out
+            };
+            for background in [[255, 255, 255, 255], [32, 48, 64, 0]] {
+                let general = resolve(&no_marks, background);
+                let once = resolve(&[], background);
+                assert_eq!(once, general, "ss {ss}");
+                // Background and shaded pixels occur.
+                let pixels: Vec<&[u8]> = once.chunks(4).collect();
+                assert!(pixels.iter().any(|p| *p == background_pixel(background)));
+                assert!(
+                    pixels
+                        .iter()
+                        .any(|p| p[3] == 255 && *p != background_pixel(background))
+                );
+                // Over a transparent background, a pixel partly covered
+                // is partly opaque.
+                if ss > 1 && background[3] == 0 {
+                    assert!(pixels.iter().any(|p| p[3] != 255 && p[3] != 0));
+                }
+            }
+        }
+    }
+}
