@@ -14,6 +14,7 @@ mod normal_sum;
 mod png_out;
 mod raster;
 mod resolve;
+mod resolve_unmarked;
 mod scene;
 mod section_fill;
 mod smooth;
@@ -327,11 +328,11 @@ fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projecte
         .map(|&q| camera.depth(q))
         .fold(
             || (f64::INFINITY, f64::NEG_INFINITY),
-            |(l, h), z| (l.min(z), h.max(z)),
+            |(l, h), z| (camera::below(z, l), camera::above(z, h)),
         )
         .reduce(
             || (f64::INFINITY, f64::NEG_INFINITY),
-            |a, b| (a.0.min(b.0), a.1.max(b.1)),
+            |a, b| (camera::below(b.0, a.0), camera::above(b.1, a.1)),
         );
     let range = if hi > lo { hi - lo } else { 1.0 };
     let s = ss as f64;

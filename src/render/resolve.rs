@@ -4,12 +4,13 @@
 //! and the samples of a pixel are averaged with straight alpha.
 
 use super::raster::{EMPTY, Projected, ZBuffer};
+use super::resolve_unmarked::unmarked_rows;
 use super::scene::Scene;
 use crate::cache_hint::prefetch;
 use rayon::prelude::*;
 
 /// Pixels ahead whose triangle's corners are fetched while one is shaded.
-const AHEAD: usize = 8;
+pub(super) const AHEAD: usize = 8;
 
 pub const EDGE_COLOR: [u8; 4] = [25, 25, 30, 255];
 
@@ -52,7 +53,7 @@ impl Image {
 }
 
 #[inline]
-fn shade(
+pub(super) fn shade(
     scene: &Scene,
     proj: &Projected,
     id: u64,
@@ -228,6 +229,18 @@ pub fn resolve_rows(
     cols: std::ops::Range<usize>,
     out: &mut [u8],
 ) {
+    // Without an edge overlay (every banded picture), a pixel's samples
+    // are read once, with the anti-aliasing factor a constant.
+    if samples.edges.is_empty() {
+        let args = (scene, proj, samples, background, py0, cols.clone());
+        match ss {
+            1 => return unmarked_rows::<1>(args, out),
+            2 => return unmarked_rows::<2>(args, out),
+            3 => return unmarked_rows::<3>(args, out),
+            4 => return unmarked_rows::<4>(args, out),
+            _ => {}
+        }
+    }
     let width = samples.width / ss;
     // The triangle shown at a pixel's first sample, when there is one.
     let first_tri = |px: usize, py: usize| {
