@@ -407,7 +407,7 @@ fn read_runs<'s>(
                     .collect(),
             ));
         }
-        let (mut built, mut found) = (doc::Parts::default(), Diagnostics::default());
+        let (mut built, mut found) = (doc::Parts::for_elements(&elements), Diagnostics::default());
         for element in &elements {
             check(element, &mut found);
             parts.add_part(element, &mut built, &mut found);

@@ -118,6 +118,31 @@ impl<'a> DocumentBuilder<'a> {
 #[derive(Debug, Default)]
 pub struct Parts(Document);
 
+impl Parts {
+    /// Empty parts with room for what `elements` define at most (their
+    /// parameters and basis coordinates aside): lists grown by doubling
+    /// would leave their earlier blocks free on the building thread.
+    pub fn for_elements(elements: &[Element]) -> Parts {
+        let count = |name: &str| elements.iter().filter(|e| e.name == name).count();
+        let [parameters, basis, systems, subdomains, boundaries] = [
+            "parameters",
+            "basis_coordinate",
+            "coordinate_system",
+            "subdomain",
+            "boundary",
+        ]
+        .map(count);
+        let objects = elements.len() - parameters - basis - systems - subdomains - boundaries;
+        Parts(Document {
+            coordinate_systems: Vec::with_capacity(systems),
+            objects: Vec::with_capacity(objects),
+            subdomains: Vec::with_capacity(subdomains),
+            boundaries: Vec::with_capacity(boundaries),
+            ..Document::default()
+        })
+    }
+}
+
 /// Builds [`Parts`]: [`DocumentBuilder::add`] without the document.
 #[derive(Debug, Clone, Copy)]
 pub struct PartBuilder<'a> {
