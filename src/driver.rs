@@ -353,40 +353,67 @@ struct Reading<'r, 'b, 's> {
     diags: &'r mut Diagnostics,
 }
 
+/// What a rayon thread read of one run for [`read_runs`].
+enum RunRead<'s> {
+    /// The run's part of the typed document, built there, with its findings
+    /// (structure and document, element by element) in the serial order.
+    Built(doc::Parts, Diagnostics),
+    /// A run with an element the extractor may take: its elements with their
+    /// structure findings, for the main thread to extract and add.
+    Elements(Vec<(syntax::Element<'s>, Diagnostics)>),
+}
+
 /// [`read_element`] for every element of a split file, as a pipeline: the
-/// rayon threads parse the runs and check their elements' structure (the
-/// larger part of reading), the main thread takes them in file order and
-/// builds the typed document. Everything the document keeps is allocated on
-/// the main thread, which frees it later (memory freed from another thread's
-/// heap waits there, and raised the peak); the elements it is done with go
-/// back to a rayon thread to be freed. The root's check (`check_root`) runs
-/// beside them, its findings put first. The findings come in the order of
-/// reading the file serially, for any number of threads.
+/// rayon threads parse the runs, check their elements' structure and build
+/// their parts of the typed document, the main thread takes the parts in file
+/// order and copies them into the document ([`doc::DocumentBuilder::copy_in`]).
+/// Everything the document keeps is allocated on the main thread, which frees
+/// it later (memory freed from another thread's heap waits there, and raised
+/// the peak); what the rayon threads built goes back to one of them to be
+/// freed, and they free the element trees they parsed. A run with an element
+/// the implicit path may take comes as elements, extracted and added on the
+/// main thread. The root's check (`check_root`) runs beside them, its findings
+/// put first. The findings come in the order of reading the file serially,
+/// for any number of threads.
 fn read_runs<'s>(
     runs: &syntax::Runs<'_, 's>,
     check_root: impl FnOnce(&mut Diagnostics) + Send,
     read: Reading<'_, '_, 's>,
 ) -> Result<(), syntax::Reparse> {
-    type Checked<'s> = Result<Vec<(syntax::Element<'s>, Diagnostics)>, syntax::Reparse>;
-    let checked = |i: usize| -> Checked<'s> {
-        let elements = runs.elements(i)?;
-        Ok(elements
-            .into_iter()
-            .map(|element| {
-                let mut found = Diagnostics::default();
-                if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
-                    doc::structure::check(&element, rule, &mut found);
-                }
-                (element, found)
-            })
-            .collect())
-    };
+    type Checked<'s> = Result<RunRead<'s>, syntax::Reparse>;
     let Reading {
         extractor,
         builder,
         extracted,
         diags,
     } = read;
+    let parts = builder.part_builder();
+    let check = |element: &syntax::Element, found: &mut Diagnostics| {
+        if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
+            doc::structure::check(element, rule, found);
+        }
+    };
+    let checked = |i: usize| -> Checked<'s> {
+        let elements = runs.elements(i)?;
+        if !elements.iter().all(|e| extractor.leaves(e)) {
+            return Ok(RunRead::Elements(
+                elements
+                    .into_iter()
+                    .map(|element| {
+                        let mut found = Diagnostics::default();
+                        check(&element, &mut found);
+                        (element, found)
+                    })
+                    .collect(),
+            ));
+        }
+        let (mut built, mut found) = (doc::Parts::for_elements(&elements), Diagnostics::default());
+        for element in &elements {
+            check(element, &mut found);
+            parts.add_part(element, &mut built, &mut found);
+        }
+        Ok(RunRead::Built(built, found))
+    };
     let root_findings_at = diags.items.len();
     // A job's panic travels to this thread, which is waiting for its result.
     let (root_sender, root_receiver) = std::sync::mpsc::channel();
@@ -422,16 +449,24 @@ fn read_runs<'s>(
             if next + RUNS_AHEAD < runs.len() {
                 spawn(next + RUNS_AHEAD);
             }
-            let run = run.unwrap_or_else(|panic| std::panic::resume_unwind(panic))?;
-            let mut done = Vec::with_capacity(run.len());
-            for (element, found) in run {
-                diags.extend(found);
-                if let Some(element) = extractor.take(element, extracted) {
-                    builder.add(&element, diags);
-                    done.push(element);
+            match run.unwrap_or_else(|panic| std::panic::resume_unwind(panic))? {
+                RunRead::Built(built, found) => {
+                    diags.extend(found);
+                    builder.copy_in(&built);
+                    scope.spawn(move |_| drop(built));
+                }
+                RunRead::Elements(run) => {
+                    let mut done = Vec::with_capacity(run.len());
+                    for (element, found) in run {
+                        diags.extend(found);
+                        if let Some(element) = extractor.take(element, extracted) {
+                            builder.add(&element, diags);
+                            done.push(element);
+                        }
+                    }
+                    scope.spawn(move |_| drop(done));
                 }
             }
-            scope.spawn(move |_| drop(done));
         }
         let root = wait_for(&root_receiver)?;
         let root = root.unwrap_or_else(|panic| std::panic::resume_unwind(panic));
@@ -616,6 +651,83 @@ mod tests {
             .expect("a thread pool");
         let source = SourceFile::new("many.xml".to_string(), text.to_string());
         pool.install(|| check_source(source, &Options::default()).diagnostics)
+    }
+
+    /// Every kind of top-level element the typed document keeps, `count`
+    /// times over: parameters, coordinate systems, boxes in them, spheres,
+    /// subdomains (a union every 5th), boundaries, with malformed numbers
+    /// (document findings), unknown attributes (structure findings) and, at
+    /// a third, a trimmed surface (whose run the main thread must extract
+    /// and add itself). `tail` goes right before the root's end tag.
+    fn every_part(count: usize, tail: &str) -> String {
+        let mut xml = String::from(
+            "<geometry version=\"1\">\n  <basis_coordinate>\n    <coordinate name=\"X\"><value x1=\"0\" x2=\"1 +\"/></coordinate>\n  </basis_coordinate>\n",
+        );
+        for i in 0..count {
+            if i == count / 3 {
+                xml.push_str("  <sphere_surface name=\"cap\" radius=\"1.5\" from_latitude=\"-90\" to_latitude=\"90\"><trim equation=\"x^2 - 0.25\"/></sphere_surface>\n");
+            }
+            let radius = if i % 17 == 0 { "r*(" } else { "r + 0.1" };
+            let extra = if i % 19 == 0 { " color=\"red\"" } else { "" };
+            xml.push_str(&format!(
+                "  <parameters><parameter name=\"p{i}\" value=\"{i}/2\"/></parameters>\n  <coordinate_system name=\"cs{i}\"><origin x=\"{i}\" y=\"0\" z=\"0\"/><rotation x=\"0\" y=\"0\" z=\"{i}\"/></coordinate_system>\n  <parallelepiped name=\"b{i}\" cs=\"cs{i}\"{extra}><first_point x=\"0\" y=\"0\" z=\"0\"/><second_point x=\"1\" y=\"p{i}\" z=\"1e0\"/></parallelepiped>\n  <sphere name=\"s{i}\"><center x=\"{i}\" y=\"3\" z=\"0\"/><radius value=\"{radius}\"/></sphere>\n"
+            ));
+            if i % 5 == 0 {
+                xml.push_str(&format!("  <subdomain name=\"d{i}\" material=\"steel\"><union><solid ref=\"b{i}\"/><solid ref=\"s{i}\"/></union></subdomain>\n"));
+            } else {
+                xml.push_str(&format!(
+                    "  <subdomain name=\"d{i}\"><solid ref=\"s{i}\"/></subdomain>\n"
+                ));
+            }
+            if i % 30 == 0 {
+                xml.push_str(&format!(
+                    "  <boundary name=\"g{i}\" faces=\"b{i}.xmin  s{i}.surface\"/>\n"
+                ));
+            }
+        }
+        xml.push_str(tail);
+        xml.push_str("</geometry>\n");
+        xml
+    }
+
+    fn read_with(threads: usize, text: &str) -> (doc::Document, Diagnostics) {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("a thread pool");
+        let source = SourceFile::new("parts.xml".to_string(), text.to_string());
+        pool.install(|| {
+            let mut diags = Diagnostics::default();
+            let (document, _) = read(&source, &Options::default(), &mut diags).expect("reads");
+            (document, diags)
+        })
+    }
+
+    #[test]
+    fn documents_built_on_threads_are_the_whole_reads_document() {
+        let split = every_part(1_500, "");
+        let source = SourceFile::new("parts.xml".to_string(), split.clone());
+        let parsed = syntax::parse_document(&source, &Limits::default()).expect("parses");
+        let runs = parsed.runs().expect("the file is read in runs").len();
+        assert!(runs > RUNS_AHEAD, "{runs} runs");
+        let whole = every_part(1_500, "  <!-- parsed whole -->\n");
+
+        let (serial, found) = read_with(1, &whole);
+        assert_eq!(serial.parameters.len(), 1_500);
+        assert_eq!(serial.basis.len(), 2);
+        assert_eq!(serial.coordinate_systems.len(), 1_500);
+        // The boxes and spheres; the trimmed surface is an object too.
+        assert_eq!(serial.objects.len(), 3_001);
+        assert_eq!(serial.subdomains.len(), 1_500);
+        assert_eq!(serial.boundaries.len(), 50);
+        let count = |code: Code| found.items.iter().filter(|d| d.code == code).count();
+        assert_eq!(count(Code::BadExpression), 1 + 89);
+        assert_eq!(count(Code::UnknownAttribute), 79);
+        for threads in [1, 2, 3] {
+            let (document, diags) = read_with(threads, &split);
+            assert!(document == serial, "the document on {threads} threads");
+            assert_eq!(diags.items, found.items, "{threads} threads");
+        }
     }
 
     #[test]

@@ -69,16 +69,100 @@ impl<'a> DocumentBuilder<'a> {
 
     /// Adds what one top-level element defines.
     pub fn add(&mut self, element: &Element, diags: &mut Diagnostics) {
+        self.part_builder().add(element, &mut self.doc, diags);
+    }
+
+    /// What builds [`Parts`] apart from this document (on another thread)
+    /// exactly as [`DocumentBuilder::add`] builds them into it.
+    pub fn part_builder(&self) -> PartBuilder<'a> {
+        PartBuilder {
+            source: self.source,
+            limits: self.limits,
+        }
+    }
+
+    /// Adds copies of what `parts` holds, as if its elements had been added
+    /// here one by one. The copies are allocated by the calling thread, so
+    /// the document's memory comes from its own heap whichever thread built
+    /// `parts` (memory a thread frees into another thread's heap waits there,
+    /// which raised the peak).
+    pub fn copy_in(&mut self, parts: &Parts) {
+        // Destructured whole, so a new list of the document cannot be missed.
+        let Document {
+            dimension: _,
+            title: _,
+            parameters,
+            basis,
+            coordinate_systems,
+            objects,
+            subdomains,
+            boundaries,
+        } = &parts.0;
+        let doc = &mut self.doc;
+        doc.parameters.extend_from_slice(parameters);
+        doc.basis.extend_from_slice(basis);
+        doc.coordinate_systems.extend_from_slice(coordinate_systems);
+        doc.objects.extend_from_slice(objects);
+        doc.subdomains.extend_from_slice(subdomains);
+        doc.boundaries.extend_from_slice(boundaries);
+    }
+
+    pub fn finish(self) -> Document {
+        self.doc
+    }
+}
+
+/// The parts of a typed document that some top-level elements define, in
+/// their order: built on a rayon thread by [`PartBuilder::add`], added to the
+/// document by [`DocumentBuilder::copy_in`].
+#[derive(Debug, Default)]
+pub struct Parts(Document);
+
+impl Parts {
+    /// Empty parts with room for what `elements` define at most (their
+    /// parameters and basis coordinates aside): lists grown by doubling
+    /// would leave their earlier blocks free on the building thread.
+    pub fn for_elements(elements: &[Element]) -> Parts {
+        let count = |name: &str| elements.iter().filter(|e| e.name == name).count();
+        let [parameters, basis, systems, subdomains, boundaries] = [
+            "parameters",
+            "basis_coordinate",
+            "coordinate_system",
+            "subdomain",
+            "boundary",
+        ]
+        .map(count);
+        let objects = elements.len() - parameters - basis - systems - subdomains - boundaries;
+        Parts(Document {
+            coordinate_systems: Vec::with_capacity(systems),
+            objects: Vec::with_capacity(objects),
+            subdomains: Vec::with_capacity(subdomains),
+            boundaries: Vec::with_capacity(boundaries),
+            ..Document::default()
+        })
+    }
+}
+
+/// Builds [`Parts`]: [`DocumentBuilder::add`] without the document.
+#[derive(Debug, Clone, Copy)]
+pub struct PartBuilder<'a> {
+    source: &'a SourceFile,
+    limits: ExprLimits,
+}
+
+impl PartBuilder<'_> {
+    /// Adds what one top-level element defines to `parts`.
+    pub fn add_part(&self, element: &Element, parts: &mut Parts, diags: &mut Diagnostics) {
+        self.add(element, &mut parts.0, diags);
+    }
+
+    fn add(&self, element: &Element, doc: &mut Document, diags: &mut Diagnostics) {
         Builder {
             source: self.source,
             diags,
             limits: self.limits,
         }
-        .top_level(element, &mut self.doc);
-    }
-
-    pub fn finish(self) -> Document {
-        self.doc
+        .top_level(element, doc);
     }
 }
 

@@ -7,5 +7,7 @@ pub mod grammar;
 pub mod model;
 pub mod structure;
 
-pub use build::{DocumentBuilder, build, build_with, parse_attribute_expr, parse_ref};
+pub use build::{
+    DocumentBuilder, PartBuilder, Parts, build, build_with, parse_attribute_expr, parse_ref,
+};
 pub use model::*;

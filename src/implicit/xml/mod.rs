@@ -97,6 +97,13 @@ impl Extractor {
         }
     }
 
+    /// Whether [`Extractor::take`] hands `child` back untouched and takes
+    /// nothing of it, so its part of the document can be built apart (on
+    /// another thread) without the extraction.
+    pub fn leaves(&self, child: &Element) -> bool {
+        !self.any && !TRIMMED.contains(&child.name)
+    }
+
     /// Moves `child` into `out` when the implicit path owns it, else hands it
     /// back; copies of a trimmed surface's `<trim>` trees go to `out.trims`.
     pub fn take<'s>(&self, child: Element<'s>, out: &mut Extracted<'s>) -> Option<Element<'s>> {
