@@ -7,8 +7,8 @@ use geomc::convert::{ConvertOptions, apply, inspect::MeshReport};
 use geomc::diag::{Code, Diagnostic, render_human};
 use geomc::formats::read::{ReadFormat, ReadLimits, load_mesh_keeping_input, load_mesh_limited};
 use geomc::formats::{
-    Encoding, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic, write_atomic_file,
-    writer_for_path,
+    Encoding, MeshFacts, MeshWriter, WRITERS, WriteError, WriteOptions, write_atomic,
+    write_atomic_file, writer_for_path,
 };
 use geomc::span::SourceFile;
 use std::path::{Path, PathBuf};
@@ -190,10 +190,11 @@ pub fn run(args: &Args) -> i32 {
         max_file_size: args.max_file_size,
         max_elements: args.max_mesh_elements,
     };
-    let (mut loaded, checked, input) = match load_mesh_keeping_input(&args.input, from, &limits) {
+    let (mut loaded, kept) = match load_mesh_keeping_input(&args.input, from, &limits) {
         Ok(l) => l,
         Err(d) => return read_failed(&args.input, &d),
     };
+    let checked = kept.checked;
     if is_empty(&loaded.mesh) {
         report(
             &args.input,
@@ -224,7 +225,10 @@ pub fn run(args: &Args) -> i32 {
     // The input's bytes: unmapped at once, or by the checks' thread once its
     // counting is done (while the writer finishes; unmapping 96 MB took
     // about 5 ms with both threads waiting).
-    let input = check_while_writing.then_some(input);
+    let input = check_while_writing.then_some(kept.input);
+    // What the reader found holds for the mesh as read: only when nothing
+    // changes it before it is written.
+    let facts = kept.facts.filter(|_| check_while_writing);
     if !checked && !check_while_writing {
         loaded.check();
     }
@@ -283,16 +287,27 @@ pub fn run(args: &Args) -> i32 {
     let written = if check_while_writing {
         let (checks, written) = rayon::join(
             || {
-                let counts = geomc::formats::read::clean::check_whole(&loaded.mesh);
+                let counts = match &facts {
+                    Some(f) => geomc::formats::read::clean::check_whole_known(&loaded.mesh, f),
+                    None => geomc::formats::read::clean::check_whole(&loaded.mesh),
+                };
                 drop(input);
                 counts
             },
-            || write(&args.output, writer, &loaded.mesh, &write_options),
+            || {
+                write(
+                    &args.output,
+                    writer,
+                    &loaded.mesh,
+                    facts.as_ref(),
+                    &write_options,
+                )
+            },
         );
         report(&args.input, &checks.warnings());
         written
     } else {
-        write(&args.output, writer, &loaded.mesh, &write_options)
+        write(&args.output, writer, &loaded.mesh, None, &write_options)
     };
     match written {
         Ok(warnings) => {
@@ -328,11 +343,13 @@ pub fn run(args: &Args) -> i32 {
     }
 }
 
-/// Like `formats::write_mesh_file`, with the writer chosen by the caller.
+/// Like `formats::write_mesh_file`, with the writer chosen by the caller,
+/// and the reader's facts of the mesh when it is as read.
 fn write(
     path: &Path,
     writer: &dyn MeshWriter,
     mesh: &geomc::mesh::Mesh,
+    facts: Option<&MeshFacts>,
     options: &WriteOptions,
 ) -> Result<Vec<geomc::formats::Warning>, WriteError> {
     let folder = path.parent().unwrap_or(Path::new(""));
@@ -343,7 +360,9 @@ fn write(
             write_atomic(&side_path, |w| Ok(w.write_all(&side.bytes)?))?;
             written.push(side_path);
         }
-        write_atomic_file(path, |out| writer.write_file(mesh, options, out))
+        write_atomic_file(path, |out| {
+            writer.write_file_known(mesh, facts, options, out)
+        })
     })();
     if result.is_err() {
         for side_path in written {

@@ -11,7 +11,8 @@
 use super::file_ranges::{self, Range, fill_converted};
 use super::groups::{self, Source};
 use super::{
-    FileOutput, MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count, warning,
+    FileOutput, MeshFacts, MeshWriter, SideFile, Warning, WriteError, WriteOptions, base64, count,
+    warning,
 };
 use crate::mesh::Mesh;
 use serde_json::{Value, json};
@@ -44,7 +45,7 @@ impl MeshWriter for Gltf {
         options: &WriteOptions,
         out: &mut dyn Write,
     ) -> Result<Vec<Warning>, WriteError> {
-        let (doc, warnings) = self.document(mesh, options)?;
+        let (doc, warnings) = self.document(mesh, None, options)?;
         if self.glb {
             let json = doc.json(None);
             write_glb(&json, &doc, out)?;
@@ -67,10 +68,20 @@ impl MeshWriter for Gltf {
         options: &WriteOptions,
         out: &mut FileOutput,
     ) -> Result<Vec<Warning>, WriteError> {
+        self.write_file_known(mesh, None, options, out)
+    }
+
+    fn write_file_known(
+        &self,
+        mesh: &Mesh,
+        facts: Option<&MeshFacts>,
+        options: &WriteOptions,
+        out: &mut FileOutput,
+    ) -> Result<Vec<Warning>, WriteError> {
         if !self.glb {
             return self.write(mesh, options, out);
         }
-        let (doc, warnings) = self.document(mesh, options)?;
+        let (doc, warnings) = self.document(mesh, facts, options)?;
         write_glb_file(&doc.json(None), &doc, out, PARALLEL_FROM)?;
         Ok(warnings)
     }
@@ -91,13 +102,18 @@ impl MeshWriter for Gltf {
 }
 
 impl Gltf {
-    /// The checked mesh's document and the warnings of writing it.
+    /// The checked mesh's document and the warnings of writing it; the
+    /// check takes what it can from a reader's `facts`.
     fn document<'m>(
         &self,
         mesh: &'m Mesh,
+        facts: Option<&MeshFacts>,
         options: &WriteOptions,
     ) -> Result<(Document<'m>, Vec<Warning>), WriteError> {
-        let scanned = groups::check_scanned(mesh, true)?;
+        let scanned = match facts {
+            Some(facts) => groups::check_known(mesh, facts)?,
+            None => groups::check_scanned(mesh, true)?,
+        };
         let doc = Document::of(mesh, self.name(), &scanned);
         let mut warnings = doc.warnings.clone();
         warnings.extend(groups::dropped_volumes(self.name(), mesh));
@@ -179,7 +195,7 @@ impl Piece {
                     // nodes and its triangles the face's own.
                     write_blocks(&mesh.nodes[..used], block, out, position)?;
                     let triangles = &mesh.faces[*face as usize].triangles;
-                    groups::emit_unit_normals(mesh, triangles, used, &mut |run| {
+                    groups::emit_unit_normals(mesh, triangles, None, used, &mut |run| {
                         write_blocks(run.as_flattened(), block, out, f32::to_le_bytes)
                     })?;
                     return write_blocks(triangles.as_flattened(), block, out, u32::to_le_bytes);
@@ -287,6 +303,9 @@ struct Document<'a> {
     buffer_len: usize,
     scene: Vec<usize>,
     warnings: Vec<Warning>,
+    /// Per face: its triangles' `node_window::block_ranges`, when the
+    /// mesh's check had them from a reader.
+    blocks: Vec<Option<Vec<(u32, u32)>>>,
 }
 
 impl<'a> Document<'a> {
@@ -301,6 +320,7 @@ impl<'a> Document<'a> {
             buffer_len: 0,
             scene: Vec::new(),
             warnings: Vec::new(),
+            blocks: scanned.blocks.clone(),
         };
         let mut empty = Vec::new();
         let mut expander = groups::Expander::scanned(mesh, scanned);
@@ -714,6 +734,8 @@ enum InOrder<'d> {
     /// The normals of a face as it is, nodes `0..used`.
     Normals {
         triangles: &'d [[u32; 3]],
+        /// The triangles' block ranges, when known.
+        blocks: Option<&'d [(u32, u32)]>,
         used: usize,
     },
 }
@@ -738,8 +760,12 @@ impl InOrder<'_> {
                 piece.write(expander, block, out)?;
                 pace.wrote(piece.byte_len())
             }
-            InOrder::Normals { triangles, used } => {
-                groups::emit_unit_normals(expander.mesh(), triangles, *used, &mut |run| {
+            InOrder::Normals {
+                triangles,
+                blocks,
+                used,
+            } => {
+                groups::emit_unit_normals(expander.mesh(), triangles, *blocks, *used, &mut |run| {
                     out.write_converted(run.as_flattened(), f32::to_le_bytes)?;
                     pace.wrote(12 * run.len())
                 })
@@ -788,7 +814,15 @@ impl Document<'_> {
                             }),
                         });
                         let normals = offset + 12 * used as u64;
-                        in_order.push((normals, InOrder::Normals { triangles, used }));
+                        let blocks = self.blocks.get(*face as usize).and_then(|b| b.as_deref());
+                        in_order.push((
+                            normals,
+                            InOrder::Normals {
+                                triangles,
+                                blocks,
+                                used,
+                            },
+                        ));
                         ranges.push(Range {
                             offset: normals + 12 * used as u64,
                             len: 12 * triangles.len(),
@@ -814,6 +848,7 @@ impl Document<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::formats::mesh_facts::FaceFacts;
     use crate::mesh::{MeshFace, MeshPolyline};
 
     /// A wavy strip of `n` triangles over nodes numbered in first-use order.
@@ -852,14 +887,26 @@ mod tests {
             .expect("written in order");
         let dir = tempfile::tempdir().expect("temporary folder");
         let path = dir.path().join("parts.glb");
-        super::super::write_atomic_file(&path, |out| {
-            let (doc, _) = GLB.document(mesh, &WriteOptions::default())?;
-            let (order, parts) = doc.layout(0);
-            assert_eq!((parts.len(), order.len()), (ranges, in_order));
-            write_glb_file(&doc.json(None), &doc, out, 0)
-        })
-        .expect("written by parts");
-        assert_eq!(std::fs::read(&path).expect("read back"), whole);
+        // Checked by scanning, and with a reader's facts of the mesh.
+        let faces = mesh
+            .faces
+            .iter()
+            .map(|f| FaceFacts::of(&f.triangles))
+            .collect();
+        let facts = MeshFacts::of(&mesh.nodes, faces).expect("finite nodes");
+        for facts in [None, Some(&facts)] {
+            super::super::write_atomic_file(&path, |out| {
+                let (doc, _) = GLB.document(mesh, facts, &WriteOptions::default())?;
+                let (order, parts) = doc.layout(0);
+                assert_eq!((parts.len(), order.len()), (ranges, in_order));
+                let planned = doc.blocks.iter().filter(|b| b.is_some()).count();
+                let known = if facts.is_some() { mesh.faces.len() } else { 0 };
+                assert_eq!(planned, known);
+                write_glb_file(&doc.json(None), &doc, out, 0)
+            })
+            .expect("written by parts");
+            assert_eq!(std::fs::read(&path).expect("read back"), whole);
+        }
     }
 
     #[test]

@@ -4,6 +4,7 @@
 //! vertex normals that are smooth within a face and flat across its edges.
 
 use super::WriteError;
+use super::mesh_facts::MeshFacts;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
 use std::borrow::Cow;
@@ -22,6 +23,9 @@ pub(crate) struct Scanned {
     pub identity: Vec<Option<usize>>,
     /// The bounds of all nodes (`None` without nodes).
     pub bounds: Option<Bounds>,
+    /// Per face: its `node_window::block_ranges` when a reader found them
+    /// (else empty, or `None`).
+    pub blocks: Vec<Option<Vec<(u32, u32)>>>,
 }
 
 /// The smallest and the largest coordinates of some nodes.
@@ -32,6 +36,32 @@ pub(crate) type Bounds = ([f64; 3], [f64; 3]);
 /// that looks for a coordinate that is not finite), which the glTF writer
 /// needs: two passes over the mesh fewer than finding them after it.
 pub(crate) fn check_scanned(mesh: &Mesh, scan: bool) -> Result<Scanned, WriteError> {
+    check_with(mesh, if scan { Scans::Writer } else { Scans::None })
+}
+
+/// [`check_scanned`] with scanning for a mesh a reader has summed up: the
+/// nodes' bounds, each face's order and largest node come from `facts`
+/// (which also say every coordinate is finite) instead of two passes over
+/// the mesh. Facts that do not fit the mesh are not used.
+pub(crate) fn check_known(mesh: &Mesh, facts: &MeshFacts) -> Result<Scanned, WriteError> {
+    if !facts.fits(mesh) {
+        return check_scanned(mesh, true);
+    }
+    check_with(mesh, Scans::Known(facts))
+}
+
+/// Where [`check_with`] takes the nodes' and faces' scans from.
+#[derive(Clone, Copy)]
+enum Scans<'f> {
+    /// Finite coordinates and largest indices only.
+    None,
+    /// Also the bounds and each face's order, scanned here.
+    Writer,
+    /// All of it from a reader's facts.
+    Known(&'f MeshFacts),
+}
+
+fn check_with(mesh: &Mesh, scans: Scans) -> Result<Scanned, WriteError> {
     let bad = |what: String| Err(WriteError::InvalidMesh(what));
     if mesh.dimension != 2 && mesh.dimension != 3 {
         return bad(format!("dimension {} (2 or 3 expected)", mesh.dimension));
@@ -43,12 +73,17 @@ pub(crate) fn check_scanned(mesh: &Mesh, scan: bool) -> Result<Scanned, WriteErr
         ));
     }
     let mut scanned = Scanned::default();
-    let non_finite = if scan {
-        let (first, bounds) = nodes_scan(&mesh.nodes);
-        scanned.bounds = bounds;
-        first
-    } else {
-        first_non_finite(&mesh.nodes)
+    let non_finite = match scans {
+        Scans::None => first_non_finite(&mesh.nodes),
+        Scans::Writer => {
+            let (first, bounds) = nodes_scan(&mesh.nodes);
+            scanned.bounds = bounds;
+            first
+        }
+        Scans::Known(facts) => {
+            scanned.bounds = facts.bounds;
+            None
+        }
     };
     if let Some(i) = non_finite {
         return bad(format!("node {i} has a coordinate that is not finite"));
@@ -68,13 +103,21 @@ pub(crate) fn check_scanned(mesh: &Mesh, scan: bool) -> Result<Scanned, WriteErr
             return bad(format!("edge `{}` refers to a node out of range", e.name));
         }
     }
-    for f in &mesh.faces {
-        let largest = if scan {
-            let order = FirstUse::of(&f.triangles);
-            scanned.identity.push(order.identity());
-            order.largest()
-        } else {
-            largest_index(&f.triangles)
+    for (i, f) in mesh.faces.iter().enumerate() {
+        let largest = match scans {
+            Scans::None => largest_index(&f.triangles),
+            Scans::Writer => {
+                let order = FirstUse::of(&f.triangles);
+                scanned.identity.push(order.identity());
+                order.largest()
+            }
+            Scans::Known(facts) => {
+                // `fits` said there is one per face.
+                let known = &facts.faces[i];
+                scanned.identity.push(known.order.identity());
+                scanned.blocks.push(Some(known.blocks.clone()));
+                known.largest()
+            }
         };
         if !f.triangles.is_empty() && !node_ok(&largest) {
             return bad(format!("face `{}` refers to a node out of range", f.name));
@@ -566,8 +609,8 @@ const LANES: usize = 4;
 
 /// How some indices follow first-use order, summed up so that the
 /// summaries of consecutive parts combine ([`FirstUse::then`]).
-#[derive(Clone, Copy, Default)]
-struct FirstUse {
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub(crate) struct FirstUse {
     /// One more than the largest index (0: none).
     top: u64,
     /// The largest index that came before its turn: the parts before must
@@ -586,7 +629,7 @@ impl FirstUse {
     }
 
     /// The indices follow first-use order: `Some(k)`, they are `0..k`.
-    fn identity(self) -> Option<usize> {
+    pub(crate) fn identity(self) -> Option<usize> {
         if self.need > 0 {
             return None;
         }
@@ -594,12 +637,12 @@ impl FirstUse {
     }
 
     /// The largest index (0 when there is none).
-    fn largest(self) -> u32 {
+    pub(crate) fn largest(self) -> u32 {
         u32::try_from(self.top.saturating_sub(1)).unwrap_or(u32::MAX)
     }
 
     /// This part, then `later`.
-    fn then(self, later: FirstUse) -> FirstUse {
+    pub(crate) fn then(self, later: FirstUse) -> FirstUse {
         let early = if later.need > self.top { later.need } else { 0 };
         FirstUse {
             top: self.top.max(later.top),
@@ -611,7 +654,7 @@ impl FirstUse {
     /// its own largest index so far (one chain of dependent steps per part
     /// instead of one for all: the single chain was 80% of the writer's
     /// measuring pass).
-    fn piece(values: &[u32]) -> FirstUse {
+    pub(crate) fn piece(values: &[u32]) -> FirstUse {
         let part = values.len().div_ceil(LANES).max(1);
         let mut lanes = [FirstUse::default(); LANES];
         let mut parts = values.chunks(part);
@@ -642,7 +685,7 @@ impl FirstUse {
 
 /// [`first_non_finite`] and the nodes' bounds, in one pass of parallel
 /// pieces (no bounds when a coordinate is not finite, or without nodes).
-fn nodes_scan(nodes: &[[f64; 3]]) -> (Option<usize>, Option<Bounds>) {
+pub(crate) fn nodes_scan(nodes: &[[f64; 3]]) -> (Option<usize>, Option<Bounds>) {
     const RUN: usize = 1024;
     type Run = (bool, [f64; 3], [f64; 3]);
     let empty: Run = (false, [f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
@@ -745,13 +788,23 @@ const MAX_NORMAL_WINDOW: usize = 1 << 16;
 /// goes out once no later triangle uses it: no vector of sums as large as
 /// the mesh (24 MB of fresh pages on 2 million triangles). Else all sums
 /// are formed first.
+///
+/// `blocks`: the triangles' `node_window::block_ranges`, when known (the
+/// plan is then made without a pass over the triangles).
 pub(crate) fn emit_unit_normals(
     mesh: &Mesh,
     triangles: &[[u32; 3]],
+    blocks: Option<&[(u32, u32)]>,
     used: usize,
     emit: &mut dyn FnMut(&[[f32; 3]]) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let Some(plan) = super::node_window::plan(&[triangles], used, MAX_NORMAL_WINDOW) else {
+    let plan = match blocks {
+        Some(ranges) => {
+            super::node_window::plan_from(&[triangles], ranges, used, MAX_NORMAL_WINDOW)
+        }
+        None => super::node_window::plan(&[triangles], used, MAX_NORMAL_WINDOW),
+    };
+    let Some(plan) = plan else {
         let (sums, fallback) = node_sums(mesh, triangles, used);
         let mut run = Vec::with_capacity(NORMAL_RUN);
         for chunk in sums.chunks(NORMAL_RUN) {
@@ -1025,9 +1078,14 @@ mod tests {
     }
 
     /// The normals [`emit_unit_normals`] hands out, gathered.
-    fn emitted(mesh: &Mesh, triangles: &[[u32; 3]], used: usize) -> Vec<[f32; 3]> {
+    fn emitted(
+        mesh: &Mesh,
+        triangles: &[[u32; 3]],
+        blocks: Option<&[(u32, u32)]>,
+        used: usize,
+    ) -> Vec<[f32; 3]> {
         let mut all = Vec::new();
-        emit_unit_normals(mesh, triangles, used, &mut |run| {
+        emit_unit_normals(mesh, triangles, blocks, used, &mut |run| {
             all.extend_from_slice(run);
             Ok(())
         })
@@ -1076,7 +1134,10 @@ mod tests {
                 .iter()
                 .map(|v| v.map(|c| c as f32))
                 .collect();
-            assert_eq!(emitted(&mesh, triangles, used), whole);
+            assert_eq!(emitted(&mesh, triangles, None, used), whole);
+            // The plan made from known block ranges: the same normals.
+            let blocks = super::super::node_window::block_ranges(triangles);
+            assert_eq!(emitted(&mesh, triangles, Some(&blocks), used), whole);
             whole
         };
         let windowed = |triangles: &[[u32; 3]]| {
@@ -1196,6 +1257,59 @@ mod tests {
             plain,
             Err("invalid mesh: face `out of order` refers to a node out of range".into())
         );
+    }
+
+    #[test]
+    fn the_known_check_takes_a_readers_facts_that_fit_the_mesh() {
+        use crate::formats::mesh_facts::FaceFacts;
+        let face = |name: &str, triangles: Vec<[u32; 3]>| crate::mesh::MeshFace {
+            name: name.into(),
+            triangles,
+            boundary: Vec::new(),
+        };
+        let facts_of = |mesh: &Mesh| {
+            let faces = mesh
+                .faces
+                .iter()
+                .map(|f| FaceFacts::of(&f.triangles))
+                .collect();
+            MeshFacts::of(&mesh.nodes, faces).expect("finite nodes")
+        };
+        let mut mesh = Mesh {
+            dimension: 3,
+            nodes: vec![
+                [0.0, 0.0, 0.0],
+                [1.0, -3.0, 0.0],
+                [0.0, 1.0, 2.0],
+                [1.0, 1.0, 0.5],
+            ],
+            faces: vec![
+                face("in order", vec![[0, 1, 2], [2, 1, 3]]),
+                face("out of order", vec![[0, 2, 1]]),
+            ],
+            ..Mesh::default()
+        };
+        let facts = facts_of(&mesh);
+        let known = check_known(&mesh, &facts).expect("a valid mesh");
+        assert_eq!(known.identity, vec![Some(4), None]);
+        assert_eq!(known.bounds, Some(([0.0, -3.0, 0.0], [1.0, 1.0, 2.0])));
+        assert_eq!(known.blocks, vec![Some(vec![(0, 3)]), Some(vec![(0, 2)])]);
+        // The scanning check finds the same, without block ranges.
+        let scanned = check_scanned(&mesh, true).expect("a valid mesh");
+        assert_eq!(
+            (scanned.identity, scanned.bounds),
+            (known.identity, known.bounds)
+        );
+        assert!(scanned.blocks.is_empty());
+        // Facts of the mesh before a triangle was added do not fit: the
+        // check scans, and finds the node out of range.
+        mesh.faces[1].triangles.push([0, 1, 4]);
+        let stale = check_known(&mesh, &facts).map_err(|e| e.to_string());
+        let out_of_range = "invalid mesh: face `out of order` refers to a node out of range";
+        assert_eq!(stale, Err(out_of_range.into()));
+        // Facts that fit and know the largest node: the same error.
+        let fitting = check_known(&mesh, &facts_of(&mesh)).map_err(|e| e.to_string());
+        assert_eq!(fitting, Err(out_of_range.into()));
     }
 
     #[test]

@@ -15,6 +15,7 @@ mod file_ranges;
 pub mod frag;
 mod gltf;
 mod groups;
+mod mesh_facts;
 mod msh;
 mod msh22;
 mod msh_bounds;
@@ -26,6 +27,7 @@ mod vtu;
 
 pub use atomic::{FileOutput, Parts, write_atomic, write_atomic_file};
 pub use frag::{FragDocument, read_frag_xml};
+pub use mesh_facts::MeshFacts;
 
 use crate::mesh::Mesh;
 use std::fmt;
@@ -111,6 +113,18 @@ pub trait MeshWriter: Sync {
         out: &mut FileOutput,
     ) -> Result<Vec<Warning>, WriteError> {
         self.write(mesh, options, out)
+    }
+    /// [`MeshWriter::write_file`] for a mesh as a reader left it, with what
+    /// the reader found on it (`facts`, see [`MeshFacts`]): a writer that
+    /// would scan the mesh for the same takes them instead. The same bytes.
+    fn write_file_known(
+        &self,
+        mesh: &Mesh,
+        _facts: Option<&MeshFacts>,
+        options: &WriteOptions,
+        out: &mut FileOutput,
+    ) -> Result<Vec<Warning>, WriteError> {
+        self.write_file(mesh, options, out)
     }
     /// Files the main file refers to, for the same mesh and options. Most
     /// formats are self-contained.

@@ -23,8 +23,32 @@ pub(crate) struct NodeWindow<'t> {
 /// The window over `parts` (in order), or `None` when some block uses a
 /// node not below `n` or the window would be wider than `max` nodes.
 pub(crate) fn plan<'t>(parts: &[&'t [[u32; 3]]], n: usize, max: usize) -> Option<NodeWindow<'t>> {
+    let ranges: Vec<(u32, u32)> = parts.iter().flat_map(|p| block_ranges(p)).collect();
+    plan_from(parts, &ranges, n, max)
+}
+
+/// The smallest and largest node of each block of [`BLOCK`] triangles, in
+/// order: what [`plan`] is made from, which a reader can find once for
+/// every pass that needs a plan ([`plan_from`]).
+pub(crate) fn block_ranges(triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
+    triangles
+        .chunks(BLOCK)
+        .map(|b| range(b.as_flattened()))
+        .collect()
+}
+
+/// [`plan`] from the parts' [`block_ranges`] one after another (`None`
+/// also when they are not one range per block of the parts).
+pub(crate) fn plan_from<'t>(
+    parts: &[&'t [[u32; 3]]],
+    ranges: &[(u32, u32)],
+    n: usize,
+    max: usize,
+) -> Option<NodeWindow<'t>> {
     let blocks: Vec<&[[u32; 3]]> = parts.iter().flat_map(|p| p.chunks(BLOCK)).collect();
-    let ranges: Vec<(u32, u32)> = blocks.iter().map(|b| range(b.as_flattened())).collect();
+    if blocks.len() != ranges.len() {
+        return None;
+    }
     let mut first = Vec::with_capacity(blocks.len());
     let mut span = 0usize;
     let mut smallest = u32::MAX;

@@ -6,6 +6,8 @@
 use super::Loaded;
 use super::clean;
 use crate::diag::{Code, Diagnostic};
+use crate::formats::MeshFacts;
+use crate::formats::mesh_facts::FaceFacts;
 use crate::mesh::{
     CellKind, Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain, MeshVolume,
 };
@@ -87,10 +89,35 @@ impl Builder {
 
     /// [`Builder::finish`] without the surface checks ([`Loaded::check`]
     /// runs them later, e.g. while `convert` writes).
-    pub fn finish_unchecked(mut self) -> Result<Loaded, Vec<Diagnostic>> {
+    pub fn finish_unchecked(self) -> Result<Loaded, Vec<Diagnostic>> {
+        self.finish_with(false).map(|(loaded, _)| loaded)
+    }
+
+    /// [`Builder::finish_unchecked`]; with `facts`, also what its passes
+    /// over the nodes and triangles found ([`MeshFacts`]), for the passes
+    /// after it (without, those passes look for the largest index and the
+    /// first coordinate that is not finite only).
+    pub fn finish_with(
+        mut self,
+        facts: bool,
+    ) -> Result<(Loaded, Option<MeshFacts>), Vec<Diagnostic>> {
         let n = self.nodes.len();
+        // One per group with triangles: the faces' facts, in face order.
+        let faces: Vec<FaceFacts> = if facts {
+            self.groups
+                .iter()
+                .filter(|g| !g.triangles.is_empty())
+                .map(|g| FaceFacts::of(&g.triangles))
+                .collect()
+        } else {
+            Vec::new()
+        };
+        let mut known = faces.iter();
         for g in &self.groups {
-            let largest = crate::formats::groups::largest_index(&g.triangles);
+            let largest = match (g.triangles.is_empty(), facts) {
+                (false, true) => known.next().map_or(u32::MAX, FaceFacts::largest),
+                _ => crate::formats::groups::largest_index(&g.triangles),
+            };
             let bad = (!g.triangles.is_empty() && largest as usize >= n)
                 || g.lines.iter().flatten().any(|&v| v as usize >= n)
                 || g.points.iter().any(|&v| v as usize >= n)
@@ -103,13 +130,21 @@ impl Builder {
                 )]);
             }
         }
-        if let Some(i) = crate::formats::groups::first_non_finite(&self.nodes) {
-            return Err(vec![Diagnostic::new(
+        let non_finite = |i: usize| {
+            vec![Diagnostic::new(
                 Code::MeshNonFinite,
                 None,
                 format!("node {} has a coordinate that is not finite", i + 1),
-            )]);
-        }
+            )]
+        };
+        let facts = if facts {
+            Some(MeshFacts::of(&self.nodes, faces).map_err(non_finite)?)
+        } else {
+            if let Some(i) = crate::formats::groups::first_non_finite(&self.nodes) {
+                return Err(non_finite(i));
+            }
+            None
+        };
         let mut mesh = Mesh {
             dimension: 3,
             nodes: self.nodes,
@@ -150,12 +185,13 @@ impl Builder {
             }
         }
         attach_fragments(&mut mesh, &self.subdomains, &self.fragments, &face_of_group);
-        Ok(Loaded {
+        let loaded = Loaded {
             mesh,
             warnings: self.warnings,
             report: clean::CleanReport::default(),
             binary: None,
-        })
+        };
+        Ok((loaded, facts))
     }
 }
 

@@ -5,6 +5,7 @@
 //! say which groups are watertight.
 
 use crate::diag::{Code, Diagnostic};
+use crate::formats::MeshFacts;
 use crate::mesh::Mesh;
 
 #[derive(Debug, Clone, Default, PartialEq, Eq)]
@@ -78,7 +79,7 @@ impl EdgeCounts {
 /// The checks of a whole mesh and of each face.
 pub fn check(mesh: &Mesh) -> CleanReport {
     let scale = diagonal(mesh);
-    let whole = whole_counts(mesh, scale);
+    let whole = whole_counts(mesh, scale, None);
     let faces = if mesh.faces.len() == 1 {
         vec![whole.clone()]
     } else {
@@ -93,13 +94,27 @@ pub fn check(mesh: &Mesh) -> CleanReport {
 /// The checks of the whole mesh only (what `convert`'s warnings say), without
 /// the per-face counts of [`check`].
 pub fn check_whole(mesh: &Mesh) -> EdgeCounts {
-    whole_counts(mesh, diagonal(mesh))
+    whole_counts(mesh, diagonal(mesh), None)
+}
+
+/// [`check_whole`] of a mesh as a reader left it: the bounds and the
+/// node-window plan's block ranges come from the reader's `facts` instead
+/// of passes over the nodes and triangles (facts that do not fit the mesh
+/// are not used). The same counts.
+pub fn check_whole_known(mesh: &Mesh, facts: &MeshFacts) -> EdgeCounts {
+    if !facts.fits(mesh) {
+        return check_whole(mesh);
+    }
+    let scale = facts
+        .bounds
+        .map_or(0.0, |(lo, hi)| diagonal_of_bounds(lo, hi));
+    whole_counts(mesh, scale, Some(&facts.all_blocks()))
 }
 
 /// The counts over all faces' triangles together, read in place.
-fn whole_counts(mesh: &Mesh, scale: f64) -> EdgeCounts {
+fn whole_counts(mesh: &Mesh, scale: f64, blocks: Option<&[(u32, u32)]>) -> EdgeCounts {
     let parts: Vec<&[[u32; 3]]> = mesh.faces.iter().map(|f| f.triangles.as_slice()).collect();
-    counts_of_parts(&mesh.nodes, &parts, scale)
+    counts_of_parts(&mesh.nodes, &parts, scale, blocks)
 }
 
 fn diagonal(mesh: &Mesh) -> f64 {
@@ -111,6 +126,11 @@ fn diagonal(mesh: &Mesh) -> f64 {
             *h = h.max(v);
         }
     }
+    diagonal_of_bounds(lo, hi)
+}
+
+/// The length of the bounds' diagonal, 0 when it is not finite (no nodes).
+fn diagonal_of_bounds(lo: [f64; 3], hi: [f64; 3]) -> f64 {
     let d: f64 = lo
         .iter()
         .zip(&hi)
@@ -125,15 +145,20 @@ fn diagonal(mesh: &Mesh) -> f64 {
 /// 4 bytes each), then each node's few entries grouped by edge. Linear in
 /// the mesh, and the same on any thread count.
 pub fn counts(nodes: &[[f64; 3]], triangles: &[[u32; 3]], scale: f64) -> EdgeCounts {
-    counts_of_parts(nodes, &[triangles], scale)
+    counts_of_parts(nodes, &[triangles], scale, None)
 }
 
 /// [`counts`] of the triangles of several lists together: in a window of
 /// live nodes when the triangles allow one (see `window.rs`), else by a
 /// counting sort of all half-edges.
-fn counts_of_parts(nodes: &[[f64; 3]], parts: &[&[[u32; 3]]], scale: f64) -> EdgeCounts {
+fn counts_of_parts(
+    nodes: &[[f64; 3]],
+    parts: &[&[[u32; 3]]],
+    scale: f64,
+    blocks: Option<&[(u32, u32)]>,
+) -> EdgeCounts {
     let floor = AreaFloor::of(scale);
-    if let Some(counts) = super::clean_window::counts(nodes, parts, &floor) {
+    if let Some(counts) = super::clean_window::counts(nodes, parts, blocks, &floor) {
         return counts;
     }
     counts_by_sort(nodes, parts, &floor)

@@ -27,13 +27,20 @@ struct Bucket {
 
 /// The counts of `clean::counts_of_parts`, or `None` when the triangles use
 /// too wide a range of nodes at once (or a node not below `nodes.len()`).
+/// `blocks`: the parts' `node_window::block_ranges` one after another,
+/// when known (the plan is then made without a pass over the triangles).
 pub(super) fn counts(
     nodes: &[[f64; 3]],
     parts: &[&[[u32; 3]]],
+    blocks: Option<&[(u32, u32)]>,
     floor: &AreaFloor,
 ) -> Option<EdgeCounts> {
+    use crate::formats::node_window::{plan, plan_from};
     let n = nodes.len();
-    let plan = crate::formats::node_window::plan(parts, n, MAX_WINDOW)?;
+    let plan = match blocks {
+        Some(ranges) => plan_from(parts, ranges, n, MAX_WINDOW),
+        None => plan(parts, n, MAX_WINDOW),
+    }?;
     let window = plan.size;
     let mask = window - 1;
     let mut ring = vec![
@@ -163,6 +170,7 @@ fn count_held(held: &[u32], uses: &mut [u16], mask: usize, out: &mut EdgeCounts)
 mod tests {
     use super::super::clean::counts_by_sort;
     use super::*;
+    use crate::formats::node_window::block_ranges;
 
     /// Held buckets of repeated edges in both directions (clean pairs,
     /// open edges, same-way pairs, edges used three to five times) counted
@@ -240,7 +248,8 @@ mod tests {
             tris.push([id(rows - 1, k), id(rows - 1, k + 1), top]);
         }
         let floor = AreaFloor::of(30.0);
-        let by_window = |tris: &[[u32; 3]]| counts(&nodes, &[tris], &floor).expect("a window");
+        let by_window =
+            |tris: &[[u32; 3]]| counts(&nodes, &[tris], None, &floor).expect("a window");
         let by_sort = |tris: &[[u32; 3]]| counts_by_sort(&nodes, &[tris], &floor);
         let whole = by_window(&tris);
         assert_eq!(whole, by_sort(&tris));
@@ -263,17 +272,20 @@ mod tests {
         assert_eq!((c.inconsistent, c.non_manifold, c.degenerate), (3, 3, 1));
         // Split into parts: the same counts as together.
         let (a, b) = changed.split_at(7777);
-        assert_eq!(counts(&nodes, &[a, b], &floor), Some(c));
+        assert_eq!(counts(&nodes, &[a, b], None, &floor), Some(c.clone()));
+        // With the parts' block ranges known: the same counts.
+        let known = [block_ranges(a), block_ranges(b)].concat();
+        assert_eq!(counts(&nodes, &[a, b], Some(&known), &floor), Some(c));
         // A node used again far later needs a window wider than allowed.
         let far = nodes.len();
         nodes.extend((0..MAX_WINDOW as u32 + 10).map(|i| [f64::from(i), 1.0, 2.0]));
         let mut wide = vec![[0, 1, 2]];
         wide.extend((far..far + MAX_WINDOW).map(|i| [i as u32, i as u32 + 1, i as u32 + 2]));
         wide.push([0, 2, 3]);
-        assert_eq!(counts(&nodes, &[&wide], &floor), None);
+        assert_eq!(counts(&nodes, &[&wide], None, &floor), None);
         // Without the first and last triangles the window is narrow again.
         let strip = &wide[1..wide.len() - 1];
-        let narrow = counts(&nodes, &[strip], &floor).expect("a window");
+        let narrow = counts(&nodes, &[strip], None, &floor).expect("a window");
         assert_eq!(narrow, counts_by_sort(&nodes, &[strip], &floor));
         // Edges (i, i + 1) and (i, i + 2); neighbours run the same way along
         // the first kind, the second kind and both ends are open.

@@ -31,6 +31,7 @@ mod vtu;
 pub use build::Builder;
 
 use crate::diag::{Code, Diagnostic};
+use crate::formats::MeshFacts;
 use crate::mesh::Mesh;
 use crate::span::Span;
 use std::path::Path;
@@ -189,7 +190,7 @@ pub fn load_mesh_unchecked(
     format: Option<ReadFormat>,
     limits: &ReadLimits,
 ) -> Result<(Loaded, bool), Vec<Diagnostic>> {
-    load_unchecked(path, format, limits, false).map(|(loaded, checked, _)| (loaded, checked))
+    load_unchecked(path, format, limits, false).map(|(loaded, kept)| (loaded, kept.checked))
 }
 
 /// The input file's bytes after reading, still mapped: unmapping a large
@@ -201,29 +202,45 @@ pub struct InputBytes {
     _bytes: Option<mapped::FileBytes>,
 }
 
+/// What [`load_mesh_keeping_input`] hands back beside the mesh.
+pub struct Kept {
+    /// Whether the surface checks ran (as [`load_mesh_unchecked`] says).
+    pub checked: bool,
+    pub input: InputBytes,
+    /// What the reader found on the mesh as read (`None` when the surface
+    /// checks ran): for passes over the mesh before it is changed.
+    pub facts: Option<MeshFacts>,
+}
+
 /// [`load_mesh_unchecked`] that hands back the input's bytes instead of
 /// freeing them (`convert` frees them on the checks' thread once its
-/// counting is done).
+/// counting is done), and the mesh's facts.
 pub fn load_mesh_keeping_input(
     path: &Path,
     format: Option<ReadFormat>,
     limits: &ReadLimits,
-) -> Result<(Loaded, bool, InputBytes), Vec<Diagnostic>> {
+) -> Result<(Loaded, Kept), Vec<Diagnostic>> {
     load_unchecked(path, format, limits, true)
 }
 
+/// With `keep`, the input's bytes and the mesh's facts are kept.
 fn load_unchecked(
     path: &Path,
     format: Option<ReadFormat>,
     limits: &ReadLimits,
-    keep_input: bool,
-) -> Result<(Loaded, bool, InputBytes), Vec<Diagnostic>> {
+    keep: bool,
+) -> Result<(Loaded, Kept), Vec<Diagnostic>> {
     if matches!(format, None | Some(ReadFormat::Stl))
         && let Some(read) = stl::read_binary_file(path, format.is_some())
     {
-        let mut loaded = read?.finish_unchecked()?;
+        let (mut loaded, facts) = read?.finish_with(keep)?;
         loaded.binary = Some(true);
-        return Ok((loaded, false, InputBytes { _bytes: None }));
+        let kept = Kept {
+            checked: false,
+            input: InputBytes { _bytes: None },
+            facts,
+        };
+        return Ok((loaded, kept));
     }
     let file = mapped::FileBytes::open(path).map_err(|e| {
         vec![Diagnostic::new(
@@ -250,21 +267,31 @@ fn load_unchecked(
         }
     };
     if format == ReadFormat::FragXml {
-        return frag::load(path, bytes, limits).map(|l| (l, true, InputBytes { _bytes: None }));
+        let kept = Kept {
+            checked: true,
+            input: InputBytes { _bytes: None },
+            facts: None,
+        };
+        return frag::load(path, bytes, limits).map(|l| (l, kept));
     }
     let folder = path.parent().unwrap_or(Path::new(""));
     let (builder, binary) = parse(format, bytes, folder, limits)?;
     // The file's bytes are not needed for the checks: free them first,
     // unless the caller frees them later.
-    let input = if keep_input {
+    let input = if keep {
         InputBytes { _bytes: Some(file) }
     } else {
         drop(file);
         InputBytes { _bytes: None }
     };
-    let mut loaded = builder.finish_unchecked()?;
+    let (mut loaded, facts) = builder.finish_with(keep)?;
     loaded.binary = binary;
-    Ok((loaded, false, input))
+    let kept = Kept {
+        checked: false,
+        input,
+        facts,
+    };
+    Ok((loaded, kept))
 }
 
 /// Reads a mesh from bytes already in memory. `folder` is where relative
