@@ -71,6 +71,10 @@ pub(super) struct Resolver<'a> {
     objects: Objects,
 }
 
+/// What a task of the parallel pass gives back: the findings of its objects
+/// by index, the names they used, and how many it resolved.
+type AloneTask = (Vec<(usize, Diagnostics)>, Used, usize);
+
 /// Objects per task of the parallel pass (each a few microseconds).
 const ALONE_CHUNK: usize = 512;
 
@@ -192,7 +196,7 @@ impl<'a> Resolver<'a> {
             Frames::Shared(frames) => *frames,
         };
         let (doc, names, values, tables) = (*doc, *names, *values, *tables);
-        let done: Vec<(Vec<(usize, Diagnostics)>, Used, usize)> = state
+        let done: Vec<AloneTask> = state
             .par_chunks_mut(ALONE_CHUNK)
             .enumerate()
             .map(|(chunk, slots)| {

@@ -336,12 +336,10 @@ impl<'d> Values<'d> {
                 let start = self.stack.iter().position(|n| n == name).unwrap_or(0);
                 let mut cycle: Vec<&str> = self.stack[start..].iter().map(String::as_str).collect();
                 cycle.push(name);
-                let span = match self.sources.get(name) {
-                    Some((_, Source::Parameter { span, .. } | Source::Basis { span, .. })) => {
-                        Some(*span)
-                    }
-                    None => None,
-                };
+                let span = self
+                    .sources
+                    .get(name)
+                    .map(|(_, Source::Parameter { span, .. } | Source::Basis { span, .. })| *span);
                 diags.push(
                     Diagnostic::new(
                         Code::ReferenceCycle,
