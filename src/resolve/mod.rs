@@ -6,6 +6,8 @@ mod geometry;
 mod name_index;
 mod names;
 mod objects;
+#[cfg(test)]
+mod parallel_tests;
 mod point_calculus;
 mod polygons;
 mod shapes;
@@ -103,6 +105,26 @@ pub fn resolve(
     overrides: &[Override],
     diags: &mut Diagnostics,
 ) -> Resolved {
+    resolve_in(source, doc, overrides, diags, Pass::Parallel).0
+}
+
+/// How the objects are resolved: the serial pass alone is what the parallel
+/// one is tested against.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Pass {
+    Parallel,
+    #[cfg(test)]
+    Serial,
+}
+
+/// [`resolve`], and how many objects were resolved alone on the workers.
+fn resolve_in(
+    source: &SourceFile,
+    doc: &Document,
+    overrides: &[Override],
+    diags: &mut Diagnostics,
+    pass: Pass,
+) -> (Resolved, usize) {
     // The name table (with its findings) and the resolver's own tables side
     // by side; the findings are reported first, as when built alone.
     let ((names, found), tables) = rayon::join(
@@ -113,12 +135,11 @@ pub fn resolve(
         || objects::Tables::build(doc),
     );
     diags.extend(found);
-    let names = std::rc::Rc::new(names);
     let pairs: Vec<(String, Expr)> = overrides
         .iter()
         .map(|o| (o.name.clone(), o.value.clone()))
         .collect();
-    let mut values = Values::new(doc, &pairs);
+    let mut values = Values::new(doc, &pairs, &names);
     for o in overrides {
         if !values.is_parameter(&o.name) {
             let candidates = values.parameter_names();
@@ -140,18 +161,23 @@ pub fn resolve(
             diags.push(d);
         }
     }
-    values.other_names = std::rc::Rc::clone(&names);
     let parameters = values.evaluate_all(diags);
     check_basis_order(doc, &values, diags);
-    let mut resolver = objects::Resolver::new(doc, &names, tables, values, diags);
-    let objects = resolver.resolve_all();
+    // From here on the values are fixed: the resolvers share them.
+    let mut resolver = objects::Resolver::new(doc, &names, &tables, &values);
+    let (objects, alone) = match pass {
+        Pass::Parallel => resolver.resolve_all(),
+        #[cfg(test)]
+        Pass::Serial => (resolver.resolve_serially(), 0),
+    };
     let subdomain_areas = doc
         .subdomains
         .iter()
         .map(|def| shapes::subdomain_area(&mut resolver, def, doc.dimension))
         .collect();
-    let values = resolver.finish();
-    for (name, span) in values.unused_parameters() {
+    let (used, found) = resolver.finish();
+    diags.extend(found);
+    for (name, span) in values.unused_parameters(&used) {
         diags.push(
             Diagnostic::new(
                 Code::UnusedParameter,
@@ -162,13 +188,14 @@ pub fn resolve(
         );
     }
     let by_name = NameIndex::build(&objects);
-    Resolved {
+    let resolved = Resolved {
         dimension: doc.dimension,
         objects,
         by_name,
         parameters,
         subdomain_areas,
-    }
+    };
+    (resolved, alone)
 }
 
 /// Paper 000 supposes basis coordinates ascend with their index (x1 < x2 < …).

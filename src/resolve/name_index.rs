@@ -3,19 +3,19 @@
 //! allocations, and the lookups compared the same names anyway.
 
 use super::ResolvedObject;
-use foldhash::HashMap;
 use std::hash::BuildHasher;
 
-/// No object: the end of a chain.
-const NONE: u32 = u32::MAX;
-
-/// A hash of each name → the last object with that hash; `previous[i]`
-/// links object `i` to the one before it with the same hash. A lookup walks
-/// the chain and compares the names, so a name given twice finds its last
-/// object (as a map filled in order would).
+/// Open addressing over the names' hashes: `slots[h]` is 1 + the last object
+/// of a name whose probe sequence (linear, from its hash) stops at `h`, 0 an
+/// empty slot; `previous[i]` is 1 + the object before `i` with the same
+/// name, 0 for the first. A slot is four bytes (a map of hashes to indices
+/// was sixteen, and twice the memory at the front end's peak, when the
+/// subdomains look their solids up); a lookup compares names only in its
+/// few probes, and a name given twice finds its last object (as a map
+/// filled in order would).
 #[derive(Debug, Clone, Default)]
 pub struct NameIndex {
-    last: HashMap<u64, u32>,
+    slots: Vec<u32>,
     previous: Vec<u32>,
 }
 
@@ -25,42 +25,62 @@ fn hash(name: &str) -> u64 {
 
 impl NameIndex {
     pub fn build(objects: &[ResolvedObject]) -> NameIndex {
-        let mut last = HashMap::default();
-        last.reserve(objects.len());
-        let previous = (objects.iter().enumerate())
-            .map(|(i, o)| last.insert(hash(&o.name), i as u32).unwrap_or(NONE))
-            .collect();
-        NameIndex { last, previous }
+        // At most two thirds full, so probes stay short and end on an empty slot.
+        let size = (objects.len() + objects.len() / 2 + 1).next_power_of_two();
+        let mut slots = vec![0u32; size];
+        let mut previous = Vec::with_capacity(objects.len());
+        for (i, object) in objects.iter().enumerate() {
+            let slot = probe(&slots, objects, &object.name);
+            let before = slots.get(slot).copied().unwrap_or(0);
+            previous.push(before);
+            if let Some(s) = slots.get_mut(slot) {
+                *s = i as u32 + 1;
+            }
+        }
+        NameIndex { slots, previous }
     }
 
     /// The index of the last object named `name` in `objects` (the list the
     /// index was built from).
     pub fn get(&self, objects: &[ResolvedObject], name: &str) -> Option<usize> {
-        let mut at = self.last.get(&hash(name)).copied().unwrap_or(NONE);
-        while at != NONE {
-            let i = at as usize;
-            if objects.get(i)?.name == name {
-                return Some(i);
-            }
-            at = self.previous.get(i).copied().unwrap_or(NONE);
+        let slot = probe(&self.slots, objects, name);
+        match self.slots.get(slot).copied() {
+            None | Some(0) => None,
+            Some(s) => Some(s as usize - 1),
         }
-        None
     }
 
     /// Every object named `name` (a name given twice has several), in
     /// document order.
     pub fn all(&self, objects: &[ResolvedObject], name: &str) -> Vec<usize> {
         let mut found = Vec::new();
-        let mut at = self.last.get(&hash(name)).copied().unwrap_or(NONE);
-        while let Some(object) = objects.get(at as usize) {
-            if object.name == name {
-                found.push(at as usize);
-            }
-            at = self.previous.get(at as usize).copied().unwrap_or(NONE);
+        let mut at = self.get(objects, name);
+        while let Some(i) = at {
+            found.push(i);
+            at = match self.previous.get(i).copied() {
+                None | Some(0) => None,
+                Some(s) => Some(s as usize - 1),
+            };
         }
         found.reverse();
         found
     }
+}
+
+/// The slot of `name`: the one holding its last object, or the empty slot
+/// where its probe sequence ends.
+fn probe(slots: &[u32], objects: &[ResolvedObject], name: &str) -> usize {
+    let mask = slots.len().wrapping_sub(1);
+    let mut at = hash(name) as usize & mask;
+    for _ in 0..slots.len() {
+        match slots[at] {
+            0 => return at,
+            s if objects.get(s as usize - 1).is_some_and(|o| o.name == name) => return at,
+            _ => at = (at + 1) & mask,
+        }
+    }
+    // Not reached: the table is never full.
+    slots.len()
 }
 
 #[cfg(test)]
@@ -94,5 +114,28 @@ mod tests {
         assert_eq!(index.all(&objects, "a"), [0, 2, 4]);
         assert_eq!(index.all(&objects, "c"), [3]);
         assert!(index.all(&objects, "d").is_empty());
+    }
+
+    #[test]
+    fn many_names_find_what_a_scan_finds() {
+        // Every third name repeats an earlier one; the table is two thirds
+        // full at most, so probes collide and wrap around its end.
+        let names: Vec<String> = (0..3_000)
+            .map(|i| {
+                if i % 3 == 2 {
+                    format!("n{}", i / 7)
+                } else {
+                    format!("n{i}")
+                }
+            })
+            .collect();
+        let objects: Vec<ResolvedObject> = names.iter().map(|n| object(n)).collect();
+        let index = NameIndex::build(&objects);
+        for name in names.iter().map(String::as_str).chain(["n3000", "m1", ""]) {
+            let every: Vec<usize> = (0..objects.len()).filter(|&i| names[i] == name).collect();
+            assert_eq!(index.get(&objects, name), every.last().copied(), "{name}");
+            assert_eq!(index.all(&objects, name), every, "{name}");
+        }
+        assert_eq!(index.all(&objects, "n0"), [0, 2, 5]);
     }
 }

@@ -5,7 +5,7 @@
 use super::ResolvedObject;
 use super::geometry::{Geometry, Link};
 use super::names::NameTable;
-use super::values::{Ctx, Values};
+use super::values::{Ctx, Used, Values};
 use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::doc::{Axis, CoordinateSystem, Document, Number, Object, PointSpec, Ref, VectorSpec};
 use crate::geom::{Frame, Point3, Vec3};
@@ -21,18 +21,62 @@ enum FrameState {
 enum State {
     InProgress,
     Done(Option<Geometry>),
+    /// Resolved on a worker by a resolver of its own (see `resolve_alone`);
+    /// its findings are reported when the serial pass first asks for it.
+    Alone(Option<Geometry>),
+}
+
+/// The resolver's view of the other objects.
+enum Objects {
+    /// Every object's state: the serial resolver, which resolves a referenced
+    /// object on demand (with cycle detection).
+    All {
+        state: Vec<Option<State>>,
+        /// The findings of objects resolved alone, by object index (sorted),
+        /// until the serial pass reaches them.
+        pending: Vec<(usize, Diagnostics)>,
+    },
+    /// A worker's resolver of objects that need no other object: set when
+    /// one did (its result is then dropped and the serial pass resolves it).
+    Alone { needed_another: bool },
+}
+
+/// Coordinate-system frames: filled by the serial resolver, read by the
+/// workers' once every system is resolved.
+enum Frames<'a> {
+    Own(HashMap<String, FrameState>),
+    Shared(&'a HashMap<String, FrameState>),
+}
+
+impl Frames<'_> {
+    fn get(&self, name: &str) -> Option<&FrameState> {
+        match self {
+            Frames::Own(frames) => frames.get(name),
+            Frames::Shared(frames) => frames.get(name),
+        }
+    }
 }
 
 pub(super) struct Resolver<'a> {
     pub doc: &'a Document,
     pub names: &'a NameTable<'a>,
-    pub values: Values<'a>,
-    pub diags: &'a mut Diagnostics,
-    by_name: HashMap<&'a str, usize>,
-    systems: HashMap<String, &'a CoordinateSystem>,
-    frames: HashMap<String, FrameState>,
-    state: Vec<Option<State>>,
+    /// Parameter and basis values, fixed before any object is resolved.
+    pub values: &'a Values<'a>,
+    /// The parameters and basis coordinates this resolver's numbers used.
+    pub used: Used,
+    /// This resolver's findings, in the order it made them.
+    pub diags: Diagnostics,
+    tables: &'a Tables<'a>,
+    frames: Frames<'a>,
+    objects: Objects,
 }
+
+/// What a task of the parallel pass gives back: the findings of its objects
+/// by index, the names they used, and how many it resolved.
+type AloneTask = (Vec<(usize, Diagnostics)>, Used, usize);
+
+/// Objects per task of the parallel pass (each a few microseconds).
+const ALONE_CHUNK: usize = 512;
 
 /// The resolver's lookup tables of a document's objects and coordinate
 /// systems (the first of a repeated name), built apart from the name table:
@@ -61,32 +105,58 @@ impl<'a> Resolver<'a> {
     pub fn new(
         doc: &'a Document,
         names: &'a NameTable<'a>,
-        tables: Tables<'a>,
-        values: Values<'a>,
-        diags: &'a mut Diagnostics,
+        tables: &'a Tables<'a>,
+        values: &'a Values<'a>,
     ) -> Self {
         Resolver {
             doc,
             names,
             values,
-            diags,
-            by_name: tables.by_name,
-            systems: tables.systems,
-            frames: HashMap::new(),
-            state: vec![None; doc.objects.len()],
+            used: Used::default(),
+            diags: Diagnostics::default(),
+            tables,
+            frames: Frames::Own(HashMap::new()),
+            objects: Objects::All {
+                state: vec![None; doc.objects.len()],
+                pending: Vec::new(),
+            },
         }
     }
 
     pub fn by_name_index(&self, name: &str) -> Option<&usize> {
-        self.by_name.get(name)
+        self.tables.by_name.get(name)
     }
 
-    pub fn finish(self) -> Values<'a> {
-        self.values
+    /// The names this resolver used and its findings.
+    pub fn finish(self) -> (Used, Diagnostics) {
+        (self.used, self.diags)
     }
 
-    pub fn resolve_all(&mut self) -> Vec<ResolvedObject> {
-        // Coordinate systems first, so unused ones are checked too.
+    /// Resolves every object, as [`Resolver::resolve_serially`] does, with
+    /// the objects that need no other object (most of a large file's
+    /// primitives) resolved first on the rayon threads; also says how many
+    /// were.
+    pub fn resolve_all(&mut self) -> (Vec<ResolvedObject>, usize) {
+        self.resolve_systems();
+        let alone = if self.doc.objects.len() >= 2 * ALONE_CHUNK {
+            self.resolve_alone()
+        } else {
+            0
+        };
+        (self.resolve_objects(), alone)
+    }
+
+    /// Every object resolved on this thread only (the reference the
+    /// parallel pass is tested against).
+    #[cfg(test)]
+    pub fn resolve_serially(&mut self) -> Vec<ResolvedObject> {
+        self.resolve_systems();
+        self.resolve_objects()
+    }
+
+    /// Coordinate systems first, so unused ones are checked too (an origin
+    /// given as a named point resolves that object).
+    fn resolve_systems(&mut self) {
         let systems: Vec<&CoordinateSystem> = self.doc.coordinate_systems.iter().collect();
         for cs in systems {
             let reference = crate::doc::Ref {
@@ -98,14 +168,101 @@ impl<'a> Resolver<'a> {
             };
             self.frame_of(&reference);
         }
-        // Every object resolved once, in document order (a reference may
-        // resolve a later one first); then the geometries are moved out of the
-        // resolver's state instead of copied (nothing reads them after this:
-        // the subdomains' area limits are plain numbers).
+    }
+
+    /// Resolves each object not resolved yet on a worker, with a resolver of
+    /// its own that shares the frozen values, frames and tables: an object
+    /// that needs another object's geometry is left to the serial pass. The
+    /// results wait in the states (allocated here, on the calling thread),
+    /// their findings in `pending`, until the serial pass reaches them, so
+    /// the findings come in the serial order whatever the threads did.
+    fn resolve_alone(&mut self) -> usize {
+        use rayon::prelude::*;
+        let Resolver {
+            doc,
+            names,
+            values,
+            used,
+            tables,
+            frames,
+            objects,
+            ..
+        } = self;
+        let Objects::All { state, pending } = objects else {
+            return 0;
+        };
+        let frames = match frames {
+            Frames::Own(frames) => &*frames,
+            Frames::Shared(frames) => *frames,
+        };
+        let (doc, names, values, tables) = (*doc, *names, *values, *tables);
+        let done: Vec<AloneTask> = state
+            .par_chunks_mut(ALONE_CHUNK)
+            .enumerate()
+            .map(|(chunk, slots)| {
+                let mut alone = Resolver {
+                    doc,
+                    names,
+                    values,
+                    used: Used::default(),
+                    diags: Diagnostics::default(),
+                    tables,
+                    frames: Frames::Shared(frames),
+                    objects: Objects::Alone {
+                        needed_another: false,
+                    },
+                };
+                let mut found = Vec::new();
+                let mut count = 0;
+                for (k, slot) in slots.iter_mut().enumerate() {
+                    if slot.is_some() {
+                        continue;
+                    }
+                    let i = chunk * ALONE_CHUNK + k;
+                    alone.objects = Objects::Alone {
+                        needed_another: false,
+                    };
+                    let geometry = alone.resolve_object(&doc.objects[i]);
+                    let diags = std::mem::take(&mut alone.diags);
+                    if let Objects::Alone {
+                        needed_another: true,
+                    } = alone.objects
+                    {
+                        // The names it used before are used again by the
+                        // serial pass, on the same path: a merge adds none
+                        // that the serial resolver would not.
+                        continue;
+                    }
+                    if !diags.items.is_empty() {
+                        found.push((i, diags));
+                    }
+                    *slot = Some(State::Alone(geometry));
+                    count += 1;
+                }
+                (found, alone.used, count)
+            })
+            .collect();
+        let mut total = 0;
+        for (found, task_used, count) in done {
+            pending.extend(found);
+            used.merge(task_used);
+            total += count;
+        }
+        total
+    }
+
+    /// Every object resolved once, in document order (a reference may
+    /// resolve a later one first); then the geometries are moved out of the
+    /// resolver's state instead of copied (nothing reads them after this:
+    /// the subdomains' area limits are plain numbers).
+    fn resolve_objects(&mut self) -> Vec<ResolvedObject> {
         for i in 0..self.doc.objects.len() {
             self.resolve_once(i);
         }
-        let states = std::mem::take(&mut self.state);
+        let Objects::All { state, .. } = &mut self.objects else {
+            return Vec::new();
+        };
+        let states = std::mem::take(state);
         states
             .into_iter()
             .zip(&self.doc.objects)
@@ -123,46 +280,68 @@ impl<'a> Resolver<'a> {
     /// The geometry of object `i`, resolved once.
     pub fn geometry(&mut self, i: usize) -> Option<Geometry> {
         self.resolve_once(i);
-        match self.state.get(i) {
-            Some(Some(State::Done(geometry))) => geometry.clone(),
-            _ => None,
+        match &self.objects {
+            Objects::All { state, .. } => match state.get(i) {
+                Some(Some(State::Done(geometry))) => geometry.clone(),
+                _ => None,
+            },
+            Objects::Alone { .. } => None,
         }
     }
 
     /// Resolves object `i` unless it was: its geometry (or `None` after an
-    /// error) is then in `state[i]`.
+    /// error) is then in `state[i]`. A worker's resolver only notes that its
+    /// object needs another.
     fn resolve_once(&mut self, i: usize) {
-        match self.state.get(i) {
-            // Out of range only after `resolve_all` moved the geometries out.
-            None | Some(Some(State::Done(_))) => return,
-            Some(Some(State::InProgress)) => {
-                let object = &self.doc.objects[i];
-                self.diags.push(
-                    Diagnostic::new(
-                        Code::ReferenceCycle,
-                        object.name.span,
-                        format!(
-                            "{} '{}' is defined through itself",
-                            object.kind.element(),
-                            object.name.text
+        let state = match &mut self.objects {
+            Objects::All { state, pending } => match state.get_mut(i) {
+                // Out of range only after `resolve_all` moved the geometries out.
+                None | Some(Some(State::Done(_))) => return,
+                Some(slot @ Some(State::Alone(_))) => {
+                    if let Some(State::Alone(geometry)) = slot.take() {
+                        *slot = Some(State::Done(geometry));
+                    }
+                    if let Ok(k) = pending.binary_search_by_key(&i, |(j, _)| *j) {
+                        self.diags.extend(std::mem::take(&mut pending[k].1));
+                    }
+                    return;
+                }
+                Some(Some(State::InProgress)) => {
+                    let object = &self.doc.objects[i];
+                    self.diags.push(
+                        Diagnostic::new(
+                            Code::ReferenceCycle,
+                            object.name.span,
+                            format!(
+                                "{} '{}' is defined through itself",
+                                object.kind.element(),
+                                object.name.text
+                            ),
+                        )
+                        .with_help(
+                            "a transform or reference chain leads back to this object; break the chain",
                         ),
-                    )
-                    .with_help(
-                        "a transform or reference chain leads back to this object; break the chain",
-                    ),
-                );
-                self.state[i] = Some(State::Done(None));
+                    );
+                    state[i] = Some(State::Done(None));
+                    return;
+                }
+                Some(None) => state,
+            },
+            Objects::Alone { needed_another } => {
+                *needed_another = true;
                 return;
             }
-            Some(None) => {}
-        }
-        self.state[i] = Some(State::InProgress);
+        };
+        state[i] = Some(State::InProgress);
         let object: &'a Object = &self.doc.objects[i];
         let geometry = self.resolve_object(object);
-        if let Some(State::Done(None)) = self.state[i] {
+        let Objects::All { state, .. } = &mut self.objects else {
+            return;
+        };
+        if let Some(State::Done(None)) = state[i] {
             return;
         }
-        self.state[i] = Some(State::Done(geometry));
+        state[i] = Some(State::Done(geometry));
     }
 
     fn resolve_object(&mut self, object: &'a Object) -> Option<Geometry> {
@@ -176,7 +355,7 @@ impl<'a> Resolver<'a> {
     /// The frame of a coordinate system, through its parents (cycles reported).
     pub fn frame_of(&mut self, reference: &Ref) -> Option<Frame> {
         let name = reference.name.as_str();
-        let Some(cs) = self.systems.get(name).copied() else {
+        let Some(cs) = self.tables.systems.get(name).copied() else {
             let d = match self.names.kind_of(name) {
                 Some(kind) => Diagnostic::new(
                     Code::WrongKind,
@@ -191,7 +370,7 @@ impl<'a> Resolver<'a> {
                         format!("undefined coordinate system '{name}'"),
                     );
                     d.help = Some(
-                        match did_you_mean(name, self.systems.keys().map(String::as_str)) {
+                        match did_you_mean(name, self.tables.systems.keys().map(String::as_str)) {
                             Some(best) => format!("did you mean '{best}'?"),
                             None => format!("define it with <coordinate_system name=\"{name}\">"),
                         },
@@ -202,25 +381,29 @@ impl<'a> Resolver<'a> {
             self.diags.push(d);
             return None;
         };
-        match self.frames.get(name) {
+        let in_progress = match self.frames.get(name) {
             Some(FrameState::Done(frame)) => return *frame,
-            Some(FrameState::InProgress) => {
-                self.diags.push(
-                    Diagnostic::new(
-                        Code::ReferenceCycle,
-                        cs.name.span,
-                        format!(
-                            "coordinate system '{name}' lies inside itself through its cs= chain"
-                        ),
-                    )
-                    .with_help("remove cs= from one of the systems in the chain"),
-                );
-                self.frames.insert(name.to_string(), FrameState::Done(None));
-                return None;
-            }
-            None => {}
+            Some(FrameState::InProgress) => true,
+            None => false,
+        };
+        let Frames::Own(frames) = &mut self.frames else {
+            // Every system was resolved before the workers started.
+            self.needs_another();
+            return None;
+        };
+        if in_progress {
+            frames.insert(name.to_string(), FrameState::Done(None));
+            self.diags.push(
+                Diagnostic::new(
+                    Code::ReferenceCycle,
+                    cs.name.span,
+                    format!("coordinate system '{name}' lies inside itself through its cs= chain"),
+                )
+                .with_help("remove cs= from one of the systems in the chain"),
+            );
+            return None;
         }
-        self.frames.insert(name.to_string(), FrameState::InProgress);
+        frames.insert(name.to_string(), FrameState::InProgress);
         let parent = match &cs.parent {
             Some(p) => self.frame_of(p),
             None => Some(Frame::identity()),
@@ -244,15 +427,25 @@ impl<'a> Resolver<'a> {
                 linear: parent.linear * rotation.linear,
             })
         });
-        self.frames
-            .insert(name.to_string(), FrameState::Done(frame));
+        if let Frames::Own(frames) = &mut self.frames {
+            frames.insert(name.to_string(), FrameState::Done(frame));
+        }
         frame
+    }
+
+    /// Notes, on a worker's resolver, that its object needs another object
+    /// or system (the serial pass resolves it instead).
+    fn needs_another(&mut self) {
+        if let Objects::Alone { needed_another } = &mut self.objects {
+            *needed_another = true;
+        }
     }
 
     // ---- numbers, points, vectors ----
 
     pub fn number(&mut self, n: &Number) -> Option<f64> {
-        self.values.eval(n, Ctx::Any, self.diags)
+        self.values
+            .eval(n, Ctx::Any, &mut self.used, &mut self.diags)
     }
 
     /// A point in global coordinates. `need3` asks for a warning when a 3D
@@ -288,12 +481,13 @@ impl<'a> Resolver<'a> {
             return None;
         }
         let local = vector3(
-            &mut self.values,
+            self.values,
+            &mut self.used,
             spec.x.as_ref(),
             spec.y.as_ref(),
             spec.z.as_ref(),
             true,
-            self.diags,
+            &mut self.diags,
         )?;
         let missing_z = spec.z.is_none() && self.doc.dimension == 3;
         if need3 && (spec.x.is_none() || spec.y.is_none() || missing_z) {
@@ -382,12 +576,13 @@ impl<'a> Resolver<'a> {
 
     pub fn vector(&mut self, spec: &VectorSpec, frame: &Frame) -> Option<Vec3> {
         let v = vector3(
-            &mut self.values,
+            self.values,
+            &mut self.used,
             spec.x.as_ref(),
             spec.y.as_ref(),
             spec.z.as_ref(),
             true,
-            self.diags,
+            &mut self.diags,
         )?;
         Some(frame.linear * v)
     }
@@ -395,12 +590,13 @@ impl<'a> Resolver<'a> {
     /// A vector of plain numbers (angles, scale factors): basis coordinates not allowed.
     pub fn numbers3(&mut self, spec: &VectorSpec) -> Option<Vec3> {
         vector3(
-            &mut self.values,
+            self.values,
+            &mut self.used,
             spec.x.as_ref(),
             spec.y.as_ref(),
             spec.z.as_ref(),
             false,
-            self.diags,
+            &mut self.diags,
         )
     }
 
@@ -409,7 +605,7 @@ impl<'a> Resolver<'a> {
     /// Finds the object a reference names, checking that its element is one of
     /// `kinds` (element names as in the format; "*" accepts any object).
     pub fn lookup(&mut self, reference: &Ref, kinds: &[&str]) -> Option<usize> {
-        let Some(&i) = self.by_name.get(reference.name.as_str()) else {
+        let Some(&i) = self.tables.by_name.get(reference.name.as_str()) else {
             let d = match self.names.kind_of(&reference.name) {
                 Some(kind) => Diagnostic::new(
                     Code::WrongKind,
@@ -559,7 +755,8 @@ fn describe_kinds(kinds: &[&str]) -> String {
 /// Evaluates three optional components (missing = 0). As coordinates, each
 /// may use basis coordinates of its own axis.
 fn vector3(
-    values: &mut Values,
+    values: &Values,
+    used: &mut Used,
     x: Option<&Number>,
     y: Option<&Number>,
     z: Option<&Number>,
@@ -578,7 +775,7 @@ fn vector3(
             } else {
                 Ctx::Any
             };
-            match values.eval(n, ctx, diags) {
+            match values.eval(n, ctx, used, diags) {
                 Some(v) => out[slot] = v,
                 None => ok = false,
             }

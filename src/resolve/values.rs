@@ -6,7 +6,7 @@ use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::doc::{Axis, Document, Number};
 use crate::expr::{self, EvalError, Expr};
 use crate::span::Span;
-use foldhash::{HashMap, HashMapExt, HashSet, HashSetExt};
+use foldhash::{HashMap, HashMapExt, HashSet};
 use std::collections::BTreeMap;
 
 /// Where a number is used: basis coordinates are allowed only as coordinates
@@ -36,16 +36,44 @@ enum State {
     Done(Option<f64>),
 }
 
-/// The evaluator of numeric attributes.
+/// The parameters and basis coordinates some expressions used, by their
+/// index in [`Values`]. A resolver on each thread keeps its own; unions of
+/// them are what the unused-parameter check reads, so the order in which
+/// they are merged does not matter.
+#[derive(Debug, Clone, Default)]
+pub struct Used(HashSet<u32>);
+
+impl Used {
+    pub fn merge(&mut self, other: Used) {
+        self.0.extend(other.0);
+    }
+}
+
+/// What a name in an expression stands for where it is used.
+enum Admitted {
+    /// A parameter, or a basis coordinate of the expected axis: its value.
+    Value,
+    /// A basis coordinate where it cannot be used (reported): used, no value.
+    UsedOnly,
+    /// Not a parameter or basis coordinate (reported unless `pi`).
+    No,
+}
+
+/// The evaluator of numeric attributes. Parameters and basis coordinates are
+/// evaluated first ([`Values::evaluate_all`], which needs `&mut`); after that
+/// the values are frozen and every other number is evaluated through `&self`
+/// with a [`Used`] of the caller's, so resolvers on several threads share one.
 pub struct Values<'d> {
-    sources: HashMap<String, Source>,
+    /// Each name's index (for [`Used`]) and definition.
+    sources: HashMap<String, (u32, Source)>,
     /// Parameter names in definition order.
     parameter_order: Vec<String>,
     state: HashMap<String, State>,
-    used: HashSet<String>,
+    /// Names used by parameters and basis coordinates themselves.
+    used: Used,
     /// Every defined name with its kind, to say "wrong kind" instead of
-    /// "undefined" (shared with the resolver, not copied).
-    pub other_names: std::rc::Rc<super::NameTable<'d>>,
+    /// "undefined".
+    names: &'d super::NameTable<'d>,
     stack: Vec<String>,
 }
 
@@ -53,7 +81,11 @@ impl<'d> Values<'d> {
     /// Collects parameters and basis coordinates; `overrides` (from `--set`)
     /// replace parameter expressions. Duplicate names are reported by the name
     /// table, so the first definition wins here.
-    pub fn new(doc: &Document, overrides: &[(String, Expr)]) -> Values<'d> {
+    pub fn new(
+        doc: &Document,
+        overrides: &[(String, Expr)],
+        names: &'d super::NameTable<'d>,
+    ) -> Values<'d> {
         let mut sources = HashMap::new();
         let mut parameter_order = Vec::new();
         for p in &doc.parameters {
@@ -61,23 +93,31 @@ impl<'d> Values<'d> {
                 continue;
             }
             parameter_order.push(p.name.text.clone());
+            let id = sources.len() as u32;
             sources.insert(
                 p.name.text.clone(),
-                Source::Parameter {
-                    expr: p.value.expr().map(std::borrow::Cow::into_owned),
-                    span: p.name.span,
-                },
+                (
+                    id,
+                    Source::Parameter {
+                        expr: p.value.expr().map(std::borrow::Cow::into_owned),
+                        span: p.name.span,
+                    },
+                ),
             );
         }
         for b in &doc.basis {
-            sources.entry(b.name.text.clone()).or_insert(Source::Basis {
-                axis: b.axis,
-                expr: b.value.expr().map(std::borrow::Cow::into_owned),
-                span: b.name.span,
-            });
+            let id = sources.len() as u32;
+            sources.entry(b.name.text.clone()).or_insert((
+                id,
+                Source::Basis {
+                    axis: b.axis,
+                    expr: b.value.expr().map(std::borrow::Cow::into_owned),
+                    span: b.name.span,
+                },
+            ));
         }
         for (name, expr) in overrides {
-            if let Some(Source::Parameter { expr: slot, .. }) = sources.get_mut(name) {
+            if let Some((_, Source::Parameter { expr: slot, .. })) = sources.get_mut(name) {
                 *slot = Some(expr.clone());
             }
         }
@@ -85,8 +125,8 @@ impl<'d> Values<'d> {
             sources,
             parameter_order,
             state: HashMap::new(),
-            used: HashSet::new(),
-            other_names: Default::default(),
+            used: Used::default(),
+            names,
             stack: Vec::new(),
         }
     }
@@ -97,7 +137,7 @@ impl<'d> Values<'d> {
     }
 
     pub fn is_parameter(&self, name: &str) -> bool {
-        matches!(self.sources.get(name), Some(Source::Parameter { .. }))
+        matches!(self.sources.get(name), Some((_, Source::Parameter { .. })))
     }
 
     pub fn parameter_names(&self) -> Vec<&str> {
@@ -105,32 +145,83 @@ impl<'d> Values<'d> {
     }
 
     /// The value of a numeric attribute, or `None` after reporting why not.
-    pub fn eval(&mut self, number: &Number, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
+    /// Reads the values [`Values::evaluate_all`] fixed; the names it uses go
+    /// into `used`.
+    pub fn eval(
+        &self,
+        number: &Number,
+        ctx: Ctx,
+        used: &mut Used,
+        diags: &mut Diagnostics,
+    ) -> Option<f64> {
         let expr = number.expr()?;
-        self.eval_expr(&expr, ctx, diags)
+        self.eval_frozen(&expr, ctx, used, diags)
     }
 
     pub fn eval_opt(
-        &mut self,
+        &self,
         number: &Option<Number>,
         ctx: Ctx,
+        used: &mut Used,
         diags: &mut Diagnostics,
     ) -> Option<Option<f64>> {
         match number {
             None => Some(None),
-            Some(n) => self.eval(n, ctx, diags).map(Some),
+            Some(n) => self.eval(n, ctx, used, diags).map(Some),
         }
     }
 
-    fn eval_expr(&mut self, expr: &Expr, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
+    fn eval_frozen(
+        &self,
+        expr: &Expr,
+        ctx: Ctx,
+        used: &mut Used,
+        diags: &mut Diagnostics,
+    ) -> Option<f64> {
         let mut failed = false;
         let result = expr::eval(expr, &mut |name, span| {
-            let value = self.lookup(name, span, ctx, diags);
+            let value = match self.admit(name, span, ctx, used, diags) {
+                // Every value was fixed by `evaluate_all`.
+                Admitted::Value => match self.state.get(name) {
+                    Some(State::Done(v)) => *v,
+                    _ => None,
+                },
+                Admitted::UsedOnly | Admitted::No => None,
+            };
             if value.is_none() && name != "pi" {
                 failed = true;
             }
             value.or(if name == "pi" { None } else { Some(0.0) })
         });
+        self.finish_eval(result, failed, diags)
+    }
+
+    /// Evaluates a parameter's or basis coordinate's own expression, the
+    /// names it uses evaluated on demand.
+    fn eval_expr(&mut self, expr: &Expr, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
+        let mut failed = false;
+        let result = expr::eval(expr, &mut |name, span| {
+            let mut used = std::mem::take(&mut self.used);
+            let admitted = self.admit(name, span, ctx, &mut used, diags);
+            self.used = used;
+            let value = match admitted {
+                Admitted::Value => self.value_of(name, diags),
+                Admitted::UsedOnly | Admitted::No => None,
+            };
+            if value.is_none() && name != "pi" {
+                failed = true;
+            }
+            value.or(if name == "pi" { None } else { Some(0.0) })
+        });
+        self.finish_eval(result, failed, diags)
+    }
+
+    fn finish_eval(
+        &self,
+        result: Result<f64, EvalError>,
+        failed: bool,
+        diags: &mut Diagnostics,
+    ) -> Option<f64> {
         if failed {
             return None;
         }
@@ -151,16 +242,26 @@ impl<'d> Values<'d> {
         }
     }
 
-    fn lookup(&mut self, name: &str, span: Span, ctx: Ctx, diags: &mut Diagnostics) -> Option<f64> {
-        match self.sources.get(name).cloned() {
-            Some(Source::Parameter { .. }) => {
-                self.used.insert(name.to_string());
-                self.value_of(name, diags)
+    /// Whether `name` may give a value where it is used (a wrong use is
+    /// reported); a parameter or basis coordinate is marked used either way.
+    fn admit(
+        &self,
+        name: &str,
+        span: Span,
+        ctx: Ctx,
+        used: &mut Used,
+        diags: &mut Diagnostics,
+    ) -> Admitted {
+        match self.sources.get(name) {
+            Some((id, Source::Parameter { .. })) => {
+                used.0.insert(*id);
+                Admitted::Value
             }
-            Some(Source::Basis { axis, .. }) => {
-                self.used.insert(name.to_string());
+            Some((id, Source::Basis { axis, .. })) => {
+                used.0.insert(*id);
+                let axis = *axis;
                 match ctx {
-                    Ctx::Coordinate(want) if want == axis => self.value_of(name, diags),
+                    Ctx::Coordinate(want) if want == axis => Admitted::Value,
                     Ctx::Coordinate(want) => {
                         diags.push(
                             Diagnostic::new(
@@ -177,7 +278,7 @@ impl<'d> Values<'d> {
                                 want.letter()
                             )),
                         );
-                        None
+                        Admitted::UsedOnly
                     }
                     Ctx::Any => {
                         diags.push(
@@ -188,14 +289,14 @@ impl<'d> Values<'d> {
                             )
                             .with_help("basis coordinates give x, y or z coordinates; define a <parameter> for other values"),
                         );
-                        None
+                        Admitted::UsedOnly
                     }
                 }
             }
-            None if name == "pi" => None,
+            None if name == "pi" => Admitted::No,
             None => {
                 if let Some(kind) = self
-                    .other_names
+                    .names
                     .kind_of(name)
                     .filter(|&k| k != "parameter" && k != "basis coordinate")
                 {
@@ -222,7 +323,7 @@ impl<'d> Values<'d> {
                     });
                     diags.push(d);
                 }
-                None
+                Admitted::No
             }
         }
     }
@@ -235,12 +336,10 @@ impl<'d> Values<'d> {
                 let start = self.stack.iter().position(|n| n == name).unwrap_or(0);
                 let mut cycle: Vec<&str> = self.stack[start..].iter().map(String::as_str).collect();
                 cycle.push(name);
-                let span = match self.sources.get(name) {
-                    Some(Source::Parameter { span, .. } | Source::Basis { span, .. }) => {
-                        Some(*span)
-                    }
-                    None => None,
-                };
+                let span = self
+                    .sources
+                    .get(name)
+                    .map(|(_, Source::Parameter { span, .. } | Source::Basis { span, .. })| *span);
                 diags.push(
                     Diagnostic::new(
                         Code::ReferenceCycle,
@@ -258,8 +357,8 @@ impl<'d> Values<'d> {
             None => {}
         }
         let (expr, ctx) = match self.sources.get(name) {
-            Some(Source::Parameter { expr, .. }) => (expr.clone(), Ctx::Any),
-            Some(Source::Basis { axis, expr, .. }) => (expr.clone(), Ctx::Coordinate(*axis)),
+            Some((_, Source::Parameter { expr, .. })) => (expr.clone(), Ctx::Any),
+            Some((_, Source::Basis { axis, expr, .. })) => (expr.clone(), Ctx::Coordinate(*axis)),
             None => return None,
         };
         self.state.insert(name.to_string(), State::InProgress);
@@ -297,7 +396,7 @@ impl<'d> Values<'d> {
         self.sources
             .iter()
             .filter_map(|(n, s)| match (s, self.state.get(n)) {
-                (Source::Basis { axis: a, .. }, Some(State::Done(Some(v)))) if *a == axis => {
+                ((_, Source::Basis { axis: a, .. }), Some(State::Done(Some(v)))) if *a == axis => {
                     Some((n.clone(), *v))
                 }
                 _ => None,
@@ -305,13 +404,16 @@ impl<'d> Values<'d> {
             .collect()
     }
 
-    /// Parameters never used by any expression (their spans).
-    pub fn unused_parameters(&self) -> Vec<(String, Span)> {
+    /// Parameters that no expression used: not the parameters' own nor any
+    /// of `used` (their spans).
+    pub fn unused_parameters(&self, used: &Used) -> Vec<(String, Span)> {
         let mut out: Vec<(String, Span)> = self
             .sources
             .iter()
-            .filter_map(|(n, s)| match s {
-                Source::Parameter { span, .. } if !self.used.contains(n) => {
+            .filter_map(|(n, (id, s))| match s {
+                Source::Parameter { span, .. }
+                    if !self.used.0.contains(id) && !used.0.contains(id) =>
+                {
                     Some((n.clone(), *span))
                 }
                 _ => None,
