@@ -1223,29 +1223,30 @@ mod tests {
         assert_eq!(nodes_scan(&[]), (None, None));
     }
 
-    /// The scanning check finds each face's first-use prefix and the same
-    /// errors as the plain one.
-    #[test]
-    fn the_scanning_check_finds_each_faces_order() {
+    /// Two faces over four nodes (the second at `second`): the first uses
+    /// its nodes in order (0, 1, 2, 3), the second does not.
+    fn in_and_out_of_order(second: [f64; 3]) -> Mesh {
         let face = |name: &str, triangles: Vec<[u32; 3]>| crate::mesh::MeshFace {
             name: name.into(),
             triangles,
             boundary: Vec::new(),
         };
-        let mut mesh = Mesh {
+        Mesh {
             dimension: 3,
-            nodes: vec![
-                [0.0, 0.0, 0.0],
-                [1.0, 0.0, 0.0],
-                [0.0, 1.0, 2.0],
-                [1.0, 1.0, 0.5],
-            ],
+            nodes: vec![[0.0, 0.0, 0.0], second, [0.0, 1.0, 2.0], [1.0, 1.0, 0.5]],
             faces: vec![
                 face("in order", vec![[0, 1, 2], [2, 1, 3]]),
                 face("out of order", vec![[0, 2, 1]]),
             ],
             ..Mesh::default()
-        };
+        }
+    }
+
+    /// The scanning check finds each face's first-use prefix and the same
+    /// errors as the plain one.
+    #[test]
+    fn the_scanning_check_finds_each_faces_order() {
+        let mut mesh = in_and_out_of_order([1.0, 0.0, 0.0]);
         let scanned = check_scanned(&mesh, true).expect("a valid mesh");
         assert_eq!(scanned.identity, vec![Some(4), None]);
         assert_eq!(scanned.bounds, Some(([0.0, 0.0, 0.0], [1.0, 1.0, 2.0])));
@@ -1262,11 +1263,6 @@ mod tests {
     #[test]
     fn the_known_check_takes_a_readers_facts_that_fit_the_mesh() {
         use crate::formats::mesh_facts::FaceFacts;
-        let face = |name: &str, triangles: Vec<[u32; 3]>| crate::mesh::MeshFace {
-            name: name.into(),
-            triangles,
-            boundary: Vec::new(),
-        };
         let facts_of = |mesh: &Mesh| {
             let faces = mesh
                 .faces
@@ -1275,20 +1271,7 @@ mod tests {
                 .collect();
             MeshFacts::of(&mesh.nodes, faces).expect("finite nodes")
         };
-        let mut mesh = Mesh {
-            dimension: 3,
-            nodes: vec![
-                [0.0, 0.0, 0.0],
-                [1.0, -3.0, 0.0],
-                [0.0, 1.0, 2.0],
-                [1.0, 1.0, 0.5],
-            ],
-            faces: vec![
-                face("in order", vec![[0, 1, 2], [2, 1, 3]]),
-                face("out of order", vec![[0, 2, 1]]),
-            ],
-            ..Mesh::default()
-        };
+        let mut mesh = in_and_out_of_order([1.0, -3.0, 0.0]);
         let facts = facts_of(&mesh);
         let known = check_known(&mesh, &facts).expect("a valid mesh");
         assert_eq!(known.identity, vec![Some(4), None]);

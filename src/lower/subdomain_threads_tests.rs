@@ -171,14 +171,7 @@ fn subdomains_lower_and_check_alike_on_any_thread_count() {
         s.map_or(0, |s| s.solids.len())
     };
     assert_eq!((solids("m9"), solids("c9"), solids("F9")), (2, 1, 0));
-    let expected = outcome(&one);
-    for threads in [2, 3] {
-        assert_eq!(
-            outcome(&checked(threads, &text)),
-            expected,
-            "{threads} threads"
-        );
-    }
+    alike_on_more_threads(&text, &one);
 }
 
 #[test]
@@ -196,10 +189,15 @@ fn crossing_solids_are_reported_alike_on_any_thread_count() {
         first.as_deref(),
         Some("the boundaries of 'x0' and 'y0' cross near (0.5, 29.652928812, -0.79343657)")
     );
-    let expected = outcome(&one);
+    alike_on_more_threads(&text, &one);
+}
+
+/// Checks `text` on 2 and 3 threads against its one-thread check `one`.
+fn alike_on_more_threads(text: &str, one: &Checked) {
+    let expected = outcome(one);
     for threads in [2, 3] {
         assert_eq!(
-            outcome(&checked(threads, &text)),
+            outcome(&checked(threads, text)),
             expected,
             "{threads} threads"
         );

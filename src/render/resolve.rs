@@ -258,69 +258,109 @@ pub fn resolve_rows(
                 row[px * 4..px * 4 + 4].copy_from_slice(&bg);
                 continue;
             }
-            // Shading gathers a triangle, then its corners' positions and
-            // light: fetch the triangle of the pixel 16 ahead and the
-            // corners of the one 8 ahead, so the loads overlap.
-            if let Some(tri) = (px + 2 * AHEAD < cols.end)
-                .then(|| first_tri(px + 2 * AHEAD, py))
-                .flatten()
-            {
-                prefetch(&scene.tris[tri]);
-                prefetch(&scene.corner_slots[tri]);
-            }
-            if let Some(tri) = (px + AHEAD < cols.end)
-                .then(|| first_tri(px + AHEAD, py))
-                .flatten()
-            {
-                for (n, slot) in scene.tris[tri].into_iter().zip(scene.corner_slots[tri]) {
-                    prefetch(&proj.xy_f[n as usize]);
-                    prefetch(&scene.light[slot as usize]);
-                }
-            }
+            prefetch_ahead(scene, proj, px, cols.end, |px| first_tri(px, py));
             if let Some(color) = uniform(scene, proj, samples, ss, px, py) {
                 row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
                 continue;
             }
-            let mut sum = [0u32; 4];
-            let mut last: Option<(u64, [u8; 3])> = None;
+            let mut sum = PixelSum::default();
             for sy in py * ss..(py + 1) * ss {
                 for sx in px * ss..(px + 1) * ss {
-                    let (color, alpha) = if samples.edge(sx, sy) {
-                        ([EDGE_COLOR[0], EDGE_COLOR[1], EDGE_COLOR[2]], 255)
+                    if samples.edge(sx, sy) {
+                        sum.add([EDGE_COLOR[0], EDGE_COLOR[1], EDGE_COLOR[2]], 255);
                     } else {
                         let value = samples.value(sx, sy);
-                        if value == EMPTY {
-                            (
-                                [background[0], background[1], background[2]],
-                                background[3] as u32,
-                            )
-                        } else {
-                            let id = value & 0xffff_ffff;
-                            let color = match last {
-                                Some((l, c)) if l == id => c,
-                                _ => {
-                                    let c = shade(scene, proj, id, sx, sy, px, py);
-                                    last = Some((id, c));
-                                    c
-                                }
-                            };
-                            (color, 255)
-                        }
-                    };
-                    for c in 0..3 {
-                        sum[c] += color[c] as u32 * alpha;
+                        sum.add_sample(value, background, || {
+                            shade(scene, proj, value & 0xffff_ffff, sx, sy, px, py)
+                        });
                     }
-                    sum[3] += alpha;
                 }
             }
-            let n = (ss * ss) as u32;
-            let out = &mut row[px * 4..px * 4 + 4];
-            for c in 0..3 {
-                if let Some(v) = (sum[c] + sum[3] / 2).checked_div(sum[3]) {
-                    out[c] = v as u8;
-                }
-            }
-            out[3] = ((sum[3] + n / 2) / n) as u8;
+            sum.write((ss * ss) as u32, &mut row[px * 4..px * 4 + 4]);
         }
+    }
+}
+
+/// Fetches what shading a pixel ahead will gather: a triangle, then its
+/// corners' positions and light. The triangle of the pixel 16 ahead and the
+/// corners of the one 8 ahead, so the loads overlap (`first_tri` gives the
+/// triangle at a pixel's first sample; `end` ends the row's columns).
+#[inline(always)]
+pub(super) fn prefetch_ahead(
+    scene: &Scene,
+    proj: &Projected,
+    px: usize,
+    end: usize,
+    first_tri: impl Fn(usize) -> Option<usize>,
+) {
+    if let Some(tri) = (px + 2 * AHEAD < end)
+        .then(|| first_tri(px + 2 * AHEAD))
+        .flatten()
+    {
+        prefetch(&scene.tris[tri]);
+        prefetch(&scene.corner_slots[tri]);
+    }
+    if let Some(tri) = (px + AHEAD < end).then(|| first_tri(px + AHEAD)).flatten() {
+        for (n, slot) in scene.tris[tri].into_iter().zip(scene.corner_slots[tri]) {
+            prefetch(&proj.xy_f[n as usize]);
+            prefetch(&scene.light[slot as usize]);
+        }
+    }
+}
+
+/// The colour sums of a mixed pixel's samples; a run of samples showing one
+/// triangle shades it once.
+#[derive(Default)]
+pub(super) struct PixelSum {
+    sum: [u32; 4],
+    last: Option<(u64, [u8; 3])>,
+}
+
+impl PixelSum {
+    /// Adds a sample of `color` with coverage `alpha` (0–255).
+    #[inline(always)]
+    pub(super) fn add(&mut self, color: [u8; 3], alpha: u32) {
+        for (sum, &channel) in self.sum.iter_mut().zip(&color) {
+            *sum += channel as u32 * alpha;
+        }
+        self.sum[3] += alpha;
+    }
+
+    /// Adds a sample of value `value`: the background when empty, else its
+    /// triangle's surface, shaded by `shade` unless the last shaded sample
+    /// showed the same triangle side.
+    #[inline(always)]
+    pub(super) fn add_sample(
+        &mut self,
+        value: u64,
+        background: [u8; 4],
+        shade: impl FnOnce() -> [u8; 3],
+    ) {
+        if value == EMPTY {
+            let color = [background[0], background[1], background[2]];
+            return self.add(color, background[3] as u32);
+        }
+        let id = value & 0xffff_ffff;
+        let color = match self.last {
+            Some((l, c)) if l == id => c,
+            _ => {
+                let c = shade();
+                self.last = Some((id, c));
+                c
+            }
+        };
+        self.add(color, 255);
+    }
+
+    /// Writes the average of `n` samples into `out` (RGBA).
+    #[inline(always)]
+    pub(super) fn write(&self, n: u32, out: &mut [u8]) {
+        let sum = &self.sum;
+        for c in 0..3 {
+            if let Some(v) = (sum[c] + sum[3] / 2).checked_div(sum[3]) {
+                out[c] = v as u8;
+            }
+        }
+        out[3] = ((sum[3] + n / 2) / n) as u8;
     }
 }

@@ -8,9 +8,8 @@
 //! without edges, so the same bytes.
 
 use super::raster::{EMPTY, Projected};
-use super::resolve::{AHEAD, Samples, background_pixel, shade};
+use super::resolve::{PixelSum, Samples, background_pixel, prefetch_ahead, shade};
 use super::scene::Scene;
-use crate::cache_hint::prefetch;
 
 /// What [`unmarked_rows`] resolves: the scene, the projection, the samples
 /// (no edge mask), the background, the first pixel row and the pixel columns.
@@ -32,8 +31,6 @@ pub(super) fn unmarked_rows<const SS: usize>(
     let sample_width = samples.width;
     let width = sample_width / SS;
     let bg = background_pixel(background);
-    let tris: &[[u32; 3]] = &scene.tris;
-    let slots: &[[u32; 3]] = &scene.corner_slots;
     let group_of = |id: u64| scene.side_group((id >> 1) as usize, (id & 1) as usize);
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
@@ -67,25 +64,7 @@ pub(super) fn unmarked_rows<const SS: usize>(
                 row[px * 4..px * 4 + 4].copy_from_slice(&bg);
                 continue;
             }
-            // Shading gathers a triangle, then its corners' positions and
-            // light: fetch the triangle of the pixel 16 ahead and the
-            // corners of the one 8 ahead, so the loads overlap.
-            if let Some(tri) = (px + 2 * AHEAD < cols.end)
-                .then(|| first_tri(px + 2 * AHEAD))
-                .flatten()
-            {
-                prefetch(&tris[tri]);
-                prefetch(&slots[tri]);
-            }
-            if let Some(tri) = (px + AHEAD < cols.end)
-                .then(|| first_tri(px + AHEAD))
-                .flatten()
-            {
-                for (n, slot) in tris[tri].into_iter().zip(slots[tri]) {
-                    prefetch(&proj.xy_f[n as usize]);
-                    prefetch(&scene.light[slot as usize]);
-                }
-            }
+            prefetch_ahead(scene, proj, px, cols.end, first_tri);
             // Every sample shows one colour group's surface (no section
             // cap): shaded once, at the first sample.
             if !any_empty {
@@ -104,41 +83,15 @@ pub(super) fn unmarked_rows<const SS: usize>(
                     continue;
                 }
             }
-            let mut sum = [0u32; 4];
-            let mut last: Option<(u64, [u8; 3])> = None;
+            let mut sum = PixelSum::default();
             for (r, run) in pixel.iter().enumerate() {
                 for (c, &value) in run.iter().enumerate() {
-                    let (color, alpha) = if value == EMPTY {
-                        (
-                            [background[0], background[1], background[2]],
-                            background[3] as u32,
-                        )
-                    } else {
-                        let id = value & 0xffff_ffff;
-                        let color = match last {
-                            Some((l, c)) if l == id => c,
-                            _ => {
-                                let c = shade(scene, proj, id, sx + c, sy + r, px, py);
-                                last = Some((id, c));
-                                c
-                            }
-                        };
-                        (color, 255)
-                    };
-                    for k in 0..3 {
-                        sum[k] += color[k] as u32 * alpha;
-                    }
-                    sum[3] += alpha;
+                    sum.add_sample(value, background, || {
+                        shade(scene, proj, value & 0xffff_ffff, sx + c, sy + r, px, py)
+                    });
                 }
             }
-            let n = (SS * SS) as u32;
-            let out = &mut row[px * 4..px * 4 + 4];
-            for k in 0..3 {
-                if let Some(v) = (sum[k] + sum[3] / 2).checked_div(sum[3]) {
-                    out[k] = v as u8;
-                }
-            }
-            out[3] = ((sum[3] + n / 2) / n) as u8;
+            sum.write((SS * SS) as u32, &mut row[px * 4..px * 4 + 4]);
         }
     }
 }
