@@ -619,6 +619,7 @@ fn check_domain(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_threads::on_threads;
 
     /// `count` spheres, each a subdomain; every 7th has an unknown attribute
     /// (E111, a structure finding), every 11th a malformed radius (a document
@@ -645,12 +646,10 @@ mod tests {
     }
 
     fn checked_with(threads: usize, text: &str) -> Diagnostics {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool");
         let source = SourceFile::new("many.xml".to_string(), text.to_string());
-        pool.install(|| check_source(source, &Options::default()).diagnostics)
+        on_threads(threads, || {
+            check_source(source, &Options::default()).diagnostics
+        })
     }
 
     /// Every kind of top-level element the typed document keeps, `count`
@@ -691,12 +690,8 @@ mod tests {
     }
 
     fn read_with(threads: usize, text: &str) -> (doc::Document, Diagnostics) {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool");
         let source = SourceFile::new("parts.xml".to_string(), text.to_string());
-        pool.install(|| {
+        on_threads(threads, || {
             let mut diags = Diagnostics::default();
             let (document, _) = read(&source, &Options::default(), &mut diags).expect("reads");
             (document, diags)

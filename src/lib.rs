@@ -27,6 +27,8 @@ pub mod render;
 pub mod resolve;
 pub mod span;
 pub mod syntax;
+#[cfg(test)]
+mod test_threads;
 pub mod trimmed;
 pub mod valid;
 

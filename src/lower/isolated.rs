@@ -482,6 +482,7 @@ mod tests {
     use super::*;
     use crate::geom::{Frame, Mat3, Vec3};
     use crate::ir::Dimension;
+    use crate::test_threads::on_threads;
 
     fn frame(x: f64, linear: Mat3) -> Frame {
         Frame {
@@ -566,11 +567,7 @@ mod tests {
         let mut model = Model::empty(Dimension::Three);
         let mut map = SourceMap::default();
         let mut welder = super::super::weld::Welder::new(1e-6);
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("a thread pool");
-        pool.install(|| {
+        on_threads(threads, || {
             super::super::lower_solids(&mut model, &mut map, &mut welder, &jobs, isolated)
         });
         let samples = format!("{map:?} {:?}", welder.face_samples);

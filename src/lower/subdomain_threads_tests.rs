@@ -6,6 +6,7 @@ use crate::diag::Code;
 use crate::driver::{Checked, Options, check_source};
 use crate::ir::SubdomainCells;
 use crate::span::SourceFile;
+use crate::test_threads::on_threads;
 use std::fmt::Write as _;
 
 /// `groups` copies of six kinds of subdomain definitions, on a grid 10 apart
@@ -113,12 +114,8 @@ fn definitions(groups: usize, crossing: bool) -> String {
 }
 
 fn checked(threads: usize, text: &str) -> Checked {
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("a thread pool");
     let source = SourceFile::new("subdomains.xml".to_string(), text.to_string());
-    pool.install(|| check_source(source, &Options::default()))
+    on_threads(threads, || check_source(source, &Options::default()))
 }
 
 /// The model, source map and diagnostics, compared whole.

@@ -6,6 +6,7 @@ use super::{Pass, Resolved, resolve_in};
 use crate::diag::{Code, Diagnostics};
 use crate::span::SourceFile;
 use crate::syntax::{self, Limits};
+use crate::test_threads::on_threads;
 
 /// Kinds of object (by `i % 20`) whose resolution needs another object.
 const NEEDS_ANOTHER: [usize; 7] = [2, 4, 6, 14, 15, 18, 19];
@@ -137,12 +138,9 @@ fn resolved(xml: &str, pass: Pass, threads: usize) -> (Diagnostics, Resolved, us
     let mut read = Diagnostics::default();
     let doc = crate::doc::build(&source, &root, &mut read);
     assert!(read.items.is_empty(), "{:?}", read.items.first());
-    let pool = rayon::ThreadPoolBuilder::new()
-        .num_threads(threads)
-        .build()
-        .expect("a thread pool");
     let mut diags = Diagnostics::default();
-    let (resolved, alone) = pool.install(|| resolve_in(&source, &doc, &[], &mut diags, pass));
+    let (resolved, alone) =
+        on_threads(threads, || resolve_in(&source, &doc, &[], &mut diags, pass));
     (diags, resolved, alone)
 }
 

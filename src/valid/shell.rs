@@ -1334,11 +1334,7 @@ mod tests {
             b.push_subdomain(&format!("d{k}"), SubdomainCells::Volume { boundary: faces });
         }
         let run = |threads: usize| {
-            rayon::ThreadPoolBuilder::new()
-                .num_threads(threads)
-                .build()
-                .expect("a thread pool")
-                .install(|| check_topology(&b.model, &b.map))
+            crate::test_threads::on_threads(threads, || check_topology(&b.model, &b.map))
         };
         let one = run(1);
         let open: Vec<&Diagnostic> = (one.items.iter())
