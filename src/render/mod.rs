@@ -19,6 +19,7 @@ mod scene;
 mod section_fill;
 mod smooth;
 mod svg;
+mod triangle;
 
 pub use camera::{Camera, View};
 pub use legend::LegendEntry;

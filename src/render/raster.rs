@@ -6,12 +6,11 @@
 //! cracks) and the top-left rule decides which triangle owns a sample on one.
 
 use super::scene::{HIDDEN, Scene};
-use crate::cache_hint::prefetch;
+use super::triangle::{self, SUB};
+use crate::cache_hint::prefetch_at;
 use rayon::prelude::*;
 
 pub const EMPTY: u64 = u64::MAX;
-/// Sub-sample steps per sample of the snapped coordinates.
-const SUB: i64 = 16;
 /// Sample rows per band (the unit of parallel work).
 const BAND: usize = 32;
 /// Triangles per binning chunk.
@@ -57,29 +56,6 @@ fn facing(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], u32)> {
     let [a, b, c] = v;
     let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
     (area != 0).then_some((v, u32::from(area > 0)))
-}
-
-/// The triangle's corners ordered with positive area, and which side faces the eye.
-#[inline]
-fn setup(proj: &Projected, t: [u32; 3]) -> Option<([[i64; 2]; 3], [f32; 3], u32)> {
-    let [p, q, r] = t.map(|n| proj.snapped[n as usize]);
-    let (a, b, c) = (
-        [p.x as i64, p.y as i64],
-        [q.x as i64, q.y as i64],
-        [r.x as i64, r.y as i64],
-    );
-    let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    if area == 0 {
-        return None;
-    }
-    let z = [p.z, q.z, r.z];
-    // Image y points down, so a triangle counter-clockwise from the eye has a
-    // negative area here: that is its front.
-    if area < 0 {
-        Some(([a, c, b], [z[0], z[2], z[1]], 0))
-    } else {
-        Some(([a, b, c], z, 1))
-    }
 }
 
 #[inline]
@@ -183,24 +159,30 @@ pub fn draw_band(
     ys: std::ops::Range<usize>,
 ) {
     let (y0, y1) = (ys.start, ys.end);
+    // `triangle::draw` indexes the band's samples without bounds checks.
+    assert!(y0 <= y1 && (y1 - y0) * width <= rows.len());
+    let (tris, nodes) = (&scene.tris[..], &proj.snapped[..]);
     for chunk in bins {
-        let ids = &chunk.ids[band];
+        let ids = &chunk.ids[band][..];
         for (i, &tri) in ids.iter().enumerate() {
             // A band's triangles lie scattered over the mesh, and a corner
             // is two dependent loads (the triangle, then its node): fetch the
             // triangle 16 places ahead and the corners of the one 8 ahead
-            // (its triangle fetched 8 places ago), so the loads overlap.
+            // (its triangle fetched 8 places ago), so the loads overlap. A
+            // hint needs no bounds check: it reads nothing.
             if let Some(&far) = ids.get(i + 2 * AHEAD) {
-                prefetch(&scene.tris[far as usize]);
+                prefetch_at(tris.as_ptr().wrapping_add(far as usize));
             }
-            if let Some(&near) = ids.get(i + AHEAD) {
-                for n in scene.tris[near as usize] {
-                    prefetch(&proj.snapped[n as usize]);
+            if let Some(near) = ids.get(i + AHEAD).and_then(|&t| tris.get(t as usize)) {
+                for &n in near {
+                    prefetch_at(nodes.as_ptr().wrapping_add(n as usize));
                 }
             }
-            if let Some((v, z, back)) = setup(proj, scene.tris[tri as usize]) {
-                draw(rows, width, y0, y1, v, z, tri * 2 + back);
-            }
+            let [a, b, c] = tris[tri as usize];
+            let corners = [nodes[a as usize], nodes[b as usize], nodes[c as usize]];
+            // SAFETY: `rows` holds the band's (y1 - y0) × width samples
+            // (asserted above).
+            unsafe { triangle::draw(rows, width, y0, y1, corners, tri) };
         }
     }
 }
@@ -222,114 +204,6 @@ pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -
         width,
         height,
         data,
-    }
-}
-
-/// Fills the samples of rows `y0..y1` (stored from `rows[0]`) inside the
-/// triangle `v` (positive area) where it is nearer than what is there.
-#[inline]
-fn draw(
-    rows: &mut [u64],
-    width: usize,
-    y0: usize,
-    y1: usize,
-    v: [[i64; 2]; 3],
-    z: [f32; 3],
-    id: u32,
-) {
-    let min_x = v[0][0].min(v[1][0]).min(v[2][0]);
-    let max_x = v[0][0].max(v[1][0]).max(v[2][0]);
-    let min_y = v[0][1].min(v[1][1]).min(v[2][1]);
-    let max_y = v[0][1].max(v[1][1]).max(v[2][1]);
-    let sx0 = (min_x - SUB / 2 + SUB - 1).div_euclid(SUB);
-    let sx1 = (max_x - SUB / 2).div_euclid(SUB).min(width as i64 - 1);
-    let sy0 = (min_y - SUB / 2 + SUB - 1).div_euclid(SUB);
-    let sy1 = (max_y - SUB / 2).div_euclid(SUB).min(y1 as i64 - 1);
-    let (x_first, y_first) = (sx0.max(0), sy0.max(y0 as i64));
-    if x_first > sx1 || y_first > sy1 {
-        return;
-    }
-    // The depth plane's one division, issued before the edge set-up so its
-    // latency overlaps it (waiting for it at the first covered sample was a
-    // tenth of drawing); the rest of the plane is made only once a sample is
-    // found inside (most tiny triangles of a large mesh cover none).
-    let area =
-        (v[1][0] - v[0][0]) * (v[2][1] - v[0][1]) - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0]);
-    let inv = 1.0 / area as f64;
-    // Edge k runs from v[k] to v[k+1]; E_k(p) = (b−a)×(p−a) is positive inside.
-    let mut e_row = [0i64; 3];
-    let mut step_x = [0i64; 3];
-    let mut step_y = [0i64; 3];
-    let px = x_first * SUB + SUB / 2;
-    let py = y_first * SUB + SUB / 2;
-    for k in 0..3 {
-        let (a, b) = (v[k], v[(k + 1) % 3]);
-        let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
-        // Top-left rule (y down): an edge going up, or horizontal going left… in
-        // this orientation: owning samples exactly on it for exactly one of the
-        // two triangles that share it.
-        let owns = dy < 0 || (dy == 0 && dx > 0);
-        e_row[k] = dx * (py - a[1]) - dy * (px - a[0]) - if owns { 0 } else { 1 };
-        step_x[k] = -dy * SUB;
-        step_y[k] = dx * SUB;
-    }
-    // Depth as a plane over sample coordinates, referenced at the triangle's
-    // own first sample so bands agree exactly.
-    let plane = || {
-        let (x1, y1_, x2, y2) = (
-            (v[1][0] - v[0][0]) as f64,
-            (v[1][1] - v[0][1]) as f64,
-            (v[2][0] - v[0][0]) as f64,
-            (v[2][1] - v[0][1]) as f64,
-        );
-        let (z1, z2) = ((z[1] - z[0]) as f64, (z[2] - z[0]) as f64);
-        // dz per snapped unit, then per sample.
-        let gx = (z1 * y2 - z2 * y1_) * inv;
-        let gy = (z2 * x1 - z1 * x2) * inv;
-        let (rx, ry) = (sx0 * SUB + SUB / 2, sy0 * SUB + SUB / 2);
-        let z_ref = z[0] as f64 + gx * (rx - v[0][0]) as f64 + gy * (ry - v[0][1]) as f64;
-        (
-            z_ref as f32,
-            (gx * SUB as f64) as f32,
-            (gy * SUB as f64) as f32,
-        )
-    };
-    let mut depth_plane: Option<(f32, f32, f32)> = None;
-    let id = id as u64;
-    // The box lies in the band's rows (`sy1 < y1`) and the picture's columns
-    // (`sx1 < width`), so the sample loop indexes without a bounds check per
-    // sample, and with `while` loops instead of `RangeInclusive`: callgrind
-    // counted them at about 37 M of a render's 752 M instructions.
-    assert!((sy1 as usize - y0 + 1) * width <= rows.len() && (sx1 as usize) < width);
-    let mut sy = y_first;
-    while sy <= sy1 {
-        let base = (sy as usize - y0) * width;
-        let mut e = e_row;
-        let mut sx = x_first;
-        while sx <= sx1 {
-            if (e[0] | e[1] | e[2]) >= 0 {
-                let (z_ref, dzdx, dzdy) = *depth_plane.get_or_insert_with(plane);
-                let zy = z_ref + dzdy * (sy - sy0) as f32;
-                let depth = (zy + dzdx * (sx - sx0) as f32).max(0.0);
-                let value = ((depth.to_bits() as u64) << 32) | id;
-                // SAFETY: y0 <= y_first <= sy <= sy1 and 0 <= x_first <= sx
-                // <= sx1 (the clamps and the early return above), so the
-                // index is below (sy1 - y0 + 1) × width <= rows.len(),
-                // asserted above.
-                let slot = unsafe { rows.get_unchecked_mut(base + sx as usize) };
-                if value < *slot {
-                    *slot = value;
-                }
-            }
-            e[0] += step_x[0];
-            e[1] += step_x[1];
-            e[2] += step_x[2];
-            sx += 1;
-        }
-        sy += 1;
-        e_row[0] += step_y[0];
-        e_row[1] += step_y[1];
-        e_row[2] += step_y[2];
     }
 }
 
