@@ -148,9 +148,10 @@ fn pack(a: i64, b: i64, c: i64) -> i64 {
 
 /// Top-left rule (y down): an edge going up, or horizontal going right,
 /// owns the sample centres exactly on it, so of two triangles sharing an
-/// edge exactly one draws them. It owns them when `dy < 0 || (dy == 0 && dx
-/// > 0)`, that is when `dy·2^32 − dx < 0` (|dx|, |dy| < 2^26): one sign
-/// instead of branches. 1 when the edge does not own them.
+/// edge exactly one draws them. It owns them when
+/// `dy < 0 || (dy == 0 && dx > 0)`, that is when `dy·2^32 − dx < 0`
+/// (|dx|, |dy| < 2^26): one sign instead of branches. 1 when the edge does
+/// not own them.
 #[inline(always)]
 fn not_owned(dx: i64, dy: i64) -> i64 {
     1 + (((dy << 32) - dx) >> 63)
