@@ -43,7 +43,6 @@ use crate::ir::{
 use crate::resolve::{Geometry, Resolved};
 use crate::span::Span;
 use foldhash::HashMap;
-use rayon::prelude::*;
 use std::borrow::Cow;
 
 /// The model and its side table of source positions.
@@ -51,43 +50,6 @@ use std::borrow::Cow;
 pub struct Lowered {
     pub model: Model,
     pub source_map: SourceMap,
-}
-
-/// Entities per task when a large model is freed (and the fewest faces and
-/// edges a model has to be freed in parallel).
-const FREED_PER_TASK: usize = 4_096;
-
-impl Drop for Lowered {
-    /// Frees a large model's entities on the rayon threads. On files of many
-    /// primitives they hold about a million small allocations (names, loops,
-    /// each solid's lists, made on the workers): freed one after another on
-    /// the thread that dropped the model, they were a serial tail of a few
-    /// per cent of the front end's wall time (3% of its instructions).
-    fn drop(&mut self) {
-        let model = &mut self.model;
-        if model.faces.len() + model.edges.len() < FREED_PER_TASK {
-            return;
-        }
-        fn free<T: Send>(items: Vec<T>) {
-            items
-                .into_par_iter()
-                .with_min_len(FREED_PER_TASK)
-                .for_each(drop);
-        }
-        use std::mem::take;
-        let (faces, edges) = (take(&mut model.faces), take(&mut model.edges));
-        let (vertices, solids) = (take(&mut model.vertices), take(&mut model.solids));
-        let subdomains = take(&mut model.subdomains);
-        rayon::join(
-            || rayon::join(|| free(faces), || free(edges)),
-            || {
-                rayon::join(
-                    || free(vertices),
-                    || rayon::join(|| free(solids), || free(subdomains)),
-                )
-            },
-        );
-    }
 }
 
 /// Names of lowered entities, for `faces=` and `edges=` lists.
