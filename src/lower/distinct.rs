@@ -20,7 +20,9 @@ use crate::geom::{Frame, Point3, SolidShape};
 /// and its faces have different edges; a ball's two faces share its equator,
 /// and a cone's cap and side share its rim when there is only one.
 pub(super) fn unwelded_counts(shape: &SolidShape, tol: f64) -> Option<[u32; 3]> {
-    let apart = |a: Point3, b: Point3| !((a - b).norm() <= tol);
+    // The weld's test, negated (a distance that is not a number is apart).
+    let near = |a: Point3, b: Point3| (a - b).norm() <= tol;
+    let apart = |a: Point3, b: Point3| !near(a, b);
     match shape {
         SolidShape::Box { frame } => {
             let corners: [Point3; 8] = std::array::from_fn(|n| box_corner(frame, n));
