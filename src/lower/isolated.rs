@@ -7,6 +7,7 @@
 //! solids one after another, whatever the number of threads.
 
 use super::brep::Brep;
+use super::distinct::unwelded_counts;
 use super::reserved::{Part, Tail};
 use super::weld::{Chains, FaceSamples, Grid, probe_points, same_edge};
 use crate::geom::{Point3, SolidShape};
@@ -41,6 +42,14 @@ pub(super) fn lower_run(
         .par_iter()
         .with_min_len(TASK)
         .map_init(LocalWeld::default, |weld, job| {
+            // A regular primitive needs no boundary for its counts.
+            if let Some([vertices, edges, faces]) = unwelded_counts(job.shape, grid.tol) {
+                return Counts {
+                    vertices,
+                    edges,
+                    faces,
+                };
+            }
             weld.weld(job.shape, grid);
             weld.counts()
         })
@@ -475,6 +484,16 @@ impl LocalWeld {
             vertices: self.vertex_of.iter().map(|&v| vertex(v)).collect(),
         });
     }
+}
+
+/// The (vertices, edges, faces) of welding `shape`'s boundary on its own
+/// with tolerance `tol`, as the isolated runs weld it.
+#[cfg(test)]
+pub(super) fn weld_counts(shape: &SolidShape, tol: f64) -> [u32; 3] {
+    let mut weld = LocalWeld::default();
+    weld.weld(shape, super::weld::Welder::new(tol).grid());
+    let c = weld.counts();
+    [c.vertices, c.edges, c.faces]
 }
 
 #[cfg(test)]

@@ -6,6 +6,7 @@
 mod booleans;
 mod brep;
 mod contour_straight;
+mod distinct;
 mod edge_parts;
 mod explicit;
 mod isolated;
