@@ -38,25 +38,52 @@ pub(crate) struct FaceFacts {
 
 /// Blocks per parallel piece of [`FaceFacts::of`] (49,152 indices: a
 /// piece is summed up twice while it is in the processor's cache).
-const PIECE_BLOCKS: usize = 16;
+pub(crate) const PIECE_BLOCKS: usize = 16;
+
+/// Triangles per piece of [`FaceFacts::piece`].
+pub(crate) const PIECE_TRIANGLES: usize = BLOCK * PIECE_BLOCKS;
+
+/// One piece of a face's triangles summed up: its first-use summary and
+/// its blocks' node ranges.
+pub(crate) type FacePiece = (FirstUse, Vec<(u32, u32)>);
 
 impl FaceFacts {
     pub(crate) fn of(triangles: &[[u32; 3]]) -> FaceFacts {
-        let pieces: Vec<(FirstUse, Vec<(u32, u32)>)> = triangles
-            .par_chunks(BLOCK * PIECE_BLOCKS)
-            .map(|piece| (FirstUse::piece(piece.as_flattened()), block_ranges(piece)))
+        let pieces: Vec<FacePiece> = triangles
+            .par_chunks(PIECE_TRIANGLES)
+            .map(FaceFacts::piece)
             .collect();
+        FaceFacts::from_pieces(triangles.len(), pieces)
+    }
+
+    /// A piece of [`PIECE_TRIANGLES`] triangles (the last one may be
+    /// shorter), summed up.
+    pub(crate) fn piece(triangles: &[[u32; 3]]) -> FacePiece {
+        (
+            FirstUse::piece(triangles.as_flattened()),
+            block_ranges(triangles),
+        )
+    }
+
+    /// The facts of `triangles` triangles from their [`FaceFacts::piece`]s,
+    /// in order from the first triangle on.
+    pub(crate) fn from_pieces(triangles: usize, pieces: Vec<FacePiece>) -> FaceFacts {
         let mut order = FirstUse::default();
-        let mut blocks = Vec::with_capacity(triangles.len().div_ceil(BLOCK));
+        let mut blocks = Vec::with_capacity(triangles.div_ceil(BLOCK));
         for (summary, ranges) in pieces {
             order = order.then(summary);
             blocks.extend(ranges);
         }
         FaceFacts {
-            triangles: triangles.len(),
+            triangles,
             order,
             blocks,
         }
+    }
+
+    /// Whether these are facts of as many triangles as `triangles` holds.
+    pub(crate) fn counts(&self, triangles: &[[u32; 3]]) -> bool {
+        self.triangles == triangles.len()
     }
 
     /// The largest node index (0 without triangles).
@@ -80,6 +107,20 @@ impl MeshFacts {
         })
     }
 
+    /// The facts of `nodes` nodes whose coordinates are known to be finite,
+    /// with these bounds (`None` without nodes).
+    pub(crate) fn of_finite(
+        nodes: usize,
+        bounds: Option<Bounds>,
+        faces: Vec<FaceFacts>,
+    ) -> MeshFacts {
+        MeshFacts {
+            nodes,
+            bounds,
+            faces,
+        }
+    }
+
     /// Whether these could be `mesh`'s facts: as many nodes, and the same
     /// faces with as many triangles each.
     pub(crate) fn fits(&self, mesh: &Mesh) -> bool {
@@ -99,6 +140,33 @@ impl MeshFacts {
             .iter()
             .flat_map(|f| f.blocks.iter().copied())
             .collect()
+    }
+}
+
+/// The bounds of `nodes` when every coordinate is finite and there are
+/// nodes; `None` otherwise.
+pub(crate) fn finite_bounds(nodes: &[[f64; 3]]) -> Option<Bounds> {
+    let (bad, lo, hi) = nodes.iter().fold(
+        (false, [f64::INFINITY; 3], [f64::NEG_INFINITY; 3]),
+        |(bad, lo, hi), p| {
+            (
+                bad | !(p[0].is_finite() & p[1].is_finite() & p[2].is_finite()),
+                std::array::from_fn(|k| lo[k].min(p[k])),
+                std::array::from_fn(|k| hi[k].max(p[k])),
+            )
+        },
+    );
+    (!bad && !nodes.is_empty()).then_some((lo, hi))
+}
+
+/// The bounds of two sets of nodes together.
+pub(crate) fn merge_bounds(a: Option<Bounds>, b: Option<Bounds>) -> Option<Bounds> {
+    match (a, b) {
+        (Some((lo, hi)), Some((l, h))) => Some((
+            std::array::from_fn(|k| lo[k].min(l[k])),
+            std::array::from_fn(|k| hi[k].max(h[k])),
+        )),
+        (a, b) => a.or(b),
     }
 }
 

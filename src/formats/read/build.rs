@@ -7,6 +7,7 @@ use super::Loaded;
 use super::clean;
 use crate::diag::{Code, Diagnostic};
 use crate::formats::MeshFacts;
+use crate::formats::groups::Bounds;
 use crate::formats::mesh_facts::FaceFacts;
 use crate::mesh::{
     CellKind, Mesh, MeshFace, MeshFragment, MeshPolyline, MeshSubdomain, MeshVolume,
@@ -55,6 +56,38 @@ pub struct Builder {
     /// Subdomains by name, with their material, when the file names them.
     pub subdomains: Vec<(String, Option<String>)>,
     pub fragments: Vec<FragmentInfo>,
+    /// What the reader summed up while reading, for [`Builder::finish_with`].
+    pub(crate) known: Known,
+}
+
+/// Facts a reader found while it decoded the nodes and triangles
+/// (`read::summed`), so that [`Builder::finish_with`] need not scan them
+/// again. Used only where the counts still match: readers only append.
+#[derive(Debug, Default)]
+pub(crate) struct Known {
+    /// The bounds of the first `.0` nodes, every coordinate of which is
+    /// finite (`None`: not known).
+    pub(crate) nodes: Option<(usize, Option<Bounds>)>,
+    /// Per group index, the facts of its triangles.
+    pub(crate) faces: HashMap<usize, FaceFacts>,
+}
+
+impl Known {
+    /// `count` more nodes after the first `before`, with these bounds: kept
+    /// when the nodes before were all known (or there were none).
+    pub(crate) fn add_nodes(&mut self, before: usize, count: usize, bounds: Option<Bounds>) {
+        let so_far = match self.nodes {
+            Some((known, b)) if known == before => Some(b),
+            None if before == 0 => Some(None),
+            _ => None,
+        };
+        self.nodes = so_far.map(|b| {
+            (
+                before + count,
+                crate::formats::mesh_facts::merge_bounds(b, bounds),
+            )
+        });
+    }
 }
 
 impl Builder {
@@ -102,12 +135,20 @@ impl Builder {
         facts: bool,
     ) -> Result<(Loaded, Option<MeshFacts>), Vec<Diagnostic>> {
         let n = self.nodes.len();
+        let mut found = std::mem::take(&mut self.known);
         // One per group with triangles: the faces' facts, in face order.
         let faces: Vec<FaceFacts> = if facts {
             self.groups
                 .iter()
-                .filter(|g| !g.triangles.is_empty())
-                .map(|g| FaceFacts::of(&g.triangles))
+                .enumerate()
+                .filter(|(_, g)| !g.triangles.is_empty())
+                .map(|(i, g)| {
+                    found
+                        .faces
+                        .remove(&i)
+                        .filter(|f| f.counts(&g.triangles))
+                        .unwrap_or_else(|| FaceFacts::of(&g.triangles))
+                })
                 .collect()
         } else {
             Vec::new()
@@ -138,7 +179,10 @@ impl Builder {
             )]
         };
         let facts = if facts {
-            Some(MeshFacts::of(&self.nodes, faces).map_err(non_finite)?)
+            match found.nodes {
+                Some((count, bounds)) if count == n => Some(MeshFacts::of_finite(n, bounds, faces)),
+                _ => Some(MeshFacts::of(&self.nodes, faces).map_err(non_finite)?),
+            }
         } else {
             if let Some(i) = crate::formats::groups::first_non_finite(&self.nodes) {
                 return Err(non_finite(i));

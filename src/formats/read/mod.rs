@@ -25,6 +25,7 @@ mod mapped;
 mod msh;
 mod obj;
 mod stl;
+mod summed;
 mod text;
 mod vtu;
 

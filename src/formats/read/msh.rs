@@ -9,9 +9,13 @@
 //! (`$NodeData`, `$Periodic`, …) are skipped.
 
 use super::build::{Builder, FastMap};
+use super::summed::extend_summed;
 use super::text::{Scanner, Token, syntax};
 use super::{error_at, error_at_byte};
 use crate::diag::{Code, Diagnostic};
+use crate::formats::mesh_facts::{
+    FaceFacts, FacePiece, PIECE_TRIANGLES, finite_bounds, merge_bounds,
+};
 use crate::mesh::CellKind;
 use rayon::prelude::*;
 use std::collections::BTreeMap;
@@ -152,31 +156,60 @@ impl NodeIndex {
     }
 }
 
+/// Nodes per parallel piece of a binary node block (96 kB of coordinates).
+const NODE_PIECE: usize = 4096;
+
 /// [`Reader::binary_triangles`] when the node tags run on from `first`
 /// (`len` nodes): a node's index is its tag less `first`, so the corners
 /// are found by a subtraction and a bound check on every tag at once
 /// (no lookup call per tag: that was a fifth of reading the 2-million-triangle
-/// bench file). `false`, with nothing added, when a tag is not a node's.
-fn run_triangles(block: &[u8], first: u64, len: u64, triangles: &mut Vec<[u32; 3]>) -> bool {
+/// bench file). `None`, with nothing added, when a tag is not a node's;
+/// else the pieces summed up (`FaceFacts::piece`).
+fn run_triangles(
+    block: &[u8],
+    first: u64,
+    len: u64,
+    triangles: &mut Vec<[u32; 3]>,
+) -> Option<Vec<FacePiece>> {
     let unknown = AtomicBool::new(false);
-    let base = triangles.len();
     let index = |r: &[u8], at: usize| {
         let tag = super::bytes_at::<8>(r, at).map_or(0, u64::from_le_bytes);
         // Below `first` wraps past every index (`first + len` fits in u64).
         tag.wrapping_sub(first)
     };
-    triangles.par_extend(block.par_chunks_exact(32).map(|r| {
+    triangles_summed(triangles, block, &unknown, |r| {
         let [a, b, c] = [index(r, 8), index(r, 16), index(r, 24)];
         if (a >= len) | (b >= len) | (c >= len) {
             unknown.store(true, Ordering::Relaxed);
         }
         [a as u32, b as u32, c as u32]
-    }));
+    })
+}
+
+/// Appends the triangles `decode` makes of the 32-byte records of `block`,
+/// each piece of them summed up for the face's facts while in cache.
+/// `None`, with nothing added, when `unknown` was set (a tag that is not a
+/// node's).
+fn triangles_summed(
+    triangles: &mut Vec<[u32; 3]>,
+    block: &[u8],
+    unknown: &AtomicBool,
+    decode: impl Fn(&[u8]) -> [u32; 3] + Sync,
+) -> Option<Vec<FacePiece>> {
+    let base = triangles.len();
+    let pieces = extend_summed(
+        triangles,
+        block,
+        32,
+        PIECE_TRIANGLES,
+        decode,
+        FaceFacts::piece,
+    );
     if unknown.load(Ordering::Relaxed) {
         triangles.truncate(base);
-        return false;
+        return None;
     }
-    true
+    Some(pieces)
 }
 
 /// What an element type is, by Gmsh's numbering.
@@ -686,25 +719,24 @@ impl<'a> Reader<'a> {
         if n == 0 || !self.nodes.run_continues(tags, next) {
             return false;
         }
-        let non_finite = AtomicBool::new(false);
         let value =
             |r: &[u8], at: usize| f64::from_le_bytes(super::bytes_at::<8>(r, at).unwrap_or([0; 8]));
-        self.b.nodes.par_extend(
-            coordinates
-                .par_chunks_exact(24)
-                .with_min_len(4096)
-                .map(|r| {
-                    let p = [value(r, 0), value(r, 8), value(r, 16)];
-                    if !(p[0].is_finite() & p[1].is_finite() & p[2].is_finite()) {
-                        non_finite.store(true, Ordering::Relaxed);
-                    }
-                    p
-                }),
+        // Each piece's bounds found while it is in cache (`None`: a
+        // coordinate that is not finite).
+        let pieces = extend_summed(
+            &mut self.b.nodes,
+            coordinates,
+            24,
+            NODE_PIECE,
+            |r| [value(r, 0), value(r, 8), value(r, 16)],
+            finite_bounds,
         );
-        if non_finite.load(Ordering::Relaxed) {
+        if pieces.iter().any(Option::is_none) {
             self.b.nodes.truncate(next);
             return false;
         }
+        let bounds = pieces.into_iter().fold(None, merge_bounds);
+        self.b.known.add_nodes(next, n, bounds);
         self.nodes.extend_run(tags, n);
         true
     }
@@ -761,26 +793,32 @@ impl<'a> Reader<'a> {
         let Some(g) = self.b.groups.get_mut(group) else {
             return false;
         };
-        if let Some((first, len)) = nodes.run {
-            return run_triangles(block, first, u64::from(len), &mut g.triangles);
-        }
-        let tag = |r: &[u8], at: usize| {
-            super::bytes_at::<8>(r, at).and_then(|b| nodes.get(u64::from_le_bytes(b)))
-        };
-        let unknown = AtomicBool::new(false);
         let base = g.triangles.len();
-        g.triangles.par_extend(block.par_chunks_exact(32).map(|r| {
-            match (tag(r, 8), tag(r, 16), tag(r, 24)) {
-                (Some(a), Some(b), Some(c)) => [a, b, c],
-                _ => {
-                    unknown.store(true, Ordering::Relaxed);
-                    [0; 3]
+        let pieces = if let Some((first, len)) = nodes.run {
+            run_triangles(block, first, u64::from(len), &mut g.triangles)
+        } else {
+            let tag = |r: &[u8], at: usize| {
+                super::bytes_at::<8>(r, at).and_then(|b| nodes.get(u64::from_le_bytes(b)))
+            };
+            let unknown = AtomicBool::new(false);
+            triangles_summed(&mut g.triangles, block, &unknown, |r| {
+                match (tag(r, 8), tag(r, 16), tag(r, 24)) {
+                    (Some(a), Some(b), Some(c)) => [a, b, c],
+                    _ => {
+                        unknown.store(true, Ordering::Relaxed);
+                        [0; 3]
+                    }
                 }
-            }
-        }));
-        if unknown.load(Ordering::Relaxed) {
-            g.triangles.truncate(base);
+            })
+        };
+        let Some(pieces) = pieces else {
             return false;
+        };
+        // The pieces start at the face's first triangle only when the
+        // group had none before: else the facts are found after reading.
+        if base == 0 {
+            let facts = FaceFacts::from_pieces(g.triangles.len(), pieces);
+            self.b.known.faces.insert(group, facts);
         }
         true
     }
@@ -1083,6 +1121,66 @@ impl<'a> Reader<'a> {
 #[cfg(test)]
 mod tests {
     use super::NodeIndex;
+
+    /// A binary MSH 4.1 file of two faces, one in first-use order and one
+    /// not, each over several pieces: the facts found while reading its
+    /// blocks are those a pass over the mesh after reading finds.
+    #[test]
+    fn facts_found_while_reading_equal_a_pass_after_it() {
+        use crate::formats::groups::nodes_scan;
+        use crate::formats::mesh_facts::FaceFacts;
+        use crate::formats::{Encoding, MeshFacts, MeshWriter, WriteOptions};
+        use crate::mesh::{Mesh, MeshFace};
+        let n = 50_000u32;
+        let nodes: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let x = f64::from(i);
+                [3.0 * x.sin(), (0.01 * x).cos() - 2.0, 1e-4 * x]
+            })
+            .collect();
+        let face = |name: &str, triangles: Vec<[u32; 3]>| MeshFace {
+            name: name.into(),
+            triangles,
+            boundary: Vec::new(),
+        };
+        let strip: Vec<[u32; 3]> = (0..30_000).map(|i| [i, i + 1, i + 2]).collect();
+        let ahead: Vec<[u32; 3]> = (30_000..n - 2).map(|i| [i + 2, i, i + 1]).collect();
+        let mesh = Mesh {
+            dimension: 3,
+            nodes,
+            faces: vec![face("a", strip), face("b", ahead)],
+            ..Mesh::default()
+        };
+        let options = WriteOptions {
+            encoding: Some(Encoding::Binary),
+            ..WriteOptions::default()
+        };
+        let mut bytes = Vec::new();
+        crate::formats::msh::Msh
+            .write(&mesh, &options, &mut bytes)
+            .expect("written");
+        let (builder, _) = super::read(&bytes).expect("read");
+        assert_eq!(builder.known.faces.len(), 2);
+        let (_, bounds) = nodes_scan(&mesh.nodes);
+        assert_eq!(builder.known.nodes, Some((n as usize, bounds)));
+        let (loaded, facts) = builder.finish_with(true).expect("finished");
+        let facts = facts.expect("facts");
+        assert_eq!(loaded.mesh.nodes, mesh.nodes);
+        let scanned: Vec<FaceFacts> = loaded
+            .mesh
+            .faces
+            .iter()
+            .map(|f| FaceFacts::of(&f.triangles))
+            .collect();
+        assert_eq!(
+            Ok(facts.clone()),
+            MeshFacts::of(&loaded.mesh.nodes, scanned)
+        );
+        assert_eq!(facts.faces[0].order.identity(), Some(30_002));
+        assert_eq!(facts.faces[1].order.identity(), None);
+        assert_eq!(facts.faces[1].largest(), n - 1);
+        assert_eq!(facts.bounds.map(|(lo, _)| lo[2]), Some(0.0));
+    }
 
     #[test]
     fn node_tags_that_run_on_need_no_table_and_a_break_moves_them_into_it() {
