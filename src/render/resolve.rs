@@ -334,15 +334,26 @@ pub(super) fn prefetch_ahead(
     end: usize,
     first_tri: impl Fn(usize) -> Option<usize>,
 ) {
+    // A smooth one-face scene's light slots are its triangles' own nodes
+    // (the same array): the triangle is then read and fetched once.
+    let own_slots = std::ptr::eq(scene.corner_slots.as_ptr(), scene.tris.as_ptr());
     if let Some(tri) = (px + 2 * AHEAD < end)
         .then(|| first_tri(px + 2 * AHEAD))
         .flatten()
     {
         prefetch(&scene.tris[tri]);
-        prefetch(&scene.corner_slots[tri]);
+        if !own_slots {
+            prefetch(&scene.corner_slots[tri]);
+        }
     }
     if let Some(tri) = (px + AHEAD < end).then(|| first_tri(px + AHEAD)).flatten() {
-        for (n, slot) in scene.tris[tri].into_iter().zip(scene.corner_slots[tri]) {
+        let t = scene.tris[tri];
+        let slots = if own_slots {
+            t
+        } else {
+            scene.corner_slots[tri]
+        };
+        for (n, slot) in t.into_iter().zip(slots) {
             prefetch(&proj.xy_f[n as usize]);
             prefetch(&scene.light[slot as usize]);
         }
