@@ -20,28 +20,17 @@ const LIMIT: f64 = 1e6;
 pub fn project(points: &[[f64; 3]], camera: &Camera, ss: usize) -> Projected {
     let (lo, hi) = depth_range(points, camera);
     let range = if hi > lo { hi - lo } else { 1.0 };
-    let map = NodeMap {
-        camera,
-        ss: ss as f64,
-        lo,
-        range,
-    };
+    let map = NodeMap::new(camera, ss as f64, lo, range);
     let n = points.len();
     let mut snapped: Vec<Snapped> = Vec::with_capacity(n);
     let mut xy_f: Vec<[f32; 2]> = Vec::with_capacity(n);
     (points.par_chunks(BLOCK))
         .zip(snapped.spare_capacity_mut()[..n].par_chunks_mut(BLOCK))
         .zip(xy_f.spare_capacity_mut()[..n].par_chunks_mut(BLOCK))
-        .for_each(|((from, to_snapped), to_xy)| {
-            for ((q, s), f) in from.iter().zip(to_snapped).zip(to_xy) {
-                let (node, xy) = map.node(q);
-                s.write(node);
-                f.write(xy);
-            }
-        });
+        .for_each(|((from, to_snapped), to_xy)| map.block(from, to_snapped, to_xy));
     // SAFETY: the chunks above cover the first `n` slots of both vectors
-    // (`points`, `..n` of each spare capacity, one block size), and every
-    // slot of them was written.
+    // (`points`, `..n` of each spare capacity, one block size), and
+    // `NodeMap::block` writes every slot of its chunks.
     unsafe {
         snapped.set_len(n);
         xy_f.set_len(n);
@@ -56,6 +45,8 @@ fn depth_range(points: &[[f64; 3]], camera: &Camera) -> (f64, f64) {
     let blocks: Vec<(f64, f64)> = points
         .par_chunks(BLOCK)
         .map(|block| {
+            // A copy: its fields stay in registers over the loop.
+            let camera = *camera;
             block
                 .iter()
                 .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
@@ -71,87 +62,115 @@ fn depth_range(points: &[[f64; 3]], camera: &Camera) -> (f64, f64) {
         })
 }
 
-/// What one node's projection needs.
-struct NodeMap<'c> {
-    camera: &'c Camera,
+/// What one node's projection needs, as plain values (copied into each
+/// block's loop, so they stay in registers instead of being reloaded
+/// through a reference per node).
+#[derive(Clone, Copy)]
+struct NodeMap {
+    center: [f64; 3],
+    toward_eye: [f64; 3],
+    /// `[right[k], up[k]]`: the x and y lanes' factors of coordinate k.
+    right_up: [[f64; 2]; 3],
+    /// `[w/2, h/2]` and `[scale, −scale]`.
+    half: [f64; 2],
+    scale: [f64; 2],
     ss: f64,
     lo: f64,
     range: f64,
+    #[cfg(not(target_arch = "x86_64"))]
+    camera: Camera,
 }
 
-impl NodeMap<'_> {
-    /// The node's snapped position and normalised depth, and its unsnapped
-    /// sample-space x and y.
-    #[inline(always)]
-    fn node(&self, q: &[f64; 3]) -> (Snapped, [f32; 2]) {
-        #[cfg(target_arch = "x86_64")]
-        {
-            self.node_sse2(q)
-        }
-        #[cfg(not(target_arch = "x86_64"))]
-        {
-            scalar_node(self.camera, self.ss, self.lo, self.range, *q)
+impl NodeMap {
+    fn new(camera: &Camera, ss: f64, lo: f64, range: f64) -> NodeMap {
+        NodeMap {
+            center: camera.center,
+            toward_eye: camera.toward_eye,
+            right_up: std::array::from_fn(|k| [camera.right[k], camera.up[k]]),
+            half: [0.5 * camera.width as f64, 0.5 * camera.height as f64],
+            scale: [camera.scale, -camera.scale],
+            ss,
+            lo,
+            range,
+            #[cfg(not(target_arch = "x86_64"))]
+            camera: *camera,
         }
     }
 
-    #[cfg(target_arch = "x86_64")]
-    #[inline(always)]
-    fn node_sse2(&self, q: &[f64; 3]) -> (Snapped, [f32; 2]) {
-        // SAFETY (every intrinsic below): SSE2 is part of every x86-64, and
-        // none of them reads memory.
-        unsafe { self.lanes(q) }
+    /// Projects a block of nodes into the slots of `snapped` and `xy_f`
+    /// (one per node: every slot is written).
+    fn block(
+        self,
+        points: &[[f64; 3]],
+        snapped: &mut [std::mem::MaybeUninit<Snapped>],
+        xy_f: &mut [std::mem::MaybeUninit<[f32; 2]>],
+    ) {
+        assert!(snapped.len() == points.len() && xy_f.len() == points.len());
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of every x86-64.
+        unsafe {
+            self.block_sse2(points, snapped, xy_f)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        for ((q, s), f) in points.iter().zip(snapped).zip(xy_f) {
+            let (node, xy) = scalar_node(&self.camera, self.ss, self.lo, self.range, *q);
+            s.write(node);
+            f.write(xy);
+        }
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "sse2")]
-    #[inline]
-    fn lanes(&self, q: &[f64; 3]) -> (Snapped, [f32; 2]) {
+    fn block_sse2(
+        self,
+        points: &[[f64; 3]],
+        snapped: &mut [std::mem::MaybeUninit<Snapped>],
+        xy_f: &mut [std::mem::MaybeUninit<[f32; 2]>],
+    ) {
         use std::arch::x86_64::*;
-        let c = self.camera;
-        let d = [q[0] - c.center[0], q[1] - c.center[1], q[2] - c.center[2]];
-        let z = -(d[0] * c.toward_eye[0] + d[1] * c.toward_eye[1] + d[2] * c.toward_eye[2]);
-        let z = ((z - self.lo) / self.range) as f32;
-        // Lanes (x, y): x = w/2 + s·(d·right), y = h/2 + (−s)·(d·up), which is
-        // h/2 − s·(d·up) bit for bit (negation is exact).
-        let lanes = |a: f64, b: f64| _mm_set_pd(b, a);
-        let dots = _mm_add_pd(
-            _mm_add_pd(
-                _mm_mul_pd(_mm_set1_pd(d[0]), lanes(c.right[0], c.up[0])),
-                _mm_mul_pd(_mm_set1_pd(d[1]), lanes(c.right[1], c.up[1])),
-            ),
-            _mm_mul_pd(_mm_set1_pd(d[2]), lanes(c.right[2], c.up[2])),
-        );
-        let image = _mm_add_pd(
-            lanes(0.5 * c.width as f64, 0.5 * c.height as f64),
-            _mm_mul_pd(lanes(c.scale, -c.scale), dots),
-        );
-        // `clamp`: `maxpd`/`minpd` return their second operand when either
-        // is NaN, so a NaN stays NaN as `f64::clamp` keeps it.
-        let v = _mm_min_pd(
-            _mm_set1_pd(LIMIT),
-            _mm_max_pd(_mm_set1_pd(-LIMIT), _mm_mul_pd(image, _mm_set1_pd(self.ss))),
-        );
-        let xy = _mm_cvtpd_ps(v);
-        // `snap`: v·16 plus a half with v's sign, truncated; a NaN lane is
-        // zeroed first, as `as i32` turns NaN into 0.
-        let v16 = _mm_mul_pd(v, _mm_set1_pd(16.0));
-        let half = _mm_or_pd(_mm_and_pd(v16, _mm_set1_pd(-0.0)), _mm_set1_pd(0.5));
-        let rounded = _mm_add_pd(v16, half);
-        let rounded = _mm_and_pd(rounded, _mm_cmpord_pd(rounded, rounded));
-        let snapped = _mm_cvttpd_epi32(rounded);
-        let xy_bits = _mm_cvtsi128_si64(_mm_castps_si128(xy)) as u64;
-        let s_bits = _mm_cvtsi128_si64(snapped) as u64;
-        (
-            Snapped {
+        let pair = |v: [f64; 2]| _mm_set_pd(v[1], v[0]);
+        let [f0, f1, f2] = self.right_up.map(pair);
+        let (half, scale) = (pair(self.half), pair(self.scale));
+        let ss = _mm_set1_pd(self.ss);
+        let (limit_lo, limit_hi) = (_mm_set1_pd(-LIMIT), _mm_set1_pd(LIMIT));
+        let (sixteen, sign, one_half) = (_mm_set1_pd(16.0), _mm_set1_pd(-0.0), _mm_set1_pd(0.5));
+        let (c, t) = (self.center, self.toward_eye);
+        for ((q, s), f) in points.iter().zip(snapped).zip(xy_f) {
+            let d = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+            // `Camera::depth`: −(d·toward_eye), summed as `dot` sums.
+            let z = -(d[0] * t[0] + d[1] * t[1] + d[2] * t[2]);
+            let z = ((z - self.lo) / self.range) as f32;
+            // Lanes (x, y): x = w/2 + s·(d·right), y = h/2 + (−s)·(d·up),
+            // which is h/2 − s·(d·up) bit for bit (negation is exact).
+            let dots = _mm_add_pd(
+                _mm_add_pd(
+                    _mm_mul_pd(_mm_set1_pd(d[0]), f0),
+                    _mm_mul_pd(_mm_set1_pd(d[1]), f1),
+                ),
+                _mm_mul_pd(_mm_set1_pd(d[2]), f2),
+            );
+            let image = _mm_add_pd(half, _mm_mul_pd(scale, dots));
+            // `clamp`: `maxpd`/`minpd` return their second operand when
+            // either is NaN, so a NaN stays NaN as `f64::clamp` keeps it.
+            let v = _mm_min_pd(limit_hi, _mm_max_pd(limit_lo, _mm_mul_pd(image, ss)));
+            let xy = _mm_cvtpd_ps(v);
+            // `snap`: v·16 plus a half with v's sign, truncated; a NaN lane
+            // is zeroed first, as `as i32` turns NaN into 0.
+            let v16 = _mm_mul_pd(v, sixteen);
+            let rounded = _mm_add_pd(v16, _mm_or_pd(_mm_and_pd(v16, sign), one_half));
+            let rounded = _mm_and_pd(rounded, _mm_cmpord_pd(rounded, rounded));
+            let s_bits = _mm_cvtsi128_si64(_mm_cvttpd_epi32(rounded)) as u64;
+            let xy_bits = _mm_cvtsi128_si64(_mm_castps_si128(xy)) as u64;
+            s.write(Snapped {
                 x: s_bits as u32 as i32,
                 y: (s_bits >> 32) as u32 as i32,
                 z,
-            },
-            [
+            });
+            f.write([
                 f32::from_bits(xy_bits as u32),
                 f32::from_bits((xy_bits >> 32) as u32),
-            ],
-        )
+            ]);
+        }
     }
 }
 
