@@ -253,8 +253,8 @@ mod tests {
             })
             .collect();
         points[5] = [f64::NAN, 1.0, 2.0];
-        let right = [0.7071067811865476, 0.7071067811865475, 0.0];
-        let up = [-0.408248290463863, 0.408248290463863, 0.816496580927726];
+        let right = [0.6, 0.8, 0.0];
+        let up = [-0.48, 0.36, 0.8];
         for cut in [points.len(), 40] {
             let part = &points[..cut];
             let (lo, hi) = extent(part, right, up);
