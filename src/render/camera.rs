@@ -76,13 +76,7 @@ impl Camera {
         let toward_eye = [az.sin() * el.cos(), -az.cos() * el.cos(), el.sin()];
         let right = [az.cos(), az.sin(), 0.0];
         let up = cross(toward_eye, right);
-        let mut lo = [f64::INFINITY; 2];
-        let mut hi = [f64::NEG_INFINITY; 2];
-        for p in points {
-            let (u, v) = (dot(*p, right), dot(*p, up));
-            lo = [below(u, lo[0]), below(v, lo[1])];
-            hi = [above(u, hi[0]), above(v, hi[1])];
-        }
+        let (mut lo, mut hi) = extent(points, right, up);
         if points.is_empty() {
             lo = [-1.0, -1.0];
             hi = [1.0, 1.0];
@@ -136,6 +130,83 @@ impl Camera {
     }
 }
 
+/// Nodes per unit of parallel work in [`extent`].
+const BLOCK: usize = 1 << 13;
+
+/// The least and greatest `p·right` and `p·up` over the points (infinite
+/// bounds when there are none). Blocks are folded in order and joined in
+/// block order with the same comparisons, so the bounds are the serial
+/// fold's (on ties the first value is kept either way) for any thread count.
+fn extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64; 2]) {
+    use rayon::prelude::*;
+    let empty = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    let blocks: Vec<([f64; 2], [f64; 2])> = points
+        .par_chunks(BLOCK)
+        .map(|block| block_extent(block, right, up))
+        .collect();
+    blocks.into_iter().fold(empty, |(lo, hi), (bl, bh)| {
+        (
+            [below(bl[0], lo[0]), below(bl[1], lo[1])],
+            [above(bh[0], hi[0]), above(bh[1], hi[1])],
+        )
+    })
+}
+
+/// [`extent`] of one block, serially: with SSE2 the two dot products are the
+/// lanes of one vector (the same products and sums in the same order as
+/// [`dot`]), and `minpd`/`maxpd` are [`below`]/[`above`] lane by lane.
+#[inline]
+fn block_extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64; 2]) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // SAFETY: SSE2 is part of every x86-64.
+        unsafe { block_extent_sse2(points, right, up) }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        scalar_extent(points, right, up)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "sse2")]
+fn block_extent_sse2(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64; 2]) {
+    {
+        use std::arch::x86_64::*;
+        let lanes = |k: usize| _mm_set_pd(up[k], right[k]);
+        let (r0, r1, r2) = (lanes(0), lanes(1), lanes(2));
+        let mut lo = _mm_set1_pd(f64::INFINITY);
+        let mut hi = _mm_set1_pd(f64::NEG_INFINITY);
+        for p in points {
+            let uv = _mm_add_pd(
+                _mm_add_pd(
+                    _mm_mul_pd(_mm_set1_pd(p[0]), r0),
+                    _mm_mul_pd(_mm_set1_pd(p[1]), r1),
+                ),
+                _mm_mul_pd(_mm_set1_pd(p[2]), r2),
+            );
+            // `minpd a, b` is `a < b ? a : b`: `below(uv, lo)` per lane.
+            lo = _mm_min_pd(uv, lo);
+            hi = _mm_max_pd(uv, hi);
+        }
+        let pair = |v: __m128d| [_mm_cvtsd_f64(v), _mm_cvtsd_f64(_mm_unpackhi_pd(v, v))];
+        (pair(lo), pair(hi))
+    }
+}
+
+/// The serial fold [`block_extent`]'s lanes follow (and the path off x86-64).
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+fn scalar_extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64; 2]) {
+    let mut lo = [f64::INFINITY; 2];
+    let mut hi = [f64::NEG_INFINITY; 2];
+    for p in points {
+        let (u, v) = (dot(*p, right), dot(*p, up));
+        lo = [below(u, lo[0]), below(v, lo[1])];
+        hi = [above(u, hi[0]), above(v, hi[1])];
+    }
+    (lo, hi)
+}
+
 /// `v` when it is below `bound`, else `bound`: `f64::min` for a bound that is
 /// never NaN (a NaN `v` keeps the bound), in one `minsd` instead of the
 /// three or four instructions `f64::min`'s NaN rule costs; a million nodes
@@ -166,6 +237,41 @@ pub fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn extent_lanes_are_the_serial_fold_bit_for_bit() {
+        // Values whose products round, ties of +0 and −0 (the first is
+        // kept), a NaN (never taken) and more than one block.
+        let mut points: Vec<[f64; 3]> = (0..3 * BLOCK + 17)
+            .map(|i| {
+                let t = i as f64 * 0.618_033_988_749_895;
+                [
+                    t.sin() * 1.3e3,
+                    (t * 1.7).cos() * 0.37,
+                    t.fract() * 1e-3 - 7.0,
+                ]
+            })
+            .collect();
+        points[5] = [f64::NAN, 1.0, 2.0];
+        let right = [0.6, 0.8, 0.0];
+        let up = [-0.48, 0.36, 0.8];
+        for cut in [points.len(), 40] {
+            let part = &points[..cut];
+            let (lo, hi) = extent(part, right, up);
+            let (want_lo, want_hi) = scalar_extent(part, right, up);
+            assert_eq!(lo.map(f64::to_bits), want_lo.map(f64::to_bits));
+            assert_eq!(hi.map(f64::to_bits), want_hi.map(f64::to_bits));
+            assert!(lo[0] < hi[0] && lo[1] < hi[1]);
+        }
+        let zeros = [[-0.0, -0.0, -0.0], [0.0, 0.0, 0.0], [-0.0, 0.0, -0.0]];
+        let (lo, hi) = extent(&zeros, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
+        assert_eq!(lo.map(f64::to_bits), [(-0.0f64).to_bits(); 2]);
+        assert_eq!(hi.map(f64::to_bits), [(-0.0f64).to_bits(); 2]);
+        assert_eq!(
+            extent(&[], right, up),
+            ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2])
+        );
+    }
 
     #[test]
     fn named_views_and_projection() {

@@ -12,6 +12,7 @@ mod legend;
 mod light;
 mod normal_sum;
 mod png_out;
+mod project;
 mod raster;
 mod resolve;
 mod resolve_unmarked;
@@ -260,7 +261,7 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
     let scene = scene::build(mesh, options, &camera);
     let mut warnings: Vec<RenderWarning> = section_warning(&scene, options).into_iter().collect();
     let ss = options.antialias as usize;
-    let proj = project(&scene, &camera, ss);
+    let proj = project::project(&scene.points, &camera, ss);
     let (sw, sh) = (options.width as usize * ss, options.height as usize * ss);
     let mut image = if options.edges == Edges::None {
         let (w, h) = (options.width as usize, options.height as usize);
@@ -318,58 +319,6 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
 fn sample_point(proj: &raster::Projected, node: u32) -> [f32; 3] {
     let p = proj.xy_f[node as usize];
     [p[0], p[1], proj.snapped[node as usize].z]
-}
-
-/// Node positions in sample space, depths normalised to [0, 1].
-fn project(scene: &scene::Scene, camera: &Camera, ss: usize) -> raster::Projected {
-    use rayon::prelude::*;
-    let (lo, hi) = scene
-        .points
-        .par_iter()
-        .map(|&q| camera.depth(q))
-        .fold(
-            || (f64::INFINITY, f64::NEG_INFINITY),
-            |(l, h), z| (camera::below(z, l), camera::above(z, h)),
-        )
-        .reduce(
-            || (f64::INFINITY, f64::NEG_INFINITY),
-            |a, b| (camera::below(b.0, a.0), camera::above(b.1, a.1)),
-        );
-    let range = if hi > lo { hi - lo } else { 1.0 };
-    let s = ss as f64;
-    // Far outside the picture only the clamped bounding box matters.
-    let limit = 1e6;
-    let (snapped, xy_f): (Vec<raster::Snapped>, Vec<[f32; 2]>) = scene
-        .points
-        .par_iter()
-        .map(|&q| {
-            let p = camera.project(q);
-            let (x, y) = (
-                (p[0] * s).clamp(-limit, limit),
-                (p[1] * s).clamp(-limit, limit),
-            );
-            let z = ((p[2] - lo) / range) as f32;
-            (
-                raster::Snapped {
-                    x: snap(x),
-                    y: snap(y),
-                    z,
-                },
-                [x as f32, y as f32],
-            )
-        })
-        .unzip();
-    raster::Projected { snapped, xy_f }
-}
-
-/// A sample-space coordinate in 1/16 sample steps, rounded half away from
-/// zero (`f64::round` is a library call on baseline x86-64; this is two
-/// instructions, and a million nodes make it count). `v` is within ±1e6
-/// samples, so the steps fit an `i32`.
-#[inline]
-fn snap(v: f64) -> i32 {
-    let v = v * 16.0;
-    (v + 0.5f64.copysign(v)) as i32
 }
 
 /// Renders and encodes a PNG.

@@ -122,17 +122,23 @@ pub fn bin(
     // Each sample row's band, looked up: two divisions by a band height
     // that is not always a power of two cost a fifth of binning.
     let band_of: Vec<u32> = (0..height).map(|y| (y / band_rows) as u32).collect();
-    (0..scene.tris.len().div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| {
+    // When every face shows the same pair of groups (one face, or faces of
+    // one colour), which sides are seen is known once, not per triangle.
+    let same_visible = scene.same_sides.map(|sides| sides.map(|g| g != HIDDEN));
+    (scene.tris.par_chunks(CHUNK))
+        .enumerate()
+        .map(|(c, chunk)| {
             let mut ids: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
             let mut cols = vec![(u32::MAX, 0u32); n_bands];
-            let end = ((c + 1) * CHUNK).min(scene.tris.len());
-            for tri in c * CHUNK..end {
-                let Some((v, back)) = facing(proj, scene.tris[tri]) else {
+            for (tri, &t) in (c * CHUNK..).zip(chunk) {
+                let Some((v, back)) = facing(proj, t) else {
                     continue;
                 };
-                if !visible_side(scene, tri, back) {
+                let seen = match same_visible {
+                    Some(visible) => visible[back as usize],
+                    None => visible_side(scene, tri, back),
+                };
+                if !seen {
                     continue;
                 }
                 if let Some((x0, x1, first, last)) = sample_box(&v, width, height) {

@@ -1,0 +1,292 @@
+//! Nodes to sample space for the raster: each node's snapped x and y with its
+//! depth normalised over the model's depth range, and its unsnapped x and y
+//! for shading. Half a million nodes make the per-node instructions count,
+//! so x and y are computed as the two lanes of one SSE2 vector: the same IEEE
+//! operations in the same order as [`Camera::project`] followed by the
+//! scalar scaling, clamping and snapping of [`scalar_node`], lane by lane
+//! (nothing fused), so the same bits.
+
+use super::camera::{Camera, above, below};
+use super::raster::{Projected, Snapped};
+use rayon::prelude::*;
+
+/// Nodes per unit of parallel work.
+const BLOCK: usize = 1 << 13;
+/// Far outside the picture only the clamped bounding box matters.
+const LIMIT: f64 = 1e6;
+
+/// Node positions in sample space (`ss` samples per pixel along each axis),
+/// depths normalised to [0, 1].
+pub fn project(points: &[[f64; 3]], camera: &Camera, ss: usize) -> Projected {
+    let (lo, hi) = depth_range(points, camera);
+    let range = if hi > lo { hi - lo } else { 1.0 };
+    let map = NodeMap::new(camera, ss as f64, lo, range);
+    let n = points.len();
+    let mut snapped: Vec<Snapped> = Vec::with_capacity(n);
+    let mut xy_f: Vec<[f32; 2]> = Vec::with_capacity(n);
+    (points.par_chunks(BLOCK))
+        .zip(snapped.spare_capacity_mut()[..n].par_chunks_mut(BLOCK))
+        .zip(xy_f.spare_capacity_mut()[..n].par_chunks_mut(BLOCK))
+        .for_each(|((from, to_snapped), to_xy)| map.block(from, to_snapped, to_xy));
+    // SAFETY: the chunks above cover the first `n` slots of both vectors
+    // (`points`, `..n` of each spare capacity, one block size), and
+    // `NodeMap::block` writes every slot of its chunks.
+    unsafe {
+        snapped.set_len(n);
+        xy_f.set_len(n);
+    }
+    Projected { snapped, xy_f }
+}
+
+/// The least and greatest depth of the nodes ([`Camera::depth`]). Blocks
+/// are folded in order and joined in block order with the same comparisons,
+/// so the result is the serial fold's for any thread count.
+fn depth_range(points: &[[f64; 3]], camera: &Camera) -> (f64, f64) {
+    let blocks: Vec<(f64, f64)> = points
+        .par_chunks(BLOCK)
+        .map(|block| {
+            // A copy: its fields stay in registers over the loop.
+            let camera = *camera;
+            block
+                .iter()
+                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                    let z = camera.depth(*q);
+                    (below(z, l), above(z, h))
+                })
+        })
+        .collect();
+    blocks
+        .into_iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), (bl, bh)| {
+            (below(bl, l), above(bh, h))
+        })
+}
+
+/// What one node's projection needs, as plain values (copied into each
+/// block's loop, so they stay in registers instead of being reloaded
+/// through a reference per node).
+#[derive(Clone, Copy)]
+struct NodeMap {
+    center: [f64; 3],
+    toward_eye: [f64; 3],
+    /// `[right[k], up[k]]`: the x and y lanes' factors of coordinate k.
+    right_up: [[f64; 2]; 3],
+    /// `[w/2, h/2]` and `[scale, −scale]`.
+    half: [f64; 2],
+    scale: [f64; 2],
+    ss: f64,
+    lo: f64,
+    range: f64,
+    #[cfg(not(target_arch = "x86_64"))]
+    camera: Camera,
+}
+
+impl NodeMap {
+    fn new(camera: &Camera, ss: f64, lo: f64, range: f64) -> NodeMap {
+        NodeMap {
+            center: camera.center,
+            toward_eye: camera.toward_eye,
+            right_up: std::array::from_fn(|k| [camera.right[k], camera.up[k]]),
+            half: [0.5 * camera.width as f64, 0.5 * camera.height as f64],
+            scale: [camera.scale, -camera.scale],
+            ss,
+            lo,
+            range,
+            #[cfg(not(target_arch = "x86_64"))]
+            camera: *camera,
+        }
+    }
+
+    /// Projects a block of nodes into the slots of `snapped` and `xy_f`
+    /// (one per node: every slot is written).
+    fn block(
+        self,
+        points: &[[f64; 3]],
+        snapped: &mut [std::mem::MaybeUninit<Snapped>],
+        xy_f: &mut [std::mem::MaybeUninit<[f32; 2]>],
+    ) {
+        assert!(snapped.len() == points.len() && xy_f.len() == points.len());
+        #[cfg(target_arch = "x86_64")]
+        // SAFETY: SSE2 is part of every x86-64.
+        unsafe {
+            self.block_sse2(points, snapped, xy_f)
+        }
+        #[cfg(not(target_arch = "x86_64"))]
+        for ((q, s), f) in points.iter().zip(snapped).zip(xy_f) {
+            let (node, xy) = scalar_node(&self.camera, self.ss, self.lo, self.range, *q);
+            s.write(node);
+            f.write(xy);
+        }
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "sse2")]
+    fn block_sse2(
+        self,
+        points: &[[f64; 3]],
+        snapped: &mut [std::mem::MaybeUninit<Snapped>],
+        xy_f: &mut [std::mem::MaybeUninit<[f32; 2]>],
+    ) {
+        use std::arch::x86_64::*;
+        let pair = |v: [f64; 2]| _mm_set_pd(v[1], v[0]);
+        let [f0, f1, f2] = self.right_up.map(pair);
+        let (half, scale) = (pair(self.half), pair(self.scale));
+        let ss = _mm_set1_pd(self.ss);
+        let (limit_lo, limit_hi) = (_mm_set1_pd(-LIMIT), _mm_set1_pd(LIMIT));
+        let (sixteen, sign, one_half) = (_mm_set1_pd(16.0), _mm_set1_pd(-0.0), _mm_set1_pd(0.5));
+        let (c, t) = (self.center, self.toward_eye);
+        for ((q, s), f) in points.iter().zip(snapped).zip(xy_f) {
+            let d = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
+            // `Camera::depth`: −(d·toward_eye), summed as `dot` sums.
+            let z = -(d[0] * t[0] + d[1] * t[1] + d[2] * t[2]);
+            let z = ((z - self.lo) / self.range) as f32;
+            // Lanes (x, y): x = w/2 + s·(d·right), y = h/2 + (−s)·(d·up),
+            // which is h/2 − s·(d·up) bit for bit (negation is exact).
+            let dots = _mm_add_pd(
+                _mm_add_pd(
+                    _mm_mul_pd(_mm_set1_pd(d[0]), f0),
+                    _mm_mul_pd(_mm_set1_pd(d[1]), f1),
+                ),
+                _mm_mul_pd(_mm_set1_pd(d[2]), f2),
+            );
+            let image = _mm_add_pd(half, _mm_mul_pd(scale, dots));
+            // `clamp`: `maxpd`/`minpd` return their second operand when
+            // either is NaN, so a NaN stays NaN as `f64::clamp` keeps it.
+            let v = _mm_min_pd(limit_hi, _mm_max_pd(limit_lo, _mm_mul_pd(image, ss)));
+            let xy = _mm_cvtpd_ps(v);
+            // `snap`: v·16 plus a half with v's sign, truncated; a NaN lane
+            // is zeroed first, as `as i32` turns NaN into 0.
+            let v16 = _mm_mul_pd(v, sixteen);
+            let rounded = _mm_add_pd(v16, _mm_or_pd(_mm_and_pd(v16, sign), one_half));
+            let rounded = _mm_and_pd(rounded, _mm_cmpord_pd(rounded, rounded));
+            let s_bits = _mm_cvtsi128_si64(_mm_cvttpd_epi32(rounded)) as u64;
+            let xy_bits = _mm_cvtsi128_si64(_mm_castps_si128(xy)) as u64;
+            s.write(Snapped {
+                x: s_bits as u32 as i32,
+                y: (s_bits >> 32) as u32 as i32,
+                z,
+            });
+            f.write([
+                f32::from_bits(xy_bits as u32),
+                f32::from_bits((xy_bits >> 32) as u32),
+            ]);
+        }
+    }
+}
+
+/// One node as the scalar code computes it: the reference the vector lanes
+/// follow (and the path off x86-64).
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+fn scalar_node(camera: &Camera, s: f64, lo: f64, range: f64, q: [f64; 3]) -> (Snapped, [f32; 2]) {
+    let p = camera.project(q);
+    let (x, y) = (
+        (p[0] * s).clamp(-LIMIT, LIMIT),
+        (p[1] * s).clamp(-LIMIT, LIMIT),
+    );
+    let z = ((p[2] - lo) / range) as f32;
+    (
+        Snapped {
+            x: snap(x),
+            y: snap(y),
+            z,
+        },
+        [x as f32, y as f32],
+    )
+}
+
+/// A sample-space coordinate in 1/16 sample steps, rounded half away from
+/// zero (`f64::round` is a library call on baseline x86-64). `v` is within
+/// ±1e6 samples, so the steps fit an `i32`.
+#[inline]
+fn snap(v: f64) -> i32 {
+    let v = v * 16.0;
+    (v + 0.5f64.copysign(v)) as i32
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::camera::View;
+    use super::*;
+
+    /// Points whose products round, far outside the picture, on the sample
+    /// grid's halves, negative zeros and NaN.
+    fn awkward_points() -> Vec<[f64; 3]> {
+        let mut points: Vec<[f64; 3]> = (0..4000)
+            .map(|i| {
+                let t = i as f64 * 0.618_033_988_749_895;
+                [
+                    t.sin() * 1.3 + t.fract() * 1e-7,
+                    (t * 1.7).cos() * 0.37,
+                    (t * 0.3).sin() * 2.1 - 1e-9 * t,
+                ]
+            })
+            .collect();
+        points.extend([
+            [1e9, -3e8, 2.0],
+            [-1e12, 1e12, -5.0],
+            [-0.0, -0.0, -0.0],
+            [f64::NAN, 0.5, 0.25],
+            [0.25, f64::NAN, 0.5],
+            [0.5, 0.25, f64::NAN],
+            [f64::INFINITY, 0.0, 0.0],
+        ]);
+        points
+    }
+
+    #[test]
+    fn vector_lanes_project_as_the_scalar_code_bit_for_bit() {
+        let points = awkward_points();
+        let fitted = &points[..4000];
+        for (view, ss, (w, h)) in [
+            (View::ISO, 2, (1024, 1024)),
+            (View::FRONT, 1, (333, 211)),
+            (View::TOP, 3, (640, 480)),
+            (
+                View {
+                    azimuth: 200.0,
+                    elevation: -30.0,
+                },
+                4,
+                (97, 1301),
+            ),
+        ] {
+            let camera = Camera::fit(view, fitted, w, h);
+            let proj = project(&points, &camera, ss);
+            assert_eq!(proj.snapped.len(), points.len());
+            let (lo, hi) = depth_range(&points, &camera);
+            assert!(lo < hi);
+            let range = hi - lo;
+            let mut inside = 0;
+            for (i, q) in points.iter().enumerate() {
+                let (want, want_xy) = scalar_node(&camera, ss as f64, lo, range, *q);
+                let got = proj.snapped[i];
+                assert_eq!((got.x, got.y), (want.x, want.y), "node {i}");
+                assert_eq!(got.z.to_bits(), want.z.to_bits(), "node {i}");
+                assert_eq!(proj.xy_f[i].map(f32::to_bits), want_xy.map(f32::to_bits));
+                let picture = (w * ss as u32 * 16) as i32;
+                inside += usize::from((0..picture).contains(&got.x));
+            }
+            // The fitted points lie inside the picture, the far ones are clamped.
+            assert!(inside >= 4000, "{inside}");
+            assert_eq!(proj.snapped[4000].x.abs(), (LIMIT * 16.0) as i32);
+            assert_eq!(proj.snapped[4004].y, 0, "NaN snaps to 0");
+        }
+    }
+
+    #[test]
+    fn depth_range_is_the_serial_fold() {
+        let points = awkward_points();
+        let camera = Camera::fit(View::ISO, &points[..4000], 800, 600);
+        let serial = points
+            .iter()
+            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                let z = camera.depth(*q);
+                (below(z, l), above(z, h))
+            });
+        let got = depth_range(&points, &camera);
+        assert_eq!(
+            (got.0.to_bits(), got.1.to_bits()),
+            (serial.0.to_bits(), serial.1.to_bits())
+        );
+    }
+}
