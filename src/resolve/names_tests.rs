@@ -17,7 +17,9 @@ fn document(xml: &str) -> (SourceFile, Document) {
 }
 
 fn sphere(name: &str) -> String {
-    format!("<sphere name=\"{name}\"><center x=\"0\" y=\"0\" z=\"0\"/><radius value=\"1\"/></sphere>\n")
+    format!(
+        "<sphere name=\"{name}\"><center x=\"0\" y=\"0\" z=\"0\"/><radius value=\"1\"/></sphere>\n"
+    )
 }
 
 #[test]
@@ -83,7 +85,11 @@ fn many_names_find_what_a_scan_of_the_document_finds() {
     }
     xml += "</parameters>\n";
     for i in 0..3_000 {
-        let name = if i % 3 == 2 { format!("n{}", i / 7) } else { format!("n{i}") };
+        let name = if i % 3 == 2 {
+            format!("n{}", i / 7)
+        } else {
+            format!("n{i}")
+        };
         xml += &sphere(&name);
         if i % 11 == 0 {
             xml += &format!("<subdomain name=\"s{i}\"><solid ref=\"n{i}\"/></subdomain>\n");
