@@ -125,10 +125,10 @@ fn run(
     // which keeps the peak memory of large files down (the parsed document
     // is gone already).
     release(options);
-    let resolved = resolve::resolve(source, &document, &options.overrides, diags);
     // Everything later reads the resolved objects, not the document's: on large
-    // files they are a fifth of the peak memory while the model is lowered.
-    document.objects = Vec::new();
+    // files they are a fifth of the peak memory while the model is lowered, so
+    // resolution takes them.
+    let resolved = resolve::resolve(source, &mut document, &options.overrides, diags);
     release(options);
     // Lowering takes the subdomain definitions (dropped once lowered, before
     // the overlap check at the memory peak); only their count is read later.

@@ -25,12 +25,18 @@ fn hash(name: &str) -> u64 {
 
 impl NameIndex {
     pub fn build(objects: &[ResolvedObject]) -> NameIndex {
+        NameIndex::build_with(objects.len(), |i| objects.get(i).map(|o| o.name.as_str()))
+    }
+
+    /// The index of `count` objects, object `i` named `name(i)`: built from
+    /// the document's names, it serves the resolved objects of the same names.
+    pub fn build_with<'n>(count: usize, name: impl Fn(usize) -> Option<&'n str>) -> NameIndex {
         // At most two thirds full, so probes stay short and end on an empty slot.
-        let size = (objects.len() + objects.len() / 2 + 1).next_power_of_two();
+        let size = (count + count / 2 + 1).next_power_of_two();
         let mut slots = vec![0u32; size];
-        let mut previous = Vec::with_capacity(objects.len());
-        for (i, object) in objects.iter().enumerate() {
-            let slot = probe(&slots, objects, &object.name);
+        let mut previous = Vec::with_capacity(count);
+        for i in 0..count {
+            let slot = probe(&slots, &name, name(i).unwrap_or_default());
             let before = slots.get(slot).copied().unwrap_or(0);
             previous.push(before);
             if let Some(s) = slots.get_mut(slot) {
@@ -43,7 +49,8 @@ impl NameIndex {
     /// The index of the last object named `name` in `objects` (the list the
     /// index was built from).
     pub fn get(&self, objects: &[ResolvedObject], name: &str) -> Option<usize> {
-        let slot = probe(&self.slots, objects, name);
+        let name_of = |i: usize| objects.get(i).map(|o| o.name.as_str());
+        let slot = probe(&self.slots, &name_of, name);
         match self.slots.get(slot).copied() {
             None | Some(0) => None,
             Some(s) => Some(s as usize - 1),
@@ -69,13 +76,13 @@ impl NameIndex {
 
 /// The slot of `name`: the one holding its last object, or the empty slot
 /// where its probe sequence ends.
-fn probe(slots: &[u32], objects: &[ResolvedObject], name: &str) -> usize {
+fn probe<'n>(slots: &[u32], name_of: &impl Fn(usize) -> Option<&'n str>, name: &str) -> usize {
     let mask = slots.len().wrapping_sub(1);
     let mut at = hash(name) as usize & mask;
     for _ in 0..slots.len() {
         match slots[at] {
             0 => return at,
-            s if objects.get(s as usize - 1).is_some_and(|o| o.name == name) => return at,
+            s if name_of(s as usize - 1) == Some(name) => return at,
             _ => at = (at + 1) & mask,
         }
     }

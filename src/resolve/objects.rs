@@ -17,13 +17,16 @@ enum FrameState {
     Done(Option<Frame>),
 }
 
-#[derive(Debug, Clone, PartialEq)]
+/// Where an object's resolution is; its geometry is in its
+/// [`ResolvedObject`] as soon as it has one.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum State {
+    Unresolved,
     InProgress,
-    Done(Option<Geometry>),
+    Done,
     /// Resolved on a worker by a resolver of its own (see `resolve_alone`);
     /// its findings are reported when the serial pass first asks for it.
-    Alone(Option<Geometry>),
+    Alone,
 }
 
 /// The resolver's view of the other objects.
@@ -31,7 +34,12 @@ enum Objects {
     /// Every object's state: the serial resolver, which resolves a referenced
     /// object on demand (with cycle detection).
     All {
-        state: Vec<Option<State>>,
+        state: Vec<State>,
+        /// What [`Resolver::resolve_all`] gives back, filled in place (a
+        /// second list of a hundred thousand geometries, copied from the
+        /// states, was fresh memory the main thread faulted in). The names
+        /// are left empty: the caller moves the document's in.
+        resolved: Vec<ResolvedObject>,
         /// The findings of objects resolved alone, by object index (sorted),
         /// until the serial pass reaches them.
         pending: Vec<(usize, Diagnostics)>,
@@ -78,26 +86,19 @@ type AloneTask = (Vec<(usize, Diagnostics)>, Used, usize);
 /// Objects per task of the parallel pass (each a few microseconds).
 const ALONE_CHUNK: usize = 512;
 
-/// The resolver's lookup tables of a document's objects and coordinate
-/// systems (the first of a repeated name), built apart from the name table:
-/// on large files both are hundreds of thousands of inserts, so the driver
-/// builds them side by side.
+/// The resolver's table of coordinate systems (the first of a repeated
+/// name); the objects are looked up in the name table.
 pub(super) struct Tables<'a> {
-    by_name: HashMap<&'a str, usize>,
     systems: HashMap<String, &'a CoordinateSystem>,
 }
 
 impl<'a> Tables<'a> {
     pub fn build(doc: &'a Document) -> Tables<'a> {
-        let mut by_name = HashMap::with_capacity(doc.objects.len());
-        for (i, o) in doc.objects.iter().enumerate() {
-            by_name.entry(o.name.text.as_str()).or_insert(i);
-        }
         let mut systems = HashMap::new();
         for cs in &doc.coordinate_systems {
             systems.entry(cs.name.text.clone()).or_insert(cs);
         }
-        Tables { by_name, systems }
+        Tables { systems }
     }
 }
 
@@ -117,14 +118,22 @@ impl<'a> Resolver<'a> {
             tables,
             frames: Frames::Own(HashMap::new()),
             objects: Objects::All {
-                state: vec![None; doc.objects.len()],
+                state: vec![State::Unresolved; doc.objects.len()],
+                resolved: (doc.objects.iter())
+                    .map(|object| ResolvedObject {
+                        name: String::new(),
+                        span: object.span,
+                        geometry: None,
+                    })
+                    .collect(),
                 pending: Vec::new(),
             },
         }
     }
 
-    pub fn by_name_index(&self, name: &str) -> Option<&usize> {
-        self.tables.by_name.get(name)
+    /// The first object named `name`.
+    pub fn by_name_index(&self, name: &str) -> Option<usize> {
+        self.names.first_object(name)
     }
 
     /// The names this resolver used and its findings.
@@ -188,7 +197,12 @@ impl<'a> Resolver<'a> {
             objects,
             ..
         } = self;
-        let Objects::All { state, pending } = objects else {
+        let Objects::All {
+            state,
+            resolved,
+            pending,
+        } = objects
+        else {
             return 0;
         };
         let frames = match frames {
@@ -196,10 +210,10 @@ impl<'a> Resolver<'a> {
             Frames::Shared(frames) => *frames,
         };
         let (doc, names, values, tables) = (*doc, *names, *values, *tables);
-        let done: Vec<AloneTask> = state
-            .par_chunks_mut(ALONE_CHUNK)
+        let done: Vec<AloneTask> = (state.par_chunks_mut(ALONE_CHUNK))
+            .zip(resolved.par_chunks_mut(ALONE_CHUNK))
             .enumerate()
-            .map(|(chunk, slots)| {
+            .map(|(chunk, (slots, results))| {
                 let mut alone = Resolver {
                     doc,
                     names,
@@ -214,8 +228,8 @@ impl<'a> Resolver<'a> {
                 };
                 let mut found = Vec::new();
                 let mut count = 0;
-                for (k, slot) in slots.iter_mut().enumerate() {
-                    if slot.is_some() {
+                for (k, (slot, result)) in slots.iter_mut().zip(results).enumerate() {
+                    if *slot != State::Unresolved {
                         continue;
                     }
                     let i = chunk * ALONE_CHUNK + k;
@@ -236,7 +250,8 @@ impl<'a> Resolver<'a> {
                     if !diags.items.is_empty() {
                         found.push((i, diags));
                     }
-                    *slot = Some(State::Alone(geometry));
+                    *slot = State::Alone;
+                    result.geometry = geometry;
                     count += 1;
                 }
                 (found, alone.used, count)
@@ -252,37 +267,31 @@ impl<'a> Resolver<'a> {
     }
 
     /// Every object resolved once, in document order (a reference may
-    /// resolve a later one first); then the geometries are moved out of the
-    /// resolver's state instead of copied (nothing reads them after this:
-    /// the subdomains' area limits are plain numbers).
+    /// resolve a later one first); then the resolved objects are moved out
+    /// of the resolver (nothing reads them after this: the subdomains' area
+    /// limits are plain numbers). Their names are empty.
     fn resolve_objects(&mut self) -> Vec<ResolvedObject> {
         for i in 0..self.doc.objects.len() {
             self.resolve_once(i);
         }
-        let Objects::All { state, .. } = &mut self.objects else {
+        let Objects::All {
+            state, resolved, ..
+        } = &mut self.objects
+        else {
             return Vec::new();
         };
-        let states = std::mem::take(state);
-        states
-            .into_iter()
-            .zip(&self.doc.objects)
-            .map(|(state, object)| ResolvedObject {
-                name: object.name.text.clone(),
-                span: object.span,
-                geometry: match state {
-                    Some(State::Done(geometry)) => geometry,
-                    _ => None,
-                },
-            })
-            .collect()
+        *state = Vec::new();
+        std::mem::take(resolved)
     }
 
     /// The geometry of object `i`, resolved once.
     pub fn geometry(&mut self, i: usize) -> Option<Geometry> {
         self.resolve_once(i);
         match &self.objects {
-            Objects::All { state, .. } => match state.get(i) {
-                Some(Some(State::Done(geometry))) => geometry.clone(),
+            Objects::All {
+                state, resolved, ..
+            } => match (state.get(i), resolved.get(i)) {
+                (Some(State::Done), Some(object)) => object.geometry.clone(),
                 _ => None,
             },
             Objects::Alone { .. } => None,
@@ -294,19 +303,17 @@ impl<'a> Resolver<'a> {
     /// object needs another.
     fn resolve_once(&mut self, i: usize) {
         let state = match &mut self.objects {
-            Objects::All { state, pending } => match state.get_mut(i) {
+            Objects::All { state, pending, .. } => match state.get_mut(i) {
                 // Out of range only after `resolve_all` moved the geometries out.
-                None | Some(Some(State::Done(_))) => return,
-                Some(slot @ Some(State::Alone(_))) => {
-                    if let Some(State::Alone(geometry)) = slot.take() {
-                        *slot = Some(State::Done(geometry));
-                    }
+                None | Some(State::Done) => return,
+                Some(slot @ State::Alone) => {
+                    *slot = State::Done;
                     if let Ok(k) = pending.binary_search_by_key(&i, |(j, _)| *j) {
                         self.diags.extend(std::mem::take(&mut pending[k].1));
                     }
                     return;
                 }
-                Some(Some(State::InProgress)) => {
+                Some(State::InProgress) => {
                     let object = &self.doc.objects[i];
                     self.diags.push(
                         Diagnostic::new(
@@ -322,26 +329,34 @@ impl<'a> Resolver<'a> {
                             "a transform or reference chain leads back to this object; break the chain",
                         ),
                     );
-                    state[i] = Some(State::Done(None));
+                    // Its geometry stays `None`.
+                    state[i] = State::Done;
                     return;
                 }
-                Some(None) => state,
+                Some(State::Unresolved) => state,
             },
             Objects::Alone { needed_another } => {
                 *needed_another = true;
                 return;
             }
         };
-        state[i] = Some(State::InProgress);
+        state[i] = State::InProgress;
         let object: &'a Object = &self.doc.objects[i];
         let geometry = self.resolve_object(object);
-        let Objects::All { state, .. } = &mut self.objects else {
+        let Objects::All {
+            state, resolved, ..
+        } = &mut self.objects
+        else {
             return;
         };
-        if let Some(State::Done(None)) = state[i] {
+        if state[i] == State::Done {
+            // A cycle through it was reported: it stays unresolved.
             return;
         }
-        state[i] = Some(State::Done(geometry));
+        state[i] = State::Done;
+        if let Some(object) = resolved.get_mut(i) {
+            object.geometry = geometry;
+        }
     }
 
     fn resolve_object(&mut self, object: &'a Object) -> Option<Geometry> {
@@ -605,7 +620,7 @@ impl<'a> Resolver<'a> {
     /// Finds the object a reference names, checking that its element is one of
     /// `kinds` (element names as in the format; "*" accepts any object).
     pub fn lookup(&mut self, reference: &Ref, kinds: &[&str]) -> Option<usize> {
-        let Some(&i) = self.tables.by_name.get(reference.name.as_str()) else {
+        let Some(i) = self.names.first_object(&reference.name) else {
             let d = match self.names.kind_of(&reference.name) {
                 Some(kind) => Diagnostic::new(
                     Code::WrongKind,

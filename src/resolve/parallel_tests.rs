@@ -2,7 +2,7 @@
 //! gives: the same findings in the same order, the same geometries, the same
 //! unused parameters, on any number of threads.
 
-use super::{Pass, Resolved, resolve_in};
+use super::{Pass, Resolved, named, resolve_in};
 use crate::diag::{Code, Diagnostics};
 use crate::span::SourceFile;
 use crate::syntax::{self, Limits};
@@ -141,7 +141,8 @@ fn resolved(xml: &str, pass: Pass, threads: usize) -> (Diagnostics, Resolved, us
     let mut diags = Diagnostics::default();
     let (resolved, alone) =
         on_threads(threads, || resolve_in(&source, &doc, &[], &mut diags, pass));
-    (diags, resolved, alone)
+    let names = doc.objects.iter().map(|object| object.name.text.clone());
+    (diags, named(resolved, names), alone)
 }
 
 #[test]

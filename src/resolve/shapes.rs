@@ -865,7 +865,7 @@ pub(super) fn surface_of(r: &mut Resolver, reference: &Ref) -> Option<Surface> {
 
 /// The two surfaces of an intersection line, without reporting anything.
 fn intersection_surfaces(r: &mut Resolver, reference: &Ref) -> Option<Box<[Surface; 2]>> {
-    let i = *r.by_name_index(&reference.name)?;
+    let i = r.by_name_index(&reference.name)?;
     match r.geometry(i)? {
         Geometry::Line(LineCarrier::Intersection { surfaces }) => Some(surfaces),
         _ => None,

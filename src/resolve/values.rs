@@ -155,6 +155,13 @@ impl<'d> Values<'d> {
         diags: &mut Diagnostics,
     ) -> Option<f64> {
         let expr = number.expr()?;
+        // Most numbers of large files are plain: no name to look up, and
+        // the evaluator would return the value as it is when finite.
+        if let expr::ExprKind::Number(value) = expr.kind {
+            if value.is_finite() {
+                return Some(value);
+            }
+        }
         self.eval_frozen(&expr, ctx, used, diags)
     }
 
