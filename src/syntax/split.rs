@@ -11,6 +11,7 @@
 //! prefixed names, entities in a `name=` value) or any error of a piece means
 //! the whole file is parsed as before, so diagnostics never depend on the split.
 
+use super::plain;
 use super::tree::{self, Element, Head, Misplaced, Origin};
 use super::{Limits, check_depth};
 use crate::span::Span;
@@ -133,6 +134,15 @@ impl<'s> Split<'s> {
         let start = self.children.get(first).ok_or(Reparse)?.start;
         let last = self.run_end(first) - 1;
         let end = self.children.get(last).ok_or(Reparse)?.end;
+        if let Some(elements) = plain::read_run(
+            self.text,
+            start,
+            end,
+            self.limits.max_depth,
+            last + 1 - first,
+        ) {
+            return self.matched(first, last, elements, out);
+        }
         let piece = self.text.get(start..end).ok_or(Reparse)?;
         let mut buffer = String::with_capacity(OPEN.len() + piece.len() + CLOSE.len());
         buffer.push_str(OPEN);
@@ -163,6 +173,25 @@ impl<'s> Split<'s> {
             return Err(Reparse);
         }
         Ok(index)
+    }
+
+    /// The elements [`plain::read_run`] read of the run from `first` to
+    /// `last`, checked against the scan as roxmltree's are.
+    fn matched(
+        &self,
+        first: usize,
+        last: usize,
+        elements: Vec<Element<'s>>,
+        out: &mut impl Extend<Element<'s>>,
+    ) -> Result<usize, Reparse> {
+        let heads = self.heads.get(first..=last).ok_or(Reparse)?;
+        if heads.len() != elements.len()
+            || !heads.iter().zip(&elements).all(|(h, e)| *h == e.head())
+        {
+            return Err(Reparse);
+        }
+        out.extend(elements);
+        Ok(last + 1)
     }
 }
 
