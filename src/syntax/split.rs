@@ -3,9 +3,10 @@
 //! it was alive beside the typed document (the front end's memory peak).
 //!
 //! A scan finds the root's start tag, each child element's extent and its
-//! [`Head`], and the root's end. Every piece of the file is still parsed by
-//! roxmltree with the same options: the prolog and root start tag (closed by
-//! hand), then runs of consecutive children inside a wrapper element. The
+//! [`Head`], and the root's end. The prolog and root start tag (closed by
+//! hand) are parsed by roxmltree, then runs of consecutive children: a plain
+//! run by [`super::plain`], any other inside a wrapper element by roxmltree
+//! with the same options. The
 //! split is taken only when the text between the children is whitespace;
 //! anything the scan does not expect (comments or text at the top level,
 //! prefixed names, entities in a `name=` value) or any error of a piece means
@@ -390,19 +391,19 @@ fn skip_whitespace(bytes: &[u8], mut pos: usize) -> usize {
 /// The end (after `>`) of the start tag at `pos`, and whether it is `/>`.
 /// Quoted attribute values may hold `>`.
 fn start_tag_end(bytes: &[u8], pos: usize) -> Option<(usize, bool)> {
-    let mut quote = None;
     let mut i = pos + 1;
     loop {
-        let b = *bytes.get(i)?;
-        match quote {
-            Some(q) if b == q => quote = None,
-            Some(_) => {}
-            None if b == b'"' || b == b'\'' => quote = Some(b),
-            None if b == b'<' => return None,
-            None if b == b'>' => return Some((i + 1, bytes.get(i - 1) == Some(&b'/'))),
-            None => {}
+        // Outside quotes only these four bytes matter; a quoted value is
+        // skipped whole to its closing quote.
+        i += bytes
+            .get(i..)?
+            .iter()
+            .position(|b| matches!(b, b'<' | b'>' | b'"' | b'\''))?;
+        match *bytes.get(i)? {
+            b'<' => return None,
+            b'>' => return Some((i + 1, bytes.get(i - 1) == Some(&b'/'))),
+            quote => i += 1 + memchr::memchr(quote, bytes.get(i + 1..)?)? + 1,
         }
-        i += 1;
     }
 }
 
@@ -613,6 +614,22 @@ mod tests {
         }
         assert_eq!(kinds, [false, true].into());
         assert_eq!(scan_children(&text, from, 0), Some(one));
+    }
+
+    #[test]
+    fn start_tags_end_at_the_first_close_outside_quotes() {
+        for (tag, end) in [
+            ("<a x=\"1>2\"/> <b/>", Some((12, true))),
+            ("<a x='\"'> </a>", Some((9, false))),
+            ("<a x=\"<\" y='>'>", Some((15, false))),
+            ("<a x=\"/\">", Some((9, false))),
+            ("<a/>", Some((4, true))),
+            ("<a <b>", None),
+            ("<a x=\"1>", None),
+            ("<a x='1'", None),
+        ] {
+            assert_eq!(start_tag_end(tag.as_bytes(), 0), end, "{tag}");
+        }
     }
 
     #[test]
