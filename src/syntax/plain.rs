@@ -161,7 +161,8 @@ impl<'s> Reader<'s> {
                 name,
                 span: Span::new(tag_start, self.pos),
                 name_span: Span::new(name_start, name_start + name.len()),
-                attributes: attributes.drain(..).collect(),
+                // A copy sized exactly (the values are borrowed): the scratch list keeps its room.
+                attributes: attributes.to_vec(),
                 children: Vec::new(),
                 text: Vec::new(),
             },
