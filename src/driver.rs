@@ -366,11 +366,9 @@ enum RunRead<'s> {
 /// [`read_element`] for every element of a split file, as a pipeline: the
 /// rayon threads parse the runs, check their elements' structure and build
 /// their parts of the typed document, the main thread takes the parts in file
-/// order and copies them into the document ([`doc::DocumentBuilder::copy_in`]).
-/// Everything the document keeps is allocated on the main thread, which frees
-/// it later (memory freed from another thread's heap waits there, and raised
-/// the peak); what the rayon threads built goes back to one of them to be
-/// freed, and they free the element trees they parsed. A run with an element
+/// order and moves them into the document ([`doc::DocumentBuilder::append`]);
+/// the emptied parts go back to a rayon thread to be freed, and the rayon
+/// threads free the element trees they parsed. A run with an element
 /// the implicit path may take comes as elements, extracted and added on the
 /// main thread. The root's check (`check_root`) runs beside them, its findings
 /// put first. The findings come in the order of reading the file serially,
@@ -388,11 +386,6 @@ fn read_runs<'s>(
         diags,
     } = read;
     let parts = builder.part_builder();
-    let check = |element: &syntax::Element, found: &mut Diagnostics| {
-        if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
-            doc::structure::check(element, rule, found);
-        }
-    };
     let checked = |i: usize| -> Checked<'s> {
         let elements = runs.elements(i)?;
         if !elements.iter().all(|e| extractor.leaves(e)) {
@@ -401,15 +394,16 @@ fn read_runs<'s>(
                     .into_iter()
                     .map(|element| {
                         let mut found = Diagnostics::default();
-                        check(&element, &mut found);
+                        check_top_level(&element, &mut found, &mut Default::default());
                         (element, found)
                     })
                     .collect(),
             ));
         }
         let (mut built, mut found) = (doc::Parts::for_elements(&elements), Diagnostics::default());
+        let mut scratch = doc::structure::Scratch::default();
         for element in &elements {
-            check(element, &mut found);
+            check_top_level(element, &mut found, &mut scratch);
             parts.add_part(element, &mut built, &mut found);
         }
         Ok(RunRead::Built(built, found))
@@ -450,9 +444,9 @@ fn read_runs<'s>(
                 spawn(next + RUNS_AHEAD);
             }
             match run.unwrap_or_else(|panic| std::panic::resume_unwind(panic))? {
-                RunRead::Built(built, found) => {
+                RunRead::Built(mut built, found) => {
                     diags.extend(found);
-                    builder.copy_in(&built);
+                    builder.append(&mut built);
                     scope.spawn(move |_| drop(built));
                 }
                 RunRead::Elements(run) => {
@@ -475,6 +469,18 @@ fn read_runs<'s>(
             .splice(root_findings_at..root_findings_at, root.items);
         Ok(())
     })
+}
+
+/// The structure check of one top-level element (an unknown one is the
+/// root's check to report), in the lists of `scratch`.
+fn check_top_level<'e, 's>(
+    element: &'e syntax::Element<'s>,
+    found: &mut Diagnostics,
+    scratch: &mut doc::structure::Scratch<'e, 's>,
+) {
+    if let Some(rule) = grammar::GEOMETRY.child_rule(element.name) {
+        doc::structure::check_reusing(element, rule, found, scratch);
+    }
 }
 
 /// The next message of a job of [`read_runs`]. On a rayon thread (the driver

@@ -8,39 +8,75 @@ use crate::syntax::{Element, Head};
 
 /// Checks `root` (and everything below it) against `rule`.
 pub fn check(root: &Element, rule: &'static Rule, diags: &mut Diagnostics) {
-    let mut stack = vec![(root, rule)];
-    while let Some((element, rule)) = stack.pop() {
-        let known = check_element(element, rule, diags);
-        for (child, child_rule) in known.into_iter().rev() {
-            stack.push((child, child_rule));
+    check_reusing(root, rule, diags, &mut Scratch::default());
+}
+
+/// The lists a [`check_reusing`] works in, kept from one call to the next:
+/// a check of a large file's elements used to allocate a few per element.
+#[derive(Default)]
+pub struct Scratch<'e, 's> {
+    pending: Vec<(&'e Element<'s>, &'static Rule)>,
+    heads: Vec<Head<'e>>,
+    known: Vec<Head<'e>>,
+    known_rules: Vec<(usize, &'static Rule)>,
+}
+
+/// [`check`] in the lists of `scratch`.
+pub fn check_reusing<'e, 's>(
+    root: &'e Element<'s>,
+    rule: &'static Rule,
+    diags: &mut Diagnostics,
+    scratch: &mut Scratch<'e, 's>,
+) {
+    let Scratch {
+        pending,
+        heads,
+        known,
+        known_rules,
+    } = scratch;
+    pending.clear();
+    pending.push((root, rule));
+    while let Some((element, rule)) = pending.pop() {
+        heads.clear();
+        heads.extend(element.children.iter().map(Element::head));
+        check_heads_into(element, heads, rule, diags, known, known_rules);
+        for &(i, child_rule) in known_rules.iter().rev() {
+            if let Some(child) = element.children.get(i) {
+                pending.push((child, child_rule));
+            }
         }
     }
 }
 
-/// Checks `element` itself against `rule`: its attributes, its text, and the
-/// names, counts and order of its children, but nothing inside them.
-/// Returns the children whose rules are known, with their rules.
-pub fn check_element<'e, 's>(
-    element: &'e Element<'s>,
-    rule: &'static Rule,
-    diags: &mut Diagnostics,
-) -> Vec<(&'e Element<'s>, &'static Rule)> {
-    let heads: Vec<Head> = element.children.iter().map(Element::head).collect();
-    check_element_heads(element, &heads, rule, diags)
-        .into_iter()
-        .filter_map(|(i, r)| Some((element.children.get(i)?, r)))
-        .collect()
-}
-
-/// [`check_element`] with the children given as [`Head`]s (the driver checks a
-/// large file's root this way, then each child as it is built). Returns the
-/// indices of the children whose rules are known, with their rules.
+/// Checks `element` itself against `rule` with its children given as
+/// [`Head`]s (the driver checks a large file's root this way, then each child
+/// as it is built): its attributes, its text, and the names, counts and order
+/// of the children, but nothing inside them. Returns the indices of the
+/// children whose rules are known, with their rules.
 pub fn check_element_heads(
     element: &Element,
     children: &[Head],
     rule: &'static Rule,
     diags: &mut Diagnostics,
 ) -> Vec<(usize, &'static Rule)> {
+    let mut known_rules = Vec::with_capacity(children.len());
+    let mut known = Vec::with_capacity(children.len());
+    check_heads_into(element, children, rule, diags, &mut known, &mut known_rules);
+    known_rules
+}
+
+/// Checks `element` itself against `rule`: its attributes, its text, and the
+/// names, counts and order of its `children`, but nothing inside them.
+/// Leaves in `known_rules` the indices of the children whose rules are known,
+/// with their rules (`known`: their heads, a scratch list).
+fn check_heads_into<'h>(
+    element: &Element,
+    children: &[Head<'h>],
+    rule: &'static Rule,
+    diags: &mut Diagnostics,
+    known: &mut Vec<Head<'h>>,
+    known_rules: &mut Vec<(usize, &'static Rule)>,
+) {
     check_attributes(element, rule, diags);
     for (text, span) in &element.text {
         diags.push(
@@ -56,7 +92,7 @@ pub fn check_element_heads(
             .with_help("put data in attributes; use an XML comment <!-- … --> for notes"),
         );
     }
-    check_children(element, children, rule, diags)
+    check_children(element, children, rule, diags, known, known_rules);
 }
 
 fn abbreviate(text: &str) -> String {
@@ -143,16 +179,18 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
     }
 }
 
-/// Reports problems with the children and returns the indices of the ones
-/// whose rules are known, with their rules.
-fn check_children(
+/// Reports problems with the children and leaves in `known_rules` the
+/// indices of the ones whose rules are known, with their rules.
+fn check_children<'h>(
     element: &Element,
-    children: &[Head],
+    children: &[Head<'h>],
     rule: &'static Rule,
     diags: &mut Diagnostics,
-) -> Vec<(usize, &'static Rule)> {
-    let mut known_rules = Vec::with_capacity(children.len());
-    let mut known: Vec<Head> = Vec::with_capacity(children.len());
+    known: &mut Vec<Head<'h>>,
+    known_rules: &mut Vec<(usize, &'static Rule)>,
+) {
+    known_rules.clear();
+    known.clear();
     for (i, child) in children.iter().enumerate() {
         if let Some(child_rule) = rule.child_rule(child.name) {
             known_rules.push((i, child_rule));
@@ -188,14 +226,14 @@ fn check_children(
         Content::Empty => {}
         Content::All(children) => {
             for spec in children {
-                check_count(element, &known, spec, diags);
+                check_count(element, known, spec, diags);
             }
         }
         Content::Sequence(children) => {
             for spec in children {
-                check_count(element, &known, spec, diags);
+                check_count(element, known, spec, diags);
             }
-            check_order(element, &known, children, diags);
+            check_order(element, known, children, diags);
         }
         Content::Choice { min, max, .. } => {
             let n = known.len() as u32;
@@ -238,9 +276,8 @@ fn check_children(
                 }
             }
         }
-        Content::Forms(forms) => check_forms(element, &known, forms, diags),
+        Content::Forms(forms) => check_forms(element, known, forms, diags),
     }
-    known_rules
 }
 
 fn plural(n: u32) -> &'static str {
@@ -248,8 +285,10 @@ fn plural(n: u32) -> &'static str {
 }
 
 fn check_count(element: &Element, known: &[Head], spec: &Child, diags: &mut Diagnostics) {
-    let found: Vec<&Head> = known.iter().filter(|c| c.name == spec.rule.name).collect();
-    let n = found.len() as u32;
+    let found = known.iter().filter(|c| c.name == spec.rule.name);
+    // The element past the most allowed, then how many there are in all.
+    let extra = spec.max.and_then(|max| found.clone().nth(max as usize));
+    let n = found.count() as u32;
     if n < spec.min {
         let need = if spec.min == 1 {
             "a".to_string()
@@ -273,27 +312,25 @@ fn check_count(element: &Element, known: &[Head], spec: &Child, diags: &mut Diag
             )),
         );
     }
-    if let Some(max) = spec.max {
-        if let Some(extra) = found.get(max as usize) {
-            diags.push(
-                Diagnostic::new(
-                    Code::DuplicateElement,
-                    extra.name_span,
-                    format!(
-                        "<{}> may have {} <{}> element{}, found {n}",
-                        element.name,
-                        if max == 1 {
-                            "only one".to_string()
-                        } else {
-                            format!("at most {max}")
-                        },
-                        spec.rule.name,
-                        plural(max)
-                    ),
-                )
-                .with_help(format!("remove the extra <{}>", spec.rule.name)),
-            );
-        }
+    if let (Some(max), Some(extra)) = (spec.max, extra) {
+        diags.push(
+            Diagnostic::new(
+                Code::DuplicateElement,
+                extra.name_span,
+                format!(
+                    "<{}> may have {} <{}> element{}, found {n}",
+                    element.name,
+                    if max == 1 {
+                        "only one".to_string()
+                    } else {
+                        format!("at most {max}")
+                    },
+                    spec.rule.name,
+                    plural(max)
+                ),
+            )
+            .with_help(format!("remove the extra <{}>", spec.rule.name)),
+        );
     }
 }
 

@@ -6,6 +6,7 @@
 // User-controlled bytes and values: no panicking index (docs/reliability.md).
 #![cfg_attr(not(test), deny(clippy::indexing_slicing))]
 
+mod plain;
 mod split;
 mod tree;
 

@@ -3,14 +3,16 @@
 //! it was alive beside the typed document (the front end's memory peak).
 //!
 //! A scan finds the root's start tag, each child element's extent and its
-//! [`Head`], and the root's end. Every piece of the file is still parsed by
-//! roxmltree with the same options: the prolog and root start tag (closed by
-//! hand), then runs of consecutive children inside a wrapper element. The
+//! [`Head`], and the root's end. The prolog and root start tag (closed by
+//! hand) are parsed by roxmltree, then runs of consecutive children: a plain
+//! run by [`super::plain`], any other inside a wrapper element by roxmltree
+//! with the same options. The
 //! split is taken only when the text between the children is whitespace;
 //! anything the scan does not expect (comments or text at the top level,
 //! prefixed names, entities in a `name=` value) or any error of a piece means
 //! the whole file is parsed as before, so diagnostics never depend on the split.
 
+use super::plain;
 use super::tree::{self, Element, Head, Misplaced, Origin};
 use super::{Limits, check_depth};
 use crate::span::Span;
@@ -133,6 +135,15 @@ impl<'s> Split<'s> {
         let start = self.children.get(first).ok_or(Reparse)?.start;
         let last = self.run_end(first) - 1;
         let end = self.children.get(last).ok_or(Reparse)?.end;
+        if let Some(elements) = plain::read_run(
+            self.text,
+            start,
+            end,
+            self.limits.max_depth,
+            last + 1 - first,
+        ) {
+            return self.matched(first, last, elements, out);
+        }
         let piece = self.text.get(start..end).ok_or(Reparse)?;
         let mut buffer = String::with_capacity(OPEN.len() + piece.len() + CLOSE.len());
         buffer.push_str(OPEN);
@@ -163,6 +174,25 @@ impl<'s> Split<'s> {
             return Err(Reparse);
         }
         Ok(index)
+    }
+
+    /// The elements [`plain::read_run`] read of the run from `first` to
+    /// `last`, checked against the scan as roxmltree's are.
+    fn matched(
+        &self,
+        first: usize,
+        last: usize,
+        elements: Vec<Element<'s>>,
+        out: &mut impl Extend<Element<'s>>,
+    ) -> Result<usize, Reparse> {
+        let heads = self.heads.get(first..=last).ok_or(Reparse)?;
+        if heads.len() != elements.len()
+            || !heads.iter().zip(&elements).all(|(h, e)| *h == e.head())
+        {
+            return Err(Reparse);
+        }
+        out.extend(elements);
+        Ok(last + 1)
     }
 }
 
@@ -361,19 +391,19 @@ fn skip_whitespace(bytes: &[u8], mut pos: usize) -> usize {
 /// The end (after `>`) of the start tag at `pos`, and whether it is `/>`.
 /// Quoted attribute values may hold `>`.
 fn start_tag_end(bytes: &[u8], pos: usize) -> Option<(usize, bool)> {
-    let mut quote = None;
     let mut i = pos + 1;
     loop {
-        let b = *bytes.get(i)?;
-        match quote {
-            Some(q) if b == q => quote = None,
-            Some(_) => {}
-            None if b == b'"' || b == b'\'' => quote = Some(b),
-            None if b == b'<' => return None,
-            None if b == b'>' => return Some((i + 1, bytes.get(i - 1) == Some(&b'/'))),
-            None => {}
+        // Outside quotes only these four bytes matter; a quoted value is
+        // skipped whole to its closing quote.
+        i += bytes
+            .get(i..)?
+            .iter()
+            .position(|b| matches!(b, b'<' | b'>' | b'"' | b'\''))?;
+        match *bytes.get(i)? {
+            b'<' => return None,
+            b'>' => return Some((i + 1, bytes.get(i - 1) == Some(&b'/'))),
+            quote => i += 1 + memchr::memchr(quote, bytes.get(i + 1..)?)? + 1,
         }
-        i += 1;
     }
 }
 
@@ -584,6 +614,22 @@ mod tests {
         }
         assert_eq!(kinds, [false, true].into());
         assert_eq!(scan_children(&text, from, 0), Some(one));
+    }
+
+    #[test]
+    fn start_tags_end_at_the_first_close_outside_quotes() {
+        for (tag, end) in [
+            ("<a x=\"1>2\"/> <b/>", Some((12, true))),
+            ("<a x='\"'> </a>", Some((9, false))),
+            ("<a x=\"<\" y='>'>", Some((15, false))),
+            ("<a x=\"/\">", Some((9, false))),
+            ("<a/>", Some((4, true))),
+            ("<a <b>", None),
+            ("<a x=\"1>", None),
+            ("<a x='1'", None),
+        ] {
+            assert_eq!(start_tag_end(tag.as_bytes(), 0), end, "{tag}");
+        }
     }
 
     #[test]

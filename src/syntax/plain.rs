@@ -1,0 +1,341 @@
+//! Runs of plain markup read straight into element trees, without roxmltree.
+//!
+//! roxmltree's parse of a run and the conversion of its nodes into
+//! [`Element`]s were about a fifth of the front end's CPU time on large files;
+//! most such files are plain: ASCII elements with quoted attributes and
+//! whitespace between them. This reader takes exactly that subset, where an
+//! XML parser has nothing to decide (no entity, comment, CDATA section,
+//! processing instruction, text, namespace, non-ASCII or control character,
+//! nor a value roxmltree would normalise), and gives the trees roxmltree's
+//! path gives. Anything else, well-formed or not, makes it give up (`None`)
+//! and the run goes to roxmltree as before, which also reports every error:
+//! this reader never decides that a file is wrong.
+
+use super::tree::{Attribute, Element};
+use crate::span::Span;
+use std::borrow::Cow;
+
+/// The elements of `text[start..end]`, a run of whole elements separated by
+/// whitespace, as roxmltree's path builds them; `None` when the run is not
+/// plain (see the module) or nests deeper than `max_depth` (the root being
+/// level 1, so the run's elements are level 2). `elements`: how many
+/// elements the run is expected to hold (only sizes the list).
+pub(super) fn read_run(
+    text: &str,
+    start: usize,
+    end: usize,
+    max_depth: usize,
+    elements: usize,
+) -> Option<Vec<Element<'_>>> {
+    if !text.get(start..end)?.is_ascii() {
+        return None;
+    }
+    let mut reader = Reader {
+        text,
+        bytes: text.as_bytes().get(..end)?,
+        pos: start,
+    };
+    // Finished elements: the run's, and the children of the open elements
+    // after the index each was opened at (moved into it, sized exactly, when
+    // it closes).
+    let mut finished: Vec<Element> = Vec::with_capacity(elements);
+    let mut open: Vec<(Element, usize)> = Vec::new();
+    let mut attributes = Vec::new();
+    loop {
+        reader.skip_whitespace();
+        let Some(&byte) = reader.bytes.get(reader.pos) else {
+            return open.is_empty().then_some(finished);
+        };
+        if byte != b'<' {
+            return None;
+        }
+        if reader.bytes.get(reader.pos + 1) == Some(&b'/') {
+            let (mut element, first) = open.pop()?;
+            reader.pos += 2;
+            if reader.name()? != element.name {
+                return None;
+            }
+            reader.skip_whitespace();
+            reader.expect(b'>')?;
+            element.span = Span::new(element.span.range().start, reader.pos);
+            element.children = finished.drain(first..).collect();
+            finished.push(element);
+            continue;
+        }
+        if open.len() + 2 > max_depth {
+            return None;
+        }
+        let (element, closed) = reader.start_tag(&mut attributes)?;
+        if closed {
+            finished.push(element);
+        } else {
+            open.push((element, finished.len()));
+        }
+    }
+}
+
+struct Reader<'s> {
+    text: &'s str,
+    /// The text up to the run's end.
+    bytes: &'s [u8],
+    pos: usize,
+}
+
+impl<'s> Reader<'s> {
+    fn skip_whitespace(&mut self) -> usize {
+        let from = self.pos;
+        while self
+            .bytes
+            .get(self.pos)
+            .is_some_and(|b| matches!(b, b' ' | b'\t' | b'\r' | b'\n'))
+        {
+            self.pos += 1;
+        }
+        self.pos - from
+    }
+
+    fn expect(&mut self, byte: u8) -> Option<()> {
+        (self.bytes.get(self.pos) == Some(&byte)).then(|| self.pos += 1)
+    }
+
+    /// A name of ASCII letters, digits, `_`, `-` and `.` not starting with a
+    /// digit, `-` or `.`, followed by whitespace, `/`, `>` or `=` (a `:`, i.e.
+    /// a prefix, gives `None`).
+    fn name(&mut self) -> Option<&'s str> {
+        let start = self.pos;
+        if !self
+            .bytes
+            .get(start)
+            .is_some_and(|b| b.is_ascii_alphabetic() || *b == b'_')
+        {
+            return None;
+        }
+        self.pos += 1;
+        while let Some(&b) = self.bytes.get(self.pos) {
+            match b {
+                b'a'..=b'z' | b'A'..=b'Z' | b'0'..=b'9' | b'_' | b'-' | b'.' => self.pos += 1,
+                b' ' | b'\t' | b'\r' | b'\n' | b'/' | b'>' | b'=' => break,
+                _ => return None,
+            }
+        }
+        self.text.get(start..self.pos)
+    }
+
+    /// The start tag at `pos` (a `<`) as an element without children, and
+    /// whether it closed itself (`/>`). `attributes`: a reused scratch list.
+    fn start_tag(&mut self, attributes: &mut Vec<Attribute<'s>>) -> Option<(Element<'s>, bool)> {
+        let tag_start = self.pos;
+        self.pos += 1;
+        let name = self.name()?;
+        attributes.clear();
+        let closed = loop {
+            let spaced = self.skip_whitespace() > 0;
+            match self.bytes.get(self.pos)? {
+                b'>' => {
+                    self.pos += 1;
+                    break false;
+                }
+                b'/' => {
+                    self.pos += 1;
+                    self.expect(b'>')?;
+                    break true;
+                }
+                // An attribute must follow whitespace.
+                _ if !spaced => return None,
+                _ => {
+                    let attribute = self.attribute()?;
+                    // A repeated attribute and a namespace declaration are
+                    // roxmltree's to judge.
+                    if attribute.name == "xmlns"
+                        || attributes.iter().any(|a| a.name == attribute.name)
+                    {
+                        return None;
+                    }
+                    attributes.push(attribute);
+                }
+            }
+        };
+        let name_start = tag_start + 1;
+        Some((
+            Element {
+                name,
+                span: Span::new(tag_start, self.pos),
+                name_span: Span::new(name_start, name_start + name.len()),
+                // A copy sized exactly (the values are borrowed): the scratch list keeps its room.
+                attributes: attributes.to_vec(),
+                children: Vec::new(),
+                text: Vec::new(),
+            },
+            closed,
+        ))
+    }
+
+    /// `name = "value"` at `pos`; `None` for a value roxmltree would expand
+    /// or normalise (`&`, tab, line ends), or refuse (`<`, control characters).
+    fn attribute(&mut self) -> Option<Attribute<'s>> {
+        let name_start = self.pos;
+        let name = self.name()?;
+        let name_span = Span::new(name_start, self.pos);
+        self.skip_whitespace();
+        self.expect(b'=')?;
+        self.skip_whitespace();
+        let quote = *self.bytes.get(self.pos)?;
+        if quote != b'"' && quote != b'\'' {
+            return None;
+        }
+        let value_start = self.pos + 1;
+        let length = memchr::memchr(quote, self.bytes.get(value_start..)?)?;
+        let value = self.text.get(value_start..value_start + length)?;
+        if value.bytes().any(|b| b < b' ' || b == b'<' || b == b'&') {
+            return None;
+        }
+        self.pos = value_start + length + 1;
+        Some(Attribute {
+            name,
+            name_span,
+            value: Cow::Borrowed(value),
+            value_span: Span::new(value_start, value_start + length),
+        })
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::split::options;
+    use super::super::tree::{self, Origin};
+    use super::*;
+    use crate::syntax::Limits;
+
+    /// The run as the split's roxmltree path reads it: inside a wrapper,
+    /// whitespace only between the elements, nesting within `max_depth`.
+    fn by_roxmltree(text: &str, max_depth: usize) -> Option<Vec<Element<'_>>> {
+        let wrapped = format!("<r>{text}</r>");
+        let limits = Limits {
+            max_depth,
+            ..Limits::default()
+        };
+        let document = roxmltree::Document::parse_with_options(&wrapped, options(&limits)).ok()?;
+        let wrapper = document.root_element();
+        super::super::check_depth(wrapper, &limits).ok()?;
+        let at = Origin {
+            source: text,
+            shift: -3,
+        };
+        let mut elements = Vec::new();
+        for node in wrapper.children() {
+            if node.is_element() {
+                elements.push(tree::build(node, at).ok()?);
+            } else if !node.text().is_some_and(|t| t.trim().is_empty()) {
+                return None;
+            }
+        }
+        Some(elements)
+    }
+
+    fn plain(text: &str, max_depth: usize) -> Option<Vec<Element<'_>>> {
+        read_run(text, 0, text.len(), max_depth, 0)
+    }
+
+    const PLAIN: &str = "\n  <sphere name=\"p0\"><center x=\"0\" y = '1.5' z=\"a>b\"/><radius value=\"r*2\"></radius></sphere>\n\
+        \t<subdomain name=\"d0\" material=\"steel\" ><union><solid ref=\"p0\"/><solid ref='p_1.x-y'/></union></subdomain >\r\n\
+        <parallelepiped name=\"p1\"><first_point x=\"2\" y=\"0\" z=\"0\"   /><second_point x=\"2.5\" y=\"0.5\" z=\"0.5\"/></parallelepiped>  ";
+
+    #[test]
+    fn plain_runs_read_as_roxmltree_reads_them() {
+        let read = plain(PLAIN, 64).expect("the run is plain");
+        assert_eq!(Some(&read), by_roxmltree(PLAIN, 64).as_ref());
+        assert_eq!(read.len(), 3);
+        let center = &read[0].children[0];
+        assert_eq!(center.attributes[1].value, "1.5");
+        assert_eq!(center.attributes[2].value, "a>b");
+        let at = PLAIN.find("1.5").expect("in the text");
+        assert_eq!(center.attributes[1].value_span, Span::new(at, at + 3));
+        assert_eq!(read[1].children[0].children.len(), 2);
+        assert_eq!(read[1].children[0].children[1].children.len(), 0);
+        let end = PLAIN.find("</subdomain >").expect("in the text") + "</subdomain >".len();
+        assert_eq!(read[1].span.range().end, end);
+        // Nesting: the union's solids are level 4.
+        assert_eq!(plain(PLAIN, 4), by_roxmltree(PLAIN, 4));
+        assert_eq!(plain(PLAIN, 3), None);
+        assert_eq!(by_roxmltree(PLAIN, 3), None);
+    }
+
+    #[test]
+    fn what_roxmltree_must_judge_is_left_to_it() {
+        for text in [
+            "<a x=\"1 &amp; 2\"/>",
+            "<a x=\"1\t2\"/>",
+            "<a x=\"1\n2\"/>",
+            "<a><!-- note --></a>",
+            "<a><![CDATA[x]]></a>",
+            "<a><?pi x?></a>",
+            "<a>text</a>",
+            "<a xmlns=\"u\"/>",
+            "<p:a xmlns:p=\"u\"/>",
+            "<a p:x=\"1\" xmlns:p=\"u\"/>",
+            "<a x=\"é\"/>",
+            "<é/>",
+        ] {
+            assert!(by_roxmltree(text, 64).is_some(), "{text}");
+            assert_eq!(plain(text, 64), None, "{text}");
+        }
+        for text in [
+            "<a x=\"1\" x=\"2\"/>",
+            "<a x=\"1\"y=\"2\"/>",
+            "<a x=\"<\"/>",
+            "<a x=1/>",
+            "<a></b>",
+            "<a>",
+            "</a>",
+            "<a/ >",
+            "<1a/>",
+            "<a\u{1}/>",
+            "<a x=\"\u{1}\"/>",
+        ] {
+            assert_eq!(by_roxmltree(text, 64), None, "{text}");
+            assert_eq!(plain(text, 64), None, "{text}");
+        }
+    }
+
+    /// Random edits of a plain run: whatever this reader accepts, roxmltree
+    /// reads to the same trees.
+    #[test]
+    fn edited_runs_it_accepts_are_what_roxmltree_reads() {
+        let alphabet: &[u8] = b"<>/=\"' \t\n\r&!?:-._aZ09x\x01";
+        let mut state = 0x2545_f491_4f6c_dd1d_u64;
+        let mut next = |bound: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % bound as u64) as usize
+        };
+        let (mut accepted, mut refused_by_both) = (0, 0);
+        for _ in 0..8_000 {
+            let mut bytes = PLAIN.as_bytes().to_vec();
+            for _ in 0..1 + next(3) {
+                let at = next(bytes.len());
+                let byte = alphabet[next(alphabet.len())];
+                match next(3) {
+                    0 => bytes.insert(at, byte),
+                    1 => bytes[at] = byte,
+                    _ => drop(bytes.remove(at)),
+                }
+            }
+            let Ok(text) = String::from_utf8(bytes) else {
+                continue;
+            };
+            let depth = 3 + next(3);
+            match plain(&text, depth) {
+                Some(read) => {
+                    accepted += 1;
+                    assert_eq!(Some(read), by_roxmltree(&text, depth), "{text:?}");
+                }
+                None if by_roxmltree(&text, depth).is_none() => refused_by_both += 1,
+                None => {}
+            }
+        }
+        // Both sides of the line are exercised.
+        assert!(accepted > 500, "{accepted} {refused_by_both}");
+        assert!(refused_by_both > 500, "{accepted} {refused_by_both}");
+    }
+}
