@@ -19,7 +19,8 @@ pub struct NameIndex {
     previous: Vec<u32>,
 }
 
-fn hash(name: &str) -> u64 {
+/// The names' hash of both name tables (`names.rs` folds it to 32 bits).
+pub(super) fn hash(name: &str) -> u64 {
     foldhash::fast::FixedState::with_seed(0x6e61_6d65).hash_one(name)
 }
 

@@ -4,7 +4,6 @@
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::doc::Document;
 use crate::span::{SourceFile, Span};
-use std::hash::BuildHasher;
 
 /// One definition of a name, in the table's list (sorted by position).
 #[derive(Debug, Clone, Copy)]
@@ -43,8 +42,9 @@ pub struct NameTable<'d> {
 /// How many names ahead the build asks for a slot's cache line.
 const PREFETCH_AHEAD: usize = 16;
 
+/// The name index's hash, folded to the four bytes a slot keeps.
 fn hash(name: &str) -> u32 {
-    let h = foldhash::fast::FixedState::with_seed(0x6e61_6d65).hash_one(name);
+    let h = super::name_index::hash(name);
     (h >> 32) as u32 ^ h as u32
 }
 
