@@ -7,7 +7,6 @@
 
 use super::scene::{HIDDEN, Scene};
 use super::triangle::{self, SUB};
-use crate::cache_hint::prefetch_at;
 use rayon::prelude::*;
 
 pub const EMPTY: u64 = u64::MAX;
@@ -164,37 +163,13 @@ pub fn draw_band(
     width: usize,
     ys: std::ops::Range<usize>,
 ) {
-    let (y0, y1) = (ys.start, ys.end);
-    // `triangle::draw` indexes the band's samples without bounds checks.
-    assert!(y0 <= y1 && (y1 - y0) * width <= rows.len());
-    let (tris, nodes) = (&scene.tris[..], &proj.snapped[..]);
-    for chunk in bins {
-        let ids = &chunk.ids[band][..];
-        for (i, &tri) in ids.iter().enumerate() {
-            // A band's triangles lie scattered over the mesh, and a corner
-            // is two dependent loads (the triangle, then its node): fetch the
-            // triangle 16 places ahead and the corners of the one 8 ahead
-            // (its triangle fetched 8 places ago), so the loads overlap. A
-            // hint needs no bounds check: it reads nothing.
-            if let Some(&far) = ids.get(i + 2 * AHEAD) {
-                prefetch_at(tris.as_ptr().wrapping_add(far as usize));
-            }
-            if let Some(near) = ids.get(i + AHEAD).and_then(|&t| tris.get(t as usize)) {
-                for &n in near {
-                    prefetch_at(nodes.as_ptr().wrapping_add(n as usize));
-                }
-            }
-            let [a, b, c] = tris[tri as usize];
-            let corners = [nodes[a as usize], nodes[b as usize], nodes[c as usize]];
-            // SAFETY: `rows` holds the band's (y1 - y0) × width samples
-            // (asserted above).
-            unsafe { triangle::draw(rows, width, y0, y1, corners, tri) };
-        }
-    }
+    // `triangle::draw_chunks` indexes the band's samples without bounds
+    // checks.
+    assert!(ys.start <= ys.end && ys.len() * width <= rows.len());
+    let chunks = bins.iter().map(|chunk| &chunk.ids[band][..]);
+    // SAFETY: `rows` holds the band's samples (asserted above).
+    unsafe { triangle::draw_chunks(rows, width, ys, &scene.tris, &proj.snapped, chunks) };
 }
-
-/// Triangles ahead whose corners are fetched while one is drawn.
-const AHEAD: usize = 8;
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
     let bins = bin(scene, proj, width, height, BAND);

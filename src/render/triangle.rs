@@ -6,30 +6,150 @@
 //! set-up keeps few values live (corners relative to the first one) and a
 //! triangle under `SMALL` snapped units across steps its three edges as
 //! fields of one integer: one add per sample and one test of three sign
-//! bits, instead of three adds and three tests.
+//! bits, instead of three adds and three tests. Where the processor has
+//! AVX-512, `lanes` does the same eight triangles at a time.
 
 use super::raster::Snapped;
+use crate::cache_hint::prefetch_at;
+
+#[cfg(target_arch = "x86_64")]
+mod lanes;
 
 /// Sub-sample steps per sample of the snapped coordinates.
 pub const SUB: i64 = 16;
 
-/// Fills the samples of rows `y0..y1` (stored from `rows[0]`) inside
-/// triangle `tri` with corners `t` where it is nearer than what is there:
-/// each sample keeps the smaller of its value and the triangle's depth bits
-/// above `2 × tri + back side`. Edge-on triangles draw nothing.
+/// Triangles ahead whose corners are fetched while one is set up: a corner
+/// is two dependent loads (the triangle, then its node), scattered over the
+/// mesh.
+const AHEAD: usize = 8;
+
+/// Draws triangles `ids` of each chunk of `chunks` (corners `tris`, nodes
+/// `nodes`) into rows `ys` of the z-buffer (stored from `rows[0]`, rows
+/// `width` samples long): each sample inside a triangle keeps the smaller
+/// of its value and the triangle's depth bits above `2 × triangle + back
+/// side`. Edge-on triangles draw nothing.
 ///
 /// # Safety
-/// `y0 <= y1` and `rows` holds at least `(y1 - y0) × width` samples: the
-/// sample loops index without bounds checks.
-#[inline(always)]
-pub unsafe fn draw(
+/// `ys.start <= ys.end` and `rows` holds at least `ys.len() × width`
+/// samples: the sample loops index without bounds checks.
+pub unsafe fn draw_chunks<'a>(
     rows: &mut [u64],
     width: usize,
-    y0: usize,
-    y1: usize,
+    ys: std::ops::Range<usize>,
+    tris: &[[u32; 3]],
+    nodes: &[Snapped],
+    chunks: impl Iterator<Item = &'a [u32]>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    let lanes = lanes::available();
+    #[cfg(not(target_arch = "x86_64"))]
+    let lanes = false;
+    // SAFETY: the caller's promise.
+    unsafe { draw_chunks_by(lanes, rows, width, ys, tris, nodes, chunks) }
+}
+
+/// [`draw_chunks`], eight triangles at a time in vector lanes when `lanes`
+/// (the processor has AVX-512), else one after another (set up, then
+/// filled: a batch of set-ups before their sample loops was slower).
+///
+/// # Safety
+/// As [`draw_chunks`]; `lanes` only when [`lanes::available`].
+unsafe fn draw_chunks_by<'a>(
+    lanes: bool,
+    rows: &mut [u64],
+    width: usize,
+    ys: std::ops::Range<usize>,
+    tris: &[[u32; 3]],
+    nodes: &[Snapped],
+    chunks: impl Iterator<Item = &'a [u32]>,
+) {
+    #[cfg(target_arch = "x86_64")]
+    if lanes {
+        for ids in chunks {
+            // SAFETY: the caller's promise; the processor has the
+            // instructions.
+            unsafe { lanes::draw_ids(rows, width, &ys, tris, nodes, ids) };
+        }
+        return;
+    }
+    for ids in chunks {
+        for (i, &tri) in ids.iter().enumerate() {
+            // Ahead: the triangle 16 places on, the corners of the one 8 on
+            // (its triangle fetched 8 places ago), so the dependent loads
+            // overlap. A band's ids in a chunk ascend, but by jumps (a ring
+            // of the mesh to the next) the hardware does not follow.
+            if let Some(&far) = ids.get(i + 2 * AHEAD) {
+                prefetch_at(tris.as_ptr().wrapping_add(far as usize));
+            }
+            if let Some(near) = ids.get(i + AHEAD).and_then(|&t| tris.get(t as usize)) {
+                for &c in near {
+                    // A hint needs no bounds check: it reads nothing.
+                    prefetch_at(nodes.as_ptr().wrapping_add(c as usize));
+                }
+            }
+            let [a, b, c] = tris[tri as usize];
+            let corners = [nodes[a as usize], nodes[b as usize], nodes[c as usize]];
+            let mut small = Small::default();
+            // SAFETY: the caller's promise; `set_up` places a small
+            // triangle's box in the band.
+            unsafe {
+                if set_up(rows, width, &ys, corners, tri, &mut small) {
+                    small.fill(rows.as_mut_ptr(), width);
+                }
+            }
+        }
+    }
+}
+
+/// A small triangle set up for its sample loop: its packed edges at the
+/// box's first sample and their steps, the box's first sample in the band,
+/// and what else the loop needs.
+#[derive(Clone, Copy, Default)]
+struct Small {
+    outside: i64,
+    sx: i64,
+    sy: i64,
+    first: usize,
+    fill: Fill,
+}
+
+impl Small {
+    /// # Safety
+    /// The box from `rows.add(self.first)` lies in the band.
+    #[inline(always)]
+    unsafe fn fill(&self, rows: *mut u64, width: usize) {
+        // A copy in registers: the stores to the band could alias `self`.
+        let small = *self;
+        // SAFETY: the caller's promise.
+        unsafe {
+            small.fill.packed(
+                rows.add(small.first),
+                width,
+                small.outside,
+                small.sx,
+                small.sy,
+            )
+        }
+    }
+}
+
+/// Sets up triangle `tri` with corners `t` for rows `ys` of the band:
+/// a small one into `small` (true), a large one drawn at once; false when
+/// it draws nothing or is drawn.
+///
+/// # Safety
+/// `ys.start <= ys.end` and `rows` holds at least `ys.len() × width`
+/// samples.
+#[inline(always)]
+unsafe fn set_up(
+    rows: &mut [u64],
+    width: usize,
+    ys: &std::ops::Range<usize>,
     t: [Snapped; 3],
     tri: u32,
-) {
+    small: &mut Small,
+) -> bool {
+    let (y0, y1) = (ys.start, ys.end);
     let [p, q, r] = t;
     let (ax, ay) = (p.x as i64, p.y as i64);
     // Corners b and c relative to a: the values the set-up keeps are small.
@@ -37,7 +157,7 @@ pub unsafe fn draw(
     let (rx, ry) = (r.x as i64 - ax, r.y as i64 - ay);
     let signed = qx * ry - qy * rx;
     if signed == 0 {
-        return;
+        return false;
     }
     // Image y points down, so a triangle counter-clockwise from the eye has
     // a negative area here: that is its front. b and c are ordered so that
@@ -59,7 +179,7 @@ pub unsafe fn draw(
     let sy1 = (ay + hi_y - SUB / 2).div_euclid(SUB).min(y1 as i64 - 1);
     let (x_first, y_first) = (sx0.max(0), sy0.max(y0 as i64));
     if x_first > sx1 || y_first > sy1 {
-        return;
+        return false;
     }
     let plane = Plane::new(
         [p.z, zb, zc],
@@ -79,13 +199,8 @@ pub unsafe fn draw(
     let (dx2, dy2) = (-wx, -wy);
     let px = x_first * SUB + SUB / 2 - ax;
     let py = y_first * SUB + SUB / 2 - ay;
-    let fill = Fill {
-        width,
-        rows_n,
-        row_len,
-        plane,
-        id,
-    };
+    // A box within the band and the picture: under 2^32 samples each way.
+    let (rows_n, row_len) = (rows_n as u32, row_len as u32);
     if hi_x - lo_x < SMALL && hi_y - lo_y < SMALL {
         let (dxs, dys) = (pack(dx0, dx1, dx2), pack(dy0, dy1, dy2));
         let owned = pack(
@@ -97,33 +212,43 @@ pub unsafe fn draw(
             .wrapping_mul(py)
             .wrapping_sub(dys.wrapping_mul(px))
             .wrapping_add(area << FIELD);
-        let outside = BIAS.wrapping_add(owned).wrapping_sub(e);
-        // SAFETY: the box's samples lie in rows y_first..=sy1 ⊂ y0..y1 and
-        // columns x_first..=sx1 ⊂ 0..width, so every index from `first` is
-        // below (y1 - y0) × width <= rows.len() (the caller's promise).
-        unsafe {
-            fill.packed(
-                rows.as_mut_ptr().add(first),
-                outside,
-                dys.wrapping_mul(SUB),
-                dxs.wrapping_mul(-SUB),
-            )
-        }
+        // Field by field: a record built aside and copied in is read back
+        // wider than it was written, which stalls the store forwarding.
+        small.outside = BIAS.wrapping_add(owned).wrapping_sub(e);
+        small.sx = dys.wrapping_mul(SUB);
+        small.sy = dxs.wrapping_mul(-SUB);
+        // The box's samples lie in rows y_first..=sy1 ⊂ y0..y1 and columns
+        // x_first..=sx1 ⊂ 0..width, so every index from `first` is below
+        // (y1 - y0) × width <= rows.len().
+        small.first = first;
+        small.fill.id = id;
+        small.fill.plane = plane;
+        small.fill.rows_n = rows_n;
+        small.fill.row_len = row_len;
+        true
     } else {
         let e = [
             dx0 * py - dy0 * px - not_owned(dx0, dy0),
             dx1 * py - dy1 * px + area - not_owned(dx1, dy1),
             dx2 * py - dy2 * px - not_owned(dx2, dy2),
         ];
-        // SAFETY: as for the packed fill above.
+        // SAFETY: as for the small triangle's box above.
+        let fill = Fill {
+            id,
+            plane,
+            rows_n,
+            row_len,
+        };
         unsafe {
             fill.wide(
                 rows.as_mut_ptr().add(first),
+                width,
                 e,
                 [-dy0 * SUB, -dy1 * SUB, -dy2 * SUB],
                 [dx0 * SUB, dx1 * SUB, dx2 * SUB],
             )
-        }
+        };
+        false
     }
 }
 
@@ -160,12 +285,13 @@ fn not_owned(dx: i64, dy: i64) -> i64 {
 /// The depth over the box: `z_ref` at its first sample (the unclamped box
 /// corner, so bands agree exactly), `dzdx`, `dzdy` per sample, and the
 /// first drawn sample's offset from that corner.
+#[derive(Clone, Copy, Default)]
 struct Plane {
     z_ref: f32,
     dzdx: f32,
     dzdy: f32,
-    off_x: i64,
-    off_y: i64,
+    off_x: i32,
+    off_y: i32,
 }
 
 impl Plane {
@@ -186,21 +312,21 @@ impl Plane {
             z_ref: z_ref as f32,
             dzdx: (gx * SUB as f64) as f32,
             dzdy: (gy * SUB as f64) as f32,
-            off_x: off[0],
-            off_y: off[1],
+            // Within the box: under 2^31 samples.
+            off_x: off[0] as i32,
+            off_y: off[1] as i32,
         }
     }
 }
 
 /// What the sample loops need of a triangle besides its edges: the box
-/// (`rows_n + 1` rows of `row_len + 1` samples, rows `width` apart), the
-/// depth plane and the id.
+/// (`rows_n + 1` rows of `row_len + 1` samples), the depth plane and the id.
+#[derive(Clone, Copy, Default)]
 struct Fill {
-    width: usize,
-    rows_n: i64,
-    row_len: i64,
-    plane: Plane,
     id: u64,
+    plane: Plane,
+    rows_n: u32,
+    row_len: u32,
 }
 
 impl Fill {
@@ -211,7 +337,7 @@ impl Fill {
     /// `row.add(k)` is a sample of the band.
     #[inline(always)]
     unsafe fn store(&self, row: *mut u64, k: i64, zy: f32) {
-        let depth = (zy + self.plane.dzdx * (k + self.plane.off_x) as f32).max(0.0);
+        let depth = (zy + self.plane.dzdx * (k + i64::from(self.plane.off_x)) as f32).max(0.0);
         let value = (u64::from(depth.to_bits()) << 32) | self.id;
         // SAFETY: the caller's promise.
         let slot = unsafe { &mut *row.add(k as usize) };
@@ -223,16 +349,16 @@ impl Fill {
     /// The depth at the first drawn sample of box row `j`.
     #[inline(always)]
     fn row_depth(&self, j: i64) -> f32 {
-        self.plane.z_ref + self.plane.dzdy * (j + self.plane.off_y) as f32
+        self.plane.z_ref + self.plane.dzdy * (j + i64::from(self.plane.off_y)) as f32
     }
 
     /// The sample loop over packed edges (`outside` at the first sample,
-    /// `sx` and `sy` its steps per sample and per row).
+    /// `sx` and `sy` its steps per sample and per row; rows `width` apart).
     ///
     /// # Safety
     /// Every sample of the box from `row` lies in the band.
     #[inline(always)]
-    unsafe fn packed(&self, mut row: *mut u64, mut outside: i64, sx: i64, sy: i64) {
+    unsafe fn packed(&self, mut row: *mut u64, width: usize, mut outside: i64, sx: i64, sy: i64) {
         let mut j = 0;
         loop {
             let zy = self.row_depth(j);
@@ -243,29 +369,38 @@ impl Fill {
                     // SAFETY: k <= row_len, in the box.
                     unsafe { self.store(row, k, zy) };
                 }
-                if k == self.row_len {
+                if k == i64::from(self.row_len) {
                     break;
                 }
                 k += 1;
                 f = f.wrapping_add(sx);
             }
-            if j == self.rows_n {
+            if j == i64::from(self.rows_n) {
                 break;
             }
             j += 1;
             // SAFETY: j <= rows_n: the next row of the box.
-            row = unsafe { row.add(self.width) };
+            row = unsafe { row.add(width) };
             outside = outside.wrapping_add(sy);
         }
     }
 
     /// The sample loop over three `i64` edge values (`e` at the first
-    /// sample, `sx` and `sy` their steps per sample and per row).
+    /// sample, `sx` and `sy` their steps per sample and per row; rows
+    /// `width` apart). Rare (large triangles), so not inlined into the
+    /// set-up.
     ///
     /// # Safety
     /// Every sample of the box from `row` lies in the band.
-    #[inline(always)]
-    unsafe fn wide(&self, mut row: *mut u64, mut e: [i64; 3], sx: [i64; 3], sy: [i64; 3]) {
+    #[inline(never)]
+    unsafe fn wide(
+        &self,
+        mut row: *mut u64,
+        width: usize,
+        mut e: [i64; 3],
+        sx: [i64; 3],
+        sy: [i64; 3],
+    ) {
         let mut j = 0;
         loop {
             let zy = self.row_depth(j);
@@ -276,18 +411,18 @@ impl Fill {
                     // SAFETY: k <= row_len, in the box.
                     unsafe { self.store(row, k, zy) };
                 }
-                if k == self.row_len {
+                if k == i64::from(self.row_len) {
                     break;
                 }
                 k += 1;
                 f = [f[0] + sx[0], f[1] + sx[1], f[2] + sx[2]];
             }
-            if j == self.rows_n {
+            if j == i64::from(self.rows_n) {
                 break;
             }
             j += 1;
             // SAFETY: j <= rows_n: the next row of the box.
-            row = unsafe { row.add(self.width) };
+            row = unsafe { row.add(width) };
             e = [e[0] + sy[0], e[1] + sy[1], e[2] + sy[2]];
         }
     }
@@ -298,17 +433,21 @@ mod tests {
     use super::*;
     use crate::render::raster::{EMPTY, depth_of};
 
-    /// The samples of a `w`×`h` picture that `draw` fills with triangle `v`
+    /// The samples of a `w`×`h` picture that `draw_chunks` fills with
+    /// triangle `v`
     /// (snapped units, either orientation), corner depths `z`, id 7.
     fn drawn(v: [[i64; 2]; 3], z: [f32; 3], w: usize, h: usize) -> Vec<u64> {
         let mut rows = vec![EMPTY; w * h];
-        let t = [0, 1, 2].map(|k| Snapped {
+        let nodes = [0, 1, 2].map(|k| Snapped {
             x: v[k][0] as i32,
             y: v[k][1] as i32,
             z: z[k],
         });
+        // Triangle 7 of a mesh whose others are edge-on.
+        let mut tris = vec![[0, 0, 0]; 8];
+        tris[7] = [0, 1, 2];
         // SAFETY: `rows` holds h × w samples.
-        unsafe { draw(&mut rows, w, 0, h, t, 7) };
+        unsafe { draw_chunks(&mut rows, w, 0..h, &tris, &nodes, [&[7u32][..]].into_iter()) };
         rows
     }
 
@@ -428,6 +567,69 @@ mod tests {
                 checked += 1;
             }
             assert!(checked > 80, "{v:?}: {checked} samples");
+        }
+    }
+
+    #[test]
+    fn lanes_draw_the_bits_the_scalar_code_draws() {
+        // Many triangles over several bands: small ones (some sharing
+        // corners, some near the packed limit), large ones, both
+        // orientations, depths below 0 (stored as 0) and above 1. Batches
+        // of eight and the partial last one, boxes wider than eight samples
+        // and clipped at every side of the picture and the band.
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut next = |range: i64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % (2 * range as u64 + 1)) as i64 - range
+        };
+        let (w, h, band) = (75usize, 61usize, 16usize);
+        let mut nodes = Vec::new();
+        let mut tris = Vec::new();
+        for t in 0..3001u32 {
+            let c = [next(700) + 600, next(600) + 490];
+            let reach = [40, 200, 500, 3000][t as usize % 4];
+            for _ in 0..3 {
+                nodes.push(Snapped {
+                    x: (c[0] + next(reach)) as i32,
+                    y: (c[1] + next(reach)) as i32,
+                    z: next(1200) as f32 / 1000.0,
+                });
+            }
+            let n = 3 * t;
+            tris.push(if t % 5 == 4 {
+                [n, n - 2, n - 1]
+            } else {
+                [n, n + 1, n + 2]
+            });
+        }
+        let ids: Vec<u32> = (0..tris.len() as u32).collect();
+        let draw = |lanes: bool| {
+            let mut picture = vec![EMPTY; w * h];
+            for (b, rows) in picture.chunks_mut(w * band).enumerate() {
+                let ys = b * band..(b * band + band).min(h);
+                // SAFETY: `rows` holds the band's samples; `lanes` only
+                // where the processor has them.
+                unsafe { draw_chunks_by(lanes, rows, w, ys, &tris, &nodes, ids.chunks(1000)) };
+            }
+            picture
+        };
+        let scalar = draw(false);
+        let filled = scalar.iter().filter(|&&v| v != EMPTY).count();
+        let zeros = scalar
+            .iter()
+            .filter(|&&v| v != EMPTY && depth_of(v) == 0.0)
+            .count();
+        assert!(
+            filled > 4000 && zeros > 100,
+            "{filled} filled, {zeros} at depth 0"
+        );
+        #[cfg(target_arch = "x86_64")]
+        if lanes::available() {
+            let lanes = draw(true);
+            let differ = (0..w * h).filter(|&i| lanes[i] != scalar[i]).count();
+            assert_eq!(differ, 0, "samples differ");
         }
     }
 }
