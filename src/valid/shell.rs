@@ -199,7 +199,8 @@ impl EdgeUses {
             let Some(face) = model.faces.get(of.face.index()) else {
                 continue;
             };
-            for oe in face.loops.iter().flatten() {
+            // Every loop's edges, loop after loop, as one slice.
+            for oe in face.loops.edges() {
                 if oe.edge.index() < model.edges.len() {
                     let forward = oe.forward;
                     unsorted.push((oe.edge, EdgeUse { entry, forward }));
@@ -937,7 +938,9 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
         );
     }
 
-    let flags = |len: usize, ids: &mut dyn Iterator<Item = usize>| {
+    // Generic, not a `dyn Iterator`: it runs over every id of every entity
+    // list, and a call per id was most of this check.
+    fn flags(len: usize, ids: impl Iterator<Item = usize>) -> Vec<bool> {
         let mut flags = vec![false; len];
         for i in ids {
             if let Some(flag) = flags.get_mut(i) {
@@ -945,10 +948,10 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
             }
         }
         flags
-    };
+    }
     let in_solids_v = flags(
         model.vertices.len(),
-        &mut model
+        model
             .solids
             .iter()
             .flat_map(|s| &s.vertices)
@@ -956,7 +959,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     );
     let in_solids_e = flags(
         model.edges.len(),
-        &mut model
+        model
             .solids
             .iter()
             .flat_map(|s| &s.edges)
@@ -964,7 +967,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     );
     let in_solids_f = flags(
         n_faces,
-        &mut model
+        model
             .solids
             .iter()
             .flat_map(|s| &s.faces)
@@ -972,17 +975,17 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     );
     let used_vertices = flags(
         model.vertices.len(),
-        &mut model
+        model
             .edges
             .iter()
             .flat_map(|e| [e.begin.index(), e.end.index()]),
     );
     let used_edges = flags(
         model.edges.len(),
-        &mut model
+        model
             .faces
             .iter()
-            .flat_map(|f| f.loops.iter().flatten().map(|oe| oe.edge.index())),
+            .flat_map(|f| f.loops.edges().iter().map(|oe| oe.edge.index())),
     );
 
     let mut unused = |span: Option<Span>, message: String, help: &str| {
