@@ -38,26 +38,22 @@ pub(super) fn lower_run(
     grid: Grid,
     jobs: &[SolidJob],
 ) {
-    // Per solid: its counts, and whether they came from a weld (a solid
-    // whose weld may merge is welded again when written; the others are
-    // written unwelded, their boundary built once).
-    let (counts, welded): (Vec<Counts>, Vec<bool>) = jobs
+    let counts: Vec<Counts> = jobs
         .par_iter()
         .with_min_len(TASK)
         .map_init(LocalWeld::default, |weld, job| {
             // A regular primitive needs no boundary for its counts.
             if let Some([vertices, edges, faces]) = unwelded_counts(job.shape, grid.tol) {
-                let counts = Counts {
+                return Counts {
                     vertices,
                     edges,
                     faces,
                 };
-                return (counts, false);
             }
             weld.weld(job.shape, grid);
-            (weld.counts(), true)
+            weld.counts()
         })
-        .unzip();
+        .collect();
     let first = Counts {
         vertices: model.vertices.len() as u32,
         edges: model.edges.len() as u32,
@@ -103,30 +99,23 @@ pub(super) fn lower_run(
             samples,
         });
     let tasks: Vec<_> = (jobs.chunks(TASK).zip(counts.chunks(TASK)).enumerate())
-        .zip(welded.chunks(TASK))
         .zip(starts)
         .zip(out)
-        .map(|((((k, jobs), welded), start), out)| {
-            (first_solid + k * TASK, jobs, welded, start, out)
-        })
+        .map(|(((k, jobs), start), out)| (first_solid + k * TASK, jobs, start, out))
         .collect();
     // The source map is filled beside the writing, on a worker too: the
     // main thread only waits.
     let write = || {
         tasks.into_par_iter().for_each_init(
             LocalWeld::default,
-            |weld, (solid, (jobs, counts), welded, start, mut out)| {
+            |weld, (solid, (jobs, counts), start, mut out)| {
                 let mut at = start;
-                for (k, ((job, count), &welded)) in jobs.iter().zip(counts).zip(welded).enumerate()
-                {
-                    // Welded again when the first pass welded it (a weld that
-                    // merges nothing gives the unwelded boundary's entities).
-                    if welded {
+                for (k, (job, count)) in jobs.iter().zip(counts).enumerate() {
+                    // Welded again only when the first pass merged something.
+                    weld.unwelded(job.shape);
+                    if !weld.unmerged(count) {
                         weld.weld(job.shape, grid);
-                    } else {
-                        weld.unwelded(job.shape);
                     }
-                    debug_assert_eq!(weld.counts(), *count);
                     weld.write(job, solid + k, at, &mut out);
                     at = at.plus(count);
                 }
@@ -304,6 +293,13 @@ impl LocalWeld {
         self.face_of.clear();
         self.face_of
             .extend((0..brep.faces.len() as u32).map(|k| (k, true)));
+    }
+
+    /// Whether the boundary's entities are `counts` in number.
+    fn unmerged(&self, counts: &Counts) -> bool {
+        let brep = &self.brep;
+        [brep.vertices.len(), brep.edges.len(), brep.faces.len()]
+            == [counts.vertices, counts.edges, counts.faces].map(|c| c as usize)
     }
 
     /// Welds the boundary of `shape`. The welder looks up candidates in
