@@ -88,6 +88,7 @@ pub fn run(args: &Args) -> i32 {
             out(&format!("{json}\n"))
         }
     }
+    super::keep_until_exit(checked);
     EXIT_OK
 }
 

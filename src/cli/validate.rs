@@ -65,7 +65,7 @@ fn validate(args: &Args) -> i32 {
     let mut json = Vec::new();
     let (mut errors, mut warnings, mut invalid_files) = (0, 0, 0);
     let mut io_failed = false;
-    for file in &files {
+    for (k, file) in files.iter().enumerate() {
         let checked = match check_file(file, &options) {
             Ok(c) => c,
             Err(e) => {
@@ -93,6 +93,9 @@ fn validate(args: &Args) -> i32 {
             }
         }
         invalid_files += usize::from(file_failed);
+        if k + 1 == files.len() {
+            super::keep_until_exit(checked);
+        }
     }
     match args.format {
         Format::Json => out(&format!(

@@ -18,6 +18,7 @@ mod incidence;
 mod loops;
 mod name;
 mod source_map;
+mod teardown;
 
 pub use carrier::Carrier;
 pub use fragments::{Fragment, Side, derive_fragments};

@@ -515,7 +515,7 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
     // solids on a lattice of round numbers, and a lattice whose boxes are
     // centred on cell borders put every box in 8 cells (the pairs do not
     // depend on the grid, only the number of entries to sort does).
-    let key = |v: f64| (v / cell + GRID_SHIFT).floor() as i64;
+    let key = |v: f64| super::floor_index::floor_index(v / cell + GRID_SHIFT);
     // A sorted list of (cell, box) instead of a map of cells: boxes sharing a
     // cell are adjacent after sorting, and nothing is allocated per cell.
     // The cell range (lowest, highest) of a placeable box and how many cells

@@ -9,6 +9,7 @@ mod contour_straight;
 mod distinct;
 mod edge_parts;
 mod explicit;
+mod floor_index;
 mod isolated;
 mod isolation;
 mod leaves;

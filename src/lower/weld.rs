@@ -325,7 +325,7 @@ pub(super) struct Grid {
 
 impl Grid {
     fn key(&self, p: &Point3) -> [i64; 3] {
-        [p.x, p.y, p.z].map(|c| (c / self.cell).floor() as i64)
+        [p.x, p.y, p.z].map(|c| super::floor_index::floor_index(c / self.cell))
     }
 
     /// The hashed cell of `p`.

@@ -190,23 +190,35 @@ struct EdgeUses {
 }
 
 impl EdgeUses {
-    /// Fills `buffer` (emptied first, its capacity reused).
-    fn of(model: &Model, boundary: &[OrientedFace], buffer: Vec<(EdgeId, EdgeUse)>) -> EdgeUses {
-        let mut uses = buffer;
-        uses.clear();
+    /// Fills `scratch.uses` (emptied first, its capacity reused) and takes it.
+    fn of(model: &Model, boundary: &[OrientedFace], scratch: &mut Scratch) -> EdgeUses {
+        let unsorted = &mut scratch.unsorted_uses;
+        unsorted.clear();
+        let (mut low, mut high) = (u32::MAX, 0);
         for (entry, of) in boundary.iter().enumerate() {
             let Some(face) = model.faces.get(of.face.index()) else {
                 continue;
             };
-            for oe in face.loops.iter().flatten() {
+            // Every loop's edges, loop after loop, as one slice.
+            for oe in face.loops.edges() {
                 if oe.edge.index() < model.edges.len() {
                     let forward = oe.forward;
-                    uses.push((oe.edge, EdgeUse { entry, forward }));
+                    unsorted.push((oe.edge, EdgeUse { entry, forward }));
+                    low = low.min(oe.edge.0);
+                    high = high.max(oe.edge.0);
                 }
             }
         }
-        // Stable: within an edge the uses stay in boundary order.
-        uses.sort_by_key(|&(edge, _)| edge);
+        let mut uses = std::mem::take(&mut scratch.uses);
+        uses.clear();
+        let span = high.saturating_sub(low) as usize + 1;
+        if unsorted.is_empty() || span > BUCKETS_PER_USE * unsorted.len() + BUCKETS_EXTRA {
+            // Stable: within an edge the uses stay in boundary order.
+            uses.extend_from_slice(unsorted);
+            uses.sort_by_key(|&(edge, _)| edge);
+        } else {
+            bucket_by_edge(unsorted, low, span, &mut scratch.bucket_starts, &mut uses);
+        }
         EdgeUses { uses }
     }
 
@@ -218,12 +230,55 @@ impl EdgeUses {
     }
 }
 
+/// Edge ids a subdomain's uses may span, per use (plus a few), for them to
+/// be grouped by counting rather than sorted: a solid's edges are numbered
+/// together, so its boundary's uses span about a quarter of their number.
+const BUCKETS_PER_USE: usize = 4;
+const BUCKETS_EXTRA: usize = 64;
+
+/// `uses` = `unsorted` grouped by edge in ascending order, each group in
+/// `unsorted`'s order: what a stable sort by edge gives, by counting the uses
+/// of each edge in `low..low + span` (every subdomain's uses are grouped, so
+/// sorting them was most of the shell checks).
+fn bucket_by_edge(
+    unsorted: &[(EdgeId, EdgeUse)],
+    low: u32,
+    span: usize,
+    starts: &mut Vec<u32>,
+    uses: &mut Vec<(EdgeId, EdgeUse)>,
+) {
+    starts.clear();
+    starts.resize(span + 1, 0);
+    for &(edge, _) in unsorted {
+        starts[(edge.0 - low) as usize + 1] += 1;
+    }
+    for k in 0..span {
+        starts[k + 1] += starts[k];
+    }
+    let filler = (
+        EdgeId(0),
+        EdgeUse {
+            entry: 0,
+            forward: false,
+        },
+    );
+    uses.resize(unsorted.len(), filler);
+    for &item in unsorted {
+        let next = &mut starts[(item.0.0 - low) as usize];
+        uses[*next as usize] = item;
+        *next += 1;
+    }
+}
+
 /// Buffers the shell checks reuse from one subdomain to the next (one set
 /// per parallel job): fresh vectors were about fifteen allocations per
 /// subdomain, and files of many primitives have one subdomain per solid.
 #[derive(Default)]
 struct Scratch {
     uses: Vec<(EdgeId, EdgeUse)>,
+    unsorted_uses: Vec<(EdgeId, EdgeUse)>,
+    /// Per edge (from the lowest used): where its uses go.
+    bucket_starts: Vec<u32>,
     parent: Vec<usize>,
     component_of_root: Vec<usize>,
     component_of_entry: Vec<usize>,
@@ -236,6 +291,8 @@ struct Scratch {
     queue: VecDeque<usize>,
     vertices: Vec<(usize, VertexId)>,
     all_vertices: Vec<VertexId>,
+    /// Per vertex (from the lowest used): whether it was counted.
+    seen: Vec<bool>,
     counts: Vec<ShellCounts>,
 }
 
@@ -375,6 +432,7 @@ fn shell_counts(
     let vertices = &mut scratch.vertices;
     vertices.clear();
     vertices.reserve(2 * uses.uses.len());
+    let (mut low, mut high) = (u32::MAX, 0);
     for (edge, list) in uses.lists() {
         let shell = scratch.component_of_entry[list[0].1.entry];
         let Some(e) = model.edges.get(edge.index()) else {
@@ -382,6 +440,27 @@ fn shell_counts(
         };
         counts[shell].edges += 1;
         vertices.extend([(shell, e.begin), (shell, e.end)]);
+        low = low.min(e.begin.0.min(e.end.0));
+        high = high.max(e.begin.0.max(e.end.0));
+    }
+    let span = high.saturating_sub(low) as usize + 1;
+    if count == 1
+        && !vertices.is_empty()
+        && span <= BUCKETS_PER_USE * vertices.len() + BUCKETS_EXTRA
+    {
+        // One shell (every primitive's): its distinct vertices are the
+        // boundary's, marked by id instead of sorted.
+        let seen = &mut scratch.seen;
+        seen.clear();
+        seen.resize(span, false);
+        let mut distinct = 0;
+        for &(_, v) in vertices.iter() {
+            let mark = &mut seen[(v.0 - low) as usize];
+            distinct += usize::from(!*mark);
+            *mark = true;
+        }
+        counts[0].vertices = distinct;
+        return distinct;
     }
     count_distinct(vertices);
     for &(shell, _) in vertices.iter() {
@@ -409,7 +488,7 @@ pub fn shells(model: &Model, subdomain: SubdomainId) -> Vec<Shell> {
         return Vec::new();
     };
     let mut scratch = Scratch::default();
-    let uses = EdgeUses::of(model, boundary, Vec::new());
+    let uses = EdgeUses::of(model, boundary, &mut scratch);
     shell_counts(model, boundary, &uses, &mut scratch);
     let mut shells: Vec<Shell> = (scratch.counts.iter())
         .map(|c| Shell {
@@ -474,7 +553,7 @@ fn check_shell(
     if !subdomain.trimmed.is_empty() {
         return;
     }
-    let uses = EdgeUses::of(model, boundary, std::mem::take(&mut scratch.uses));
+    let uses = EdgeUses::of(model, boundary, scratch);
     check_edge_uses(
         model, source_map, id, subdomain, boundary, &uses, scratch, diags,
     );
@@ -859,7 +938,9 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
         );
     }
 
-    let flags = |len: usize, ids: &mut dyn Iterator<Item = usize>| {
+    // Generic, not a `dyn Iterator`: it runs over every id of every entity
+    // list, and a call per id was most of this check.
+    fn flags(len: usize, ids: impl Iterator<Item = usize>) -> Vec<bool> {
         let mut flags = vec![false; len];
         for i in ids {
             if let Some(flag) = flags.get_mut(i) {
@@ -867,10 +948,10 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
             }
         }
         flags
-    };
+    }
     let in_solids_v = flags(
         model.vertices.len(),
-        &mut model
+        model
             .solids
             .iter()
             .flat_map(|s| &s.vertices)
@@ -878,7 +959,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     );
     let in_solids_e = flags(
         model.edges.len(),
-        &mut model
+        model
             .solids
             .iter()
             .flat_map(|s| &s.edges)
@@ -886,7 +967,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     );
     let in_solids_f = flags(
         n_faces,
-        &mut model
+        model
             .solids
             .iter()
             .flat_map(|s| &s.faces)
@@ -894,17 +975,17 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     );
     let used_vertices = flags(
         model.vertices.len(),
-        &mut model
+        model
             .edges
             .iter()
             .flat_map(|e| [e.begin.index(), e.end.index()]),
     );
     let used_edges = flags(
         model.edges.len(),
-        &mut model
+        model
             .faces
             .iter()
-            .flat_map(|f| f.loops.iter().flatten().map(|oe| oe.edge.index())),
+            .flat_map(|f| f.loops.edges().iter().map(|oe| oe.edge.index())),
     );
 
     let mut unused = |span: Option<Span>, message: String, help: &str| {
@@ -1351,5 +1432,124 @@ mod tests {
             }
         }
         assert_eq!(run(4).items, one.items);
+    }
+
+    /// Uses of random edges in `low..low + span`, with random entries and directions.
+    fn random_uses(seed: u64, len: usize, low: u32, span: u32) -> Vec<(EdgeId, EdgeUse)> {
+        let mut state = seed;
+        let mut next = move || {
+            state = state
+                .wrapping_mul(6_364_136_223_846_793_005)
+                .wrapping_add(1_442_695_040_888_963_407);
+            (state >> 33) as u32
+        };
+        (0..len)
+            .map(|_| {
+                let edge = EdgeId(low + next() % span);
+                let entry = (next() % 16) as usize;
+                let forward = next() % 2 == 0;
+                (edge, EdgeUse { entry, forward })
+            })
+            .collect()
+    }
+
+    fn plain(uses: &[(EdgeId, EdgeUse)]) -> Vec<(u32, usize, bool)> {
+        uses.iter()
+            .map(|(e, u)| (e.0, u.entry, u.forward))
+            .collect()
+    }
+
+    #[test]
+    fn bucketed_edge_uses_are_a_stable_sort_by_edge() {
+        let mut starts = Vec::new();
+        let mut bucketed = Vec::new();
+        for (seed, len, low, span) in [
+            (1, 24, 0, 12),
+            (2, 60, 9000, 40),
+            (3, 7, 5, 1),
+            (4, 300, 17, 900),
+        ] {
+            let unsorted = random_uses(seed, len, low, span);
+            let mut sorted = unsorted.clone();
+            sorted.sort_by_key(|&(edge, _)| edge);
+            bucket_by_edge(&unsorted, low, span as usize, &mut starts, &mut bucketed);
+            assert_eq!(plain(&bucketed), plain(&sorted), "seed {seed}");
+            // Repeated edges keep their uses' order: the entries of one edge
+            // in `unsorted` order.
+            assert!(bucketed.windows(2).any(|w| w[0].0 == w[1].0));
+        }
+    }
+
+    /// `b`'s model with vertex `v` renumbered `v · gap` and edge `e`
+    /// renumbered `e · gap` (unused fillers between), so that a shell's ids
+    /// span far more than its uses and are sorted rather than bucketed.
+    fn spread(b: &Builder, gap: u32) -> crate::ir::Model {
+        let mut model = b.model.clone();
+        let filler_vertex = model.vertices[0].clone();
+        let filler_edge = model.edges[0].clone();
+        let vertex = |v: VertexId| VertexId(v.0 * gap);
+        let edge = |e: EdgeId| EdgeId(e.0 * gap);
+        model.vertices = (0..b.model.vertices.len() as u32 * gap)
+            .map(|k| match k % gap {
+                0 => b.model.vertices[(k / gap) as usize].clone(),
+                _ => filler_vertex.clone(),
+            })
+            .collect();
+        model.edges = (0..b.model.edges.len() as u32 * gap)
+            .map(|k| {
+                let mut e = match k % gap {
+                    0 => b.model.edges[(k / gap) as usize].clone(),
+                    _ => filler_edge.clone(),
+                };
+                (e.begin, e.end) = (vertex(e.begin), vertex(e.end));
+                e
+            })
+            .collect();
+        for face in &mut model.faces {
+            for oe in face.loops.edges_mut() {
+                oe.edge = edge(oe.edge);
+            }
+        }
+        model
+    }
+
+    #[test]
+    fn shells_spread_over_far_ids_count_as_close_ones() {
+        let mut open = cube();
+        let top = face_id(&open, "box.top");
+        boundary_mut(&mut open, 0).retain(|of| of.face != top);
+        let mut two = Builder::new(Dimension::Three);
+        let mut faces = two.unit_box_faces("a", [0.0; 3]);
+        faces.extend(two.unit_box_faces("b", [3.0, 0.0, 0.0]));
+        two.push_subdomain("ab", SubdomainCells::Volume { boundary: faces });
+        for (name, b, counts) in [
+            ("cube", cube(), vec![(8, 12, 6, 6)]),
+            ("open cube", open, vec![]),
+            ("torus", torus(false), vec![(1, 2, 1, 1)]),
+            ("klein bottle", torus(true), vec![]),
+            ("sphere", sphere(), vec![(1, 1, 2, 2)]),
+            ("two cubes", two, vec![(8, 12, 6, 6), (8, 12, 6, 6)]),
+        ] {
+            let close = &b.model;
+            let far = spread(&b, 100);
+            let found = |model: &crate::ir::Model| {
+                let mut diags = Diagnostics::default();
+                check_subdomain_shells(model, &b.map, &mut diags);
+                (diags.items.iter())
+                    .map(|d| (d.code, d.message.clone()))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(found(&far), found(close), "{name}");
+            let shells_of = |model: &crate::ir::Model| {
+                shells(model, SubdomainId(0))
+                    .iter()
+                    .map(|s| (s.vertices, s.edges, s.faces.len(), s.loops))
+                    .collect::<Vec<_>>()
+            };
+            assert_eq!(shells_of(&far), shells_of(close), "{name}");
+            if !counts.is_empty() {
+                assert_eq!(shells_of(close), counts, "{name}");
+            }
+        }
     }
 }
