@@ -441,37 +441,118 @@ fn find_short(byte: u8, rest: &[u8]) -> Option<usize> {
 /// The end (after its end tag's `>`) of the element whose start tag ends at
 /// `pos` (not self-closing). Comments, CDATA sections and processing
 /// instructions inside are skipped; roxmltree checks everything else when the
-/// run is parsed.
-fn element_end(bytes: &[u8], mut pos: usize) -> Option<usize> {
+/// run is parsed. Only the bytes [`Marks`] finds are looked at one by one.
+fn element_end(bytes: &[u8], pos: usize) -> Option<usize> {
     let mut depth = 1usize;
+    let mut marks = Marks::new(bytes, pos);
     loop {
-        pos += find_short(b'<', bytes.get(pos..)?)?;
-        let rest = bytes.get(pos..)?;
+        let open = marks.find(b'<')?;
+        let rest = bytes.get(open..)?;
         match *rest.get(1)? {
             b'/' => {
-                pos += find_short(b'>', rest)? + 1;
+                let close = marks.find(b'>')?;
                 depth -= 1;
                 if depth == 0 {
-                    return Some(pos);
+                    return Some(close + 1);
                 }
             }
             b'!' if rest.starts_with(b"<!--") => {
-                pos += 4 + memchr::memmem::find(bytes.get(pos + 4..)?, b"-->")? + 3;
+                let end = open + 4 + memchr::memmem::find(rest.get(4..)?, b"-->")? + 3;
+                marks = Marks::new(bytes, end);
             }
             b'!' if rest.starts_with(b"<![CDATA[") => {
-                pos += memchr::memmem::find(rest, b"]]>")? + 3;
+                marks = Marks::new(bytes, open + memchr::memmem::find(rest, b"]]>")? + 3);
             }
             b'!' => return None,
-            b'?' => pos += memchr::memmem::find(rest, b"?>")? + 2,
+            b'?' => marks = Marks::new(bytes, open + memchr::memmem::find(rest, b"?>")? + 2),
             _ => {
-                let (end, self_closing) = start_tag_end(bytes, pos)?;
-                pos = end;
+                // A start tag: its `>` outside quotes; a `<` there is an error.
+                let self_closing = loop {
+                    let at = marks.next()?;
+                    match *bytes.get(at)? {
+                        b'<' => return None,
+                        b'>' => break at.checked_sub(1).and_then(|i| bytes.get(i)) == Some(&b'/'),
+                        quote @ (b'"' | b'\'') => drop(marks.find(quote)?),
+                        _ => {}
+                    }
+                };
                 if !self_closing {
                     depth += 1;
                 }
             }
         }
     }
+}
+
+/// The positions, in order from a start, of the bytes that can matter to
+/// [`element_end`]: `<`, `>`, `"` and `'` (and `#`, `&`, which share their
+/// test and are passed over). Eight bytes are tested at once in a `u64`, so
+/// the text between them costs a few instructions per word, not per byte.
+struct Marks<'a> {
+    bytes: &'a [u8],
+    /// The position of the word `found` describes.
+    word: usize,
+    /// Bit 7 of byte `k` set: the byte at `word + k` is a mark not yet given.
+    found: u64,
+}
+
+impl<'a> Marks<'a> {
+    fn new(bytes: &'a [u8], from: usize) -> Marks<'a> {
+        Marks {
+            bytes,
+            word: from,
+            found: marks_in(bytes, from),
+        }
+    }
+
+    fn next(&mut self) -> Option<usize> {
+        while self.found == 0 {
+            self.word += 8;
+            if self.word >= self.bytes.len() {
+                return None;
+            }
+            self.found = marks_in(self.bytes, self.word);
+        }
+        let at = self.word + (self.found.trailing_zeros() / 8) as usize;
+        self.found &= self.found - 1;
+        Some(at)
+    }
+
+    /// The next mark that is `byte`.
+    fn find(&mut self, byte: u8) -> Option<usize> {
+        loop {
+            let at = self.next()?;
+            if self.bytes.get(at) == Some(&byte) {
+                return Some(at);
+            }
+        }
+    }
+}
+
+/// The marks among the eight bytes from `at` (fewer at the end, padded with
+/// zeros, which are no mark), as bit 7 of each byte.
+fn marks_in(bytes: &[u8], at: usize) -> u64 {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    let word = match bytes.get(at..at + 8) {
+        Some(word) => word.try_into().map_or(0, u64::from_le_bytes),
+        None => {
+            let mut padded = [0u8; 8];
+            let rest = bytes.get(at..).unwrap_or_default();
+            for (to, from) in padded.iter_mut().zip(rest) {
+                *to = *from;
+            }
+            u64::from_le_bytes(padded)
+        }
+    };
+    // `<` and `>` differ only in bit 1; `"`, `'`, `#` and `&` only in bits 0 and 2.
+    zero_bytes((word | ONES * 0x02) ^ (ONES * b'>' as u64))
+        | zero_bytes((word | ONES * 0x05) ^ (ONES * b'\'' as u64))
+}
+
+/// Bit 7 set in each byte of `v` that is zero, exactly (no carry crosses a byte).
+fn zero_bytes(v: u64) -> u64 {
+    const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
+    !(((v & LOW7) + LOW7) | v | LOW7)
 }
 
 /// The name starting at `pos`, up to whitespace, `/` or `>`; `None` for a
@@ -719,6 +800,39 @@ mod tests {
         }
         assert!(split_and_read > 300, "{split_and_read} {refused}");
         assert!(refused > 500, "{split_and_read} {refused}");
+    }
+
+    #[test]
+    fn marks_are_every_byte_of_their_set_in_order() {
+        let bytes: Vec<u8> = (0..=255u8)
+            .chain(b"a<b>c\"d'e#f&".iter().copied())
+            .collect();
+        for from in 0..bytes.len() {
+            let mut marks = Marks::new(&bytes, from);
+            let found: Vec<usize> = std::iter::from_fn(|| marks.next()).collect();
+            let expected: Vec<usize> = (from..bytes.len())
+                .filter(|&i| matches!(bytes[i], b'<' | b'>' | b'"' | b'\'' | b'#' | b'&'))
+                .collect();
+            assert_eq!(found, expected, "from {from}");
+        }
+        let mut marks = Marks::new(b"<a x='\"'>", 1);
+        assert_eq!(marks.find(b'\''), Some(5));
+        assert_eq!(marks.find(b'>'), Some(8));
+        assert_eq!(marks.find(b'>'), None);
+    }
+
+    #[test]
+    fn element_ends_skip_quotes_comments_and_sections() {
+        for (text, end) in [
+            ("<a><b x='>' y=\"</a>\"/></a> <c/>", Some(26)),
+            ("<a><!-- </a> --><![CDATA[</a>]]><?p </a>?></a>", Some(46)),
+            ("<a><b>t > u</b></a>", Some(19)),
+            ("<a><b x=\"1\"<c/></b></a>", None),
+            ("<a><!DOCTYPE x></a>", None),
+            ("<a><b></a>", None),
+        ] {
+            assert_eq!(element_end(text.as_bytes(), 3), end, "{text}");
+        }
     }
 
     #[test]
