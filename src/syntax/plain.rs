@@ -168,8 +168,9 @@ impl<'s> Reader<'s> {
                 name,
                 span: Span::new(tag_start, self.pos),
                 name_span: Span::new(name_start, name_start + name.len()),
-                // A copy sized exactly (the values are borrowed): the scratch list keeps its room.
-                attributes: attributes.to_vec(),
+                // Moved out sized exactly (no clone of each value): the
+                // scratch list keeps its room.
+                attributes: attributes.drain(..).collect(),
                 children: Vec::new(),
                 text: Vec::new(),
             },

@@ -431,10 +431,10 @@ const TAG_STOPS: [bool; 256] = {
 /// call costs more there), then by memchr.
 fn find_short(byte: u8, rest: &[u8]) -> Option<usize> {
     const SHORT: usize = 16;
-    match rest.iter().take(SHORT).position(|&b| b == byte) {
+    let (head, tail) = rest.split_at(SHORT.min(rest.len()));
+    match head.iter().position(|&b| b == byte) {
         Some(at) => Some(at),
-        None if rest.len() <= SHORT => None,
-        None => Some(SHORT + memchr::memchr(byte, rest.get(SHORT..)?)?),
+        None => Some(SHORT + memchr::memchr(byte, tail)?),
     }
 }
 
@@ -505,6 +505,7 @@ impl<'a> Marks<'a> {
         }
     }
 
+    #[inline]
     fn next(&mut self) -> Option<usize> {
         while self.found == 0 {
             self.word += 8;
@@ -564,7 +565,7 @@ fn name_at(text: &str, pos: usize) -> Option<&str> {
         .position(|&b| b.is_ascii_whitespace() || b == b'/' || b == b'>')
         .unwrap_or(rest.len());
     let name = text.get(pos..pos + len)?;
-    (!name.is_empty() && !name.contains(':')).then_some(name)
+    (!name.is_empty() && !name.bytes().any(|b| b == b':')).then_some(name)
 }
 
 /// The [`Head`] of the child element at `pos`, read from its start tag, the
@@ -600,7 +601,8 @@ fn scan_head(text: &str, pos: usize) -> Option<(Head<'_>, usize, bool)> {
         let value_len = find_short(quote, bytes.get(i + 1..)?)?;
         if attr == b"name" {
             let value = text.get(i + 1..i + 1 + value_len)?;
-            if value.contains(['&', '\t', '\n', '\r', '<']) || name_attribute.is_some() {
+            let normalised = |b: &u8| matches!(b, b'&' | b'\t' | b'\n' | b'\r' | b'<');
+            if value.as_bytes().iter().any(normalised) || name_attribute.is_some() {
                 return None;
             }
             name_attribute = Some(value);
