@@ -168,9 +168,8 @@ impl<'s> Reader<'s> {
                 name,
                 span: Span::new(tag_start, self.pos),
                 name_span: Span::new(name_start, name_start + name.len()),
-                // Moved out sized exactly (no clone of each value): the
-                // scratch list keeps its room.
-                attributes: attributes.drain(..).collect(),
+                // A copy sized exactly (the values are borrowed): the scratch list keeps its room.
+                attributes: attributes.to_vec(),
                 children: Vec::new(),
                 text: Vec::new(),
             },
@@ -206,9 +205,11 @@ impl<'s> Reader<'s> {
 
 /// Bytes of a name after its first: ASCII letters, digits, `_`, `-`, `.`.
 fn is_name_byte(b: u8) -> bool {
-    NAME_BYTES[usize::from(b)]
+    NAME_BYTES.get(usize::from(b)) == Some(&true)
 }
 
+// Built at compile time: every index is below 256.
+#[allow(clippy::indexing_slicing)]
 const NAME_BYTES: [bool; 256] = {
     let mut table = [false; 256];
     let mut b = 0;
@@ -229,7 +230,7 @@ fn value_length(rest: &[u8], quote: u8) -> Option<usize> {
         at += rest
             .get(at..)?
             .iter()
-            .position(|&b| VALUE_STOPS[usize::from(b)])?;
+            .position(|&b| VALUE_STOPS.get(usize::from(b)) == Some(&true))?;
         match *rest.get(at)? {
             b if b == quote => return Some(at),
             b'"' | b'\'' => at += 1,
@@ -239,6 +240,7 @@ fn value_length(rest: &[u8], quote: u8) -> Option<usize> {
 }
 
 /// Bytes a value's scan stops at: the quotes, `&`, `<` and control characters.
+#[allow(clippy::indexing_slicing)]
 const VALUE_STOPS: [bool; 256] = {
     let mut table = [false; 256];
     let mut b = 0;

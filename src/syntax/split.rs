@@ -407,7 +407,7 @@ fn tag_end_from(bytes: &[u8], mut i: usize) -> Option<(usize, bool)> {
         i += bytes
             .get(i..)?
             .iter()
-            .position(|&b| TAG_STOPS[usize::from(b)])?;
+            .position(|&b| TAG_STOPS.get(usize::from(b)) == Some(&true))?;
         match *bytes.get(i)? {
             b'<' => return None,
             b'>' => return Some((i + 1, bytes.get(i - 1) == Some(&b'/'))),
@@ -417,6 +417,8 @@ fn tag_end_from(bytes: &[u8], mut i: usize) -> Option<(usize, bool)> {
 }
 
 /// The bytes that end a start tag's stretch outside quotes: `<`, `>` and the quotes.
+// Built at compile time: every index is below 256.
+#[allow(clippy::indexing_slicing)]
 const TAG_STOPS: [bool; 256] = {
     let mut table = [false; 256];
     table[b'<' as usize] = true;
@@ -546,8 +548,8 @@ fn marks_in(bytes: &[u8], at: usize) -> u64 {
         }
     };
     // `<` and `>` differ only in bit 1; `"`, `'`, `#` and `&` only in bits 0 and 2.
-    zero_bytes((word | ONES * 0x02) ^ (ONES * b'>' as u64))
-        | zero_bytes((word | ONES * 0x05) ^ (ONES * b'\'' as u64))
+    zero_bytes((word | (ONES * 0x02)) ^ (ONES * u64::from(b'>')))
+        | zero_bytes((word | (ONES * 0x05)) ^ (ONES * u64::from(b'\'')))
 }
 
 /// Bit 7 set in each byte of `v` that is zero, exactly (no carry crosses a byte).
