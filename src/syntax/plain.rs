@@ -52,9 +52,13 @@ pub(super) fn read_run(
         if reader.bytes.get(reader.pos + 1) == Some(&b'/') {
             let (mut element, first) = open.pop()?;
             reader.pos += 2;
-            if reader.name()? != element.name {
+            // The open element's name, then (after whitespace) `>`: any other
+            // end tag is refused as reading a name and comparing would.
+            let name = element.name.as_bytes();
+            if reader.bytes.get(reader.pos..reader.pos + name.len()) != Some(name) {
                 return None;
             }
+            reader.pos += name.len();
             reader.skip_whitespace();
             reader.expect(b'>')?;
             element.span = Span::new(element.span.range().start, reader.pos);
@@ -103,21 +107,24 @@ impl<'s> Reader<'s> {
     /// a prefix, gives `None`).
     fn name(&mut self) -> Option<&'s str> {
         let start = self.pos;
-        if !self
-            .bytes
-            .get(start)
+        let rest = self.bytes.get(start..)?;
+        if !rest
+            .first()
             .is_some_and(|b| b.is_ascii_alphabetic() || *b == b'_')
         {
             return None;
         }
-        self.pos += 1;
-        while let Some(&b) = self.bytes.get(self.pos) {
-            match b {
-                b'a'..=b'z' | b'A'..=b'Z' | b'0'..=b'9' | b'_' | b'-' | b'.' => self.pos += 1,
-                b' ' | b'\t' | b'\r' | b'\n' | b'/' | b'>' | b'=' => break,
-                _ => return None,
-            }
+        let len = rest
+            .iter()
+            .position(|&b| !is_name_byte(b))
+            .unwrap_or(rest.len());
+        if !matches!(
+            rest.get(len),
+            None | Some(b' ' | b'\t' | b'\r' | b'\n' | b'/' | b'>' | b'=')
+        ) {
+            return None;
         }
+        self.pos += len;
         self.text.get(start..self.pos)
     }
 
@@ -184,11 +191,8 @@ impl<'s> Reader<'s> {
             return None;
         }
         let value_start = self.pos + 1;
-        let length = memchr::memchr(quote, self.bytes.get(value_start..)?)?;
+        let length = value_length(self.bytes.get(value_start..)?, quote)?;
         let value = self.text.get(value_start..value_start + length)?;
-        if value.bytes().any(|b| b < b' ' || b == b'<' || b == b'&') {
-            return None;
-        }
         self.pos = value_start + length + 1;
         Some(Attribute {
             name,
@@ -198,6 +202,55 @@ impl<'s> Reader<'s> {
         })
     }
 }
+
+/// Bytes of a name after its first: ASCII letters, digits, `_`, `-`, `.`.
+fn is_name_byte(b: u8) -> bool {
+    NAME_BYTES.get(usize::from(b)) == Some(&true)
+}
+
+// Built at compile time: every index is below 256.
+#[allow(clippy::indexing_slicing)]
+const NAME_BYTES: [bool; 256] = {
+    let mut table = [false; 256];
+    let mut b = 0;
+    while b < 256 {
+        let c = b as u8;
+        table[b] = c.is_ascii_alphanumeric() || matches!(c, b'_' | b'-' | b'.');
+        b += 1;
+    }
+    table
+};
+
+/// The length of a quoted value up to its closing `quote`, in one pass;
+/// `None` at a byte roxmltree would expand (`&`) or refuse (`<`, control
+/// characters, which include the tab and line ends it would normalise).
+fn value_length(rest: &[u8], quote: u8) -> Option<usize> {
+    let mut at = 0;
+    loop {
+        at += rest
+            .get(at..)?
+            .iter()
+            .position(|&b| VALUE_STOPS.get(usize::from(b)) == Some(&true))?;
+        match *rest.get(at)? {
+            b if b == quote => return Some(at),
+            b'"' | b'\'' => at += 1,
+            _ => return None,
+        }
+    }
+}
+
+/// Bytes a value's scan stops at: the quotes, `&`, `<` and control characters.
+#[allow(clippy::indexing_slicing)]
+const VALUE_STOPS: [bool; 256] = {
+    let mut table = [false; 256];
+    let mut b = 0;
+    while b < 256 {
+        let c = b as u8;
+        table[b] = c < b' ' || matches!(c, b'"' | b'\'' | b'&' | b'<');
+        b += 1;
+    }
+    table
+};
 
 #[cfg(test)]
 mod tests {

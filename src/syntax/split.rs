@@ -290,8 +290,13 @@ fn scan_from(text: &str, mut pos: usize, stop: usize) -> Option<Scanned<'_>> {
                 });
             }
             [b'<', c] if !matches!(c, b'!' | b'?') => {
-                let end = element_end(bytes, pos)?;
-                heads.push(scan_head(text, pos)?);
+                let (head, tag_end, self_closing) = scan_head(text, pos)?;
+                let end = if self_closing {
+                    tag_end
+                } else {
+                    element_end(bytes, tag_end)?
+                };
+                heads.push(head);
                 children.push(pos..end);
                 pos = end;
             }
@@ -391,71 +396,186 @@ fn skip_whitespace(bytes: &[u8], mut pos: usize) -> usize {
 /// The end (after `>`) of the start tag at `pos`, and whether it is `/>`.
 /// Quoted attribute values may hold `>`.
 fn start_tag_end(bytes: &[u8], pos: usize) -> Option<(usize, bool)> {
-    let mut i = pos + 1;
+    tag_end_from(bytes, pos + 1)
+}
+
+/// [`start_tag_end`] from `i`, a position inside the tag outside quotes.
+fn tag_end_from(bytes: &[u8], mut i: usize) -> Option<(usize, bool)> {
     loop {
         // Outside quotes only these four bytes matter; a quoted value is
         // skipped whole to its closing quote.
         i += bytes
             .get(i..)?
             .iter()
-            .position(|b| matches!(b, b'<' | b'>' | b'"' | b'\''))?;
+            .position(|&b| TAG_STOPS.get(usize::from(b)) == Some(&true))?;
         match *bytes.get(i)? {
             b'<' => return None,
             b'>' => return Some((i + 1, bytes.get(i - 1) == Some(&b'/'))),
-            quote => i += 1 + memchr::memchr(quote, bytes.get(i + 1..)?)? + 1,
+            quote => i += 1 + find_short(quote, bytes.get(i + 1..)?)? + 1,
         }
     }
 }
 
-/// The end of the element starting at `pos` (after its end tag's `>`).
-/// Comments, CDATA sections and processing instructions inside are skipped;
-/// roxmltree checks everything else when the run is parsed.
-fn element_end(bytes: &[u8], mut pos: usize) -> Option<usize> {
-    let mut depth = 0usize;
+/// The bytes that end a start tag's stretch outside quotes: `<`, `>` and the quotes.
+// Built at compile time: every index is below 256.
+#[allow(clippy::indexing_slicing)]
+const TAG_STOPS: [bool; 256] = {
+    let mut table = [false; 256];
+    table[b'<' as usize] = true;
+    table[b'>' as usize] = true;
+    table[b'"' as usize] = true;
+    table[b'\'' as usize] = true;
+    table
+};
+
+/// The first `byte` in `rest`, looked for byte by byte over the first few
+/// bytes (names, values and gaps between tags are mostly short: a memchr
+/// call costs more there), then by memchr.
+fn find_short(byte: u8, rest: &[u8]) -> Option<usize> {
+    const SHORT: usize = 16;
+    let (head, tail) = rest.split_at(SHORT.min(rest.len()));
+    match head.iter().position(|&b| b == byte) {
+        Some(at) => Some(at),
+        None => Some(SHORT + memchr::memchr(byte, tail)?),
+    }
+}
+
+/// The end (after its end tag's `>`) of the element whose start tag ends at
+/// `pos` (not self-closing). Comments, CDATA sections and processing
+/// instructions inside are skipped; roxmltree checks everything else when the
+/// run is parsed. Only the bytes [`Marks`] finds are looked at one by one.
+fn element_end(bytes: &[u8], pos: usize) -> Option<usize> {
+    let mut depth = 1usize;
+    let mut marks = Marks::new(bytes, pos);
     loop {
-        let rest = bytes.get(pos..)?;
-        if rest.starts_with(b"<!--") {
-            pos += 4 + memchr::memmem::find(bytes.get(pos + 4..)?, b"-->")? + 3;
-        } else if rest.starts_with(b"<![CDATA[") {
-            pos += memchr::memmem::find(rest, b"]]>")? + 3;
-        } else if rest.starts_with(b"<?") {
-            pos += memchr::memmem::find(rest, b"?>")? + 2;
-        } else if rest.starts_with(b"<!") {
-            return None;
-        } else if rest.starts_with(b"</") {
-            pos += memchr::memchr(b'>', rest)? + 1;
-            depth = depth.checked_sub(1)?;
-            if depth == 0 {
-                return Some(pos);
+        let open = marks.find(b'<')?;
+        let rest = bytes.get(open..)?;
+        match *rest.get(1)? {
+            b'/' => {
+                let close = marks.find(b'>')?;
+                depth -= 1;
+                if depth == 0 {
+                    return Some(close + 1);
+                }
             }
-        } else {
-            let (end, self_closing) = start_tag_end(bytes, pos)?;
-            pos = end;
-            if !self_closing {
-                depth += 1;
-            } else if depth == 0 {
-                return Some(pos);
+            b'!' if rest.starts_with(b"<!--") => {
+                let end = open + 4 + memchr::memmem::find(rest.get(4..)?, b"-->")? + 3;
+                marks = Marks::new(bytes, end);
+            }
+            b'!' if rest.starts_with(b"<![CDATA[") => {
+                marks = Marks::new(bytes, open + memchr::memmem::find(rest, b"]]>")? + 3);
+            }
+            b'!' => return None,
+            b'?' => marks = Marks::new(bytes, open + memchr::memmem::find(rest, b"?>")? + 2),
+            _ => {
+                // A start tag: its `>` outside quotes; a `<` there is an error.
+                let self_closing = loop {
+                    let at = marks.next()?;
+                    match *bytes.get(at)? {
+                        b'<' => return None,
+                        b'>' => break at.checked_sub(1).and_then(|i| bytes.get(i)) == Some(&b'/'),
+                        quote @ (b'"' | b'\'') => drop(marks.find(quote)?),
+                        _ => {}
+                    }
+                };
+                if !self_closing {
+                    depth += 1;
+                }
             }
         }
-        pos += memchr::memchr(b'<', bytes.get(pos..)?)?;
     }
+}
+
+/// The positions, in order from a start, of the bytes that can matter to
+/// [`element_end`]: `<`, `>`, `"` and `'` (and `#`, `&`, which share their
+/// test and are passed over). Eight bytes are tested at once in a `u64`, so
+/// the text between them costs a few instructions per word, not per byte.
+struct Marks<'a> {
+    bytes: &'a [u8],
+    /// The position of the word `found` describes.
+    word: usize,
+    /// Bit 7 of byte `k` set: the byte at `word + k` is a mark not yet given.
+    found: u64,
+}
+
+impl<'a> Marks<'a> {
+    fn new(bytes: &'a [u8], from: usize) -> Marks<'a> {
+        Marks {
+            bytes,
+            word: from,
+            found: marks_in(bytes, from),
+        }
+    }
+
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        while self.found == 0 {
+            self.word += 8;
+            if self.word >= self.bytes.len() {
+                return None;
+            }
+            self.found = marks_in(self.bytes, self.word);
+        }
+        let at = self.word + (self.found.trailing_zeros() / 8) as usize;
+        self.found &= self.found - 1;
+        Some(at)
+    }
+
+    /// The next mark that is `byte`.
+    fn find(&mut self, byte: u8) -> Option<usize> {
+        loop {
+            let at = self.next()?;
+            if self.bytes.get(at) == Some(&byte) {
+                return Some(at);
+            }
+        }
+    }
+}
+
+/// The marks among the eight bytes from `at` (fewer at the end, padded with
+/// zeros, which are no mark), as bit 7 of each byte.
+fn marks_in(bytes: &[u8], at: usize) -> u64 {
+    const ONES: u64 = 0x0101_0101_0101_0101;
+    let word = match bytes.get(at..at + 8) {
+        Some(word) => word.try_into().map_or(0, u64::from_le_bytes),
+        None => {
+            let mut padded = [0u8; 8];
+            let rest = bytes.get(at..).unwrap_or_default();
+            for (to, from) in padded.iter_mut().zip(rest) {
+                *to = *from;
+            }
+            u64::from_le_bytes(padded)
+        }
+    };
+    // `<` and `>` differ only in bit 1; `"`, `'`, `#` and `&` only in bits 0 and 2.
+    zero_bytes((word | (ONES * 0x02)) ^ (ONES * u64::from(b'>')))
+        | zero_bytes((word | (ONES * 0x05)) ^ (ONES * u64::from(b'\'')))
+}
+
+/// Bit 7 set in each byte of `v` that is zero, exactly (no carry crosses a byte).
+fn zero_bytes(v: u64) -> u64 {
+    const LOW7: u64 = 0x7f7f_7f7f_7f7f_7f7f;
+    !(((v & LOW7) + LOW7) | v | LOW7)
 }
 
 /// The name starting at `pos`, up to whitespace, `/` or `>`; `None` for a
 /// prefixed name (roxmltree's name would be its local part).
 fn name_at(text: &str, pos: usize) -> Option<&str> {
-    let rest = text.get(pos..)?;
+    let rest = text.as_bytes().get(pos..)?;
     let len = rest
-        .find(|c: char| c.is_ascii_whitespace() || c == '/' || c == '>')
+        .iter()
+        .position(|&b| b.is_ascii_whitespace() || b == b'/' || b == b'>')
         .unwrap_or(rest.len());
-    let name = rest.get(..len)?;
-    (!name.is_empty() && !name.contains(':')).then_some(name)
+    let name = text.get(pos..pos + len)?;
+    (!name.is_empty() && !name.bytes().any(|b| b == b':')).then_some(name)
 }
 
-/// The [`Head`] of the child element at `pos`, read from its start tag. A
-/// `name=` value roxmltree would change (entities, whitespace normalisation)
-/// gives `None`: parse whole.
-fn scan_head(text: &str, pos: usize) -> Option<Head<'_>> {
+/// The [`Head`] of the child element at `pos`, read from its start tag, the
+/// tag's end (after `>`) and whether it closed itself. A `name=` value
+/// roxmltree would change (entities, whitespace normalisation) gives `None`:
+/// parse whole. Anything else this does not expect in the tag is left to
+/// [`tag_end_from`] (and to the parse of the run).
+fn scan_head(text: &str, pos: usize) -> Option<(Head<'_>, usize, bool)> {
     let bytes = text.as_bytes();
     let name = name_at(text, pos + 1)?;
     let mut i = pos + 1 + name.len();
@@ -466,10 +586,11 @@ fn scan_head(text: &str, pos: usize) -> Option<Head<'_>> {
             b'>' | b'/' => break,
             _ => {}
         }
-        let attr_len = text
+        let attr_len = bytes
             .get(i..)?
-            .find(|c: char| c.is_ascii_whitespace() || c == '=')?;
-        let attr = text.get(i..i + attr_len)?;
+            .iter()
+            .position(|&b| b.is_ascii_whitespace() || b == b'=')?;
+        let attr = bytes.get(i..i + attr_len)?;
         i = skip_whitespace(bytes, i + attr_len);
         if bytes.get(i) != Some(&b'=') {
             return None;
@@ -479,22 +600,28 @@ fn scan_head(text: &str, pos: usize) -> Option<Head<'_>> {
         if quote != b'"' && quote != b'\'' {
             return None;
         }
-        let value_len = memchr::memchr(quote, bytes.get(i + 1..)?)?;
-        let value = text.get(i + 1..i + 1 + value_len)?;
-        if attr == "name" {
-            if value.contains(['&', '\t', '\n', '\r', '<']) || name_attribute.is_some() {
+        let value_len = find_short(quote, bytes.get(i + 1..)?)?;
+        if attr == b"name" {
+            let value = text.get(i + 1..i + 1 + value_len)?;
+            let normalised = |b: &u8| matches!(b, b'&' | b'\t' | b'\n' | b'\r' | b'<');
+            if value.as_bytes().iter().any(normalised) || name_attribute.is_some() {
                 return None;
             }
             name_attribute = Some(value);
         }
         i += value_len + 2;
     }
+    let (tag_end, self_closing) = tag_end_from(bytes, i)?;
     let name_start = pos + 1;
-    Some(Head {
-        name,
-        name_span: Span::new(name_start, name_start + name.len()),
-        name_attribute,
-    })
+    Some((
+        Head {
+            name,
+            name_span: Span::new(name_start, name_start + name.len()),
+            name_attribute,
+        },
+        tag_end,
+        self_closing,
+    ))
 }
 
 /// The end of the file when `pos` is the root's end tag and only whitespace
@@ -614,6 +741,102 @@ mod tests {
         }
         assert_eq!(kinds, [false, true].into());
         assert_eq!(scan_children(&text, from, 0), Some(one));
+    }
+
+    /// Random edits of a file of many children: whenever the scan splits it
+    /// and every run reads, the children and heads are those of a whole
+    /// parse, and when the whole parse refuses the file some run refuses too.
+    #[test]
+    fn edited_files_split_only_as_a_whole_parse_reads_them() {
+        let mut plain = String::from("<geometry version=\"1\">");
+        for i in 0..12 {
+            plain.push_str(&format!(
+                "\n <sphere name=\"s{i}\"><center x=\"{i}\" y='a>b' z=\"0\"/><radius value=\"r\"></radius></sphere>\
+                 \n <subdomain name='d{i}'><solid ref=\"s{i}\"/></subdomain>"
+            ));
+        }
+        plain.push_str("\n</geometry>\n");
+        let alphabet: &[u8] = b"<>/=\"' \t\n&!?-[]:_aZ09";
+        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
+        let mut next = |bound: usize| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state % bound as u64) as usize
+        };
+        // Runs of a few children each, so that edits fall in several runs.
+        let limits = Limits::default();
+        let (mut split_and_read, mut refused) = (0, 0);
+        for _ in 0..3_000 {
+            let mut bytes = plain.clone().into_bytes();
+            for _ in 0..1 + next(2) {
+                let at = next(bytes.len());
+                let byte = alphabet[next(alphabet.len())];
+                match next(3) {
+                    0 => bytes.insert(at, byte),
+                    1 => bytes[at] = byte,
+                    _ => drop(bytes.remove(at)),
+                }
+            }
+            let Ok(text) = String::from_utf8(bytes) else {
+                continue;
+            };
+            let whole = roxmltree::Document::parse_with_options(&text, options(&limits)).ok();
+            let Some(split) = Split::scan(&text, &limits) else {
+                continue;
+            };
+            match split.top_level().collect::<Result<Vec<_>, _>>() {
+                Ok(children) => {
+                    split_and_read += 1;
+                    assert!(whole.is_some(), "{text:?}");
+                    assert_eq!(children, whole_children(&text), "{text:?}");
+                    let root = whole.as_ref().map(|d| d.root_element());
+                    let heads: Option<Vec<Head>> = root.map(|r| {
+                        r.children()
+                            .filter(|c| c.is_element())
+                            .map(tree::head)
+                            .collect()
+                    });
+                    assert_eq!(heads.as_deref(), Some(split.heads()), "{text:?}");
+                }
+                Err(Reparse) => refused += 1,
+            }
+        }
+        assert!(split_and_read > 300, "{split_and_read} {refused}");
+        assert!(refused > 500, "{split_and_read} {refused}");
+    }
+
+    #[test]
+    fn marks_are_every_byte_of_their_set_in_order() {
+        let bytes: Vec<u8> = (0..=255u8)
+            .chain(b"a<b>c\"d'e#f&".iter().copied())
+            .collect();
+        for from in 0..bytes.len() {
+            let mut marks = Marks::new(&bytes, from);
+            let found: Vec<usize> = std::iter::from_fn(|| marks.next()).collect();
+            let expected: Vec<usize> = (from..bytes.len())
+                .filter(|&i| matches!(bytes[i], b'<' | b'>' | b'"' | b'\'' | b'#' | b'&'))
+                .collect();
+            assert_eq!(found, expected, "from {from}");
+        }
+        let mut marks = Marks::new(b"<a x='\"'>", 1);
+        assert_eq!(marks.find(b'\''), Some(5));
+        assert_eq!(marks.find(b'>'), Some(8));
+        assert_eq!(marks.find(b'>'), None);
+    }
+
+    #[test]
+    fn element_ends_skip_quotes_comments_and_sections() {
+        for (text, end) in [
+            ("<a><b x='>' y=\"</a>\"/></a> <c/>", Some(26)),
+            ("<a><!-- </a> --><![CDATA[</a>]]><?p </a>?></a>", Some(46)),
+            ("<a><b>t > u</b></a>", Some(19)),
+            ("<a><b x=\"1\"<c/></b></a>", None),
+            ("<a><!DOCTYPE x></a>", None),
+            ("<a><b></a>", None),
+        ] {
+            assert_eq!(element_end(text.as_bytes(), 3), end, "{text}");
+        }
     }
 
     #[test]
