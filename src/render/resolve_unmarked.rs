@@ -72,7 +72,7 @@ pub(super) fn unmarked_rows<const SS: usize>(
             if !any_empty {
                 let first_id = pixel[0][0] & 0xffff_ffff;
                 let group = group_of(first_id);
-                let one_group = !scene.groups[group as usize].cap
+                let one_group = !shader.is_cap(first_id, group)
                     && match scene.same_sides {
                         // A sample's group is its side's (the id's low bit):
                         // all one when both sides show one group, else when

@@ -24,6 +24,10 @@ struct Look {
 }
 
 impl Look {
+    /// Looked up per call only when faces show different groups: out of
+    /// line, so the common path of [`Shader::shade`] needs fewer registers.
+    #[cold]
+    #[inline(never)]
     fn of(scene: &Scene, group: u32) -> Look {
         let group = &scene.groups[group as usize];
         let [r, g, b] = group.color;
@@ -106,7 +110,24 @@ impl<'s, 'a> Shader<'s, 'a> {
             let light = &self.light[..self.xy.len()];
             interpolate(self.xy, light, t, t, back, sx, sy)
         } else {
-            interpolate(self.xy, self.light, t, self.slots[tri], back, sx, sy)
+            self.slot_light(t, self.slots[tri], back, sx, sy)
+        }
+    }
+
+    /// [`interpolate`] with light slots of their own (flat shading, several
+    /// faces, a section): out of line, as [`Look::of`] is.
+    #[inline(never)]
+    fn slot_light(&self, t: [u32; 3], s: [u32; 3], back: usize, sx: usize, sy: usize) -> f32 {
+        interpolate(self.xy, self.light, t, s, back, sx, sy)
+    }
+
+    /// Whether side `id` (`2 × triangle + back`), of group `group`, shows
+    /// a section cap: known per side when every face shows the same groups.
+    #[inline(always)]
+    pub(super) fn is_cap(&self, id: u64, group: u32) -> bool {
+        match self.sides[(id & 1) as usize] {
+            Some(look) => look.cap,
+            None => self.scene.groups[group as usize].cap,
         }
     }
 
