@@ -25,7 +25,7 @@ struct Look {
 
 impl Look {
     /// Looked up per call only when faces show different groups: out of
-    /// line, so the common path of [`Shader::shade`] needs fewer registers.
+    /// line, off the common path of [`Shader::shade`].
     #[cold]
     #[inline(never)]
     fn of(scene: &Scene, group: u32) -> Look {
