@@ -18,6 +18,7 @@ mod resolve;
 mod resolve_unmarked;
 mod scene;
 mod section_fill;
+mod shader;
 mod smooth;
 mod svg;
 mod triangle;

@@ -88,19 +88,16 @@ fn normal_avx2(points: &[[f64; 3]], t: [u32; 3]) -> std::arch::x86_64::__m256d {
     let b = load_point(&points[t[1] as usize]);
     let c = load_point(&points[t[2] as usize]);
     let (u, v) = (_mm256_sub_pd(b, a), _mm256_sub_pd(c, a));
-    // u × v = u.yzx · v.zxy − u.zxy · v.yzx, lane by lane as `cross` does.
+    // u × v = (u · v.yzx − u.yzx · v).yzx: lane y of the difference is
+    // u.y·v.z − u.z·v.y, the x of `cross` (the same products in the same
+    // order), and so on round, with three permutations instead of four.
+    // The spare lane stays 0·0 − 0·0.
     const YZX: i32 = 0b11_00_10_01;
-    const ZXY: i32 = 0b11_01_00_10;
-    _mm256_sub_pd(
-        _mm256_mul_pd(
-            _mm256_permute4x64_pd::<YZX>(u),
-            _mm256_permute4x64_pd::<ZXY>(v),
-        ),
-        _mm256_mul_pd(
-            _mm256_permute4x64_pd::<ZXY>(u),
-            _mm256_permute4x64_pd::<YZX>(v),
-        ),
-    )
+    let w = _mm256_sub_pd(
+        _mm256_mul_pd(u, _mm256_permute4x64_pd::<YZX>(v)),
+        _mm256_mul_pd(_mm256_permute4x64_pd::<YZX>(u), v),
+    );
+    _mm256_permute4x64_pd::<YZX>(w)
 }
 
 #[cfg(target_arch = "x86_64")]

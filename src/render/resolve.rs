@@ -6,11 +6,8 @@
 use super::raster::{EMPTY, Projected, ZBuffer};
 use super::resolve_unmarked::unmarked_rows;
 use super::scene::Scene;
-use crate::cache_hint::prefetch;
+use super::shader::Shader;
 use rayon::prelude::*;
-
-/// Pixels ahead whose triangle's corners are fetched while one is shaded.
-pub(super) const AHEAD: usize = 8;
 
 pub const EDGE_COLOR: [u8; 4] = [25, 25, 30, 255];
 
@@ -52,91 +49,6 @@ impl Image {
     }
 }
 
-#[inline]
-pub(super) fn shade(
-    scene: &Scene,
-    proj: &Projected,
-    id: u64,
-    sx: usize,
-    sy: usize,
-    px: usize,
-    py: usize,
-) -> [u8; 3] {
-    let tri = (id >> 1) as usize;
-    let back = (id & 1) as usize;
-    let group = &scene.groups[scene.side_group(tri, back) as usize];
-    let light = if group.cap {
-        // Section caps are flat and hatched, as drawings show cut material.
-        if (px + py) % 8 < 2 { 0.6 } else { 0.95 }
-    } else {
-        let s = scene.corner_slots[tri];
-        if s[0] == s[1] && s[1] == s[2] {
-            scene.light[s[0] as usize][back]
-        } else {
-            let t = scene.tris[tri];
-            let (a, b, c) = (
-                proj.xy_f[t[0] as usize],
-                proj.xy_f[t[1] as usize],
-                proj.xy_f[t[2] as usize],
-            );
-            // Sample indices are below 2^17, so `u32` to `f32` is exact, as
-            // `usize` to `f32` is, in one conversion instead of six.
-            let (x, y) = (sx as u32 as f32 + 0.5, sy as u32 as f32 + 0.5);
-            let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-            let w1 = ((c[0] - a[0]) * (y - a[1]) - (c[1] - a[1]) * (x - a[0])) / -area;
-            let w2 = ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) / area;
-            let (w1, w2) = (w1.clamp(0.0, 1.0), w2.clamp(0.0, 1.0));
-            let w0 = (1.0 - w1 - w2).max(0.0);
-            let l = |k: usize| scene.light[s[k] as usize][back];
-            w0 * l(0) + w1 * l(1) + w2 * l(2)
-        }
-    };
-    tint(group.color, light)
-}
-
-/// `color` times `light`, each channel rounded by adding a half (the value
-/// is not negative, `as` saturates at 255, and `f32::round` is a library
-/// call). With SSE2 the three channels are lanes of one vector: the same
-/// multiplication and addition per lane, and a conversion that gives what
-/// `as u8` gives for every value (NaN and negatives 0, above 255 255).
-#[inline]
-pub(super) fn tint(color: [u8; 3], light: f32) -> [u8; 3] {
-    #[cfg(target_arch = "x86_64")]
-    {
-        // SAFETY: SSE2 is part of every x86-64.
-        unsafe { tint_sse2(color, light) }
-    }
-    #[cfg(not(target_arch = "x86_64"))]
-    {
-        scalar_tint(color, light)
-    }
-}
-
-#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
-#[inline]
-fn scalar_tint(color: [u8; 3], light: f32) -> [u8; 3] {
-    color.map(|c| (c as f32 * light + 0.5) as u8)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "sse2")]
-#[inline]
-fn tint_sse2(color: [u8; 3], light: f32) -> [u8; 3] {
-    use std::arch::x86_64::*;
-    let channels = _mm_set_epi32(0, color[2] as i32, color[1] as i32, color[0] as i32);
-    let lit = _mm_add_ps(
-        _mm_mul_ps(_mm_cvtepi32_ps(channels), _mm_set1_ps(light)),
-        _mm_set1_ps(0.5),
-    );
-    // `minps 255, v` is `255 < v ? 255 : v`: a NaN stays NaN, and
-    // truncation turns it (and anything below −2^31) into i32::MIN, which
-    // the two saturating packs turn into 0, as they do every negative.
-    let ints = _mm_cvttps_epi32(_mm_min_ps(_mm_set1_ps(255.0), lit));
-    let bytes = _mm_packus_epi16(_mm_packs_epi32(ints, ints), _mm_setzero_si128());
-    let [r, g, b, _] = _mm_cvtsi128_si32(bytes).to_le_bytes();
-    [r, g, b]
-}
-
 /// A pixel whose samples all show one colour group's surface (no edge mark,
 /// no background, no section cap) lies inside a smooth surface: it is
 /// shaded once, at its first sample, instead of once per triangle in it.
@@ -144,7 +56,7 @@ fn tint_sse2(color: [u8; 3], light: f32) -> [u8; 3] {
 #[inline]
 fn uniform(
     scene: &Scene,
-    proj: &Projected,
+    shader: &Shader,
     samples: &Samples,
     ss: usize,
     px: usize,
@@ -173,7 +85,7 @@ fn uniform(
             }
         }
     }
-    Some(shade(scene, proj, first_id, sx, sy, px, py))
+    Some(shader.shade(first_id, sx, sy, px, py))
 }
 
 /// Whether every sample of the pixel shows the background (no edge mark).
@@ -289,6 +201,7 @@ pub fn resolve_rows(
         (value != EMPTY).then_some(((value & 0xffff_ffff) >> 1) as usize)
     };
     let bg = background_pixel(background);
+    let shader = Shader::new(scene, proj);
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
         for px in cols.clone() {
@@ -299,8 +212,8 @@ pub fn resolve_rows(
                 row[px * 4..px * 4 + 4].copy_from_slice(&bg);
                 continue;
             }
-            prefetch_ahead(scene, proj, px, cols.end, |px| first_tri(px, py));
-            if let Some(color) = uniform(scene, proj, samples, ss, px, py) {
+            shader.prefetch_ahead(px, cols.end, |px| first_tri(px, py));
+            if let Some(color) = uniform(scene, &shader, samples, ss, px, py) {
                 row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
                 continue;
             }
@@ -312,50 +225,12 @@ pub fn resolve_rows(
                     } else {
                         let value = samples.value(sx, sy);
                         sum.add_sample(value, background, || {
-                            shade(scene, proj, value & 0xffff_ffff, sx, sy, px, py)
+                            shader.shade(value & 0xffff_ffff, sx, sy, px, py)
                         });
                     }
                 }
             }
             sum.write((ss * ss) as u32, &mut row[px * 4..px * 4 + 4]);
-        }
-    }
-}
-
-/// Fetches what shading a pixel ahead will gather: a triangle, then its
-/// corners' positions and light. The triangle of the pixel 16 ahead and the
-/// corners of the one 8 ahead, so the loads overlap (`first_tri` gives the
-/// triangle at a pixel's first sample; `end` ends the row's columns).
-#[inline(always)]
-pub(super) fn prefetch_ahead(
-    scene: &Scene,
-    proj: &Projected,
-    px: usize,
-    end: usize,
-    first_tri: impl Fn(usize) -> Option<usize>,
-) {
-    // A smooth one-face scene's light slots are its triangles' own nodes
-    // (the same array): the triangle is then read and fetched once.
-    let own_slots = std::ptr::eq(scene.corner_slots.as_ptr(), scene.tris.as_ptr());
-    if let Some(tri) = (px + 2 * AHEAD < end)
-        .then(|| first_tri(px + 2 * AHEAD))
-        .flatten()
-    {
-        prefetch(&scene.tris[tri]);
-        if !own_slots {
-            prefetch(&scene.corner_slots[tri]);
-        }
-    }
-    if let Some(tri) = (px + AHEAD < end).then(|| first_tri(px + AHEAD)).flatten() {
-        let t = scene.tris[tri];
-        let slots = if own_slots {
-            t
-        } else {
-            scene.corner_slots[tri]
-        };
-        for (n, slot) in t.into_iter().zip(slots) {
-            prefetch(&proj.xy_f[n as usize]);
-            prefetch(&scene.light[slot as usize]);
         }
     }
 }
@@ -414,41 +289,5 @@ impl PixelSum {
             }
         }
         out[3] = ((sum[3] + n / 2) / n) as u8;
-    }
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn tint_is_the_scalar_rounding_for_every_light() {
-        let mut lights: Vec<f32> = (0..=2000).map(|i| i as f32 / 1000.0).collect();
-        lights.extend([
-            -0.0,
-            -0.001,
-            -1.5,
-            0.498_039_2,
-            1.000_000_1,
-            3.0,
-            1e30,
-            f32::INFINITY,
-            f32::NEG_INFINITY,
-            f32::NAN,
-            f32::MIN_POSITIVE,
-        ]);
-        let mut saturated = 0;
-        for light in lights {
-            for c in (0..=255u8).step_by(17).chain([1, 254]) {
-                let color = [c, 255 - c, c / 3];
-                let want = scalar_tint(color, light);
-                assert_eq!(tint(color, light), want, "{color:?} × {light}");
-                saturated += usize::from(want.contains(&255) && light > 1.0);
-            }
-        }
-        assert!(saturated > 0);
-        assert_eq!(tint([200, 100, 50], 0.5), [100, 50, 25]);
-        assert_eq!(tint([255, 255, 255], f32::NAN), [0, 0, 0]);
-        assert_eq!(tint([3, 255, 128], 2.0), [6, 255, 255]);
     }
 }

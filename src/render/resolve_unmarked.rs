@@ -8,8 +8,9 @@
 //! without edges, so the same bytes.
 
 use super::raster::{EMPTY, Projected};
-use super::resolve::{PixelSum, Samples, background_pixel, prefetch_ahead, shade};
+use super::resolve::{PixelSum, Samples, background_pixel};
 use super::scene::Scene;
+use super::shader::Shader;
 
 /// What [`unmarked_rows`] resolves: the scene, the projection, the samples
 /// (no edge mask), the background, the first pixel row and the pixel columns.
@@ -31,6 +32,7 @@ pub(super) fn unmarked_rows<const SS: usize>(
     let sample_width = samples.width;
     let width = sample_width / SS;
     let bg = background_pixel(background);
+    let shader = Shader::new(scene, proj);
     let group_of = |id: u64| scene.side_group((id >> 1) as usize, (id & 1) as usize);
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
@@ -64,21 +66,31 @@ pub(super) fn unmarked_rows<const SS: usize>(
                 row[px * 4..px * 4 + 4].copy_from_slice(&bg);
                 continue;
             }
-            prefetch_ahead(scene, proj, px, cols.end, first_tri);
+            shader.prefetch_ahead(px, cols.end, first_tri);
             // Every sample shows one colour group's surface (no section
             // cap): shaded once, at the first sample.
             if !any_empty {
                 let first_id = pixel[0][0] & 0xffff_ffff;
                 let group = group_of(first_id);
-                let one_group = !scene.groups[group as usize].cap
-                    && pixel.iter().all(|run| {
-                        run.iter().all(|&value| {
-                            let id = value & 0xffff_ffff;
-                            id == first_id || group_of(id) == group
-                        })
-                    });
+                let one_group = !shader.is_cap(first_id, group)
+                    && match scene.same_sides {
+                        // A sample's group is its side's (the id's low bit):
+                        // all one when both sides show one group, else when
+                        // every sample shows the first one's side.
+                        Some([front, back]) => {
+                            front == back
+                                || pixel.iter().flatten().fold(0, |d, &v| d | (v ^ first_id)) & 1
+                                    == 0
+                        }
+                        None => pixel.iter().all(|run| {
+                            run.iter().all(|&value| {
+                                let id = value & 0xffff_ffff;
+                                id == first_id || group_of(id) == group
+                            })
+                        }),
+                    };
                 if one_group {
-                    let color = shade(scene, proj, first_id, sx, sy, px, py);
+                    let color = shader.shade(first_id, sx, sy, px, py);
                     row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
                     continue;
                 }
@@ -87,7 +99,7 @@ pub(super) fn unmarked_rows<const SS: usize>(
             for (r, run) in pixel.iter().enumerate() {
                 for (c, &value) in run.iter().enumerate() {
                     sum.add_sample(value, background, || {
-                        shade(scene, proj, value & 0xffff_ffff, sx + c, sy + r, px, py)
+                        shader.shade(value & 0xffff_ffff, sx + c, sy + r, px, py)
                     });
                 }
             }
