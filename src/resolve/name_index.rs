@@ -29,6 +29,9 @@ pub struct NameIndex {
     earlier: Vec<(u32, u32)>,
 }
 
+/// How many names ahead the build asks for a slot's cache line.
+const PREFETCH_AHEAD: usize = 16;
+
 /// The names' hash of both name tables (`names.rs` folds it to 32 bits).
 pub(super) fn hash(name: &str) -> u64 {
     foldhash::fast::FixedState::with_seed(0x6e61_6d65).hash_one(name)
@@ -67,9 +70,26 @@ impl NameIndex {
         // At most two thirds full, so probes stay short and end on an empty slot.
         let size = (count + count / 2 + 1).next_power_of_two();
         index.slots = vec![0u32; size];
+        // The slots are written in random order: ask for one a few names
+        // ahead while this one is probed (its hash kept until then).
+        let mask = size - 1;
+        let hash_ahead = |i: usize, slots: &[u32]| -> u64 {
+            let h = name(i).map_or(0, hash);
+            if let Some(slot) = slots.get(h as usize & mask) {
+                crate::cache_hint::prefetch(slot);
+            }
+            h
+        };
+        let mut ahead = [0u64; PREFETCH_AHEAD];
+        for (i, h) in ahead.iter_mut().enumerate() {
+            *h = hash_ahead(i, &index.slots);
+        }
         for i in 0..count {
-            let this = name(i).unwrap_or_default();
-            let slot = index.probe(&name, this);
+            let h = std::mem::replace(
+                &mut ahead[i % PREFETCH_AHEAD],
+                hash_ahead(i + PREFETCH_AHEAD, &index.slots),
+            );
+            let slot = index.probe(&name, name(i).unwrap_or_default(), h);
             let Some(s) = index.slots.get_mut(slot) else {
                 continue;
             };
@@ -105,9 +125,14 @@ impl NameIndex {
 
     /// The slot of `name`: the one holding its last object, or the empty slot
     /// where its probe sequence ends.
-    fn probe<'n>(&self, name_of: &impl Fn(usize) -> Option<&'n str>, name: &str) -> usize {
+    fn probe<'n>(
+        &self,
+        name_of: &impl Fn(usize) -> Option<&'n str>,
+        name: &str,
+        hash: u64,
+    ) -> usize {
         let mask = self.slots.len().wrapping_sub(1);
-        let mut at = hash(name) as usize & mask;
+        let mut at = hash as usize & mask;
         for _ in 0..self.slots.len() {
             match self.slots[at] {
                 0 => return at,
@@ -124,7 +149,7 @@ impl NameIndex {
     /// pack them).
     pub fn get(&self, objects: &[ResolvedObject], name: &str) -> Option<usize> {
         let name_of = |i: usize| objects.get(i).map(|o| o.name.as_str());
-        let slot = self.probe(&name_of, name);
+        let slot = self.probe(&name_of, name, hash(name));
         match self.slots.get(slot).copied() {
             None | Some(0) => None,
             Some(s) => Some(s as usize - 1),
