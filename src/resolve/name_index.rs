@@ -1,36 +1,23 @@
-//! The resolved objects by name, without a copy of each name per object:
-//! on files of many primitives a `String` key per object was a hundred
-//! thousand allocations.
+//! The resolved objects by name, without a copy of each name: on files of
+//! many primitives a `String` key per object was a hundred thousand
+//! allocations, and the lookups compared the same names anyway.
 
 use super::ResolvedObject;
 use std::hash::BuildHasher;
 
 /// Open addressing over the names' hashes: `slots[h]` is 1 + the last object
 /// of a name whose probe sequence (linear, from its hash) stops at `h`, 0 an
-/// empty slot. A slot is four bytes (a map of hashes to indices was sixteen,
-/// and twice the memory at the front end's peak, when the subdomains look
-/// their solids up); a name given twice finds its last object (as a map
+/// empty slot; `previous[i]` is 1 + the object before `i` with the same
+/// name, 0 for the first. A slot is four bytes (a map of hashes to indices
+/// was sixteen, and twice the memory at the front end's peak, when the
+/// subdomains look their solids up); a lookup compares names only in its
+/// few probes, and a name given twice finds its last object (as a map
 /// filled in order would).
-///
-/// The names a probe compares are the index's own, packed one after another
-/// in object order (`text`, object `i`'s ending at `ends[i]`): comparing
-/// against the objects' own names read a 160-byte `ResolvedObject` and then
-/// the name's heap block, two cache misses per lookup on files of many
-/// objects; a lookup of the objects in order now reads the packed names in
-/// order.
 #[derive(Debug, Clone, Default)]
 pub struct NameIndex {
     slots: Vec<u32>,
-    text: String,
-    ends: Vec<u32>,
-    /// (object, 1 + the object before it with the same name), for the
-    /// objects whose name an earlier object has, by object: few or none in a
-    /// valid file, so no list of one entry per object.
-    earlier: Vec<(u32, u32)>,
+    previous: Vec<u32>,
 }
-
-/// How many names ahead the build asks for a slot's cache line.
-const PREFETCH_AHEAD: usize = 16;
 
 /// The names' hash of both name tables (`names.rs` folds it to 32 bits).
 pub(super) fn hash(name: &str) -> u64 {
@@ -45,111 +32,26 @@ impl NameIndex {
     /// The index of `count` objects, object `i` named `name(i)`: built from
     /// the document's names, it serves the resolved objects of the same names.
     pub fn build_with<'n>(count: usize, name: impl Fn(usize) -> Option<&'n str>) -> NameIndex {
-        NameIndex::build_within(count, name, u32::MAX as usize)
-    }
-
-    /// [`NameIndex::build_with`], the names packed if they take at most
-    /// `max_text` bytes in all (the ends are four bytes), compared against
-    /// the objects' own otherwise.
-    fn build_within<'n>(
-        count: usize,
-        name: impl Fn(usize) -> Option<&'n str>,
-        max_text: usize,
-    ) -> NameIndex {
-        let names = || (0..count).map(|i| name(i).unwrap_or_default());
-        let total: usize = names().map(str::len).sum();
-        let mut index = NameIndex::default();
-        if total <= max_text.min(u32::MAX as usize) {
-            index.text.reserve_exact(total);
-            index.ends.reserve_exact(count);
-            for n in names() {
-                index.text.push_str(n);
-                index.ends.push(index.text.len() as u32);
-            }
-        }
         // At most two thirds full, so probes stay short and end on an empty slot.
         let size = (count + count / 2 + 1).next_power_of_two();
-        index.slots = vec![0u32; size];
-        // The slots are written in random order: ask for one a few names
-        // ahead while this one is probed (its hash kept until then).
-        let mask = size - 1;
-        let hash_ahead = |i: usize, slots: &[u32]| -> u64 {
-            let h = name(i).map_or(0, hash);
-            if let Some(slot) = slots.get(h as usize & mask) {
-                crate::cache_hint::prefetch(slot);
-            }
-            h
-        };
-        let mut ahead = [0u64; PREFETCH_AHEAD];
-        for (i, h) in ahead.iter_mut().enumerate() {
-            *h = hash_ahead(i, &index.slots);
-        }
+        let mut slots = vec![0u32; size];
+        let mut previous = Vec::with_capacity(count);
         for i in 0..count {
-            let h = std::mem::replace(
-                &mut ahead[i % PREFETCH_AHEAD],
-                hash_ahead(i + PREFETCH_AHEAD, &index.slots),
-            );
-            let slot = index.probe(&name, name(i).unwrap_or_default(), h);
-            let Some(s) = index.slots.get_mut(slot) else {
-                continue;
-            };
-            if *s != 0 {
-                index.earlier.push((i as u32, *s));
-            }
-            *s = i as u32 + 1;
-        }
-        index
-    }
-
-    /// Whether object `i` is named `name`: by the packed copy, or by
-    /// `name_of(i)` when the names are not packed.
-    fn is_named<'n>(
-        &self,
-        name_of: &impl Fn(usize) -> Option<&'n str>,
-        i: usize,
-        name: &str,
-    ) -> bool {
-        if self.ends.is_empty() {
-            return name_of(i) == Some(name);
-        }
-        let start = match i.checked_sub(1) {
-            None => Some(0),
-            Some(before) => self.ends.get(before).map(|&e| e as usize),
-        };
-        let end = self.ends.get(i).map(|&e| e as usize);
-        match (start, end) {
-            (Some(start), Some(end)) => self.text.get(start..end) == Some(name),
-            _ => false,
-        }
-    }
-
-    /// The slot of `name`: the one holding its last object, or the empty slot
-    /// where its probe sequence ends.
-    fn probe<'n>(
-        &self,
-        name_of: &impl Fn(usize) -> Option<&'n str>,
-        name: &str,
-        hash: u64,
-    ) -> usize {
-        let mask = self.slots.len().wrapping_sub(1);
-        let mut at = hash as usize & mask;
-        for _ in 0..self.slots.len() {
-            match self.slots[at] {
-                0 => return at,
-                s if self.is_named(name_of, s as usize - 1, name) => return at,
-                _ => at = (at + 1) & mask,
+            let slot = probe(&slots, &name, name(i).unwrap_or_default());
+            let before = slots.get(slot).copied().unwrap_or(0);
+            previous.push(before);
+            if let Some(s) = slots.get_mut(slot) {
+                *s = i as u32 + 1;
             }
         }
-        // Not reached: the table is never full.
-        self.slots.len()
+        NameIndex { slots, previous }
     }
 
     /// The index of the last object named `name` in `objects` (the list the
-    /// index was built from; its names are read only if the index could not
-    /// pack them).
+    /// index was built from).
     pub fn get(&self, objects: &[ResolvedObject], name: &str) -> Option<usize> {
         let name_of = |i: usize| objects.get(i).map(|o| o.name.as_str());
-        let slot = self.probe(&name_of, name, hash(name));
+        let slot = probe(&self.slots, &name_of, name);
         match self.slots.get(slot).copied() {
             None | Some(0) => None,
             Some(s) => Some(s as usize - 1),
@@ -163,15 +65,30 @@ impl NameIndex {
         let mut at = self.get(objects, name);
         while let Some(i) = at {
             found.push(i);
-            at = (self.earlier)
-                .binary_search_by_key(&(i as u32), |&(object, _)| object)
-                .ok()
-                .and_then(|k| self.earlier.get(k))
-                .map(|&(_, before)| before as usize - 1);
+            at = match self.previous.get(i).copied() {
+                None | Some(0) => None,
+                Some(s) => Some(s as usize - 1),
+            };
         }
         found.reverse();
         found
     }
+}
+
+/// The slot of `name`: the one holding its last object, or the empty slot
+/// where its probe sequence ends.
+fn probe<'n>(slots: &[u32], name_of: &impl Fn(usize) -> Option<&'n str>, name: &str) -> usize {
+    let mask = slots.len().wrapping_sub(1);
+    let mut at = hash(name) as usize & mask;
+    for _ in 0..slots.len() {
+        match slots[at] {
+            0 => return at,
+            s if name_of(s as usize - 1) == Some(name) => return at,
+            _ => at = (at + 1) & mask,
+        }
+    }
+    // Not reached: the table is never full.
+    slots.len()
 }
 
 #[cfg(test)]
@@ -221,25 +138,12 @@ mod tests {
             })
             .collect();
         let objects: Vec<ResolvedObject> = names.iter().map(|n| object(n)).collect();
-        let name_of = |i: usize| objects.get(i).map(|o| o.name.as_str());
-        let packed = NameIndex::build(&objects);
-        // Names too long in all to pack are compared against the objects'.
-        let unpacked = NameIndex::build_within(objects.len(), name_of, 10);
-        assert_eq!(packed.text.len(), 13_003);
-        assert!(unpacked.text.is_empty() && unpacked.ends.is_empty());
-        // 857 objects repeat an earlier name.
-        assert_eq!(packed.earlier.len(), 857);
-        for index in [&packed, &unpacked] {
-            for name in names
-                .iter()
-                .map(String::as_str)
-                .chain(["n3000", "m1", "", "n"])
-            {
-                let every: Vec<usize> = (0..objects.len()).filter(|&i| names[i] == name).collect();
-                assert_eq!(index.get(&objects, name), every.last().copied(), "{name}");
-                assert_eq!(index.all(&objects, name), every, "{name}");
-            }
-            assert_eq!(index.all(&objects, "n0"), [0, 2, 5]);
+        let index = NameIndex::build(&objects);
+        for name in names.iter().map(String::as_str).chain(["n3000", "m1", ""]) {
+            let every: Vec<usize> = (0..objects.len()).filter(|&i| names[i] == name).collect();
+            assert_eq!(index.get(&objects, name), every.last().copied(), "{name}");
+            assert_eq!(index.all(&objects, name), every, "{name}");
         }
+        assert_eq!(index.all(&objects, "n0"), [0, 2, 5]);
     }
 }
