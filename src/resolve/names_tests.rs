@@ -130,3 +130,73 @@ fn many_names_find_what_a_scan_of_the_document_finds() {
         .count();
     assert_eq!(duplicates, expected_duplicates);
 }
+
+#[test]
+fn a_definition_of_a_later_list_that_comes_first_is_the_first() {
+    // The table numbers the lists in a fixed order (parameters before
+    // objects before subdomains), but the first definition of a name is the
+    // first by position, and the findings come in the order of position.
+    let xml = format!(
+        "<geometry version=\"1\">\n{}{}{}{}{}{}{}</geometry>\n",
+        "<subdomain name=\"x\"><solid ref=\"x\"/></subdomain>\n",
+        "<subdomain name=\"a b\"><solid ref=\"x\"/></subdomain>\n",
+        sphere("x"),
+        sphere("a b"),
+        "<parameters><parameter name=\"x\" value=\"1\"/><parameter name=\"q\" value=\"2\"/></parameters>\n",
+        sphere("q"),
+        sphere("x"),
+    );
+    let (source, doc) = document(&xml);
+    let mut diags = Diagnostics::default();
+    let names = NameTable::build(&source, &doc, &mut diags);
+    assert_eq!(names.kind_of("x"), Some("subdomain"));
+    assert_eq!(names.first_object("x"), Some(0));
+    assert_eq!(names.kind_of("a b"), Some("subdomain"));
+    assert_eq!(names.first_object("a b"), Some(1));
+    assert_eq!(names.kind_of("q"), Some("parameter"));
+    assert_eq!(names.first_object("q"), Some(2));
+    let found: Vec<(Code, u32, &str)> = (diags.items.iter())
+        .map(|d| (d.code, d.span.map_or(0, |s| s.start), d.message.as_str()))
+        .collect();
+    let object = |i: usize| doc.objects[i].name.span.start;
+    let repeated = |name: &str, kind: &str, line: u32| {
+        format!("the name '{name}' is already used by the {kind} on line {line}")
+    };
+    let expected = [
+        (
+            Code::NameNotIdentifier,
+            doc.subdomains[1].name.span.start,
+            "the name 'a b' contains characters that separate names in lists and expressions"
+                .to_string(),
+        ),
+        (
+            Code::DuplicateName,
+            object(0),
+            repeated("x", "subdomain", 2),
+        ),
+        (
+            Code::DuplicateName,
+            object(1),
+            repeated("a b", "subdomain", 3),
+        ),
+        (
+            Code::DuplicateName,
+            doc.parameters[0].name.span.start,
+            repeated("x", "subdomain", 2),
+        ),
+        (
+            Code::DuplicateName,
+            object(2),
+            repeated("q", "parameter", 6),
+        ),
+        (
+            Code::DuplicateName,
+            object(3),
+            repeated("x", "subdomain", 2),
+        ),
+    ];
+    let expected: Vec<(Code, u32, &str)> = (expected.iter())
+        .map(|(code, at, message)| (*code, *at, message.as_str()))
+        .collect();
+    assert_eq!(found, expected);
+}
