@@ -3,6 +3,7 @@
 //! Structure (missing or unknown elements) is the structural check's job: here
 //! anything missing simply stays `None`.
 
+use super::grammar::same_name;
 use super::model::*;
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::expr::{self, ExprLimits, ParseError};
@@ -599,17 +600,25 @@ impl Builder<'_> {
     // ---- leaves ----
 
     fn name(&mut self, e: &Element) -> Option<Name> {
-        e.attribute("name").map(|a| Name {
+        attribute(e, "name").map(|a| Name {
             text: a.value.trim().to_string(),
             span: a.value_span,
         })
     }
 
     fn number(&mut self, e: &Element, attr: &str) -> Option<Number> {
-        e.attribute(attr).map(|a| self.parse_number(a))
+        attribute(e, attr).map(|a| self.parse_number(a))
     }
 
     fn parse_number(&mut self, attr: &Attribute) -> Number {
+        // Most numbers of large files are plain literals: their value is made
+        // here, without the expression parser's trim, tree and the source
+        // comparison below (the same `Number` the parser's path gives).
+        if self.limits.max_nodes >= 1 {
+            if let Some(value) = plain_literal(&attr.value) {
+                return Number::plain(value, attr.value_span);
+            }
+        }
         // Offsets into the value map onto the source only when the raw text
         // equals the value (no entity references); otherwise point at the whole value.
         let raw = self.source.snippet(attr.value_span);
@@ -675,12 +684,12 @@ impl Builder<'_> {
     }
 
     fn reference(&mut self, e: &Element, attr: &str) -> Option<Ref> {
-        let a = e.attribute(attr)?;
+        let a = attribute(e, attr)?;
         Some(parse_ref(a.value.trim(), a.value_span))
     }
 
     fn ref_list(&mut self, e: &Element, attr: &str) -> Option<(Vec<Ref>, Span)> {
-        let a = e.attribute(attr)?;
+        let a = attribute(e, attr)?;
         let mut refs = Vec::new();
         let base = a.value_span.start as usize;
         let exact = self.source.snippet(a.value_span) == a.value;
@@ -710,42 +719,123 @@ impl Builder<'_> {
     }
 
     fn point(&mut self, e: &Element) -> PointSpec {
+        self.point_tagged(e, point_tag(e.name))
+    }
+
+    /// [`Builder::point`] of an element whose tag is known to be `tag`.
+    fn point_tagged(&mut self, e: &Element, tag: std::borrow::Cow<'static, str>) -> PointSpec {
+        let [x, y, z, point] = Coordinates::of(e);
         PointSpec {
-            x: self.number(e, "x"),
-            y: self.number(e, "y"),
-            z: self.number(e, "z"),
-            point: self.reference(e, "point").map(Box::new),
-            tag: point_tag(e.name),
+            x: x.map(|a| self.parse_number(a)),
+            y: y.map(|a| self.parse_number(a)),
+            z: z.map(|a| self.parse_number(a)),
+            point: point.map(|a| Box::new(parse_ref(a.value.trim(), a.value_span))),
+            tag,
             span: e.name_span,
         }
     }
 
     fn vector(&mut self, e: &Element) -> VectorSpec {
+        let [x, y, z, _] = Coordinates::of(e);
         VectorSpec {
-            x: self.number(e, "x"),
-            y: self.number(e, "y"),
-            z: self.number(e, "z"),
+            x: x.map(|a| self.parse_number(a)),
+            y: y.map(|a| self.parse_number(a)),
+            z: z.map(|a| self.parse_number(a)),
             span: e.name_span,
         }
     }
 
-    fn point_child(&mut self, e: &Element, name: &str) -> Option<PointSpec> {
-        e.children_named(name).next().map(|c| self.point(c))
+    fn point_child(&mut self, e: &Element, name: &'static str) -> Option<PointSpec> {
+        child_named(e, name).map(|c| self.point_tagged(c, std::borrow::Cow::Borrowed(name)))
     }
 
-    fn points_named(&mut self, e: &Element, name: &str) -> Vec<PointSpec> {
-        e.children_named(name).map(|c| self.point(c)).collect()
+    fn points_named(&mut self, e: &Element, name: &'static str) -> Vec<PointSpec> {
+        e.children
+            .iter()
+            .filter(|c| same_name(c.name, name))
+            .map(|c| self.point_tagged(c, std::borrow::Cow::Borrowed(name)))
+            .collect()
     }
 
     fn vector_child(&mut self, e: &Element, name: &str) -> Option<VectorSpec> {
-        e.children_named(name).next().map(|c| self.vector(c))
+        child_named(e, name).map(|c| self.vector(c))
     }
 
     fn value_child(&mut self, e: &Element, name: &str) -> Option<Number> {
-        e.children_named(name)
-            .next()
-            .and_then(|c| self.number(c, "value"))
+        child_named(e, name).and_then(|c| self.number(c, "value"))
     }
+}
+
+/// [`Element::attribute`] with [`same_name`].
+fn attribute<'e, 's>(e: &'e Element<'s>, name: &str) -> Option<&'e Attribute<'s>> {
+    e.attributes.iter().find(|a| same_name(a.name, name))
+}
+
+/// The first child of `e` named `name`.
+fn child_named<'e, 's>(e: &'e Element<'s>, name: &str) -> Option<&'e Element<'s>> {
+    e.children.iter().find(|c| same_name(c.name, name))
+}
+
+/// The `x`, `y`, `z` and `point` attributes of a point or vector element,
+/// found in one pass over its attributes (each the first of its name, as
+/// [`Element::attribute`] finds it); the numbers are parsed afterwards in
+/// that order, so their findings keep it.
+struct Coordinates;
+
+impl Coordinates {
+    fn of<'e, 's>(e: &'e Element<'s>) -> [Option<&'e Attribute<'s>>; 4] {
+        let mut found = [None; 4];
+        for a in &e.attributes {
+            // Byte patterns: compared inline, without a `memcmp` per name.
+            let slot = match a.name.as_bytes() {
+                [b'x'] => 0,
+                [b'y'] => 1,
+                [b'z'] => 2,
+                [b'p', b'o', b'i', b'n', b't'] => 3,
+                _ => continue,
+            };
+            if let Some(place) = found.get_mut(slot) {
+                place.get_or_insert(a);
+            }
+        }
+        found
+    }
+}
+
+/// The value of an attribute that is one unsigned decimal literal without
+/// exponent or spaces (`12`, `0.25`, `3.`), when it is exactly what
+/// `str::parse::<f64>` gives for it: a mantissa below 2^53 over a power of ten
+/// up to 10^22, both exact in an `f64`, so their quotient is correctly rounded
+/// (Clinger's fast path; the correctly rounded value is unique). Anything
+/// else is `None` and goes to the expression parser.
+fn plain_literal(text: &str) -> Option<f64> {
+    /// 10^0 … 10^22, each exact in an `f64`.
+    const POWERS: [f64; 23] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15, 1e16,
+        1e17, 1e18, 1e19, 1e20, 1e21, 1e22,
+    ];
+    let mut mantissa: u64 = 0;
+    let mut digits = 0usize;
+    let mut dot: Option<usize> = None;
+    for &b in text.as_bytes() {
+        match b {
+            b'0'..=b'9' => {
+                mantissa = mantissa * 10 + u64::from(b - b'0');
+                if mantissa >= 1 << 53 {
+                    return None;
+                }
+                digits += 1;
+            }
+            b'.' if dot.is_none() => dot = Some(digits),
+            _ => return None,
+        }
+    }
+    if digits == 0 {
+        return None;
+    }
+    let scale = POWERS.get(dot.map_or(0, |before| digits - before))?;
+    // Exact integers up to 2^53: the conversion does not round.
+    Some(mantissa as f64 / scale)
 }
 
 /// The tag of a point-valued element without allocating for the usual ones.
@@ -769,7 +859,7 @@ fn point_tag(name: &str) -> std::borrow::Cow<'static, str> {
         "point_c",
         "point_d",
     ];
-    match TAGS.iter().find(|&&t| t == name) {
+    match TAGS.iter().find(|&&t| same_name(t, name)) {
         Some(t) => std::borrow::Cow::Borrowed(t),
         None => std::borrow::Cow::Owned(name.to_string()),
     }
@@ -838,6 +928,129 @@ mod tests {
         );
         let r = parse_ref("point 3D", Span::default());
         assert_eq!((r.name.as_str(), r.index), ("point 3D", None));
+    }
+
+    /// The number the expression parser's path makes of `text` at `span`.
+    fn parsed(text: &str, span: Span) -> Number {
+        let limits = ExprLimits::default();
+        Number::new(
+            expr::parse_with(text, span.start as usize, &limits).ok(),
+            span,
+        )
+    }
+
+    #[test]
+    fn plain_literals_are_the_numbers_the_expression_parser_makes() {
+        let span = Span { start: 7, end: 0 };
+        let at = |text: &str| Span {
+            end: 7 + text.len() as u32,
+            ..span
+        };
+        // Taken here, with the parser's value to the bit.
+        for text in [
+            "0",
+            "12",
+            "0.25",
+            "3.",
+            ".5",
+            "007.50",
+            "0.1",
+            "2.675",
+            "123456.789",
+            "9007199254740991",
+            "0.0000000000000000000001",
+            "900719925474099.1",
+        ] {
+            let value = plain_literal(text).unwrap_or_else(|| panic!("{text:?} is plain"));
+            let expected: f64 = text.parse().expect("a literal");
+            assert_eq!(value.to_bits(), expected.to_bits(), "{text:?}");
+            assert_eq!(
+                Number::plain(value, at(text)),
+                parsed(text, at(text)),
+                "{text:?}"
+            );
+        }
+        // Left to the parser: not one plain literal, or past the exact range.
+        for text in [
+            "",
+            ".",
+            "1.2.3",
+            "-1",
+            "+1",
+            " 1",
+            "1 ",
+            "1e5",
+            "r",
+            "2*r",
+            "1_0",
+            "١",
+            "9007199254740992",
+            "0.00000000000000000000001",
+            "99999999999999999999",
+            "4503599627370495.5",
+        ] {
+            assert_eq!(plain_literal(text), None, "{text:?}");
+        }
+        // Random literals of 1 to 20 digits with and without a dot: every one
+        // taken is the parser's number, and most short ones are taken.
+        let mut state: u64 = 0x2545_F491_4F6C_DD1D;
+        let mut next = |n: u64| {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state % n
+        };
+        let mut taken = 0;
+        for _ in 0..20_000 {
+            let digits = 1 + next(20) as usize;
+            let mut text: String = (0..digits)
+                .map(|_| char::from(b'0' + next(10) as u8))
+                .collect();
+            if next(4) > 0 {
+                text.insert(next(digits as u64 + 1) as usize, '.');
+            }
+            if let Some(value) = plain_literal(&text) {
+                taken += 1;
+                let expected: f64 = text.parse().expect("a literal");
+                assert_eq!(value.to_bits(), expected.to_bits(), "{text:?}");
+                assert_eq!(Number::plain(value, at(&text)), parsed(&text, at(&text)));
+            }
+        }
+        assert!(taken > 12_000, "{taken} of 20,000 taken");
+    }
+
+    #[test]
+    fn coordinates_are_read_in_their_order_whatever_the_attributes_order() {
+        let xml = concat!(
+            "<geometry version=\"1\"><sphere name=\"s\">",
+            "<center z=\"1+\" point=\"p\" y=\"2\" x=\"*3\"/><radius value=\"1\"/>",
+            "</sphere></geometry>"
+        );
+        let source = SourceFile::new("c.xml", xml);
+        let root =
+            crate::syntax::parse(&source, &crate::syntax::Limits::default()).expect("parses");
+        let mut diags = Diagnostics::default();
+        let doc = build(&source, &root, &mut diags);
+        let messages: Vec<&str> = diags.items.iter().map(|d| d.message.as_str()).collect();
+        assert_eq!(messages.len(), 2, "{messages:?}");
+        assert!(messages[0].starts_with("x=\"*3\""), "{messages:?}");
+        assert!(messages[1].starts_with("z=\"1+\""), "{messages:?}");
+        let Some(Object {
+            kind:
+                ObjectKind::Sphere {
+                    center: Some(center),
+                    ..
+                },
+            ..
+        }) = doc.objects.first()
+        else {
+            panic!("a sphere with a center: {:?}", doc.objects)
+        };
+        let y = center.y.as_ref().and_then(|n| n.expr()).expect("y parses");
+        assert_eq!(y.kind, crate::expr::ExprKind::Number(2.0));
+        assert_eq!(center.x.as_ref().map(|n| n.expr()), Some(None));
+        assert_eq!(center.point.as_ref().map(|r| r.name.as_str()), Some("p"));
+        assert_eq!(center.tag, "center");
     }
 
     #[test]

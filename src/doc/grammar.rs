@@ -65,9 +65,20 @@ pub struct Rule {
     pub content: Content,
 }
 
+/// Whether two names are equal, comparing the length, the address (the
+/// structure check compares the grammar's own strings) and the first byte
+/// before calling `memcmp`: most names compared are different ones, and
+/// `memcmp` was 3% of the front end's instructions.
+#[inline]
+pub(crate) fn same_name(a: &str, b: &str) -> bool {
+    a.len() == b.len()
+        && (std::ptr::eq(a.as_ptr(), b.as_ptr())
+            || (a.as_bytes().first() == b.as_bytes().first() && (a.len() < 2 || a == b)))
+}
+
 impl Rule {
     pub fn attr(&self, name: &str) -> Option<&'static Attr> {
-        self.attrs.iter().find(|a| a.name == name)
+        self.attrs.iter().find(|a| same_name(a.name, name))
     }
 
     /// Every child rule this element may contain, in declaration order.
@@ -95,17 +106,80 @@ impl Rule {
     pub fn child_rule(&self, name: &str) -> Option<&'static Rule> {
         match self.content {
             Content::Empty => None,
-            Content::All(children) | Content::Sequence(children) => {
-                children.iter().map(|c| c.rule).find(|r| r.name == name)
+            Content::All(children) | Content::Sequence(children) => children
+                .iter()
+                .map(|c| c.rule)
+                .find(|r| same_name(r.name, name)),
+            // The root's forty options: looked up twice per top-level element.
+            Content::Choice { .. } if std::ptr::eq(self, &GEOMETRY) => top_level_index().find(name),
+            Content::Choice { options, .. } => {
+                options.iter().copied().find(|r| same_name(r.name, name))
             }
-            Content::Choice { options, .. } => options.iter().copied().find(|r| r.name == name),
             Content::Forms(forms) => forms
                 .iter()
                 .flat_map(|f| f.iter())
                 .map(|c| c.rule)
-                .find(|r| r.name == name),
+                .find(|r| same_name(r.name, name)),
         }
     }
+}
+
+/// The options of [`GEOMETRY`] by name: open addressing over a hash of a
+/// name's length and three of its bytes, each slot the option's index + 1
+/// (0: empty). A name's first option wins, as a search in order finds it.
+struct OptionIndex {
+    options: &'static [&'static Rule],
+    slots: [u8; OptionIndex::SLOTS],
+}
+
+impl OptionIndex {
+    const SLOTS: usize = 256;
+
+    fn new(options: &'static [&'static Rule]) -> OptionIndex {
+        let mut index = OptionIndex {
+            options,
+            slots: [0; OptionIndex::SLOTS],
+        };
+        for (i, rule) in options.iter().enumerate().take(OptionIndex::SLOTS / 2) {
+            if index.find(rule.name).is_some() {
+                continue;
+            }
+            let mut slot = OptionIndex::hash(rule.name);
+            while index.slots[slot] != 0 {
+                slot = (slot + 1) % OptionIndex::SLOTS;
+            }
+            index.slots[slot] = (i + 1) as u8;
+        }
+        index
+    }
+
+    fn hash(name: &str) -> usize {
+        let bytes = name.as_bytes();
+        let byte = |i: usize| u64::from(bytes.get(i).copied().unwrap_or(0));
+        let last = bytes.len().saturating_sub(1);
+        let key = bytes.len() as u64 | byte(0) << 8 | byte(last) << 16 | byte(last / 2) << 24;
+        (key.wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 56) as usize
+    }
+
+    fn find(&self, name: &str) -> Option<&'static Rule> {
+        let mut slot = OptionIndex::hash(name);
+        loop {
+            let option = usize::from(*self.slots.get(slot)?);
+            let rule = *self.options.get(option.checked_sub(1)?)?;
+            if same_name(rule.name, name) {
+                return Some(rule);
+            }
+            slot = (slot + 1) % OptionIndex::SLOTS;
+        }
+    }
+}
+
+fn top_level_index() -> &'static OptionIndex {
+    static INDEX: std::sync::OnceLock<OptionIndex> = std::sync::OnceLock::new();
+    INDEX.get_or_init(|| match GEOMETRY.content {
+        Content::Choice { options, .. } => OptionIndex::new(options),
+        _ => OptionIndex::new(&[]),
+    })
 }
 
 const fn req(name: &'static str, kind: AttrKind) -> Attr {
@@ -1060,3 +1134,53 @@ pub static GEOMETRY: Rule = Rule {
         max: None,
     },
 };
+
+#[cfg(test)]
+mod index_tests {
+    use super::*;
+
+    #[test]
+    fn the_top_level_index_finds_what_a_search_in_order_finds() {
+        let Content::Choice { options, .. } = GEOMETRY.content else {
+            panic!("the root is a choice")
+        };
+        let in_order = |name: &str| options.iter().copied().find(|r| r.name == name);
+        let mut names: Vec<String> = options.iter().map(|r| r.name.to_string()).collect();
+        assert_eq!(names.len(), 40);
+        // Near misses of every option: cut, lengthened, recased, one byte changed.
+        for option in options {
+            let name = option.name;
+            names.push(name[..name.len() - 1].to_string());
+            names.push(format!("{name}s"));
+            names.push(name.to_uppercase());
+            names.push(format!("x{}", &name[1..]));
+            names.push(format!("{}x", &name[..name.len() - 1]));
+        }
+        names.extend(["", "a", "geometry", "center", "value"].map(String::from));
+        let mut found = 0;
+        for name in &names {
+            let indexed = GEOMETRY.child_rule(name);
+            assert_eq!(indexed.map(|r| r.name), in_order(name).map(|r| r.name));
+            assert!(
+                indexed
+                    .zip(in_order(name))
+                    .is_none_or(|(a, b)| std::ptr::eq(a, b)),
+                "{name}"
+            );
+            found += usize::from(indexed.is_some());
+        }
+        assert!(found >= 40, "{found}");
+    }
+
+    #[test]
+    fn names_are_the_same_exactly_when_equal() {
+        let names = [
+            "", "x", "y", "xy", "yx", "point", "points", "pOint", "center", "centre",
+        ];
+        for a in names {
+            for b in names {
+                assert_eq!(same_name(a, b), a == b, "{a:?} {b:?}");
+            }
+        }
+    }
+}

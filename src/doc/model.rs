@@ -57,6 +57,15 @@ impl Number {
         Number { parsed, span }
     }
 
+    /// A plain number spanning its whole value: what [`Number::new`] makes of
+    /// a number literal whose span is `span`.
+    pub fn plain(value: f64, span: Span) -> Number {
+        Number {
+            parsed: Parsed::Plain(value),
+            span,
+        }
+    }
+
     /// The parsed expression, or `None` if it did not parse.
     pub fn expr(&self) -> Option<std::borrow::Cow<'_, Expr>> {
         match &self.parsed {

@@ -2,7 +2,7 @@
 //! and reports unknown, missing, duplicate and out-of-order elements and attributes,
 //! text where none belongs, and enumeration values outside their set.
 
-use super::grammar::{AttrKind, Child, Content, Rule};
+use super::grammar::{AttrKind, Child, Content, Rule, same_name};
 use crate::diag::{Code, Diagnostic, Diagnostics, did_you_mean};
 use crate::syntax::{Element, Head};
 
@@ -38,7 +38,7 @@ pub fn check_reusing<'e, 's>(
     pending.push((root, rule));
     while let Some((element, rule)) = pending.pop() {
         heads.clear();
-        heads.extend(element.children.iter().map(Element::head));
+        heads.extend(element.children.iter().map(head));
         check_heads_into(element, heads, rule, diags, known, known_rules);
         for &(i, child_rule) in known_rules.iter().rev() {
             if let Some(child) = element.children.get(i) {
@@ -95,6 +95,16 @@ fn check_heads_into<'h>(
     check_children(element, children, rule, diags, known, known_rules);
 }
 
+/// A child's [`Head`] for [`check_heads_into`], which reads only its name
+/// and name span: its `name=` is not looked up.
+fn head<'e>(element: &'e Element) -> Head<'e> {
+    Head {
+        name: element.name,
+        name_span: element.name_span,
+        name_attribute: None,
+    }
+}
+
 fn abbreviate(text: &str) -> String {
     let mut out: String = text.chars().take(40).collect();
     if text.chars().count() > 40 {
@@ -104,9 +114,18 @@ fn abbreviate(text: &str) -> String {
 }
 
 fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
+    // The rule's attributes found (bit k: `rule.attrs[k]`), so a required
+    // one found needs no second search of the element's attributes.
+    let mut seen: u64 = 0;
     for attr in &element.attributes {
-        match rule.attr(attr.name) {
-            Some(spec) => {
+        let found = rule
+            .attrs
+            .iter()
+            .enumerate()
+            .find(|(_, a)| same_name(a.name, attr.name));
+        match found {
+            Some((k, spec)) => {
+                seen |= 1u64.checked_shl(k as u32).unwrap_or(0);
                 if let AttrKind::Enum(values) = spec.kind {
                     if !values.contains(&attr.value.trim()) {
                         let listed = values
@@ -165,8 +184,15 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
             }
         }
     }
-    for spec in rule.attrs.iter().filter(|a| a.required) {
-        if element.attribute(spec.name).is_none() {
+    for (k, spec) in rule.attrs.iter().enumerate().filter(|(_, a)| a.required) {
+        let marked = seen & 1u64.checked_shl(k as u32).unwrap_or(0) != 0;
+        // Not marked: absent, or past the 64 marks, or a repeated name.
+        if !marked
+            && !element
+                .attributes
+                .iter()
+                .any(|a| same_name(a.name, spec.name))
+        {
             diags.push(
                 Diagnostic::new(
                     Code::MissingAttribute,
@@ -194,7 +220,12 @@ fn check_children<'h>(
     for (i, child) in children.iter().enumerate() {
         if let Some(child_rule) = rule.child_rule(child.name) {
             known_rules.push((i, child_rule));
-            known.push(*child);
+            // The same name, but the grammar's string: the counts and order
+            // below compare it with the rules' names, mostly the same string.
+            known.push(Head {
+                name: child_rule.name,
+                ..*child
+            });
         } else {
             let allowed = rule.child_rules();
             let mut d = Diagnostic::new(
@@ -285,7 +316,7 @@ fn plural(n: u32) -> &'static str {
 }
 
 fn check_count(element: &Element, known: &[Head], spec: &Child, diags: &mut Diagnostics) {
-    let found = known.iter().filter(|c| c.name == spec.rule.name);
+    let found = known.iter().filter(|c| same_name(c.name, spec.rule.name));
     // The element past the most allowed, then how many there are in all.
     let extra = spec.max.and_then(|max| found.clone().nth(max as usize));
     let n = found.count() as u32;
@@ -336,7 +367,7 @@ fn check_count(element: &Element, known: &[Head], spec: &Child, diags: &mut Diag
 
 /// In a sequence, each child must come no earlier than the children before it.
 fn check_order(element: &Element, known: &[Head], children: &[Child], diags: &mut Diagnostics) {
-    let position = |name: &str| children.iter().position(|c| c.rule.name == name);
+    let position = |name: &str| children.iter().position(|c| same_name(c.rule.name, name));
     let mut latest: Option<(usize, &Head)> = None;
     for child in known {
         let Some(p) = position(child.name) else {
@@ -371,7 +402,7 @@ fn check_order(element: &Element, known: &[Head], children: &[Child], diags: &mu
 }
 
 fn check_forms(element: &Element, known: &[Head], forms: &[&[Child]], diags: &mut Diagnostics) {
-    let in_form = |form: &[Child], name: &str| form.iter().any(|c| c.rule.name == name);
+    let in_form = |form: &[Child], name: &str| form.iter().any(|c| same_name(c.rule.name, name));
     let describe = |form: &[Child]| {
         form.iter()
             .map(|c| format!("<{}>", c.rule.name))
