@@ -28,6 +28,8 @@ pub mod resolve;
 pub mod span;
 pub mod syntax;
 #[cfg(test)]
+mod test_rng;
+#[cfg(test)]
 mod test_threads;
 pub mod trimmed;
 pub mod valid;

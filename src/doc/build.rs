@@ -911,6 +911,7 @@ fn relocate(expr: &mut crate::expr::Expr, span: Span) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::test_rng::TestRng;
 
     #[test]
     fn references_parse_members_and_entities() {
@@ -993,21 +994,15 @@ mod tests {
         }
         // Random literals of 1 to 20 digits with and without a dot: every one
         // taken is the parser's number, and most short ones are taken.
-        let mut state: u64 = 0x2545_F491_4F6C_DD1D;
-        let mut next = |n: u64| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state % n
-        };
+        let mut rng = TestRng::new(0x2545_F491_4F6C_DD1D);
         let mut taken = 0;
         for _ in 0..20_000 {
-            let digits = 1 + next(20) as usize;
+            let digits = 1 + rng.below(20);
             let mut text: String = (0..digits)
-                .map(|_| char::from(b'0' + next(10) as u8))
+                .map(|_| char::from(b'0' + rng.below(10) as u8))
                 .collect();
-            if next(4) > 0 {
-                text.insert(next(digits as u64 + 1) as usize, '.');
+            if rng.below(4) > 0 {
+                text.insert(rng.below(digits + 1), '.');
             }
             if let Some(value) = plain_literal(&text) {
                 taken += 1;

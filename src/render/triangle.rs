@@ -432,6 +432,7 @@ impl Fill {
 mod tests {
     use super::*;
     use crate::render::raster::{EMPTY, depth_of};
+    use crate::test_rng::TestRng;
 
     /// The samples of a `w`×`h` picture that `draw_chunks` fills with
     /// triangle `v`
@@ -477,18 +478,12 @@ mod tests {
         // A fixed pseudo-random sequence of triangles: small ones (the
         // packed edges, some close to `SMALL` across) and ones reaching far
         // outside the picture (the wide edges), in both orientations.
-        let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut next = |range: i64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % (2 * range as u64 + 1)) as i64 - range
-        };
+        let mut rng = TestRng::new(0x2545_f491_4f6c_dd1d);
         let (mut filled, mut wide, mut near_limit) = (0, 0, 0);
         for round in 0..600 {
             let reach = [120, 255, 1 << 20][round % 3];
-            let c = [next(300) + 320, next(200) + 190];
-            let v = [0, 1, 2].map(|_| [c[0] + next(reach), c[1] + next(reach)]);
+            let c = [rng.within(300) + 320, rng.within(200) + 190];
+            let v = [0, 1, 2].map(|_| [c[0] + rng.within(reach), c[1] + rng.within(reach)]);
             let area = signed_area(v);
             if area == 0 {
                 continue;
@@ -577,24 +572,18 @@ mod tests {
         // orientations, depths below 0 (stored as 0) and above 1. Batches
         // of eight and the partial last one, boxes wider than eight samples
         // and clipped at every side of the picture and the band.
-        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
-        let mut next = |range: i64| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % (2 * range as u64 + 1)) as i64 - range
-        };
+        let mut rng = TestRng::new(0x9e37_79b9_7f4a_7c15);
         let (w, h, band) = (75usize, 61usize, 16usize);
         let mut nodes = Vec::new();
         let mut tris = Vec::new();
         for t in 0..3001u32 {
-            let c = [next(700) + 600, next(600) + 490];
+            let c = [rng.within(700) + 600, rng.within(600) + 490];
             let reach = [40, 200, 500, 3000][t as usize % 4];
             for _ in 0..3 {
                 nodes.push(Snapped {
-                    x: (c[0] + next(reach)) as i32,
-                    y: (c[1] + next(reach)) as i32,
-                    z: next(1200) as f32 / 1000.0,
+                    x: (c[0] + rng.within(reach)) as i32,
+                    y: (c[1] + rng.within(reach)) as i32,
+                    z: rng.within(1200) as f32 / 1000.0,
                 });
             }
             let n = 3 * t;

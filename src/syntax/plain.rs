@@ -258,6 +258,7 @@ mod tests {
     use super::super::tree::{self, Origin};
     use super::*;
     use crate::syntax::Limits;
+    use crate::test_rng::TestRng;
 
     /// The run as the split's roxmltree path reads it: inside a wrapper,
     /// whitespace only between the elements, nesting within `max_depth`.
@@ -355,29 +356,13 @@ mod tests {
     #[test]
     fn edited_runs_it_accepts_are_what_roxmltree_reads() {
         let alphabet: &[u8] = b"<>/=\"' \t\n\r&!?:-._aZ09x\x01";
-        let mut state = 0x2545_f491_4f6c_dd1d_u64;
-        let mut next = |bound: usize| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % bound as u64) as usize
-        };
+        let mut rng = TestRng::new(0x2545_f491_4f6c_dd1d);
         let (mut accepted, mut refused_by_both) = (0, 0);
         for _ in 0..8_000 {
-            let mut bytes = PLAIN.as_bytes().to_vec();
-            for _ in 0..1 + next(3) {
-                let at = next(bytes.len());
-                let byte = alphabet[next(alphabet.len())];
-                match next(3) {
-                    0 => bytes.insert(at, byte),
-                    1 => bytes[at] = byte,
-                    _ => drop(bytes.remove(at)),
-                }
-            }
-            let Ok(text) = String::from_utf8(bytes) else {
+            let Some(text) = rng.edit(PLAIN, alphabet, 3) else {
                 continue;
             };
-            let depth = 3 + next(3);
+            let depth = 3 + rng.below(3);
             match plain(&text, depth) {
                 Some(read) => {
                     accepted += 1;

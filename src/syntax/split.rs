@@ -643,6 +643,7 @@ fn root_end(text: &str, pos: usize, root_name: &str) -> Option<usize> {
 mod tests {
     use super::*;
     use crate::span::SourceFile;
+    use crate::test_rng::TestRng;
 
     /// The children as a whole-file parse builds them.
     fn whole_children(text: &str) -> Vec<Element<'_>> {
@@ -757,28 +758,12 @@ mod tests {
         }
         plain.push_str("\n</geometry>\n");
         let alphabet: &[u8] = b"<>/=\"' \t\n&!?-[]:_aZ09";
-        let mut state = 0x9e37_79b9_7f4a_7c15_u64;
-        let mut next = |bound: usize| {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            (state % bound as u64) as usize
-        };
+        let mut rng = TestRng::new(0x9e37_79b9_7f4a_7c15);
         // Runs of a few children each, so that edits fall in several runs.
         let limits = Limits::default();
         let (mut split_and_read, mut refused) = (0, 0);
         for _ in 0..3_000 {
-            let mut bytes = plain.clone().into_bytes();
-            for _ in 0..1 + next(2) {
-                let at = next(bytes.len());
-                let byte = alphabet[next(alphabet.len())];
-                match next(3) {
-                    0 => bytes.insert(at, byte),
-                    1 => bytes[at] = byte,
-                    _ => drop(bytes.remove(at)),
-                }
-            }
-            let Ok(text) = String::from_utf8(bytes) else {
+            let Some(text) = rng.edit(&plain, alphabet, 2) else {
                 continue;
             };
             let whole = roxmltree::Document::parse_with_options(&text, options(&limits)).ok();
