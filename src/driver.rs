@@ -263,21 +263,21 @@ fn read_checked<'s>(
         );
         return Ok(None);
     }
-    if let Some(version) = root.attribute("version") {
-        if version.value.trim() != "1" {
-            diags.push(
-                Diagnostic::new(
-                    Code::UnsupportedVersion,
-                    version.value_span,
-                    format!(
-                        "format version \"{}\" is not supported; this geomc reads version 1",
-                        version.value
-                    ),
-                )
-                .with_help("set version=\"1\""),
-            );
-            return Ok(None);
-        }
+    if let Some(version) = root.attribute("version")
+        && version.value.trim() != "1"
+    {
+        diags.push(
+            Diagnostic::new(
+                Code::UnsupportedVersion,
+                version.value_span,
+                format!(
+                    "format version \"{}\" is not supported; this geomc reads version 1",
+                    version.value
+                ),
+            )
+            .with_help("set version=\"1\""),
+        );
+        return Ok(None);
     }
     read_document(source, parsed, root, options, diags).map(Some)
 }

@@ -202,13 +202,13 @@ impl Report {
 
     pub fn render_json(&self, model: &Model, matrices: bool) -> String {
         let mut value = serde_json::to_value(self).unwrap_or_default();
-        if matrices {
-            if let (Some(obj), Ok(m)) = (
+        if matrices
+            && let (Some(obj), Ok(m)) = (
                 value.as_object_mut(),
                 serde_json::to_value(IncidenceMatrices::of(model)),
-            ) {
-                obj.insert("matrices".into(), m);
-            }
+            )
+        {
+            obj.insert("matrices".into(), m);
         }
         serde_json::to_string_pretty(&value).unwrap_or_default()
     }

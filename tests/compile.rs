@@ -49,10 +49,10 @@ fn every_valid_fixture_compiles_to_every_format() {
                 continue;
             }
         };
-        if !mesh.subdomains.is_empty() {
-            if let Err(e) = sanity_check(&mesh) {
-                failures.push(format!("{}: {e}", path.display()));
-            }
+        if !mesh.subdomains.is_empty()
+            && let Err(e) = sanity_check(&mesh)
+        {
+            failures.push(format!("{}: {e}", path.display()));
         }
         let stem = path.file_stem().and_then(|s| s.to_str()).unwrap_or("x");
         // Writers reached by file ending (MSH 2.2 only by name, `--to msh22`).

@@ -93,13 +93,13 @@ pub fn load_with_section(
     let Some(model) = model.filter(|_| !diagnostics.has_errors()) else {
         return (messages, Err(EXIT_INVALID));
     };
-    if let Some(n) = cells {
-        if !(1..=1024).contains(&n) {
-            messages.push_str(&format!(
+    if let Some(n) = cells
+        && !(1..=1024).contains(&n)
+    {
+        messages.push_str(&format!(
                 "geomc: --cells {n}: give a whole number from 1 to 1024 (the grid holds (n + 1)³ samples of 8 bytes)\n"
             ));
-            return (messages, Err(EXIT_USAGE));
-        }
+        return (messages, Err(EXIT_USAGE));
     }
     let grid = cells.map_or(model.geom.cells, |n| [n; 3]);
     if let Err(d) = super::limits::check_grid(grid, limits.budget.max_grid_cells) {
@@ -127,26 +127,26 @@ pub fn load_with_section(
         return (messages, Err(EXIT_INVALID));
     }
     let mut mesh = surface_to_mesh(&surface, model.name(), model.geom.min, model.geom.max);
-    if let Some(plane) = section {
-        if !add_section(
+    if let Some(plane) = section
+        && !add_section(
             &mut mesh,
             &surface.positions,
             &surface.triangles,
             model.name(),
             plane,
-        ) && !quiet
-        {
-            let d = Diagnostic::new(
-                Code::ImplicitSectionEmpty,
-                None,
-                format!(
-                    "the section plane does not cut the surface of '{}'",
-                    model.name()
-                ),
-            )
-            .with_help("move the --section plane into the solid's bounding box, or drop --section");
-            messages.push_str(&render_human(&source, &d));
-        }
+        )
+        && !quiet
+    {
+        let d = Diagnostic::new(
+            Code::ImplicitSectionEmpty,
+            None,
+            format!(
+                "the section plane does not cut the surface of '{}'",
+                model.name()
+            ),
+        )
+        .with_help("move the --section plane into the solid's bounding box, or drop --section");
+        messages.push_str(&render_human(&source, &d));
     }
     (messages, Ok((mesh, surface.triangles.len())))
 }

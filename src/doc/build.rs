@@ -258,15 +258,15 @@ impl Builder<'_> {
                 }
             }
             _ => {
-                if let Some(kind) = self.object_kind(e) {
-                    if let Some(name) = self.name(e) {
-                        doc.objects.push(Object {
-                            name,
-                            cs: self.reference(e, "cs").map(Box::new),
-                            kind,
-                            span: e.name_span,
-                        });
-                    }
+                if let Some(kind) = self.object_kind(e)
+                    && let Some(name) = self.name(e)
+                {
+                    doc.objects.push(Object {
+                        name,
+                        cs: self.reference(e, "cs").map(Box::new),
+                        kind,
+                        span: e.name_span,
+                    });
                 }
             }
         }
@@ -614,10 +614,10 @@ impl Builder<'_> {
         // Most numbers of large files are plain literals: their value is made
         // here, without the expression parser's trim, tree and the source
         // comparison below (the same `Number` the parser's path gives).
-        if self.limits.max_nodes >= 1 {
-            if let Some(value) = plain_literal(&attr.value) {
-                return Number::plain(value, attr.value_span);
-            }
+        if self.limits.max_nodes >= 1
+            && let Some(value) = plain_literal(&attr.value)
+        {
+            return Number::plain(value, attr.value_span);
         }
         // Offsets into the value map onto the source only when the raw text
         // equals the value (no entity references); otherwise point at the whole value.
@@ -871,19 +871,20 @@ pub fn parse_ref(text: &str, span: Span) -> Ref {
     let mut name = text.to_string();
     let mut index = None;
     let mut entity = None;
-    if let Some(dot) = name.rfind('.') {
-        if dot > 0 && dot + 1 < name.len() && !name[dot + 1..].contains(']') {
-            entity = Some(name[dot + 1..].into());
-            name.truncate(dot);
-        }
+    if let Some(dot) = name.rfind('.')
+        && dot > 0
+        && dot + 1 < name.len()
+        && !name[dot + 1..].contains(']')
+    {
+        entity = Some(name[dot + 1..].into());
+        name.truncate(dot);
     }
-    if name.ends_with(']') {
-        if let Some(open) = name.rfind('[') {
-            if let Ok(i) = name[open + 1..name.len() - 1].trim().parse::<usize>() {
-                index = Some(i);
-                name.truncate(open);
-            }
-        }
+    if name.ends_with(']')
+        && let Some(open) = name.rfind('[')
+        && let Ok(i) = name[open + 1..name.len() - 1].trim().parse::<usize>()
+    {
+        index = Some(i);
+        name.truncate(open);
     }
     Ref {
         name,

@@ -126,25 +126,25 @@ fn check_attributes(element: &Element, rule: &Rule, diags: &mut Diagnostics) {
         match found {
             Some((k, spec)) => {
                 seen |= 1u64.checked_shl(k as u32).unwrap_or(0);
-                if let AttrKind::Enum(values) = spec.kind {
-                    if !values.contains(&attr.value.trim()) {
-                        let listed = values
-                            .iter()
-                            .map(|v| format!("\"{v}\""))
-                            .collect::<Vec<_>>()
-                            .join(", ");
-                        diags.push(
-                            Diagnostic::new(
-                                Code::InvalidValue,
-                                attr.value_span,
-                                format!(
-                                    "{}=\"{}\" on <{}> is not one of {listed}",
-                                    attr.name, attr.value, element.name
-                                ),
-                            )
-                            .with_help(format!("use one of {listed}")),
-                        );
-                    }
+                if let AttrKind::Enum(values) = spec.kind
+                    && !values.contains(&attr.value.trim())
+                {
+                    let listed = values
+                        .iter()
+                        .map(|v| format!("\"{v}\""))
+                        .collect::<Vec<_>>()
+                        .join(", ");
+                    diags.push(
+                        Diagnostic::new(
+                            Code::InvalidValue,
+                            attr.value_span,
+                            format!(
+                                "{}=\"{}\" on <{}> is not one of {listed}",
+                                attr.name, attr.value, element.name
+                            ),
+                        )
+                        .with_help(format!("use one of {listed}")),
+                    );
                 }
                 if spec.kind == AttrKind::Name && attr.value.trim().is_empty() {
                     diags.push(
@@ -288,23 +288,22 @@ fn check_children<'h>(
                     .with_help(format!("add {} of {options}", min - n)),
                 );
             }
-            if let Some(max) = max {
-                if n > max {
-                    if let Some(extra) = known.get(max as usize) {
-                        diags.push(
-                            Diagnostic::new(
-                                Code::DuplicateElement,
-                                extra.name_span,
-                                format!(
-                                    "<{}> may hold at most {max} child element{}, found {n}",
-                                    element.name,
-                                    plural(max)
-                                ),
-                            )
-                            .with_help("remove the extra elements, or combine them with <union>"),
-                        );
-                    }
-                }
+            if let Some(max) = max
+                && n > max
+                && let Some(extra) = known.get(max as usize)
+            {
+                diags.push(
+                    Diagnostic::new(
+                        Code::DuplicateElement,
+                        extra.name_span,
+                        format!(
+                            "<{}> may hold at most {max} child element{}, found {n}",
+                            element.name,
+                            plural(max)
+                        ),
+                    )
+                    .with_help("remove the extra elements, or combine them with <union>"),
+                );
             }
         }
         Content::Forms(forms) => check_forms(element, known, forms, diags),
@@ -373,29 +372,29 @@ fn check_order(element: &Element, known: &[Head], children: &[Child], diags: &mu
         let Some(p) = position(child.name) else {
             continue;
         };
-        if let Some((q, previous)) = latest {
-            if p < q {
-                diags.push(
-                    Diagnostic::new(
-                        Code::OutOfOrder,
-                        child.name_span,
-                        format!(
-                            "<{}> must come before <{}> inside <{}>",
-                            child.name, previous.name, element.name
-                        ),
-                    )
-                    .with_help(format!(
-                        "order the children of <{}> as {}",
-                        element.name,
-                        children
-                            .iter()
-                            .map(|c| format!("<{}>", c.rule.name))
-                            .collect::<Vec<_>>()
-                            .join(", ")
-                    )),
-                );
-                continue;
-            }
+        if let Some((q, previous)) = latest
+            && p < q
+        {
+            diags.push(
+                Diagnostic::new(
+                    Code::OutOfOrder,
+                    child.name_span,
+                    format!(
+                        "<{}> must come before <{}> inside <{}>",
+                        child.name, previous.name, element.name
+                    ),
+                )
+                .with_help(format!(
+                    "order the children of <{}> as {}",
+                    element.name,
+                    children
+                        .iter()
+                        .map(|c| format!("<{}>", c.rule.name))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                )),
+            );
+            continue;
         }
         latest = Some((p, child));
     }

@@ -64,10 +64,10 @@ pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
 
 /// [`parse`] with the size bounds given.
 pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
-    if limits.max_nodes >= 1 {
-        if let Some(expr) = plain_number(text, base) {
-            return Ok(expr);
-        }
+    if limits.max_nodes >= 1
+        && let Some(expr) = plain_number(text, base)
+    {
+        return Ok(expr);
     }
     parse_tokens(text, base, limits)
 }

@@ -233,10 +233,10 @@ pub fn polygonize_labels(solids: &[Solid], grid: &Grid) -> Interfaces {
         let mut fs: Vec<usize> = Vec::new();
         for (x, &a) in ls.iter().enumerate() {
             for &b in &ls[x + 1..] {
-                if let Some(f) = deciding_index(a, b) {
-                    if !fs.contains(&f) {
-                        fs.push(f);
-                    }
+                if let Some(f) = deciding_index(a, b)
+                    && !fs.contains(&f)
+                {
+                    fs.push(f);
                 }
             }
         }

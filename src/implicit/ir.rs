@@ -145,10 +145,10 @@ impl Ctx {
         if let Some(v) = self.const_value(a) {
             return self.constant(op.apply(v));
         }
-        if op == Unary::Neg {
-            if let Node::Unary(Unary::Neg, inner) = self.nodes[a as usize] {
-                return inner;
-            }
+        if op == Unary::Neg
+            && let Node::Unary(Unary::Neg, inner) = self.nodes[a as usize]
+        {
+            return inner;
         }
         self.intern(Node::Unary(op, a))
     }

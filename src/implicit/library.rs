@@ -269,7 +269,7 @@ fn polygon(ctx: &mut Ctx, sys: RSystem, x: NodeId, y: NodeId, vertices: &[[NodeI
 }
 
 fn convex_polygon(ctx: &mut Ctx, sys: RSystem, a: &[NodeId]) -> Result<NodeId, String> {
-    if a.len() % 2 != 0 {
+    if !a.len().is_multiple_of(2) {
         return Err(format!(
             "takes x, y and pairs of vertex coordinates, got {} arguments (odd)",
             a.len()

@@ -243,7 +243,7 @@ mod tests {
     fn oe(e: u32) -> OrientedEdge {
         OrientedEdge {
             edge: EdgeId(e),
-            forward: e % 2 == 0,
+            forward: e.is_multiple_of(2),
         }
     }
 

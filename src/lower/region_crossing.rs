@@ -453,10 +453,11 @@ fn place_crossings(
     }
     for v in contour_cuts {
         let at = model.vertex(v).position;
-        if let Some((piece, a, b)) = nearest_piece(model, fr, at) {
-            if v != a && v != b {
-                split_piece(model, source_map, piece, v);
-            }
+        if let Some((piece, a, b)) = nearest_piece(model, fr, at)
+            && v != a
+            && v != b
+        {
+            split_piece(model, source_map, piece, v);
         }
     }
 }

@@ -260,10 +260,10 @@ impl Welder {
             if theirs != self.scratch {
                 continue;
             }
-            if let Some(p) = self.face_samples.get(&FaceId(id)) {
-                if (p - sample).norm() <= self.tol {
-                    return (FaceId(id), false);
-                }
+            if let Some(p) = self.face_samples.get(&FaceId(id))
+                && (p - sample).norm() <= self.tol
+            {
+                return (FaceId(id), false);
             }
         }
         let id = FaceId(model.faces.len() as u32);

@@ -138,10 +138,10 @@ pub fn build<'a>(mesh: &'a Mesh, options: &RenderOptions, camera: &Camera) -> Sc
                     cap: false,
                 });
                 for &f in &frag.faces {
-                    if let Some(slot) = of_face.get_mut(f as usize) {
-                        if *slot == HIDDEN {
-                            *slot = g;
-                        }
+                    if let Some(slot) = of_face.get_mut(f as usize)
+                        && *slot == HIDDEN
+                    {
+                        *slot = g;
                     }
                 }
             }

@@ -712,16 +712,17 @@ impl<'a> Resolver<'a> {
             (Geometry::Group(members), None) => Some((i, Geometry::Group(members))),
             (g, None) => Some((i, g)),
             (g, Some(k)) => {
-                if let Geometry::Points { points, partial } = &g {
-                    if k >= 1 && k <= points.len() {
-                        return Some((
-                            i,
-                            Geometry::Points {
-                                points: vec![points[k - 1]],
-                                partial: vec![partial[k - 1]],
-                            },
-                        ));
-                    }
+                if let Geometry::Points { points, partial } = &g
+                    && k >= 1
+                    && k <= points.len()
+                {
+                    return Some((
+                        i,
+                        Geometry::Points {
+                            points: vec![points[k - 1]],
+                            partial: vec![partial[k - 1]],
+                        },
+                    ));
                 }
                 self.diags.push(
                     Diagnostic::new(

@@ -157,10 +157,10 @@ impl<'d> Values<'d> {
         let expr = number.expr()?;
         // Most numbers of large files are plain: no name to look up, and
         // the evaluator would return the value as it is when finite.
-        if let expr::ExprKind::Number(value) = expr.kind {
-            if value.is_finite() {
-                return Some(value);
-            }
+        if let expr::ExprKind::Number(value) = expr.kind
+            && value.is_finite()
+        {
+            return Some(value);
         }
         self.eval_frozen(&expr, ctx, used, diags)
     }

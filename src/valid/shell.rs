@@ -663,10 +663,11 @@ fn check_orientation(
     seam_conflict.clear();
     seam_conflict.resize(n, None);
     for (edge, list) in uses.lists() {
-        if let [(_, a), (_, b)] = list {
-            if a.entry == b.entry && a.forward == b.forward {
-                seam_conflict[a.entry].get_or_insert(edge);
-            }
+        if let [(_, a), (_, b)] = list
+            && a.entry == b.entry
+            && a.forward == b.forward
+        {
+            seam_conflict[a.entry].get_or_insert(edge);
         }
     }
     // (neighbour, whether the flips must differ, shared edge), each face's

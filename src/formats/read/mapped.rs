@@ -22,10 +22,11 @@ impl FileBytes {
     pub fn open(path: &Path) -> std::io::Result<FileBytes> {
         let file = File::open(path)?;
         let meta = file.metadata()?;
-        if meta.is_file() && meta.len() > 0 {
-            if let Ok(map) = map(&file) {
-                return Ok(FileBytes::Mapped(map));
-            }
+        if meta.is_file()
+            && meta.len() > 0
+            && let Ok(map) = map(&file)
+        {
+            return Ok(FileBytes::Mapped(map));
         }
         std::fs::read(path).map(FileBytes::Read)
     }

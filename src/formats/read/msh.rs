@@ -962,11 +962,11 @@ impl<'a> Reader<'a> {
                 self.multi_physical += n;
             }
             let group = self.group_for(dim, physicals.first().copied(), entity);
-            if let Kind::Triangle | Kind::Quad = kind {
-                if let Some(g) = self.b.groups.get_mut(group) {
-                    g.triangles
-                        .reserve(n * if kind == Kind::Quad { 2 } else { 1 });
-                }
+            if let Kind::Triangle | Kind::Quad = kind
+                && let Some(g) = self.b.groups.get_mut(group)
+            {
+                g.triangles
+                    .reserve(n * if kind == Kind::Quad { 2 } else { 1 });
             }
             if self.binary && self.binary_elements(n, k, kind, name, group)? {
                 read += n;

@@ -308,17 +308,17 @@ impl Reader<'_> {
                 9 | 23 | 28 => Some(4),
                 _ => None,
             };
-            if let Some(k) = need {
-                if nodes.len() < k {
-                    return Err(err(
-                        ca,
-                        Code::MeshCountMismatch,
-                        format!(
-                            "cell {i} of type {t} has {} points, it needs {k}",
-                            nodes.len()
-                        ),
-                    ));
-                }
+            if let Some(k) = need
+                && nodes.len() < k
+            {
+                return Err(err(
+                    ca,
+                    Code::MeshCountMismatch,
+                    format!(
+                        "cell {i} of type {t} has {} points, it needs {k}",
+                        nodes.len()
+                    ),
+                ));
             }
             let Some(group) = b.groups.get_mut(g) else {
                 continue;
@@ -559,13 +559,11 @@ fn group_name(
     if key.0 == usize::MAX {
         return "vtu".to_string();
     }
-    if geomc {
-        if let Some(&(_, label, kind)) = GEOMC_ARRAYS.get(key.0) {
-            if let Some(name) = names.get(&kind).and_then(|m| m.get(&key.1)) {
-                return name.clone();
-            }
-            return format!("{label} {}", key.1);
+    if geomc && let Some(&(_, label, kind)) = GEOMC_ARRAYS.get(key.0) {
+        if let Some(name) = names.get(&kind).and_then(|m| m.get(&key.1)) {
+            return name.clone();
         }
+        return format!("{label} {}", key.1);
     }
     let array = generic.unwrap_or("group");
     if key.0 == VOLUME_KEY {

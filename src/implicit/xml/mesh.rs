@@ -94,16 +94,16 @@ pub fn append(
         let shift = |t: Vec<[u32; 3]>| t.into_iter().map(|t| t.map(|i| i + base)).collect();
         push_boundary(mesh, index, &sub.name, shift(rest), shift(caps));
         out.triangles.push(surface.triangles.len());
-        if let Some(plane) = section {
-            if !add_section(
+        if let Some(plane) = section
+            && !add_section(
                 mesh,
                 &surface.positions,
                 &surface.triangles,
                 &sub.name,
                 plane,
-            ) {
-                out.missed_by_section.push(sub.name.clone());
-            }
+            )
+        {
+            out.missed_by_section.push(sub.name.clone());
         }
     }
     out

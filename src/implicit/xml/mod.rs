@@ -394,13 +394,13 @@ fn subdomain_solid(
     defs: &HashMap<String, Def>,
     diags: &mut Diagnostics,
 ) -> Option<ImplicitSolid> {
-    if let Some(r) = root.attribute("ref").filter(|_| root.name == "solid") {
-        if let Some(Def::Samples(grid, values)) = defs.get(r.value.trim()) {
-            return Some(ImplicitSolid::Samples {
-                grid: *grid,
-                values: values.clone(),
-            });
-        }
+    if let Some(r) = root.attribute("ref").filter(|_| root.name == "solid")
+        && let Some(Def::Samples(grid, values)) = defs.get(r.value.trim())
+    {
+        return Some(ImplicitSolid::Samples {
+            grid: *grid,
+            values: values.clone(),
+        });
     }
     let mut ctx = Ctx::new();
     let (root, geom) = combine(root, defs, &mut ctx, diags)?;
