@@ -10,6 +10,9 @@ use super::camera::{Camera, above, below};
 use super::raster::{Projected, Snapped};
 use rayon::prelude::*;
 
+#[cfg(target_arch = "x86_64")]
+mod avx2;
+
 /// Nodes per unit of parallel work.
 const BLOCK: usize = 1 << 13;
 /// Far outside the picture only the clamped bounding box matters.
@@ -107,9 +110,14 @@ impl NodeMap {
     ) {
         assert!(snapped.len() == points.len() && xy_f.len() == points.len());
         #[cfg(target_arch = "x86_64")]
-        // SAFETY: SSE2 is part of every x86-64.
-        unsafe {
-            self.block_sse2(points, snapped, xy_f)
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                // SAFETY: the CPU has AVX2 (checked just above).
+                unsafe { self.block_avx2(points, snapped, xy_f) };
+                return;
+            }
+            // SAFETY: SSE2 is part of every x86-64.
+            unsafe { self.block_sse2(points, snapped, xy_f) }
         }
         #[cfg(not(target_arch = "x86_64"))]
         for ((q, s), f) in points.iter().zip(snapped).zip(xy_f) {
@@ -119,6 +127,8 @@ impl NodeMap {
         }
     }
 
+    /// The node-by-node lanes: [`NodeMap::block_avx2`]'s remainder, and
+    /// the path of processors without AVX2.
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "sse2")]
     fn block_sse2(
@@ -207,6 +217,7 @@ fn snap(v: f64) -> i32 {
 mod tests {
     use super::super::camera::View;
     use super::*;
+    use std::mem::MaybeUninit;
 
     /// Points whose products round, far outside the picture, on the sample
     /// grid's halves, negative zeros and NaN.
@@ -270,6 +281,60 @@ mod tests {
             assert!(inside >= 4000, "{inside}");
             assert_eq!(proj.snapped[4000].x.abs(), (LIMIT * 16.0) as i32);
             assert_eq!(proj.snapped[4004].y, 0, "NaN snaps to 0");
+        }
+    }
+
+    /// Projects `points` through one of `NodeMap`'s block paths.
+    fn by_block(
+        map: NodeMap,
+        points: &[[f64; 3]],
+        path: fn(NodeMap, &[[f64; 3]], &mut [MaybeUninit<Snapped>], &mut [MaybeUninit<[f32; 2]>]),
+    ) -> (Vec<Snapped>, Vec<[f32; 2]>) {
+        let mut snapped = vec![MaybeUninit::new(Snapped::default()); points.len()];
+        let mut xy_f = vec![MaybeUninit::new([0.0f32; 2]); points.len()];
+        path(map, points, &mut snapped, &mut xy_f);
+        // SAFETY: every slot was initialised above (and written again).
+        let read = |v: Vec<MaybeUninit<Snapped>>| v.into_iter().map(|s| unsafe { s.assume_init() });
+        let xy = xy_f.into_iter().map(|f| unsafe { f.assume_init() });
+        (read(snapped).collect(), xy.collect())
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[test]
+    fn four_node_lanes_project_as_the_scalar_code_bit_for_bit() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let points = awkward_points();
+        for (view, ss) in [(View::ISO, 2), (View::TOP, 3), (View::FRONT, 1)] {
+            let camera = Camera::fit(view, &points[..4000], 640, 480);
+            let (lo, hi) = depth_range(&points, &camera);
+            let map = NodeMap::new(&camera, ss as f64, lo, hi - lo);
+            // Each shift puts the far, NaN and −0 points in other lanes
+            // and leaves another remainder for the node-by-node lanes.
+            for shift in 0..4 {
+                let part = &points[shift..];
+                let avx2 = |m: NodeMap, p: &[[f64; 3]], s: &mut [_], f: &mut [_]| unsafe {
+                    m.block_avx2(p, s, f)
+                };
+                let sse2 = |m: NodeMap, p: &[[f64; 3]], s: &mut [_], f: &mut [_]| unsafe {
+                    m.block_sse2(p, s, f)
+                };
+                let (four, four_xy) = by_block(map, part, avx2);
+                let (two, two_xy) = by_block(map, part, sse2);
+                for (i, q) in part.iter().enumerate() {
+                    let (want, want_xy) = scalar_node(&camera, ss as f64, lo, hi - lo, *q);
+                    for (got, got_xy) in [(four[i], four_xy[i]), (two[i], two_xy[i])] {
+                        assert_eq!((got.x, got.y), (want.x, want.y), "node {i}");
+                        assert_eq!(got.z.to_bits(), want.z.to_bits(), "node {i}");
+                        assert_eq!(got_xy.map(f32::to_bits), want_xy.map(f32::to_bits));
+                    }
+                }
+                // The NaN coordinates reach the lanes: x, y snap to 0.
+                let nan = 4003 - shift;
+                assert_eq!((four[nan].x, four[nan].y), (0, 0));
+                assert!(four[nan].z.is_nan());
+            }
         }
     }
 
