@@ -240,7 +240,7 @@ pub fn build<'a>(mesh: &'a Mesh, options: &RenderOptions, camera: &Camera) -> Sc
         groups,
         ..Scene::default()
     };
-    shade(&mut scene, options.shading, camera, spans.as_deref());
+    shade(&mut scene, options.shading, camera, spans.as_ref());
     if let Some(section) = options.section {
         cut(&mut scene, section);
     }
@@ -260,7 +260,7 @@ type Borrowed<'a> = (
     Cow<'a, [[u32; 3]]>,
     Vec<u32>,
     Option<u32>,
-    Option<Vec<(usize, usize)>>,
+    Option<smooth::NodeSpans<'a>>,
 );
 
 /// The mesh's triangles grouped by face in face order, with their face; those
@@ -273,7 +273,7 @@ fn triangles(mesh: &Mesh) -> Borrowed<'_> {
     let mut filled = (mesh.faces.iter().enumerate()).filter(|(_, f)| !f.triangles.is_empty());
     if let (Some((f, face)), None) = (filled.next(), filled.next()) {
         let spans = smooth::node_spans(&face.triangles);
-        if spans.iter().all(|&(_, hi)| hi <= n) {
+        if spans.all_below(&face.triangles, n) {
             return (
                 Cow::Borrowed(&face.triangles),
                 Vec::new(),
@@ -297,7 +297,7 @@ fn triangles(mesh: &Mesh) -> Borrowed<'_> {
 /// Light per corner: flat gives each triangle one slot; smooth averages the
 /// area-weighted normals of a node within one face (creases between faces
 /// stay sharp).
-fn shade(scene: &mut Scene, shading: Shading, camera: &Camera, spans: Option<&[(usize, usize)]>) {
+fn shade(scene: &mut Scene, shading: Shading, camera: &Camera, spans: Option<&smooth::NodeSpans>) {
     let light = light_direction(camera);
     match shading {
         Shading::Flat => {

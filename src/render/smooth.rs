@@ -52,7 +52,7 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     tri_face: &[u32],
-    spans: Option<&[(usize, usize)]>,
+    given: Option<&NodeSpans>,
     finish: impl Fn(&[Sum], &mut [T]) + Sync,
 ) -> (Option<Vec<[u32; 3]>>, Vec<T>) {
     let n = points.len();
@@ -65,8 +65,9 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
     let corner_slots: &[[u32; 3]] = own_slots.as_deref().unwrap_or(tris);
     // Each chunk's node range over the corners of its first faces.
     let made;
-    let spans: &[(usize, usize)] = match spans {
-        Some(given) if own_slots.is_none() && given.len() == tris.len().div_ceil(CHUNK) => given,
+    let given = given.filter(|g| own_slots.is_none() && g.all_below(tris, n));
+    let spans: &[(usize, usize)] = match given {
+        Some(given) => given.spans(),
         _ => {
             made = corner_slots
                 .par_chunks(CHUNK)
@@ -79,7 +80,7 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
         .iter()
         .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
     if !local {
-        let sums = serial_sums(points, tris, corner_slots, n + extra.len());
+        let sums = serial_sums(points, tris, corner_slots, n + extra.len(), given);
         let mut out = vec![T::default(); sums.len()];
         (out.par_chunks_mut(BLOCK))
             .zip(sums.par_chunks(BLOCK))
@@ -146,19 +147,41 @@ fn span(chunk: &[[u32; 3]], n: usize) -> (usize, usize) {
 }
 
 /// Per [`CHUNK`] of triangles, the range of the nodes its corners name,
-/// over all of them (`hi` is past the largest): a triangle names a node
-/// past `n` exactly when some chunk's `hi > n`. For triangles that name
-/// none, these are the spans [`per_slot`] sums one face over.
-pub fn node_spans(tris: &[[u32; 3]]) -> Vec<(usize, usize)> {
+/// over all of them (`hi` is past the largest), kept with the triangles
+/// they were taken from: only [`node_spans`] makes them, so they are those
+/// triangles' spans (borrowed, the triangles cannot change meanwhile).
+pub struct NodeSpans<'t> {
+    tris: &'t [[u32; 3]],
+    spans: Vec<(usize, usize)>,
+}
+
+impl NodeSpans<'_> {
+    pub fn spans(&self) -> &[(usize, usize)] {
+        &self.spans
+    }
+
+    /// Whether these are the spans of `tris` (the same slice) and every
+    /// corner names a node below `n`: a triangle names a node past `n`
+    /// exactly when some chunk's `hi > n`.
+    pub fn all_below(&self, tris: &[[u32; 3]], n: usize) -> bool {
+        std::ptr::eq(self.tris, tris) && self.spans.iter().all(|&(_, hi)| hi <= n)
+    }
+}
+
+/// The [`NodeSpans`] of `tris`. For triangles that name no node past the
+/// points, these are the spans [`per_slot`] sums one face over.
+pub fn node_spans(tris: &[[u32; 3]]) -> NodeSpans<'_> {
     // A plain minimum and maximum over the flat ids (no filter: every id
     // counts), which the compiler turns into vector code.
-    tris.par_chunks(CHUNK)
+    let spans = tris
+        .par_chunks(CHUNK)
         .map(|chunk| {
             let ids = chunk.as_flattened().iter();
             let (lo, hi) = ids.fold((u32::MAX, 0), |(lo, hi), &s| (lo.min(s), hi.max(s)));
             (lo as usize, hi as usize + 1)
         })
-        .collect()
+        .collect();
+    NodeSpans { tris, spans }
 }
 
 /// The slots of a mesh of several faces, and the (face, node) pairs of the
@@ -291,9 +314,14 @@ mod tests {
         // A stray id far out in the second chunk, and the last chunk short.
         tris[CHUNK + 5][1] = 4_000_000_000;
         tris.truncate(2 * CHUNK + 7);
-        let spans = node_spans(&tris);
+        let made = node_spans(&tris);
+        let spans = made.spans();
         assert_eq!(spans.len(), 3);
-        for (chunk, &got) in tris.chunks(CHUNK).zip(&spans) {
+        // The stray id is past the nodes; the spans are only these triangles'.
+        assert!(!made.all_below(&tris, 4_000_000_000));
+        assert!(made.all_below(&tris, 4_000_000_001));
+        assert!(!made.all_below(&tris.clone(), 4_000_000_001));
+        for (chunk, &got) in tris.chunks(CHUNK).zip(spans) {
             let ids = chunk.iter().flatten().map(|&i| i as usize);
             let want = (ids.clone().min().unwrap_or(0), ids.max().unwrap_or(0) + 1);
             assert_eq!(got, want);
