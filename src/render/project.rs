@@ -284,11 +284,15 @@ mod tests {
         }
     }
 
-    /// Projects `points` through one of `NodeMap`'s block paths.
+    /// One of `NodeMap`'s block paths.
+    type BlockPath =
+        fn(NodeMap, &[[f64; 3]], &mut [MaybeUninit<Snapped>], &mut [MaybeUninit<[f32; 2]>]);
+
+    /// Projects `points` through `path`.
     fn by_block(
         map: NodeMap,
         points: &[[f64; 3]],
-        path: fn(NodeMap, &[[f64; 3]], &mut [MaybeUninit<Snapped>], &mut [MaybeUninit<[f32; 2]>]),
+        path: BlockPath,
     ) -> (Vec<Snapped>, Vec<[f32; 2]>) {
         let mut snapped = vec![MaybeUninit::new(Snapped::default()); points.len()];
         let mut xy_f = vec![MaybeUninit::new([0.0f32; 2]); points.len()];
