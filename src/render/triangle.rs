@@ -23,6 +23,15 @@ pub const SUB: i64 = 16;
 /// mesh.
 const AHEAD: usize = 8;
 
+/// Whether the processor has the AVX-512 instructions (F, DQ, VL) the
+/// vector-lane paths of the rasteriser use.
+pub fn lanes_available() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    return lanes::available();
+    #[cfg(not(target_arch = "x86_64"))]
+    false
+}
+
 /// Draws triangles `ids` of each chunk of `chunks` (corners `tris`, nodes
 /// `nodes`) into rows `ys` of the z-buffer (stored from `rows[0]`, rows
 /// `width` samples long): each sample inside a triangle keeps the smaller
@@ -40,10 +49,7 @@ pub unsafe fn draw_chunks<'a>(
     nodes: &[Snapped],
     chunks: impl Iterator<Item = &'a [u32]>,
 ) {
-    #[cfg(target_arch = "x86_64")]
-    let lanes = lanes::available();
-    #[cfg(not(target_arch = "x86_64"))]
-    let lanes = false;
+    let lanes = lanes_available();
     // SAFETY: the caller's promise.
     unsafe { draw_chunks_by(lanes, rows, width, ys, tris, nodes, chunks) }
 }
