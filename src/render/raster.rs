@@ -6,7 +6,7 @@
 //! cracks) and the top-left rule decides which triangle owns a sample on one.
 
 use super::scene::{HIDDEN, Scene};
-use super::triangle::{self, SUB};
+use super::triangle::{self, Binned, SUB};
 use rayon::prelude::*;
 
 #[cfg(target_arch = "x86_64")]
@@ -93,11 +93,12 @@ fn sample_box(
     Some((x0, x1, y0, y1))
 }
 
-/// One chunk's binned triangles: per band, the ids it must draw and the
+/// One chunk's binned triangles: per band, the triangles it must draw (in
+/// order, with their corners) and the
 /// sample columns their boxes reach (`first..=last`; empty when `first >
 /// last`), so a band fills and resolves only the columns drawn on.
 pub struct ChunkBins {
-    pub ids: Vec<Vec<u32>>,
+    pub ids: Vec<Vec<Binned>>,
     pub cols: Vec<(u32, u32)>,
 }
 
@@ -176,7 +177,9 @@ fn bin_by(
                         if same_visible.is_none() && !visible_side(scene, tri as usize, back) {
                             continue;
                         }
-                        bins.push(tri, kept.x0[k], kept.x1[k], kept.y0[k], kept.y1[k]);
+                        let corners = [kept.a[k], kept.b[k], kept.c[k]];
+                        let binned = Binned { tri, corners };
+                        bins.push(binned, kept.x0[k], kept.x1[k], kept.y0[k], kept.y1[k]);
                     }
                 }
                 return ChunkBins {
@@ -198,7 +201,11 @@ fn bin_by(
                     continue;
                 }
                 if let Some((x0, x1, first, last)) = sample_box(&v, width, height) {
-                    bins.push(tri as u32, x0 as u32, x1 as u32, first as u32, last as u32);
+                    let binned = Binned {
+                        tri: tri as u32,
+                        corners: t,
+                    };
+                    bins.push(binned, x0 as u32, x1 as u32, first as u32, last as u32);
                 }
             }
             ChunkBins {
@@ -211,23 +218,23 @@ fn bin_by(
 
 /// One chunk's bins as they fill, with each sample row's band.
 struct Bins<'a> {
-    ids: Vec<Vec<u32>>,
+    ids: Vec<Vec<Binned>>,
     cols: Vec<(u32, u32)>,
     band_of: &'a [u32],
 }
 
 impl Bins<'_> {
-    /// Triangle `tri`, whose box spans sample columns `x0..=x1` and rows
+    /// Triangle `binned`, whose box spans sample columns `x0..=x1` and rows
     /// `first..=last`, into each band it reaches.
     #[inline(always)]
-    fn push(&mut self, tri: u32, x0: u32, x1: u32, first: u32, last: u32) {
+    fn push(&mut self, binned: Binned, x0: u32, x1: u32, first: u32, last: u32) {
         let from = self.band_of[first as usize] as usize;
         let to = self.band_of[last as usize] as usize;
         for (band, reach) in self.ids[from..=to]
             .iter_mut()
             .zip(&mut self.cols[from..=to])
         {
-            band.push(tri);
+            band.push(binned);
             *reach = (reach.0.min(x0), reach.1.max(x1));
         }
     }
@@ -235,7 +242,6 @@ impl Bins<'_> {
 
 /// Draws band `band` (sample rows `ys`, stored from `rows[0]`) from the bins.
 pub fn draw_band(
-    scene: &Scene,
     proj: &Projected,
     bins: &[ChunkBins],
     band: usize,
@@ -248,7 +254,7 @@ pub fn draw_band(
     assert!(ys.start <= ys.end && ys.len() * width <= rows.len());
     let chunks = bins.iter().map(|chunk| &chunk.ids[band][..]);
     // SAFETY: `rows` holds the band's samples (asserted above).
-    unsafe { triangle::draw_chunks(rows, width, ys, &scene.tris, &proj.snapped, chunks) };
+    unsafe { triangle::draw_chunks(rows, width, ys, &proj.snapped, chunks) };
 }
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
@@ -259,7 +265,7 @@ pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -
         .for_each(|(band, rows)| {
             let y0 = band * BAND;
             let y1 = (y0 + BAND).min(height);
-            draw_band(scene, proj, &bins, band, rows, width, y0..y1);
+            draw_band(proj, &bins, band, rows, width, y0..y1);
         });
     ZBuffer {
         width,
@@ -391,7 +397,8 @@ mod tests {
                 let binned: usize = (scalar.iter())
                     .flat_map(|chunk| chunk.ids.iter().map(Vec::len))
                     .sum();
-                let first = scalar[0].ids.iter().flatten().copied().collect::<Vec<_>>();
+                let first = scalar[0].ids.iter().flatten().map(|b| b.tri);
+                let first = first.collect::<Vec<_>>();
                 assert!(
                     binned > 10_000 && first.windows(2).any(|p| p[0] >= p[1]),
                     "{sides:?}, {band_rows} rows: {binned} binned, none in two bands"

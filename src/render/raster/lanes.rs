@@ -1,5 +1,5 @@
 //! Binning eight triangles at a time (AVX-512): their corner indices loaded
-//! from the chunk and spread to lanes by two permutes, each corner's snapped
+//! from the chunk and spread to lanes by three permutes, each corner's snapped
 //! x and y gathered as one 8-byte load, then the signed area, the seen
 //! side and the sample box in the lanes, and the triangles that reach the
 //! picture compressed to the front of [`Kept`] for the pushes to the bands.
@@ -14,10 +14,13 @@ use super::{SUB, Snapped};
 use std::arch::x86_64::*;
 
 /// Up to eight triangles of a group that reach the picture, in order: the
-/// triangle, its seen side (1 the back) and its sample box.
+/// triangle, its corners, its seen side (1 the back) and its sample box.
 #[derive(Default)]
 pub(super) struct Kept {
     pub tri: [u32; 8],
+    pub a: [u32; 8],
+    pub b: [u32; 8],
+    pub c: [u32; 8],
     pub back: [u32; 8],
     pub x0: [u32; 8],
     pub x1: [u32; 8],
@@ -81,11 +84,14 @@ pub(super) unsafe fn group(
             0,
             0,
         );
-        _mm512_cvtepu32_epi64(_mm512_castsi512_si256(_mm512_permutex2var_epi32(
-            lo, pick, hi,
-        )))
+        _mm512_castsi512_si256(_mm512_permutex2var_epi32(lo, pick, hi))
     };
-    let (na, nb, nc) = (corner(0), corner(1), corner(2));
+    let (a, b, c) = (corner(0), corner(1), corner(2));
+    let (na, nb, nc) = (
+        _mm512_cvtepu32_epi64(a),
+        _mm512_cvtepu32_epi64(b),
+        _mm512_cvtepu32_epi64(c),
+    );
     let limit = set1(nodes.len() as i64);
     assert!(
         (_mm512_mask_cmpge_epu64_mask(lanes, na, limit)
@@ -152,6 +158,9 @@ pub(super) unsafe fn group(
         _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7),
     );
     store(ids, &mut kept.tri);
+    store(a, &mut kept.a);
+    store(b, &mut kept.b);
+    store(c, &mut kept.c);
     store(_mm256_maskz_set1_epi32(back, 1), &mut kept.back);
     // Box bounds are in 0..size: they fit 32 bits.
     store(_mm512_cvtepi64_epi32(x0), &mut kept.x0);
