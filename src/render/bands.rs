@@ -50,7 +50,7 @@ pub fn render(
             for row in buf[..sw * (y1 - y0)].chunks_exact_mut(sw) {
                 row[cols.start * ss..cols.end * ss].fill(EMPTY);
             }
-            raster::draw_band(proj, &bins, band, buf, sw, y0..y1);
+            raster::draw_band(scene, proj, &bins, band, buf, sw, y0..y1);
             let samples = Samples {
                 data: buf,
                 width: sw,

@@ -6,11 +6,8 @@
 //! cracks) and the top-left rule decides which triangle owns a sample on one.
 
 use super::scene::{HIDDEN, Scene};
-use super::triangle::{self, Binned, SUB};
+use super::triangle::{self, SUB};
 use rayon::prelude::*;
-
-#[cfg(target_arch = "x86_64")]
-mod lanes;
 
 pub const EMPTY: u64 = u64::MAX;
 /// Sample rows per band (the unit of parallel work).
@@ -93,12 +90,11 @@ fn sample_box(
     Some((x0, x1, y0, y1))
 }
 
-/// One chunk's binned triangles: per band, the triangles it must draw (in
-/// order, with their corners) and the
+/// One chunk's binned triangles: per band, the ids it must draw and the
 /// sample columns their boxes reach (`first..=last`; empty when `first >
 /// last`), so a band fills and resolves only the columns drawn on.
 pub struct ChunkBins {
-    pub ids: Vec<Vec<Binned>>,
+    pub ids: Vec<Vec<u32>>,
     pub cols: Vec<(u32, u32)>,
 }
 
@@ -121,26 +117,6 @@ pub fn bin(
     height: usize,
     band_rows: usize,
 ) -> Vec<ChunkBins> {
-    bin_by(
-        triangle::lanes_available(),
-        scene,
-        proj,
-        width,
-        height,
-        band_rows,
-    )
-}
-
-/// [`bin`], eight triangles at a time in vector lanes when `lanes` (the
-/// processor has AVX-512), else one after another.
-fn bin_by(
-    lanes: bool,
-    scene: &Scene,
-    proj: &Projected,
-    width: usize,
-    height: usize,
-    band_rows: usize,
-) -> Vec<ChunkBins> {
     let n_bands = height.div_ceil(band_rows);
     // Each sample row's band, looked up: two divisions by a band height
     // that is not always a power of two cost a fifth of binning.
@@ -151,44 +127,8 @@ fn bin_by(
     (scene.tris.par_chunks(CHUNK))
         .enumerate()
         .map(|(c, chunk)| {
-            let mut bins = Bins {
-                ids: vec![Vec::new(); n_bands],
-                cols: vec![(u32::MAX, 0u32); n_bands],
-                band_of: &band_of,
-            };
-            #[cfg(target_arch = "x86_64")]
-            if lanes {
-                let mut kept = lanes::Kept::default();
-                for (g, group) in chunk.chunks(8).enumerate() {
-                    let first_id = (c * CHUNK + g * 8) as u32;
-                    // SAFETY: `lanes` only where the processor has AVX-512.
-                    let n = unsafe {
-                        lanes::group(
-                            group,
-                            first_id,
-                            &proj.snapped,
-                            (width, height),
-                            same_visible,
-                            &mut kept,
-                        )
-                    };
-                    for k in 0..n.min(8) {
-                        let (tri, back) = (kept.tri[k], kept.back[k]);
-                        if same_visible.is_none() && !visible_side(scene, tri as usize, back) {
-                            continue;
-                        }
-                        let corners = [kept.a[k], kept.b[k], kept.c[k]];
-                        let binned = Binned { tri, corners };
-                        bins.push(binned, kept.x0[k], kept.x1[k], kept.y0[k], kept.y1[k]);
-                    }
-                }
-                return ChunkBins {
-                    ids: bins.ids,
-                    cols: bins.cols,
-                };
-            }
-            #[cfg(not(target_arch = "x86_64"))]
-            let _ = lanes;
+            let mut ids: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
+            let mut cols = vec![(u32::MAX, 0u32); n_bands];
             for (tri, &t) in (c * CHUNK..).zip(chunk) {
                 let Some((v, back)) = facing(proj, t) else {
                     continue;
@@ -201,47 +141,21 @@ fn bin_by(
                     continue;
                 }
                 if let Some((x0, x1, first, last)) = sample_box(&v, width, height) {
-                    let binned = Binned {
-                        tri: tri as u32,
-                        corners: t,
-                    };
-                    bins.push(binned, x0 as u32, x1 as u32, first as u32, last as u32);
+                    let (from, to) = (band_of[first] as usize, band_of[last] as usize);
+                    for (band, reach) in ids[from..=to].iter_mut().zip(&mut cols[from..=to]) {
+                        band.push(tri as u32);
+                        *reach = (reach.0.min(x0 as u32), reach.1.max(x1 as u32));
+                    }
                 }
             }
-            ChunkBins {
-                ids: bins.ids,
-                cols: bins.cols,
-            }
+            ChunkBins { ids, cols }
         })
         .collect()
 }
 
-/// One chunk's bins as they fill, with each sample row's band.
-struct Bins<'a> {
-    ids: Vec<Vec<Binned>>,
-    cols: Vec<(u32, u32)>,
-    band_of: &'a [u32],
-}
-
-impl Bins<'_> {
-    /// Triangle `binned`, whose box spans sample columns `x0..=x1` and rows
-    /// `first..=last`, into each band it reaches.
-    #[inline(always)]
-    fn push(&mut self, binned: Binned, x0: u32, x1: u32, first: u32, last: u32) {
-        let from = self.band_of[first as usize] as usize;
-        let to = self.band_of[last as usize] as usize;
-        for (band, reach) in self.ids[from..=to]
-            .iter_mut()
-            .zip(&mut self.cols[from..=to])
-        {
-            band.push(binned);
-            *reach = (reach.0.min(x0), reach.1.max(x1));
-        }
-    }
-}
-
 /// Draws band `band` (sample rows `ys`, stored from `rows[0]`) from the bins.
 pub fn draw_band(
+    scene: &Scene,
     proj: &Projected,
     bins: &[ChunkBins],
     band: usize,
@@ -254,7 +168,7 @@ pub fn draw_band(
     assert!(ys.start <= ys.end && ys.len() * width <= rows.len());
     let chunks = bins.iter().map(|chunk| &chunk.ids[band][..]);
     // SAFETY: `rows` holds the band's samples (asserted above).
-    unsafe { triangle::draw_chunks(rows, width, ys, &proj.snapped, chunks) };
+    unsafe { triangle::draw_chunks(rows, width, ys, &scene.tris, &proj.snapped, chunks) };
 }
 
 pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -> ZBuffer {
@@ -265,7 +179,7 @@ pub fn rasterize(scene: &Scene, proj: &Projected, width: usize, height: usize) -
         .for_each(|(band, rows)| {
             let y0 = band * BAND;
             let y1 = (y0 + BAND).min(height);
-            draw_band(proj, &bins, band, rows, width, y0..y1);
+            draw_band(scene, proj, &bins, band, rows, width, y0..y1);
         });
     ZBuffer {
         width,
@@ -339,80 +253,6 @@ mod tests {
         assert_eq!(band_columns(&bins, 0), None);
         assert_eq!(band_columns(&bins, 1), Some((4, 20)));
         assert_eq!(band_columns(&bins, 2), Some((7, 9)));
-    }
-
-    /// A scene of `tris` whose sides show `sides` (per face, the faces
-    /// taking turns over the triangles), or one pair for every triangle.
-    fn scene_of(tris: Vec<[u32; 3]>, sides: &[[u32; 2]]) -> Scene<'static> {
-        let n = tris.len();
-        Scene {
-            tris: tris.into(),
-            same_sides: (sides.len() == 1).then(|| sides[0]),
-            face_sides: sides.to_vec(),
-            tri_face: (0..n).map(|t| (t % sides.len()) as u32).collect(),
-            ..Scene::default()
-        }
-    }
-
-    #[test]
-    fn lanes_bin_as_the_scalar_code_bins() {
-        // Over two chunks and a partial group of eight: small triangles,
-        // large ones reaching beyond every side of the picture, edge-on
-        // ones, both orientations, shared corners.
-        let mut rng = crate::test_rng::TestRng::new(0x51_7cc1_b727_220a);
-        let (w, h) = (90usize, 70usize);
-        let mut snapped = Vec::new();
-        let mut tris = Vec::new();
-        for t in 0..(CHUNK as u32 * 2 + 4_465) {
-            let c = [rng.within(1800) - 180, rng.within(1400) - 160];
-            let reach = [24, 60, 300, 3000][t as usize % 4];
-            for _ in 0..3 {
-                snapped.push(Snapped {
-                    x: (c[0] + rng.within(reach)) as i32,
-                    y: (c[1] + rng.within(reach)) as i32,
-                    z: 0.5,
-                });
-            }
-            let n = 3 * t;
-            tris.push(match t % 7 {
-                5 => [n, n, n + 2],
-                6 if t > 0 => [n, n - 2, n - 1],
-                _ => [n, n + 1, n + 2],
-            });
-        }
-        let proj = Projected {
-            snapped,
-            xy_f: Vec::new(),
-        };
-        let sides: [&[[u32; 2]]; 4] = [
-            &[[0, HIDDEN]],
-            &[[HIDDEN, 1]],
-            &[[0, 1]],
-            &[[0, HIDDEN], [HIDDEN, 1], [2, 3]],
-        ];
-        for sides in sides {
-            let scene = scene_of(tris.clone(), sides);
-            for band_rows in [16, 48] {
-                let scalar = bin_by(false, &scene, &proj, w, h, band_rows);
-                let binned: usize = (scalar.iter())
-                    .flat_map(|chunk| chunk.ids.iter().map(Vec::len))
-                    .sum();
-                let first = scalar[0].ids.iter().flatten().map(|b| b.tri);
-                let first = first.collect::<Vec<_>>();
-                assert!(
-                    binned > 10_000 && first.windows(2).any(|p| p[0] >= p[1]),
-                    "{sides:?}, {band_rows} rows: {binned} binned, none in two bands"
-                );
-                if !triangle::lanes_available() {
-                    continue;
-                }
-                let lanes = bin_by(true, &scene, &proj, w, h, band_rows);
-                assert_eq!(lanes.len(), scalar.len());
-                for (a, b) in lanes.iter().zip(&scalar) {
-                    assert!(a.ids == b.ids && a.cols == b.cols, "{sides:?}, {band_rows}");
-                }
-            }
-        }
     }
 
     #[test]

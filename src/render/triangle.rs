@@ -18,34 +18,16 @@ mod lanes;
 /// Sub-sample steps per sample of the snapped coordinates.
 pub const SUB: i64 = 16;
 
-/// Triangles ahead whose corners are fetched while one is set up: the
-/// nodes are scattered over the mesh.
+/// Triangles ahead whose corners are fetched while one is set up: a corner
+/// is two dependent loads (the triangle, then its node), scattered over the
+/// mesh.
 const AHEAD: usize = 8;
 
-/// Whether the processor has the AVX-512 instructions (F, DQ, VL) the
-/// vector-lane paths of the rasteriser use.
-pub fn lanes_available() -> bool {
-    #[cfg(target_arch = "x86_64")]
-    return lanes::available();
-    #[cfg(not(target_arch = "x86_64"))]
-    false
-}
-
-/// A triangle binned to a band: its id and its corners' node indices, so
-/// the drawing reads them in order from the band's list instead of looking
-/// each triangle up in the mesh (a dependent load, scattered).
-#[repr(C)]
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub struct Binned {
-    pub tri: u32,
-    pub corners: [u32; 3],
-}
-
-/// Draws the triangles of each list of `chunks` (corners in `nodes`) into
-/// rows `ys` of the z-buffer (stored from `rows[0]`, rows `width` samples
-/// long): each sample inside a triangle keeps the smaller of its value and
-/// the triangle's depth bits above `2 × triangle + back side`. Edge-on
-/// triangles draw nothing.
+/// Draws triangles `ids` of each chunk of `chunks` (corners `tris`, nodes
+/// `nodes`) into rows `ys` of the z-buffer (stored from `rows[0]`, rows
+/// `width` samples long): each sample inside a triangle keeps the smaller
+/// of its value and the triangle's depth bits above `2 × triangle + back
+/// side`. Edge-on triangles draw nothing.
 ///
 /// # Safety
 /// `ys.start <= ys.end` and `rows` holds at least `ys.len() × width`
@@ -54,12 +36,16 @@ pub unsafe fn draw_chunks<'a>(
     rows: &mut [u64],
     width: usize,
     ys: std::ops::Range<usize>,
+    tris: &[[u32; 3]],
     nodes: &[Snapped],
-    chunks: impl Iterator<Item = &'a [Binned]>,
+    chunks: impl Iterator<Item = &'a [u32]>,
 ) {
-    let lanes = lanes_available();
+    #[cfg(target_arch = "x86_64")]
+    let lanes = lanes::available();
+    #[cfg(not(target_arch = "x86_64"))]
+    let lanes = false;
     // SAFETY: the caller's promise.
-    unsafe { draw_chunks_by(lanes, rows, width, ys, nodes, chunks) }
+    unsafe { draw_chunks_by(lanes, rows, width, ys, tris, nodes, chunks) }
 }
 
 /// [`draw_chunks`], eight triangles at a time in vector lanes when `lanes`
@@ -73,35 +59,41 @@ unsafe fn draw_chunks_by<'a>(
     rows: &mut [u64],
     width: usize,
     ys: std::ops::Range<usize>,
+    tris: &[[u32; 3]],
     nodes: &[Snapped],
-    chunks: impl Iterator<Item = &'a [Binned]>,
+    chunks: impl Iterator<Item = &'a [u32]>,
 ) {
     #[cfg(target_arch = "x86_64")]
     if lanes {
-        for list in chunks {
+        for ids in chunks {
             // SAFETY: the caller's promise; the processor has the
             // instructions.
-            unsafe { lanes::draw_list(rows, width, &ys, nodes, list) };
+            unsafe { lanes::draw_ids(rows, width, &ys, tris, nodes, ids) };
         }
         return;
     }
-    for list in chunks {
-        for (i, binned) in list.iter().enumerate() {
-            // Ahead: the corners of the triangle 8 places on, so their
-            // loads, scattered over the mesh, overlap the set-ups.
-            if let Some(near) = list.get(i + AHEAD) {
-                for &c in &near.corners {
+    for ids in chunks {
+        for (i, &tri) in ids.iter().enumerate() {
+            // Ahead: the triangle 16 places on, the corners of the one 8 on
+            // (its triangle fetched 8 places ago), so the dependent loads
+            // overlap. A band's ids in a chunk ascend, but by jumps (a ring
+            // of the mesh to the next) the hardware does not follow.
+            if let Some(&far) = ids.get(i + 2 * AHEAD) {
+                prefetch_at(tris.as_ptr().wrapping_add(far as usize));
+            }
+            if let Some(near) = ids.get(i + AHEAD).and_then(|&t| tris.get(t as usize)) {
+                for &c in near {
                     // A hint needs no bounds check: it reads nothing.
                     prefetch_at(nodes.as_ptr().wrapping_add(c as usize));
                 }
             }
-            let [a, b, c] = binned.corners;
+            let [a, b, c] = tris[tri as usize];
             let corners = [nodes[a as usize], nodes[b as usize], nodes[c as usize]];
             let mut small = Small::default();
             // SAFETY: the caller's promise; `set_up` places a small
             // triangle's box in the band.
             unsafe {
-                if set_up(rows, width, &ys, corners, binned.tri, &mut small) {
+                if set_up(rows, width, &ys, corners, tri, &mut small) {
                     small.fill(rows.as_mut_ptr(), width);
                 }
             }
@@ -452,12 +444,11 @@ mod tests {
             y: v[k][1] as i32,
             z: z[k],
         });
-        let list = [Binned {
-            tri: 7,
-            corners: [0, 1, 2],
-        }];
+        // Triangle 7 of a mesh whose others are edge-on.
+        let mut tris = vec![[0, 0, 0]; 8];
+        tris[7] = [0, 1, 2];
         // SAFETY: `rows` holds h × w samples.
-        unsafe { draw_chunks(&mut rows, w, 0..h, &nodes, [&list[..]].into_iter()) };
+        unsafe { draw_chunks(&mut rows, w, 0..h, &tris, &nodes, [&[7u32][..]].into_iter()) };
         rows
     }
 
@@ -602,17 +593,14 @@ mod tests {
                 [n, n + 1, n + 2]
             });
         }
-        let list: Vec<Binned> = (0u32..)
-            .zip(&tris)
-            .map(|(tri, &corners)| Binned { tri, corners })
-            .collect();
+        let ids: Vec<u32> = (0..tris.len() as u32).collect();
         let draw = |lanes: bool| {
             let mut picture = vec![EMPTY; w * h];
             for (b, rows) in picture.chunks_mut(w * band).enumerate() {
                 let ys = b * band..(b * band + band).min(h);
                 // SAFETY: `rows` holds the band's samples; `lanes` only
                 // where the processor has them.
-                unsafe { draw_chunks_by(lanes, rows, w, ys, &nodes, list.chunks(1000)) };
+                unsafe { draw_chunks_by(lanes, rows, w, ys, &tris, &nodes, ids.chunks(1000)) };
             }
             picture
         };

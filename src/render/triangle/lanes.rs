@@ -13,7 +13,7 @@
 //! values, `zy + dzdx × x` in `f32`, then the larger of that and 0 as
 //! `maxss` takes it), so the band gets the same bits.
 
-use super::{BIAS, Binned, FIELD, OUTSIDE, SMALL, SUB, Snapped, set_up};
+use super::{BIAS, FIELD, OUTSIDE, SMALL, SUB, Snapped, set_up};
 use std::arch::x86_64::*;
 
 /// Whether this processor has the instructions of [`draw_ids`].
@@ -41,41 +41,47 @@ struct Set {
     row_len: [i32; 8],
 }
 
-/// Draws the triangles of `list` into rows `ys` of the z-buffer as
+/// Draws triangles `ids` into rows `ys` of the z-buffer as
 /// [`super::draw_chunks`] does.
 ///
 /// # Safety
 /// The processor has AVX-512 F, DQ and VL ([`available`]), `ys.start <=
 /// ys.end` and `rows` holds at least `ys.len() × width` samples.
 #[target_feature(enable = "avx512f,avx512dq,avx512vl")]
-pub(super) unsafe fn draw_list(
+pub(super) unsafe fn draw_ids(
     rows: &mut [u64],
     width: usize,
     ys: &std::ops::Range<usize>,
+    tris: &[[u32; 3]],
     nodes: &[Snapped],
-    list: &[Binned],
+    ids: &[u32],
 ) {
     let mut set = Set::default();
-    for (g, group) in list.chunks(8).enumerate() {
-        // The corners of the next group, so their loads, scattered over
-        // the mesh, overlap this one's (a hint reads nothing).
-        for near in list.iter().skip(g * 8 + 8).take(8) {
-            for &c in &near.corners {
-                super::prefetch_at(nodes.as_ptr().wrapping_add(c as usize));
+    for (g, group) in ids.chunks(8).enumerate() {
+        // The triangles of the group after next and the corners of the
+        // next one, so the dependent loads overlap (a hint reads nothing).
+        for &far in ids.iter().skip(g * 8 + 16).take(8) {
+            super::prefetch_at(tris.as_ptr().wrapping_add(far as usize));
+        }
+        for &near in ids.iter().skip(g * 8 + 8).take(8) {
+            if let Some(near) = tris.get(near as usize) {
+                for &c in near {
+                    super::prefetch_at(nodes.as_ptr().wrapping_add(c as usize));
+                }
             }
         }
         let lanes = ((1u32 << group.len()) - 1) as __mmask8;
         // SAFETY: the caller's promises, and the set-up's lanes index
-        // `nodes` only after checking them.
-        let (small, wide) = unsafe { set_up_lanes(group, lanes, width, ys, nodes, &mut set) };
-        for (l, binned) in group.iter().enumerate() {
+        // `tris` and `nodes` only after checking them.
+        let (small, wide) = unsafe { set_up_lanes(group, lanes, width, ys, tris, nodes, &mut set) };
+        for (l, &tri) in group.iter().enumerate() {
             if wide & (1 << l) != 0 {
                 // A large triangle: the scalar set-up draws it.
-                let [a, b, c] = binned.corners;
+                let [a, b, c] = tris[tri as usize];
                 let corners = [nodes[a as usize], nodes[b as usize], nodes[c as usize]];
                 let mut unused = super::Small::default();
                 // SAFETY: the caller's promise.
-                unsafe { set_up(rows, width, ys, corners, binned.tri, &mut unused) };
+                unsafe { set_up(rows, width, ys, corners, tri, &mut unused) };
             }
         }
         // SAFETY: the set-up placed each small triangle's box in the band.
@@ -88,55 +94,37 @@ pub(super) unsafe fn draw_list(
 /// the mask of the large ones.
 #[target_feature(enable = "avx512f,avx512dq,avx512vl")]
 unsafe fn set_up_lanes(
-    group: &[Binned],
+    group: &[u32],
     lanes: __mmask8,
     width: usize,
     ys: &std::ops::Range<usize>,
+    tris: &[[u32; 3]],
     nodes: &[Snapped],
     set: &mut Set,
 ) -> (usize, __mmask8) {
     let zero = _mm512_setzero_si512();
     let set1 = |v: i64| _mm512_set1_epi64(v);
-    // The group's records (id, three corners: 4n dwords) in two vectors,
-    // each field spread to the lanes by a permute.
-    let words = 4 * group.len();
-    let (low, high) = (
-        ((1u32 << words.min(16)) - 1) as __mmask16,
-        ((1u64 << words.saturating_sub(16)) - 1) as __mmask16,
+    // SAFETY: `lanes` covers exactly `group`'s entries.
+    let tri =
+        _mm512_cvtepu32_epi64(unsafe { _mm256_maskz_loadu_epi32(lanes, group.as_ptr().cast()) });
+    assert!(
+        _mm512_mask_cmpge_epu64_mask(lanes, tri, set1(tris.len() as i64)) == 0,
+        "a triangle id beyond the mesh"
     );
-    let at = group.as_ptr().cast::<i32>();
-    // SAFETY: the masks cover exactly the group's 4n dwords.
-    let (lo, hi) = unsafe {
-        (
-            _mm512_maskz_loadu_epi32(low, at),
-            _mm512_maskz_loadu_epi32(high, at.wrapping_add(16)),
-        )
+    let at = _mm512_mullo_epi64(tri, set1(3));
+    let corner = |k: i64| {
+        // SAFETY: every lane's triangle is in `tris` (checked above).
+        let n = unsafe {
+            _mm512_mask_i64gather_epi32::<4>(
+                _mm256_setzero_si256(),
+                lanes,
+                _mm512_add_epi64(at, set1(k)),
+                tris.as_ptr().cast(),
+            )
+        };
+        _mm512_cvtepu32_epi64(n)
     };
-    let record = |k: i32| {
-        let pick = _mm512_setr_epi32(
-            k,
-            k + 4,
-            k + 8,
-            k + 12,
-            k + 16,
-            k + 20,
-            k + 24,
-            k + 28,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-            0,
-        );
-        _mm512_cvtepu32_epi64(_mm512_castsi512_si256(_mm512_permutex2var_epi32(
-            lo, pick, hi,
-        )))
-    };
-    let tri = record(0);
-    let (na, nb, nc) = (record(1), record(2), record(3));
+    let (na, nb, nc) = (corner(0), corner(1), corner(2));
     let limit = set1(nodes.len() as i64);
     assert!(
         (_mm512_mask_cmpge_epu64_mask(lanes, na, limit)
@@ -157,7 +145,8 @@ unsafe fn set_up_lanes(
             )
         }
     };
-    // x and y as one 8-byte gather at 12 bytes × the node, split in lanes.
+    // x and y as one 8-byte gather at 12 bytes × the node (six node
+    // gathers per eight triangles instead of nine), split in the lanes.
     let xyz = |n: __m512i| {
         // SAFETY: every lane's node is in `nodes` (checked above).
         let xy = unsafe {
