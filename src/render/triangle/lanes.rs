@@ -145,10 +145,21 @@ unsafe fn set_up_lanes(
             )
         }
     };
+    // x and y as one 8-byte gather at 12 bytes × the node (six node
+    // gathers per eight triangles instead of nine), split in the lanes.
     let xyz = |n: __m512i| {
+        // SAFETY: every lane's node is in `nodes` (checked above).
+        let xy = unsafe {
+            _mm512_mask_i64gather_epi64::<4>(
+                zero,
+                lanes,
+                _mm512_mullo_epi64(n, set1(3)),
+                nodes.as_ptr().cast(),
+            )
+        };
         (
-            _mm512_cvtepi32_epi64(field(n, 0)),
-            _mm512_cvtepi32_epi64(field(n, 1)),
+            _mm512_srai_epi64::<32>(_mm512_slli_epi64::<32>(xy)),
+            _mm512_srai_epi64::<32>(xy),
             _mm256_castsi256_ps(field(n, 2)),
         )
     };
