@@ -9,8 +9,8 @@
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::geom::Curve;
 use crate::ir::{
-    Carrier, Edge, EdgeId, FaceId, Model, OrientedFace, SourceMap, SubdomainCells, SubdomainId,
-    VertexId,
+    Carrier, Edge, EdgeId, FaceId, Model, OrientedEdge, OrientedFace, SourceMap, SubdomainCells,
+    SubdomainId, VertexId,
 };
 use crate::span::Span;
 use rayon::prelude::*;
@@ -144,18 +144,11 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
             if edges.iter().any(|oe| oe.edge.index() >= model.edges.len()) {
                 continue;
             }
-            let step = |k: usize| {
-                let oe = edges[k];
-                let e = &model.edges[oe.edge.index()];
-                if oe.forward {
-                    (oe.edge, e.begin, e.end)
-                } else {
-                    (oe.edge, e.end, e.begin)
-                }
-            };
+            let step = |k: usize| loop_step(model, edges[k]);
             let n = edges.len();
-            let broken = (0..n).find(|&k| step(k).2 != step((k + 1) % n).1);
-            let Some(k) = broken else { continue };
+            let Some(k) = first_break(model, edges) else {
+                continue;
+            };
             let (edge, tail, head) = step(k);
             let (next, next_tail, _) = step((k + 1) % n);
             let message = if n == 1 {
@@ -185,6 +178,31 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
             );
         }
     }
+}
+
+/// (edge, tail, head) of a loop's edge as the loop runs; the edge exists.
+fn loop_step(model: &Model, oe: OrientedEdge) -> (EdgeId, VertexId, VertexId) {
+    let e = &model.edges[oe.edge.index()];
+    if oe.forward {
+        (oe.edge, e.begin, e.end)
+    } else {
+        (oe.edge, e.end, e.begin)
+    }
+}
+
+/// The first `k` whose edge does not end where edge `k + 1` (cyclically)
+/// begins, each edge looked up once (this runs for every loop of the
+/// model); the loop is not empty and its edges exist.
+fn first_break(model: &Model, edges: &[OrientedEdge]) -> Option<usize> {
+    let (_, first_tail, mut head) = loop_step(model, edges[0]);
+    for (k, &oe) in edges.iter().enumerate().skip(1) {
+        let (_, tail, next_head) = loop_step(model, oe);
+        if tail != head {
+            return Some(k - 1);
+        }
+        head = next_head;
+    }
+    (head != first_tail).then_some(edges.len() - 1)
 }
 
 /// One use of an edge by a face of a subdomain's boundary.
@@ -1180,6 +1198,35 @@ mod tests {
                 .iter()
                 .all(|m| m.contains("a straight segment"))
         );
+    }
+
+    #[test]
+    fn a_loop_breaks_where_a_lookup_of_both_neighbours_finds_it() {
+        // Random edges among four vertices, random loops of one to six of
+        // them: the first break, found with one lookup per edge, is the one
+        // comparing each edge's head with the next one's tail finds.
+        let mut rng = crate::test_rng::TestRng::new(0x100b_5eed);
+        let mut b = Builder::new(Dimension::Three);
+        let v: Vec<VertexId> = (0..4).map(|i| b.vertex([i as f64, 0.0, 0.0])).collect();
+        for _ in 0..24 {
+            let (a, z) = (v[rng.below(4)], v[rng.below(4)]);
+            b.push_edge(Curve::Chain { points: Vec::new() }, a, z);
+        }
+        let mut found = [0usize; 2];
+        for _ in 0..20_000 {
+            let n = 1 + rng.below(6);
+            let edges: Vec<OrientedEdge> = (0..n)
+                .map(|_| OrientedEdge {
+                    edge: EdgeId(rng.below(24) as u32),
+                    forward: rng.below(2) == 0,
+                })
+                .collect();
+            let step = |k: usize| loop_step(&b.model, edges[k]);
+            let plain = (0..n).find(|&k| step(k).2 != step((k + 1) % n).1);
+            assert_eq!(first_break(&b.model, &edges), plain, "{edges:?}");
+            found[usize::from(plain.is_some())] += 1;
+        }
+        assert!(found[0] > 500 && found[1] > 10_000, "{found:?}");
     }
 
     fn codes(diags: &Diagnostics) -> Vec<&'static str> {
