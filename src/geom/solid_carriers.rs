@@ -75,6 +75,22 @@ impl SolidShape {
             SolidShape::Disk { .. } | SolidShape::Polygon { .. } => None,
         }
     }
+
+    /// Whether edge `local`'s curve ([`SolidShape::edge_curve`]) is closed,
+    /// without making it: a box's edges are segments, every other
+    /// primitive's are whole ellipses (t from 0 to 2π). `None` where
+    /// `edge_curve` is.
+    pub fn edge_is_closed(&self, local: usize) -> Option<bool> {
+        match self {
+            SolidShape::Box { .. } => (local < 12).then_some(false),
+            SolidShape::Ball { .. } => (local == 0).then_some(true),
+            SolidShape::Cone { r0, r1, .. } => {
+                (local < cone_rims(*r0, *r1).count()).then_some(true)
+            }
+            SolidShape::Torus { .. } => (local < 2).then_some(true),
+            SolidShape::Disk { .. } | SolidShape::Polygon { .. } => None,
+        }
+    }
 }
 
 /// Corner `n` of a parallelepiped: local (n & 1, n >> 1 & 1, n >> 2 & 1).

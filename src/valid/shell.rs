@@ -9,7 +9,8 @@
 use crate::diag::{Code, Diagnostic, Diagnostics};
 use crate::geom::Curve;
 use crate::ir::{
-    EdgeId, FaceId, Model, OrientedFace, SourceMap, SubdomainCells, SubdomainId, VertexId,
+    Carrier, Edge, EdgeId, FaceId, Model, OrientedEdge, OrientedFace, SourceMap, SubdomainCells,
+    SubdomainId, VertexId,
 };
 use crate::span::Span;
 use rayon::prelude::*;
@@ -67,6 +68,19 @@ fn curve_is_closed(curve: &Curve, tolerance: f64) -> bool {
     }
 }
 
+/// Whether the edge's curve is closed: a primitive's is judged from its
+/// solid's shape without making the curve (every closed edge of a file of
+/// spheres, cones and tori is a primitive's).
+fn edge_curve_is_closed(edge: &Edge, model: &Model) -> bool {
+    if let Carrier::Primitive { solid, local } = edge.carrier
+        && let Some(closed) =
+            (model.solids.get(solid.index())).and_then(|s| s.shape.edge_is_closed(local as usize))
+    {
+        return closed;
+    }
+    curve_is_closed(&edge.curve(&model.solids), model.tolerance)
+}
+
 fn curve_description(curve: &Curve) -> String {
     match curve {
         Curve::Segment { .. } => "a straight segment".to_string(),
@@ -83,7 +97,7 @@ fn curve_description(curve: &Curve) -> String {
 pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostics) {
     for (i, edge) in model.edges.iter().enumerate() {
         let id = EdgeId(i as u32);
-        if edge.begin == edge.end && !curve_is_closed(&edge.curve(&model.solids), model.tolerance) {
+        if edge.begin == edge.end && !edge_curve_is_closed(edge, model) {
             diags.push(
                 Diagnostic::new(
                     Code::EdgeEndsCoincide,
@@ -130,18 +144,11 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
             if edges.iter().any(|oe| oe.edge.index() >= model.edges.len()) {
                 continue;
             }
-            let step = |k: usize| {
-                let oe = edges[k];
-                let e = &model.edges[oe.edge.index()];
-                if oe.forward {
-                    (oe.edge, e.begin, e.end)
-                } else {
-                    (oe.edge, e.end, e.begin)
-                }
-            };
+            let step = |k: usize| loop_step(model, edges[k]);
             let n = edges.len();
-            let broken = (0..n).find(|&k| step(k).2 != step((k + 1) % n).1);
-            let Some(k) = broken else { continue };
+            let Some(k) = first_break(model, edges) else {
+                continue;
+            };
             let (edge, tail, head) = step(k);
             let (next, next_tail, _) = step((k + 1) % n);
             let message = if n == 1 {
@@ -173,13 +180,46 @@ pub fn check_faces(model: &Model, source_map: &SourceMap, diags: &mut Diagnostic
     }
 }
 
+/// (edge, tail, head) of a loop's edge as the loop runs; the edge exists.
+fn loop_step(model: &Model, oe: OrientedEdge) -> (EdgeId, VertexId, VertexId) {
+    let e = &model.edges[oe.edge.index()];
+    if oe.forward {
+        (oe.edge, e.begin, e.end)
+    } else {
+        (oe.edge, e.end, e.begin)
+    }
+}
+
+/// The first `k` whose edge does not end where edge `k + 1` (cyclically)
+/// begins, each edge looked up once (this runs for every loop of the
+/// model); the loop is not empty and its edges exist.
+fn first_break(model: &Model, edges: &[OrientedEdge]) -> Option<usize> {
+    let (_, first_tail, mut head) = loop_step(model, edges[0]);
+    for (k, &oe) in edges.iter().enumerate().skip(1) {
+        let (_, tail, next_head) = loop_step(model, oe);
+        if tail != head {
+            return Some(k - 1);
+        }
+        head = next_head;
+    }
+    (head != first_tail).then_some(edges.len() - 1)
+}
+
 /// One use of an edge by a face of a subdomain's boundary.
 #[derive(Debug, Clone, Copy)]
 struct EdgeUse {
-    /// Index into the subdomain's boundary list.
-    entry: usize,
+    /// Index into the subdomain's boundary list, as four bytes: with the
+    /// edge id a use is 12 bytes instead of 24, and every subdomain's uses
+    /// are written twice (a boundary list of 2³² faces would not fit in memory).
+    entry: u32,
     /// Direction in the face's own loop.
     forward: bool,
+}
+
+impl EdgeUse {
+    fn entry(self) -> usize {
+        self.entry as usize
+    }
 }
 
 /// Every use of every edge by the listed faces, grouped by edge id
@@ -203,7 +243,13 @@ impl EdgeUses {
             for oe in face.loops.edges() {
                 if oe.edge.index() < model.edges.len() {
                     let forward = oe.forward;
-                    unsorted.push((oe.edge, EdgeUse { entry, forward }));
+                    unsorted.push((
+                        oe.edge,
+                        EdgeUse {
+                            entry: entry as u32,
+                            forward,
+                        },
+                    ));
                     low = low.min(oe.edge.0);
                     high = high.max(oe.edge.0);
                 }
@@ -321,7 +367,10 @@ fn components(
     }
     for (_, list) in uses.lists() {
         for pair in list.windows(2) {
-            let (a, b) = (root(parent, pair[0].1.entry), root(parent, pair[1].1.entry));
+            let (a, b) = (
+                root(parent, pair[0].1.entry()),
+                root(parent, pair[1].1.entry()),
+            );
             parent[a.max(b)] = a.min(b);
         }
     }
@@ -434,7 +483,7 @@ fn shell_counts(
     vertices.reserve(2 * uses.uses.len());
     let (mut low, mut high) = (u32::MAX, 0);
     for (edge, list) in uses.lists() {
-        let shell = scratch.component_of_entry[list[0].1.entry];
+        let shell = scratch.component_of_entry[list[0].1.entry()];
         let Some(e) = model.edges.get(edge.index()) else {
             continue;
         };
@@ -580,7 +629,7 @@ fn check_edge_uses(
             2 => {}
             1 => {
                 manifold = false;
-                let face = face_name(model, boundary[list[0].1.entry].face);
+                let face = face_name(model, boundary[list[0].1.entry()].face);
                 diags.push(
                     Diagnostic::new(
                         Code::OpenShell,
@@ -604,7 +653,7 @@ fn check_edge_uses(
                 manifold = false;
                 let faces: BTreeSet<String> = list
                     .iter()
-                    .map(|(_, u)| format!("'{}'", face_name(model, boundary[u.entry].face)))
+                    .map(|(_, u)| format!("'{}'", face_name(model, boundary[u.entry()].face)))
                     .collect();
                 diags.push(
                     Diagnostic::new(
@@ -654,7 +703,9 @@ fn check_orientation(
     // must differ, shared edge), in edge order.
     let pairs = || {
         uses.lists().filter_map(|(edge, list)| match list {
-            [(_, a), (_, b)] if a.entry != b.entry => Some((a, b, a.forward == b.forward, edge)),
+            [(_, a), (_, b)] if a.entry() != b.entry() => {
+                Some((a, b, a.forward == b.forward, edge))
+            }
             _ => None,
         })
     };
@@ -664,10 +715,10 @@ fn check_orientation(
     seam_conflict.resize(n, None);
     for (edge, list) in uses.lists() {
         if let [(_, a), (_, b)] = list
-            && a.entry == b.entry
+            && a.entry() == b.entry()
             && a.forward == b.forward
         {
-            seam_conflict[a.entry].get_or_insert(edge);
+            seam_conflict[a.entry()].get_or_insert(edge);
         }
     }
     // (neighbour, whether the flips must differ, shared edge), each face's
@@ -676,8 +727,8 @@ fn check_orientation(
     start.clear();
     start.resize(n + 1, 0);
     for (a, b, _, _) in pairs() {
-        start[a.entry + 1] += 1;
-        start[b.entry + 1] += 1;
+        start[a.entry() + 1] += 1;
+        start[b.entry() + 1] += 1;
     }
     for i in 0..n {
         start[i + 1] += start[i];
@@ -690,10 +741,10 @@ fn check_orientation(
     next.clear();
     next.extend_from_slice(&start[..n]);
     for (a, b, differ, edge) in pairs() {
-        adjacent[next[a.entry]] = (b.entry, differ, edge);
-        next[a.entry] += 1;
-        adjacent[next[b.entry]] = (a.entry, differ, edge);
-        next[b.entry] += 1;
+        adjacent[next[a.entry()]] = (b.entry(), differ, edge);
+        next[a.entry()] += 1;
+        adjacent[next[b.entry()]] = (a.entry(), differ, edge);
+        next[b.entry()] += 1;
     }
     let (start, adjacent) = (&scratch.adjacent_start, &scratch.adjacent);
     let neighbours = |a: usize| &adjacent[start[a]..start[a + 1]];
@@ -974,27 +1025,39 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
             .flat_map(|s| &s.faces)
             .map(|of| of.face.index()),
     );
-    let used_vertices = flags(
-        model.vertices.len(),
-        model
-            .edges
-            .iter()
-            .flat_map(|e| [e.begin.index(), e.end.index()]),
-    );
-    let used_edges = flags(
-        model.edges.len(),
-        model
-            .faces
-            .iter()
-            .flat_map(|f| f.loops.edges().iter().map(|oe| oe.edge.index())),
-    );
+    // Which entities are used matters only for those of no solid: on a file
+    // of primitives there are none, and these passes read every edge and
+    // every face's loops again.
+    let any_outside = |in_solids: &[bool]| in_solids.iter().any(|&f| !f);
+    let used_vertices = any_outside(&in_solids_v).then(|| {
+        flags(
+            model.vertices.len(),
+            model
+                .edges
+                .iter()
+                .flat_map(|e| [e.begin.index(), e.end.index()]),
+        )
+    });
+    let used_edges = any_outside(&in_solids_e).then(|| {
+        flags(
+            model.edges.len(),
+            model
+                .faces
+                .iter()
+                .flat_map(|f| f.loops.edges().iter().map(|oe| oe.edge.index())),
+        )
+    });
+    // An entity of a solid is never reported, used or not.
+    let unused_at = |in_solids: &[bool], used: &Option<Vec<bool>>, i: usize| {
+        !in_solids[i] && !used.as_ref().is_some_and(|u| u[i])
+    };
 
     let mut unused = |span: Option<Span>, message: String, help: &str| {
         diags.push(Diagnostic::new(Code::Dangling, span, message).with_help(help));
     };
     for (i, vertex) in model.vertices.iter().enumerate() {
         let id = VertexId(i as u32);
-        let explicit_unused = !in_solids_v[i] && !used_vertices[i];
+        let explicit_unused = unused_at(&in_solids_v, &used_vertices, i);
         if let Some(span) = explicit_unused.then(|| source_map.vertex(id)).flatten() {
             unused(
                 Some(span),
@@ -1005,7 +1068,7 @@ pub fn check_face_usage(model: &Model, source_map: &SourceMap, diags: &mut Diagn
     }
     for (i, edge) in model.edges.iter().enumerate() {
         let id = EdgeId(i as u32);
-        let explicit_unused = !in_solids_e[i] && !used_edges[i];
+        let explicit_unused = unused_at(&in_solids_e, &used_edges, i);
         if let Some(span) = explicit_unused.then(|| source_map.edge(id)).flatten() {
             unused(
                 Some(span),
@@ -1038,6 +1101,133 @@ mod tests {
     use crate::ir::{Dimension, OrientedEdge, Solid};
     use crate::valid::check_topology;
     use crate::valid::fixtures::{Builder, cube, sphere, torus};
+
+    /// Box, ball, cone and torus shapes of random frames and sizes: radii
+    /// of every sign, zero and NaN, so cones keep one, two or no rims.
+    fn random_primitives(rng: &mut crate::test_rng::TestRng) -> Vec<SolidShape> {
+        let size = |rng: &mut crate::test_rng::TestRng| match rng.below(6) {
+            0 => 0.0,
+            1 => -1.5,
+            2 => f64::NAN,
+            _ => rng.within(1_000) as f64 / 100.0,
+        };
+        let angles = Vec3::new(
+            rng.within(180) as f64,
+            rng.within(180) as f64,
+            rng.within(180) as f64,
+        );
+        let shift = Vec3::new(rng.within(50) as f64, rng.within(50) as f64, 0.5);
+        let frame = Frame::translation(shift).compose(&Frame::rotation_degrees(angles));
+        vec![
+            SolidShape::Box { frame },
+            SolidShape::Ball { frame },
+            SolidShape::Cone {
+                frame,
+                r0: size(rng),
+                r1: size(rng),
+            },
+            SolidShape::Torus {
+                frame,
+                major: size(rng),
+                minor: size(rng),
+            },
+            SolidShape::Disk { frame },
+        ]
+    }
+
+    #[test]
+    fn primitive_edges_are_closed_exactly_when_their_curves_are() {
+        let mut rng = crate::test_rng::TestRng::new(0x5eed_0021);
+        let mut closed = [0usize; 2];
+        for _ in 0..400 {
+            for shape in random_primitives(&mut rng) {
+                for local in 0..14 {
+                    let plain = (shape.edge_curve(local)).map(|c| curve_is_closed(&c, 1e-9));
+                    assert_eq!(shape.edge_is_closed(local), plain, "{shape:?} edge {local}");
+                    if let Some(c) = plain {
+                        closed[usize::from(c)] += 1;
+                    }
+                }
+            }
+        }
+        // 12 open edges per box; a ball's, a torus's two and the cones' rims closed.
+        assert_eq!(closed[0], 400 * 12);
+        assert!(closed[1] > 400 * 3, "{closed:?}");
+    }
+
+    #[test]
+    fn closed_primitive_edges_are_judged_as_their_made_curves() {
+        // Every edge of random primitives begins and ends at one vertex:
+        // the boxes' segments are E400, the rest closed, whether the curve
+        // is the solid's (judged from its shape) or made and owned.
+        let mut rng = crate::test_rng::TestRng::new(0x0dd_ba11);
+        let mut b = Builder::new(Dimension::Three);
+        let v = b.vertex([0.0; 3]);
+        for _ in 0..30 {
+            for shape in random_primitives(&mut rng) {
+                let solid = crate::ir::SolidId(b.model.solids.len() as u32);
+                let edges = (0..).take_while(|&k| shape.edge_curve(k).is_some()).count();
+                b.model.solids.push(Solid {
+                    name: std::sync::Arc::new("s".into()),
+                    shape,
+                    faces: Box::new([]),
+                    boundary_edges: Box::new([]),
+                    edges: Box::new([]),
+                    vertices: Box::new([]),
+                });
+                for local in 0..edges {
+                    let id = b.push_edge(Curve::Chain { points: Vec::new() }, v, v);
+                    b.model.edges[id.index()].carrier = Carrier::primitive(solid, local);
+                }
+            }
+        }
+        let mut from_shapes = Diagnostics::default();
+        check_faces(&b.model, &b.map, &mut from_shapes);
+        let solids = b.model.solids.clone();
+        for edge in &mut b.model.edges {
+            let curve = edge.curve(&solids).into_owned();
+            edge.carrier = Carrier::own(curve);
+        }
+        let mut from_curves = Diagnostics::default();
+        check_faces(&b.model, &b.map, &mut from_curves);
+        assert_eq!(from_shapes.items, from_curves.items);
+        assert_eq!(from_shapes.items.len(), 30 * 12);
+        assert!(codes(&from_shapes).iter().all(|&c| c == "E400"));
+        assert!(
+            messages(&from_shapes)
+                .iter()
+                .all(|m| m.contains("a straight segment"))
+        );
+    }
+
+    #[test]
+    fn a_loop_breaks_where_a_lookup_of_both_neighbours_finds_it() {
+        // Random edges among four vertices, random loops of one to six of
+        // them: the first break, found with one lookup per edge, is the one
+        // comparing each edge's head with the next one's tail finds.
+        let mut rng = crate::test_rng::TestRng::new(0x100b_5eed);
+        let mut b = Builder::new(Dimension::Three);
+        let v: Vec<VertexId> = (0..4).map(|i| b.vertex([i as f64, 0.0, 0.0])).collect();
+        for _ in 0..24 {
+            let (a, z) = (v[rng.below(4)], v[rng.below(4)]);
+            b.push_edge(Curve::Chain { points: Vec::new() }, a, z);
+        }
+        let mut found = [0usize; 2];
+        for _ in 0..20_000 {
+            let n = 1 + rng.below(6);
+            let edges: Vec<OrientedEdge> = (0..n)
+                .map(|_| OrientedEdge {
+                    edge: EdgeId(rng.below(24) as u32),
+                    forward: rng.below(2) == 0,
+                })
+                .collect();
+            let step = |k: usize| loop_step(&b.model, edges[k]);
+            let plain = (0..n).find(|&k| step(k).2 != step((k + 1) % n).1);
+            assert_eq!(first_break(&b.model, &edges), plain, "{edges:?}");
+            found[usize::from(plain.is_some())] += 1;
+        }
+        assert!(found[0] > 500 && found[1] > 10_000, "{found:?}");
+    }
 
     fn codes(diags: &Diagnostics) -> Vec<&'static str> {
         diags.items.iter().map(|d| d.code.as_str()).collect()
@@ -1447,7 +1637,7 @@ mod tests {
         (0..len)
             .map(|_| {
                 let edge = EdgeId(low + next() % span);
-                let entry = (next() % 16) as usize;
+                let entry = next() % 16;
                 let forward = next() % 2 == 0;
                 (edge, EdgeUse { entry, forward })
             })
@@ -1456,7 +1646,7 @@ mod tests {
 
     fn plain(uses: &[(EdgeId, EdgeUse)]) -> Vec<(u32, usize, bool)> {
         uses.iter()
-            .map(|(e, u)| (e.0, u.entry, u.forward))
+            .map(|(e, u)| (e.0, u.entry(), u.forward))
             .collect()
     }
 
