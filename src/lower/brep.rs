@@ -3,10 +3,10 @@
 //! Built in local indices; the welder merges them into the model.
 
 use crate::geom::solid_carriers::{
-    box_corner, box_edge_ends, box_face, box_face_center, cone_cap, cone_rim, cone_rims, ellipse,
-    torus_meridian, torus_parallel,
+    box_corner, box_edge_ends, box_face_center, cone_rim, cone_rims, ellipse, torus_meridian,
+    torus_parallel,
 };
-use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
+use crate::geom::{Curve, Frame, Mat3, Point3, SolidShape, Surface, Vec3};
 use crate::ir::{Carrier, EntityName, Face, LocalName, Loops, OrientedEdge, SolidId};
 use std::sync::Arc;
 
@@ -308,6 +308,7 @@ impl Brep {
             }
         }
         let flip = mirrors(frame);
+        let normals = Normals::of(frame);
         for (axis, names) in FACE_NAMES.iter().enumerate() {
             let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
             for (side, &face_name) in names.iter().enumerate() {
@@ -331,12 +332,15 @@ impl Brep {
                 if (side == 0) != flip {
                     reverse(&mut ring);
                 }
-                self.add_face(
-                    face_name,
-                    box_face(frame, axis, side),
-                    box_face_center(frame, axis, side),
-                    [ring],
-                );
+                // `box_face`'s plane, through the centre that is also the sample.
+                let center = box_face_center(frame, axis, side);
+                let mut local_normal = Vec3::zeros();
+                local_normal[axis] = if side == 0 { -1.0 } else { 1.0 };
+                let plane = Surface::Plane {
+                    origin: center,
+                    normal: normals.to_global(&local_normal),
+                };
+                self.add_face(face_name, plane, center, [ring]);
             }
         }
     }
@@ -362,6 +366,7 @@ impl Brep {
 
     fn cone(&mut self, frame: &Frame, r0: f64, r1: f64) {
         let flip = mirrors(frame);
+        let normals = Normals::of(frame);
         // The side's loops: one per rim, at most two.
         let mut side_loops = [(0, false); 2];
         let mut rims = 0;
@@ -390,8 +395,13 @@ impl Brep {
             });
             // The cap's outward normal is ∓axis; the side meets the rim from the other side.
             let cap_forward = (up > 0.0) != flip;
+            // `cone_cap`'s plane, through the centre that is also the sample.
             let center = frame.to_global(&Point3::new(0.0, 0.0, z));
-            self.add_face(cap, cone_cap(frame, z, up), center, [[(e, cap_forward)]]);
+            let plane = Surface::Plane {
+                origin: center,
+                normal: normals.to_global(&Vec3::new(0.0, 0.0, up)),
+            };
+            self.add_face(cap, plane, center, [[(e, cap_forward)]]);
             side_loops[rims] = (e, !cap_forward);
             rims += 1;
         }
@@ -510,6 +520,23 @@ fn reverse(ring: &mut [(usize, bool)]) {
     }
 }
 
+/// `Frame::normal_to_global` for the several plane faces of one frame, its
+/// inverse computed once instead of per face (the inverses were a sixth of
+/// building a box's boundary). The same operations, so the same bits.
+struct Normals(Option<Mat3>);
+
+impl Normals {
+    fn of(frame: &Frame) -> Normals {
+        Normals(frame.linear.try_inverse().map(|inv| inv.transpose()))
+    }
+
+    fn to_global(&self, n: &Vec3) -> Vec3 {
+        let m = self.0.map_or(*n, |inverse_transpose| inverse_transpose * n);
+        let len = m.norm();
+        if len > 0.0 { m / len } else { m }
+    }
+}
+
 fn region_normal(frame: &Frame) -> Vec3 {
     let n = frame.linear.column(0).cross(&frame.linear.column(1));
     if n.norm() > 0.0 {
@@ -604,6 +631,67 @@ mod tests {
         let turned = Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7);
         let mirrored = Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0));
         [frame(turned), frame(mirrored)]
+    }
+
+    /// A surface's numbers, bit for bit (`==` takes -0 for +0).
+    fn bits(surface: &Surface) -> Vec<u64> {
+        match surface {
+            Surface::Plane { origin, normal } => (origin.iter().chain(normal.iter()))
+                .map(|x| x.to_bits())
+                .collect(),
+            other => panic!("not a plane: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn plane_faces_are_the_carriers_bit_for_bit() {
+        use crate::geom::solid_carriers::{box_face, cone_cap};
+        // Regular, mirrored, sheared, flat, singular, tiny and huge frames,
+        // and ones with exact zeros (whose normals have signed zeros).
+        let mut linears = vec![
+            Mat3::identity(),
+            Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7),
+            Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0)),
+            Mat3::from_diagonal(&Vec3::new(1.0, 1.0, 0.0)),
+            Mat3::zeros(),
+            Mat3::new(1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 0.0, 1.0),
+            Mat3::identity() * 1e-200,
+            Mat3::identity() * 1e200,
+            Mat3::new(0.0, 0.0, -3.0, 0.0, 2.0, 0.0, -1.0, 0.0, 0.0),
+        ];
+        let mut x = 0.37_f64;
+        for _ in 0..40 {
+            linears.push(Mat3::from_fn(|_, _| {
+                x = (x * 3.9 * (1.0 - x)).clamp(1e-9, 1.0 - 1e-9);
+                4.0 * x - 2.0
+            }));
+        }
+        let mut planes = 0;
+        for linear in linears {
+            let f = frame(linear);
+            let brep = of(&SolidShape::Box { frame: f });
+            for (k, face) in brep.faces.iter().enumerate() {
+                let expected = box_face(&f, k / 2, k % 2);
+                assert_eq!(bits(&face.surface), bits(&expected), "{linear:?} face {k}");
+                assert_eq!(face.sample, box_face_center(&f, k / 2, k % 2));
+                planes += 1;
+            }
+            let cone = of(&SolidShape::Cone {
+                frame: f,
+                r0: 0.4,
+                r1: 0.2,
+            });
+            for (k, (z, _, up)) in cone_rims(0.4, 0.2).enumerate() {
+                let expected = cone_cap(&f, z, up);
+                assert_eq!(
+                    bits(&cone.faces[k].surface),
+                    bits(&expected),
+                    "{linear:?} cap {k}"
+                );
+                planes += 1;
+            }
+        }
+        assert_eq!(planes, 49 * 8);
     }
 
     #[test]
