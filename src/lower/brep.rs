@@ -108,6 +108,12 @@ impl Brep {
         })
     }
 
+    /// Every edge of `face`'s loops, loop after loop.
+    fn face_edges(&self, face: &BrepFace) -> &[(usize, bool)] {
+        let end_of = |i: usize| if i == 0 { 0 } else { self.loop_ends[i - 1] };
+        &self.loop_edges[end_of(face.loops.start)..end_of(face.loops.end)]
+    }
+
     /// The model face of `self.faces[local]`, of solid `solid` named `base`,
     /// its loop items oriented by `orient`. The serial welder and the
     /// isolated runs (`isolated.rs`) both build faces here, so the two paths
@@ -120,9 +126,18 @@ impl Brep {
         orient: impl Fn((usize, bool)) -> OrientedEdge,
     ) -> Face {
         let f = &self.faces[local];
-        let total = self.loops(f).map(<[_]>::len).sum();
-        let loops =
-            Loops::from_nested(self.loops(f).map(|l| l.iter().copied().map(&orient)), total);
+        // Every primitive face but a two-rim cone's side has one loop: its
+        // edges need no walk through the loop ends.
+        let loops = match self.loops(f).len() {
+            1 => {
+                let edges = self.face_edges(f);
+                Loops::from_nested([edges.iter().copied().map(&orient)], edges.len())
+            }
+            _ => {
+                let total = self.face_edges(f).len();
+                Loops::from_nested(self.loops(f).map(|l| l.iter().copied().map(&orient)), total)
+            }
+        };
         Face {
             name: EntityName::local(base, f.name),
             carrier: carrier(by_solid, solid, local, &f.surface),
@@ -692,6 +707,51 @@ mod tests {
             }
         }
         assert_eq!(planes, 49 * 8);
+    }
+
+    #[test]
+    fn model_faces_have_the_loops_of_their_brep_faces() {
+        let mut shapes = solids();
+        shapes.push(SolidShape::Disk {
+            frame: frame(Mat3::identity()),
+        });
+        shapes.push(SolidShape::Polygon {
+            frame: frame(Mat3::identity()),
+            vertices: vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+            ],
+        });
+        let base: Arc<Box<str>> = Arc::new("s".into());
+        // Edges renumbered and turned, so the orientation is exercised.
+        let orient = |(edge, forward): (usize, bool)| OrientedEdge {
+            edge: crate::ir::EdgeId(3 * edge as u32 + 1),
+            forward: forward == (edge % 2 == 0),
+        };
+        let mut loop_counts = Vec::new();
+        for shape in &shapes {
+            let brep = of(shape);
+            for (k, f) in brep.faces.iter().enumerate() {
+                let face = brep.model_face(k, &base, (SolidId(4), true), orient);
+                let nested: Vec<Vec<OrientedEdge>> = (brep.loops(f))
+                    .map(|l| l.iter().copied().map(orient).collect())
+                    .collect();
+                assert_eq!(
+                    face.loops,
+                    Loops::from(nested.clone()),
+                    "{shape:?} face {k}"
+                );
+                assert_eq!(face.loops.to_vecs(), nested);
+                loop_counts.push(face.loops.len());
+            }
+        }
+        // Single loops, and the two-rim cones' sides with two.
+        assert_eq!(loop_counts.iter().filter(|&&n| n == 2).count(), 4);
+        assert_eq!(
+            loop_counts.iter().filter(|&&n| n == 1).count(),
+            loop_counts.len() - 4
+        );
     }
 
     #[test]
