@@ -3,10 +3,10 @@
 //! Built in local indices; the welder merges them into the model.
 
 use crate::geom::solid_carriers::{
-    box_corner, box_edge_ends, box_face, box_face_center, cone_cap, cone_rim, cone_rims, ellipse,
-    torus_meridian, torus_parallel,
+    box_corner, box_edge_ends, box_face_center, cone_rim, cone_rims, ellipse, torus_meridian,
+    torus_parallel,
 };
-use crate::geom::{Curve, Frame, Point3, SolidShape, Surface, Vec3};
+use crate::geom::{Curve, Frame, Mat3, Point3, SolidShape, Surface, Vec3};
 use crate::ir::{Carrier, EntityName, Face, LocalName, Loops, OrientedEdge, SolidId};
 use std::sync::Arc;
 
@@ -108,6 +108,12 @@ impl Brep {
         })
     }
 
+    /// Every edge of `face`'s loops, loop after loop.
+    fn face_edges(&self, face: &BrepFace) -> &[(usize, bool)] {
+        let end_of = |i: usize| if i == 0 { 0 } else { self.loop_ends[i - 1] };
+        &self.loop_edges[end_of(face.loops.start)..end_of(face.loops.end)]
+    }
+
     /// The model face of `self.faces[local]`, of solid `solid` named `base`,
     /// its loop items oriented by `orient`. The serial welder and the
     /// isolated runs (`isolated.rs`) both build faces here, so the two paths
@@ -120,9 +126,18 @@ impl Brep {
         orient: impl Fn((usize, bool)) -> OrientedEdge,
     ) -> Face {
         let f = &self.faces[local];
-        let total = self.loops(f).map(<[_]>::len).sum();
-        let loops =
-            Loops::from_nested(self.loops(f).map(|l| l.iter().copied().map(&orient)), total);
+        // Every primitive face but a two-rim cone's side has one loop: its
+        // edges need no walk through the loop ends.
+        let loops = match self.loops(f).len() {
+            1 => {
+                let edges = self.face_edges(f);
+                Loops::from_nested([edges.iter().copied().map(&orient)], edges.len())
+            }
+            _ => {
+                let total = self.face_edges(f).len();
+                Loops::from_nested(self.loops(f).map(|l| l.iter().copied().map(&orient)), total)
+            }
+        };
         Face {
             name: EntityName::local(base, f.name),
             carrier: carrier(by_solid, solid, local, &f.surface),
@@ -308,6 +323,7 @@ impl Brep {
             }
         }
         let flip = mirrors(frame);
+        let normals = Normals::of(frame);
         for (axis, names) in FACE_NAMES.iter().enumerate() {
             let (p, q) = ((axis + 1) % 3, (axis + 2) % 3);
             for (side, &face_name) in names.iter().enumerate() {
@@ -331,12 +347,15 @@ impl Brep {
                 if (side == 0) != flip {
                     reverse(&mut ring);
                 }
-                self.add_face(
-                    face_name,
-                    box_face(frame, axis, side),
-                    box_face_center(frame, axis, side),
-                    [ring],
-                );
+                // `box_face`'s plane, through the centre that is also the sample.
+                let center = box_face_center(frame, axis, side);
+                let mut local_normal = Vec3::zeros();
+                local_normal[axis] = if side == 0 { -1.0 } else { 1.0 };
+                let plane = Surface::Plane {
+                    origin: center,
+                    normal: normals.to_global(&local_normal),
+                };
+                self.add_face(face_name, plane, center, [ring]);
             }
         }
     }
@@ -362,6 +381,7 @@ impl Brep {
 
     fn cone(&mut self, frame: &Frame, r0: f64, r1: f64) {
         let flip = mirrors(frame);
+        let normals = Normals::of(frame);
         // The side's loops: one per rim, at most two.
         let mut side_loops = [(0, false); 2];
         let mut rims = 0;
@@ -390,8 +410,13 @@ impl Brep {
             });
             // The cap's outward normal is ∓axis; the side meets the rim from the other side.
             let cap_forward = (up > 0.0) != flip;
+            // `cone_cap`'s plane, through the centre that is also the sample.
             let center = frame.to_global(&Point3::new(0.0, 0.0, z));
-            self.add_face(cap, cone_cap(frame, z, up), center, [[(e, cap_forward)]]);
+            let plane = Surface::Plane {
+                origin: center,
+                normal: normals.to_global(&Vec3::new(0.0, 0.0, up)),
+            };
+            self.add_face(cap, plane, center, [[(e, cap_forward)]]);
             side_loops[rims] = (e, !cap_forward);
             rims += 1;
         }
@@ -510,6 +535,23 @@ fn reverse(ring: &mut [(usize, bool)]) {
     }
 }
 
+/// `Frame::normal_to_global` for the several plane faces of one frame, its
+/// inverse computed once instead of per face (the inverses were a sixth of
+/// building a box's boundary). The same operations, so the same bits.
+struct Normals(Option<Mat3>);
+
+impl Normals {
+    fn of(frame: &Frame) -> Normals {
+        Normals(frame.linear.try_inverse().map(|inv| inv.transpose()))
+    }
+
+    fn to_global(&self, n: &Vec3) -> Vec3 {
+        let m = self.0.map_or(*n, |inverse_transpose| inverse_transpose * n);
+        let len = m.norm();
+        if len > 0.0 { m / len } else { m }
+    }
+}
+
 fn region_normal(frame: &Frame) -> Vec3 {
     let n = frame.linear.column(0).cross(&frame.linear.column(1));
     if n.norm() > 0.0 {
@@ -604,6 +646,112 @@ mod tests {
         let turned = Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7);
         let mirrored = Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0));
         [frame(turned), frame(mirrored)]
+    }
+
+    /// A surface's numbers, bit for bit (`==` takes -0 for +0).
+    fn bits(surface: &Surface) -> Vec<u64> {
+        match surface {
+            Surface::Plane { origin, normal } => (origin.iter().chain(normal.iter()))
+                .map(|x| x.to_bits())
+                .collect(),
+            other => panic!("not a plane: {other:?}"),
+        }
+    }
+
+    #[test]
+    fn plane_faces_are_the_carriers_bit_for_bit() {
+        use crate::geom::solid_carriers::{box_face, cone_cap};
+        // Regular, mirrored, sheared, flat, singular, tiny and huge frames,
+        // and ones with exact zeros (whose normals have signed zeros).
+        let mut linears = vec![
+            Mat3::identity(),
+            Mat3::new(0.0, -2.0, 0.1, 1.5, 0.0, 0.0, 0.2, 0.0, 0.7),
+            Mat3::from_diagonal(&Vec3::new(-1.0, 0.5, 2.0)),
+            Mat3::from_diagonal(&Vec3::new(1.0, 1.0, 0.0)),
+            Mat3::zeros(),
+            Mat3::new(1.0, 2.0, 3.0, 2.0, 4.0, 6.0, 0.0, 0.0, 1.0),
+            Mat3::identity() * 1e-200,
+            Mat3::identity() * 1e200,
+            Mat3::new(0.0, 0.0, -3.0, 0.0, 2.0, 0.0, -1.0, 0.0, 0.0),
+        ];
+        let mut x = 0.37_f64;
+        for _ in 0..40 {
+            linears.push(Mat3::from_fn(|_, _| {
+                x = (x * 3.9 * (1.0 - x)).clamp(1e-9, 1.0 - 1e-9);
+                4.0 * x - 2.0
+            }));
+        }
+        let mut planes = 0;
+        for linear in linears {
+            let f = frame(linear);
+            let brep = of(&SolidShape::Box { frame: f });
+            for (k, face) in brep.faces.iter().enumerate() {
+                let expected = box_face(&f, k / 2, k % 2);
+                assert_eq!(bits(&face.surface), bits(&expected), "{linear:?} face {k}");
+                assert_eq!(face.sample, box_face_center(&f, k / 2, k % 2));
+                planes += 1;
+            }
+            let cone = of(&SolidShape::Cone {
+                frame: f,
+                r0: 0.4,
+                r1: 0.2,
+            });
+            for (k, (z, _, up)) in cone_rims(0.4, 0.2).enumerate() {
+                let expected = cone_cap(&f, z, up);
+                assert_eq!(
+                    bits(&cone.faces[k].surface),
+                    bits(&expected),
+                    "{linear:?} cap {k}"
+                );
+                planes += 1;
+            }
+        }
+        assert_eq!(planes, 49 * 8);
+    }
+
+    #[test]
+    fn model_faces_have_the_loops_of_their_brep_faces() {
+        let mut shapes = solids();
+        shapes.push(SolidShape::Disk {
+            frame: frame(Mat3::identity()),
+        });
+        shapes.push(SolidShape::Polygon {
+            frame: frame(Mat3::identity()),
+            vertices: vec![
+                Point3::new(0.0, 0.0, 0.0),
+                Point3::new(0.0, 1.0, 0.0),
+                Point3::new(1.0, 0.0, 0.0),
+            ],
+        });
+        let base: Arc<Box<str>> = Arc::new("s".into());
+        // Edges renumbered and turned, so the orientation is exercised.
+        let orient = |(edge, forward): (usize, bool)| OrientedEdge {
+            edge: crate::ir::EdgeId(3 * edge as u32 + 1),
+            forward: forward == (edge % 2 == 0),
+        };
+        let mut loop_counts = Vec::new();
+        for shape in &shapes {
+            let brep = of(shape);
+            for (k, f) in brep.faces.iter().enumerate() {
+                let face = brep.model_face(k, &base, (SolidId(4), true), orient);
+                let nested: Vec<Vec<OrientedEdge>> = (brep.loops(f))
+                    .map(|l| l.iter().copied().map(orient).collect())
+                    .collect();
+                assert_eq!(
+                    face.loops,
+                    Loops::from(nested.clone()),
+                    "{shape:?} face {k}"
+                );
+                assert_eq!(face.loops.to_vecs(), nested);
+                loop_counts.push(face.loops.len());
+            }
+        }
+        // Single loops, and the two-rim cones' sides with two.
+        assert_eq!(loop_counts.iter().filter(|&&n| n == 2).count(), 4);
+        assert_eq!(
+            loop_counts.iter().filter(|&&n| n == 1).count(),
+            loop_counts.len() - 4
+        );
     }
 
     #[test]
