@@ -283,6 +283,14 @@ fn room_for(scanned: usize, from: usize, at: usize, room_to: usize) -> usize {
     (bytes / per_child + bytes / per_child / 8 + 1).min(bytes / 8 + 1)
 }
 
+/// Room for `room` heads and extents in all. Out of line, once per scan: in
+/// [`scan_from`]'s loop it changed what the compiler inlined there.
+#[inline(never)]
+fn make_room(heads: &mut Vec<Head>, children: &mut Vec<Range<usize>>, room: usize) {
+    heads.reserve_exact(room.saturating_sub(heads.len()));
+    children.reserve_exact(room.saturating_sub(children.len()));
+}
+
 /// Scans children from `pos` until the root's end tag, or until a child
 /// would start at or after `stop`; `None` where the file must be parsed whole.
 /// The lists are sized for the children up to `room_to` once the first few
@@ -294,9 +302,11 @@ fn scan_from(text: &str, mut pos: usize, stop: usize, room_to: usize) -> Option<
     let mut children = Vec::new();
     loop {
         if heads.len() == SAMPLED_CHILDREN {
-            let room = room_for(heads.len(), from, pos, room_to);
-            heads.reserve_exact(room.saturating_sub(heads.len()));
-            children.reserve_exact(room.saturating_sub(children.len()));
+            make_room(
+                &mut heads,
+                &mut children,
+                room_for(SAMPLED_CHILDREN, from, pos, room_to),
+            );
         }
         pos = skip_whitespace(bytes, pos);
         if pos >= stop {
@@ -544,6 +554,7 @@ impl<'a> Marks<'a> {
     }
 
     /// The next mark that is `byte`.
+    #[inline]
     fn find(&mut self, byte: u8) -> Option<usize> {
         loop {
             let at = self.next()?;
