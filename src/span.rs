@@ -2,6 +2,7 @@
 //! 1-based line:column positions (columns counted in characters, as roxmltree does).
 
 use std::ops::Range;
+use std::sync::OnceLock;
 
 /// A half-open byte range `start..end` in a source text.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default)]
@@ -122,22 +123,29 @@ fn floor_char_boundary(text: &str, mut offset: usize) -> usize {
 pub struct SourceFile {
     pub name: String,
     pub text: String,
-    pub lines: LineIndex,
+    /// Built on first use: only diagnostics read it, and building it was a
+    /// serial pass over the whole text (with a vector of every line start)
+    /// before a large file's reading could start, for nothing when the file
+    /// has no findings.
+    lines: OnceLock<LineIndex>,
 }
 
 impl SourceFile {
     pub fn new(name: impl Into<String>, text: impl Into<String>) -> SourceFile {
-        let text = text.into();
-        let lines = LineIndex::new(&text);
         SourceFile {
             name: name.into(),
-            text,
-            lines,
+            text: text.into(),
+            lines: OnceLock::new(),
         }
     }
 
+    /// The line index of [`SourceFile::text`].
+    pub fn lines(&self) -> &LineIndex {
+        self.lines.get_or_init(|| LineIndex::new(&self.text))
+    }
+
     pub fn line_col(&self, offset: usize) -> LineCol {
-        self.lines.line_col(&self.text, offset)
+        self.lines().line_col(&self.text, offset)
     }
 
     pub fn snippet(&self, span: Span) -> &str {
@@ -156,11 +164,51 @@ mod tests {
         assert_eq!(src.line_col(3), LineCol { line: 2, column: 1 });
         // 'x' follows a two-byte character.
         assert_eq!(src.line_col(5), LineCol { line: 2, column: 2 });
-        assert_eq!(src.lines.line_text(&src.text, 2), "дx y");
+        assert_eq!(src.lines().line_text(&src.text, 2), "дx y");
         assert_eq!(
-            src.lines
+            src.lines()
                 .offset_of(&src.text, LineCol { line: 2, column: 3 }),
             Some(6)
         );
+    }
+
+    /// The index built on first use (by any of the threads asking at once)
+    /// places every offset as one built from the text directly.
+    #[test]
+    fn the_index_built_on_first_use_is_the_texts() {
+        let mut rng = crate::test_rng::TestRng::new(0x2f6b_9d1c_43a7_e805);
+        for _ in 0..200 {
+            let text: String = (0..rng.below(120))
+                .map(|_| ['a', ' ', '\n', '\r', 'д', '<'][rng.below(6)])
+                .collect();
+            let src = SourceFile::new("t", text.as_str());
+            let direct = LineIndex::new(&text);
+            let copy = src.clone();
+            let asked: Vec<Vec<LineCol>> = std::thread::scope(|scope| {
+                let threads: Vec<_> = (0..3)
+                    .map(|_| scope.spawn(|| (0..=text.len()).map(|o| src.line_col(o)).collect()))
+                    .collect();
+                threads
+                    .into_iter()
+                    .map(|t| t.join().expect("no panic"))
+                    .collect()
+            });
+            let expected: Vec<LineCol> = (0..=text.len())
+                .map(|o| direct.line_col(&text, o))
+                .collect();
+            assert!(asked.iter().all(|a| *a == expected), "{text:?}");
+            // A copy made before the index was built builds its own.
+            assert_eq!(
+                copy.line_col(text.len()),
+                direct.line_col(&text, text.len())
+            );
+            let last = expected.last().map_or(1, |p| p.line);
+            assert_eq!(
+                src.lines().line_text(&text, last),
+                direct.line_text(&text, last)
+            );
+        }
+        let src = SourceFile::new("t", "a\nb\n\nc");
+        assert_eq!(src.line_col(5), LineCol { line: 4, column: 1 });
     }
 }

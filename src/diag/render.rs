@@ -18,7 +18,7 @@ pub fn render_human(source: &SourceFile, diagnostic: &Diagnostic) -> String {
                 "{}:{}:{}: {severity}[{code}]: {}",
                 source.name, start.line, start.column, diagnostic.message
             );
-            let line_text = source.lines.line_text(&source.text, start.line);
+            let line_text = source.lines().line_text(&source.text, start.line);
             let gutter = start.line.to_string();
             let pad = " ".repeat(gutter.len());
             // The caret covers the span's part on its first line, at least one column.

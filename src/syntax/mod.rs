@@ -323,7 +323,7 @@ fn xml_error(source: &SourceFile, error: &roxmltree::Error, limits: &Limits) -> 
 
 fn position_span(source: &SourceFile, pos: roxmltree::TextPos) -> Span {
     let offset = source
-        .lines
+        .lines()
         .offset_of(
             &source.text,
             crate::span::LineCol {

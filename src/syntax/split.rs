@@ -161,7 +161,7 @@ impl<'s> Split<'s> {
         for node in wrapper.children() {
             if node.is_element() {
                 let element = tree::build(node, at).map_err(|Misplaced| Reparse)?;
-                if self.heads.get(index) != Some(&element.head()) {
+                if !self.heads.get(index).is_some_and(|h| h.is_of(&element)) {
                     return Err(Reparse);
                 }
                 out.extend(Some(element));
@@ -186,9 +186,7 @@ impl<'s> Split<'s> {
         out: &mut impl Extend<Element<'s>>,
     ) -> Result<usize, Reparse> {
         let heads = self.heads.get(first..=last).ok_or(Reparse)?;
-        if heads.len() != elements.len()
-            || !heads.iter().zip(&elements).all(|(h, e)| *h == e.head())
-        {
+        if heads.len() != elements.len() || !heads.iter().zip(&elements).all(|(h, e)| h.is_of(e)) {
             return Err(Reparse);
         }
         out.extend(elements);
@@ -228,7 +226,7 @@ fn scan_children(
     match guess {
         Some(middle) => scan_halves(text, from, middle),
         None => {
-            let whole = scan_from(text, from, usize::MAX)?;
+            let whole = scan_from(text, from, usize::MAX, text.len())?;
             Some((whole.heads, whole.children, whole.at))
         }
     }
@@ -240,15 +238,17 @@ fn scan_halves(
     from: usize,
     middle: usize,
 ) -> Option<(Vec<Head<'_>>, Vec<Range<usize>>, usize)> {
+    // The first half makes room for the whole, so the second's joins it
+    // without a copy of the first into fresh pages on this thread.
     let (first, second) = rayon::join(
-        || scan_from(text, from, middle),
-        || scan_from(text, middle, usize::MAX),
+        || scan_from(text, from, middle, text.len()),
+        || scan_from(text, middle, usize::MAX, text.len()),
     );
     let mut first = first?;
     let rest = match second {
         _ if first.ended => return Some((first.heads, first.children, first.at)),
         Some(second) if first.at == middle => second,
-        _ => scan_from(text, first.at, usize::MAX)?,
+        _ => scan_from(text, first.at, usize::MAX, text.len())?,
     };
     first.heads.extend(rest.heads);
     first.children.extend(rest.children);
@@ -269,13 +269,45 @@ fn guess_child_start(bytes: &[u8], mut pos: usize) -> Option<usize> {
     }
 }
 
+/// Children whose average length sizes the scan's lists (see [`room_for`]).
+const SAMPLED_CHILDREN: usize = 32;
+
+/// How many children the bytes `from..room_to` hold if they are as long on
+/// average as the `scanned` children found in `from..at`, with an eighth more
+/// (and at most one per 8 bytes, the shortest plausible child with
+/// whitespace): lists grown by doubling copied themselves into fresh pages
+/// several times over.
+fn room_for(scanned: usize, from: usize, at: usize, room_to: usize) -> usize {
+    let per_child = (at - from).div_ceil(scanned.max(1)).max(1);
+    let bytes = room_to.saturating_sub(from);
+    (bytes / per_child + bytes / per_child / 8 + 1).min(bytes / 8 + 1)
+}
+
+/// Room for `room` heads and extents in all. Out of line, once per scan: in
+/// [`scan_from`]'s loop it changed what the compiler inlined there.
+#[inline(never)]
+fn make_room(heads: &mut Vec<Head>, children: &mut Vec<Range<usize>>, room: usize) {
+    heads.reserve_exact(room.saturating_sub(heads.len()));
+    children.reserve_exact(room.saturating_sub(children.len()));
+}
+
 /// Scans children from `pos` until the root's end tag, or until a child
 /// would start at or after `stop`; `None` where the file must be parsed whole.
-fn scan_from(text: &str, mut pos: usize, stop: usize) -> Option<Scanned<'_>> {
+/// The lists are sized for the children up to `room_to` once the first few
+/// are seen.
+fn scan_from(text: &str, mut pos: usize, stop: usize, room_to: usize) -> Option<Scanned<'_>> {
     let bytes = text.as_bytes();
+    let from = pos;
     let mut heads = Vec::new();
     let mut children = Vec::new();
     loop {
+        if heads.len() == SAMPLED_CHILDREN {
+            make_room(
+                &mut heads,
+                &mut children,
+                room_for(SAMPLED_CHILDREN, from, pos, room_to),
+            );
+        }
         pos = skip_whitespace(bytes, pos);
         if pos >= stop {
             break;
@@ -522,6 +554,7 @@ impl<'a> Marks<'a> {
     }
 
     /// The next mark that is `byte`.
+    #[inline]
     fn find(&mut self, byte: u8) -> Option<usize> {
         loop {
             let at = self.next()?;
@@ -640,6 +673,9 @@ fn root_end(text: &str, pos: usize, root_name: &str) -> Option<usize> {
 }
 
 #[cfg(test)]
+mod fixture_edits;
+
+#[cfg(test)]
 mod tests {
     use super::*;
     use crate::span::SourceFile;
@@ -742,6 +778,34 @@ mod tests {
         }
         assert_eq!(kinds, [false, true].into());
         assert_eq!(scan_children(&text, from, 0), Some(one));
+    }
+
+    #[test]
+    fn the_scans_lists_are_sized_from_their_first_children() {
+        // 32 children of 20 bytes in 640 bytes: room for 100 children of
+        // 2,000 bytes and an eighth, capped at one per 8 bytes.
+        assert_eq!(room_for(32, 0, 640, 2_000), 100 + 12 + 1);
+        assert_eq!(room_for(32, 1_000, 1_640, 3_000), 100 + 12 + 1);
+        assert_eq!(room_for(32, 0, 32, 800), 101);
+        assert_eq!(room_for(0, 5, 5, 4), 1);
+        let mut text = String::from("<geometry>");
+        for i in 0..4_000 {
+            text.push_str(&format!(
+                "\n <sphere name=\"s{i:04}\"><radius value=\"1\"/></sphere>"
+            ));
+        }
+        text.push_str("\n</geometry>");
+        let from = "<geometry>".len();
+        let middle = guess_child_start(text.as_bytes(), text.len() / 2).expect("a child");
+        let (heads, children, _) = scan_halves(&text, from, middle).expect("scans");
+        assert_eq!((heads.len(), children.len()), (4_000, 4_000));
+        // Sized once for the whole (the second half joined without growing):
+        // a list grown by doubling would hold 4,096.
+        let sampled_to = children[SAMPLED_CHILDREN - 1].end;
+        let whole = room_for(SAMPLED_CHILDREN, from, sampled_to, text.len());
+        assert_eq!(heads.capacity(), whole);
+        assert_eq!(children.capacity(), whole);
+        assert!((4_000..4_600).contains(&whole), "{whole}");
     }
 
     /// Random edits of a file of many children: whenever the scan splits it
