@@ -69,11 +69,23 @@ pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, 
     {
         return Ok(expr);
     }
+    // Room for the three nodes and two levels of `a op b`, so the short form
+    // never has to report a limit the general path would report.
+    if limits.max_nodes >= 3
+        && limits.max_depth >= 2
+        && let Some(expr) = super::short::short_form(text, base)
+    {
+        return Ok(expr);
+    }
     parse_tokens(text, base, limits)
 }
 
 /// The general path of [`parse_with`]: tokens, then the Pratt parser.
-fn parse_tokens(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
+pub(super) fn parse_tokens(
+    text: &str,
+    base: usize,
+    limits: &ExprLimits,
+) -> Result<Expr, ParseError> {
     let tokens = lex(text, base)?;
     let end = base + text.len();
     let mut parser = Parser {
