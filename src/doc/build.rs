@@ -868,6 +868,11 @@ fn point_tag(name: &str) -> std::borrow::Cow<'static, str> {
 /// `name`, `name[3]` or `name.entity` (the entity part only when the name
 /// before the dot is non-empty).
 pub fn parse_ref(text: &str, span: Span) -> Ref {
+    // Most references are bare names: no dot for an entity, no `]` ending
+    // a member index.
+    if !text.bytes().any(|b| b == b'.' || b == b']') {
+        return Ref::to_name(text, span);
+    }
     let mut name_end = text.len();
     let mut entity = None;
     if let Some(dot) = text.rfind('.')
