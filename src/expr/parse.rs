@@ -64,7 +64,9 @@ pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
 
 /// [`parse`] with the size bounds given.
 pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
-    let first = text.bytes().find(|b| !matches!(b, b' ' | b'\t' | b'\n' | b'\r'));
+    let first = text
+        .bytes()
+        .find(|b| !matches!(b, b' ' | b'\t' | b'\n' | b'\r'));
     if limits.max_nodes >= 1
         && matches!(first, Some(b'0'..=b'9' | b'.'))
         && let Some(expr) = plain_number(text, base)
