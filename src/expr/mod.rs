@@ -7,6 +7,7 @@
 
 mod eval;
 mod parse;
+mod short;
 
 pub use eval::{EvalError, eval};
 pub use parse::{ExprLimits, MAX_DEPTH, MAX_NODES, ParseError, parse, parse_with};

@@ -64,8 +64,20 @@ pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
 
 /// [`parse`] with the size bounds given.
 pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
+    let first = text
+        .bytes()
+        .find(|b| !matches!(b, b' ' | b'\t' | b'\n' | b'\r'));
     if limits.max_nodes >= 1
+        && matches!(first, Some(b'0'..=b'9' | b'.'))
         && let Some(expr) = plain_number(text, base)
+    {
+        return Ok(expr);
+    }
+    // Room for the three nodes and two levels of `a op b`, so the short form
+    // never has to report a limit the general path would report.
+    if limits.max_nodes >= 3
+        && limits.max_depth >= 2
+        && let Some(expr) = super::short::short_form(text, base)
     {
         return Ok(expr);
     }
@@ -73,7 +85,11 @@ pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, 
 }
 
 /// The general path of [`parse_with`]: tokens, then the Pratt parser.
-fn parse_tokens(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
+pub(super) fn parse_tokens(
+    text: &str,
+    base: usize,
+    limits: &ExprLimits,
+) -> Result<Expr, ParseError> {
     let tokens = lex(text, base)?;
     let end = base + text.len();
     let mut parser = Parser {

@@ -553,7 +553,8 @@ impl<'a> Marks<'a> {
         Some(at)
     }
 
-    /// The next mark that is `byte`.
+    /// The next mark that is `byte`. Inlined like `next`: out of line it
+    /// cost `scan_from` about 60 M instructions on a 100k-primitive file.
     #[inline]
     fn find(&mut self, byte: u8) -> Option<usize> {
         loop {
