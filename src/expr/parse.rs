@@ -64,9 +64,7 @@ pub fn parse(text: &str, base: usize) -> Result<Expr, ParseError> {
 
 /// [`parse`] with the size bounds given.
 pub fn parse_with(text: &str, base: usize, limits: &ExprLimits) -> Result<Expr, ParseError> {
-    let first = text
-        .bytes()
-        .find(|b| !matches!(b, b' ' | b'\t' | b'\n' | b'\r'));
+    let first = text.bytes().find(|&b| !is_space(b));
     if limits.max_nodes >= 1
         && matches!(first, Some(b'0'..=b'9' | b'.'))
         && let Some(expr) = plain_number(text, base)
@@ -152,7 +150,7 @@ fn lex(text: &str, base: usize) -> Result<Vec<(Token, Span)>, ParseError> {
     while let Some(&c) = bytes.get(i) {
         let start = i;
         match c {
-            b' ' | b'\t' | b'\n' | b'\r' => {
+            c if is_space(c) => {
                 i += 1;
                 continue;
             }
@@ -217,9 +215,14 @@ struct Parser {
     limits: ExprLimits,
 }
 
+/// A space the lexer skips between tokens.
+pub(super) fn is_space(byte: u8) -> bool {
+    matches!(byte, b' ' | b'\t' | b'\n' | b'\r')
+}
+
 /// Binding powers: (left, right). `^` is right-associative and binds tighter
 /// than unary minus on its left (-2^2 = -4), as in mathematics.
-fn infix_power(op: char) -> Option<(u8, u8, BinaryOp)> {
+pub(super) fn infix_power(op: char) -> Option<(u8, u8, BinaryOp)> {
     Some(match op {
         '+' => (1, 2, BinaryOp::Add),
         '-' => (1, 2, BinaryOp::Sub),

@@ -5,6 +5,7 @@
 //! path makes of them. Anything else is `None` and goes the general way, which
 //! also reports every error: the short form only accepts what parses.
 
+use super::parse::{infix_power, is_space};
 use super::{BinaryOp, Expr, ExprKind};
 use crate::span::Span;
 
@@ -36,21 +37,15 @@ pub(super) fn short_form(text: &str, base: usize) -> Option<Expr> {
 
 /// The first index from `at` that is not a space the lexer skips.
 fn skip_space(bytes: &[u8], mut at: usize) -> usize {
-    while matches!(bytes.get(at), Some(b' ' | b'\t' | b'\n' | b'\r')) {
+    while bytes.get(at).is_some_and(|&b| is_space(b)) {
         at += 1;
     }
     at
 }
 
+/// The parser's binary operator written as `byte`.
 fn binary_op(byte: u8) -> Option<BinaryOp> {
-    Some(match byte {
-        b'+' => BinaryOp::Add,
-        b'-' => BinaryOp::Sub,
-        b'*' => BinaryOp::Mul,
-        b'/' => BinaryOp::Div,
-        b'^' => BinaryOp::Pow,
-        _ => return None,
-    })
+    infix_power(char::from(byte)).map(|(_, _, op)| op)
 }
 
 /// A name or an unsigned literal starting at `at`, with the index after it.
@@ -76,10 +71,7 @@ fn operand(text: &str, at: usize, base: usize) -> Option<(Expr, usize)> {
         end += 1;
     }
     if let Some(&next) = bytes.get(end)
-        && !matches!(
-            next,
-            b' ' | b'\t' | b'\n' | b'\r' | b'+' | b'-' | b'*' | b'/' | b'^'
-        )
+        && !(is_space(next) || binary_op(next).is_some())
     {
         return None;
     }

@@ -313,7 +313,18 @@ fn illinois(
 }
 
 fn ellipse_point(center: &Point3, major: &Vec3, minor: &Vec3, t: f64) -> Point3 {
-    center + major * t.cos() + minor * t.sin()
+    ellipse_point_trig(center, major, minor, (t.cos(), t.sin()))
+}
+
+/// [`Curve::point`]'s ellipse point at the angle whose cosine and sine are
+/// given (for callers that computed them once for many ellipses).
+pub(crate) fn ellipse_point_trig(
+    center: &Point3,
+    major: &Vec3,
+    minor: &Vec3,
+    (cos, sin): (f64, f64),
+) -> Point3 {
+    center + major * cos + minor * sin
 }
 
 /// The angle of the point of the full ellipse nearest `p`: the best of a

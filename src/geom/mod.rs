@@ -23,6 +23,7 @@ mod tests;
 mod trace;
 
 pub use curve::Curve;
+pub(crate) use curve::ellipse_point_trig;
 pub use frame::Frame;
 pub use intersect::{BoundaryRelation, boundary_relation};
 pub use newton::{intersect_curves, intersect_surfaces};

@@ -10,7 +10,7 @@
 
 use super::weld::{probe_points, same_edge};
 use crate::geom::solid_carriers::{box_corner, cone_rims, torus_meridian, torus_parallel};
-use crate::geom::{Curve, Frame, Point3, SolidShape};
+use crate::geom::{Curve, Frame, Point3, SolidShape, ellipse_point_trig};
 use std::f64::consts::TAU;
 use std::sync::OnceLock;
 
@@ -94,7 +94,7 @@ fn ellipse_probes(curve: &Curve) -> [Point3; 3] {
                         (t.cos(), t.sin())
                     })
                 })
-                .map(|(cos, sin)| center + major * cos + minor * sin)
+                .map(|trig| ellipse_point_trig(center, major, minor, trig))
         }
         _ => probe_points(curve),
     }
