@@ -256,6 +256,80 @@ mod tests {
     }
 
     #[test]
+    fn bands_list_the_seen_triangles_reaching_them_in_order() {
+        // 70,000 random triangles (two chunks and a part), of three faces,
+        // the second showing no back and the third nothing: each band
+        // lists, ascending, exactly the triangles whose seen side faces the
+        // eye and whose sample box reaches its rows, and its columns are
+        // those boxes' reach.
+        let mut rng = crate::test_rng::TestRng::new(0x6a09_e667_f3bc_c908);
+        let (width, height, band_rows) = (90usize, 77usize, 10usize);
+        let n = 2 * CHUNK + 4_465;
+        let snapped: Vec<Snapped> = (0..3 * n)
+            .map(|k| {
+                let reach = [30, 120, 900][k / 3 % 3];
+                Snapped {
+                    x: (rng.within(reach) + 700) as i32,
+                    y: (rng.within(reach) + 600) as i32,
+                    z: 0.5,
+                }
+            })
+            .collect();
+        let tris: Vec<[u32; 3]> = (0..n as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        let tri_face: Vec<u32> = (0..n as u32).map(|t| t % 3).collect();
+        let scene = Scene {
+            points: Vec::new().into(),
+            tris: tris.into(),
+            tri_face,
+            one_face: None,
+            face_sides: vec![[0, 1], [0, HIDDEN], [HIDDEN, HIDDEN]],
+            same_sides: None,
+            corner_slots: Vec::new().into(),
+            light: Vec::new(),
+            groups: Vec::new(),
+        };
+        let proj = Projected {
+            snapped,
+            xy_f: Vec::new(),
+        };
+        let bins = bin(&scene, &proj, width, height, band_rows);
+        assert_eq!(bins.len(), 3);
+        let n_bands = height.div_ceil(band_rows);
+        let mut listed = 0;
+        for band in 0..n_bands {
+            let rows = band * band_rows..((band + 1) * band_rows).min(height);
+            let (mut expected, mut reach) = (Vec::new(), (u32::MAX, 0));
+            for (tri, t) in scene.tris.iter().enumerate() {
+                let v = t.map(|k| {
+                    let p = proj.snapped[k as usize];
+                    [i64::from(p.x), i64::from(p.y)]
+                });
+                let area = (v[1][0] - v[0][0]) * (v[2][1] - v[0][1])
+                    - (v[1][1] - v[0][1]) * (v[2][0] - v[0][0]);
+                let side = usize::from(area > 0);
+                if area == 0 || scene.face_sides[tri % 3][side] == HIDDEN {
+                    continue;
+                }
+                if let Some((x0, x1, y0, y1)) = sample_box(&v, width, height)
+                    && y0 < rows.end
+                    && rows.start <= y1
+                {
+                    expected.push(tri as u32);
+                    reach = (reach.0.min(x0 as u32), reach.1.max(x1 as u32));
+                }
+            }
+            let got: Vec<u32> = bins.iter().flat_map(|c| c.ids[band].clone()).collect();
+            assert_eq!(got, expected, "band {band}");
+            let columns = (reach.0 <= reach.1).then_some((reach.0 as usize, reach.1 as usize));
+            assert_eq!(band_columns(&bins, band), columns, "band {band}");
+            listed += got.len();
+        }
+        assert!(listed > 20_000, "{listed} listed");
+    }
+
+    #[test]
     fn sample_box_holds_the_covered_sample_centres() {
         // Corners in 1/16 sample steps: x 20..70 holds the centres of
         // samples 1..=3 (24, 40, 56), y 0..30 those of rows 0..=1 (8, 24).

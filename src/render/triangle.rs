@@ -566,6 +566,65 @@ mod tests {
     }
 
     #[test]
+    fn lanes_draw_every_list_length_as_the_scalar_code() {
+        // Band lists of every length from 0 to 41 (no group, one partial
+        // group, whole groups and a partial last one), ids in random order
+        // with repeats, on a picture whose rows and end are not at
+        // multiples of eight samples (the lanes' blocks straddle rows, and
+        // the last one passes the end): the lanes fill what the scalar code
+        // fills.
+        let mut rng = TestRng::new(0x1405_7b7e_f767_814f);
+        let (w, h) = (45usize, 41usize);
+        let (mut nodes, mut tris) = (Vec::new(), Vec::new());
+        for t in 0..300u32 {
+            // Mostly small triangles, some up to 30 samples across (box
+            // rows of several blocks), every seventh a large one.
+            let c = [rng.within(380) + 360, rng.within(340) + 328];
+            let reach = match t % 7 {
+                0 => 3000,
+                1 | 4 => 230,
+                _ => 50,
+            };
+            for _ in 0..3 {
+                nodes.push(Snapped {
+                    x: (c[0] + rng.within(reach)) as i32,
+                    y: (c[1] + rng.within(reach)) as i32,
+                    z: rng.within(1000) as f32 / 1000.0,
+                });
+            }
+            tris.push([3 * t, 3 * t + 1, 3 * t + 2]);
+        }
+        let ids: Vec<u32> = (0..41).map(|_| (rng.within(149) + 149) as u32).collect();
+        let mut drawn_samples = 0;
+        for len in 0..=ids.len() {
+            let draw = |lanes: bool| {
+                let mut picture = vec![EMPTY; w * h];
+                // SAFETY: `picture` holds the band's samples; `lanes` only
+                // where the processor has them.
+                unsafe {
+                    draw_chunks_by(
+                        lanes,
+                        &mut picture,
+                        w,
+                        0..h,
+                        &tris,
+                        &nodes,
+                        [&ids[..len]].into_iter(),
+                    )
+                };
+                picture
+            };
+            let scalar = draw(false);
+            drawn_samples += scalar.iter().filter(|&&v| v != EMPTY).count();
+            #[cfg(target_arch = "x86_64")]
+            if lanes::available() {
+                assert!(draw(true) == scalar, "{len} ids: the pictures differ");
+            }
+        }
+        assert!(drawn_samples > 4000, "{drawn_samples} samples drawn");
+    }
+
+    #[test]
     fn lanes_draw_the_bits_the_scalar_code_draws() {
         // Many triangles over several bands: small ones (some sharing
         // corners, some near the packed limit), large ones, both
