@@ -31,6 +31,7 @@ pub fn serial_sums(
     len: usize,
     spans: Option<&NodeSpans>,
 ) -> Vec<Sum> {
+    let mut sums = vec![Sum::default(); len];
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
@@ -39,42 +40,16 @@ pub fn serial_sums(
                 // SAFETY: the CPU has AVX2 (checked just above), and every
                 // corner names a point, so a slot below `len` (the spans
                 // of these very triangles say so).
-                return unsafe { own_sums_unchecked(points, tris, len) };
+                unsafe { own_sums_unchecked(points, tris, &mut sums) };
+            } else {
+                // SAFETY: the CPU has AVX2 (checked just above).
+                unsafe { sums_avx2(points, tris, slots, &mut sums) };
             }
-            let mut sums = zeroed_sums(len);
-            // SAFETY: the CPU has AVX2 (checked just above).
-            unsafe { sums_avx2(points, tris, slots, &mut sums) };
             return sums;
         }
     }
-    let mut sums = zeroed_sums(len);
     sums_scalar(points, tris, slots, &mut sums);
     sums
-}
-
-/// `len` zero sums, asked of the allocator as zeroed memory: fresh pages
-/// from the system are zero already, so 16 MB for a million-triangle mesh
-/// are not written before the sums are (`vec![Sum::default(); len]` writes
-/// every lane: a `Sum` is not a type the standard library knows is zero).
-fn zeroed_sums(len: usize) -> Vec<Sum> {
-    if len == 0 {
-        return Vec::new();
-    }
-    let Ok(layout) = std::alloc::Layout::array::<Sum>(len) else {
-        panic!("{len} normal sums overflow the address space");
-    };
-    // SAFETY: the layout has a non-zero size (`len > 0`, a `Sum` is 32
-    // bytes); a null pointer is reported as an allocation failure; zero
-    // bits are a valid `Sum` (four +0.0, its default); and the block comes
-    // from the global allocator with the layout a `Vec<Sum>` of capacity
-    // `len` frees it with.
-    unsafe {
-        let ptr = std::alloc::alloc_zeroed(layout).cast::<Sum>();
-        if ptr.is_null() {
-            std::alloc::handle_alloc_error(layout);
-        }
-        Vec::from_raw_parts(ptr, len, len)
-    }
 }
 
 fn sums_scalar(points: &[[f64; 3]], tris: &[[u32; 3]], slots: &[[u32; 3]], sums: &mut [Sum]) {
@@ -143,61 +118,26 @@ fn corner_normal(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> std::arch::x86_64:
     _mm256_permute4x64_pd::<YZX>(w)
 }
 
-/// The `len` sums of the one-face loop of [`sums_avx2`], without corner
-/// checks (about six million of them for a million triangles) and without
-/// writing the sums twice: nodes are usually numbered in the order the
-/// triangles first name them, so the sums past the highest node named so
-/// far are not yet written. A corner past it starts from a zero register
-/// instead of loading a zero written beforehand (the 16 MB fill, and a
-/// cache miss every other triangle of a strip), and only the nodes it skips
-/// are zeroed in memory. Each sum gets the same additions in the same order
-/// as in the scalar loop (the first to a zero), so the same bits.
+/// The one-face loop of [`sums_avx2`] without corner checks: about six
+/// million of them for a million triangles.
 ///
 /// # Safety
 /// The CPU has AVX2, and every node of `tris` is below `points.len()`,
-/// which is at most `len`.
+/// which is at most `sums.len()`.
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-unsafe fn own_sums_unchecked(points: &[[f64; 3]], tris: &[[u32; 3]], len: usize) -> Vec<Sum> {
-    use std::arch::x86_64::*;
-    let mut sums: Vec<Sum> = Vec::with_capacity(len);
-    let base = sums.as_mut_ptr().cast::<f64>();
-    let zero = _mm256_setzero_pd();
-    // Sums below `high` are written (a node's partial sum, or zero); those
-    // from `high` on are not.
-    let mut high = 0usize;
+unsafe fn own_sums_unchecked(points: &[[f64; 3]], tris: &[[u32; 3]], sums: &mut [Sum]) {
     for t in tris {
-        // SAFETY: every node of `t` is below `points.len()` ≤ `len` (the
-        // caller's promise), so its sum lies in the allocation; a `Sum` is
-        // four f64s aligned to 32 bytes; a sum below `high` is written.
+        // SAFETY: every node of `t` is below `points.len()` ≤ `sums.len()`
+        // (the caller's promise).
         unsafe {
             let [a, b, c] = t.map(|k| points.get_unchecked(k as usize));
             let n = corner_normal(a, b, c);
-            for &m in t {
-                let (m, at) = (m as usize, base.add(4 * m as usize));
-                let old = if m < high {
-                    _mm256_load_pd(at)
-                } else {
-                    // Not written yet: the nodes skipped are zeroed.
-                    for skipped in high..m {
-                        _mm256_store_pd(base.add(4 * skipped), zero);
-                    }
-                    high = m + 1;
-                    zero
-                };
-                _mm256_store_pd(at, _mm256_add_pd(old, n));
+            for &k in t {
+                add_avx2(sums.get_unchecked_mut(k as usize), n);
             }
         }
     }
-    // SAFETY: the sums from `high` to `len` lie in the allocation, and then
-    // every sum below `len` is written.
-    unsafe {
-        for skipped in high..len {
-            _mm256_store_pd(base.add(4 * skipped), zero);
-        }
-        sums.set_len(len);
-    }
-    sums
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -306,7 +246,7 @@ mod tests {
     }
 
     #[test]
-    fn first_touch_sums_are_the_scalar_sums_bit_for_bit_on_random_meshes() {
+    fn unchecked_sums_are_the_scalar_sums_bit_for_bit_on_random_meshes() {
         let points = scattered(600);
         let n = points.len() as u32;
         let mut state = 0x9e37_79b9_7f4a_7c15u64;
@@ -365,17 +305,14 @@ mod tests {
         sums_scalar(&points, &tris, &tris, &mut want);
         let spans = node_spans(&tris);
         assert!(spans.all_below(&tris, points.len()));
-        // A freed block of the same size, full of NaN, for the allocator to
-        // hand out again: a sum read before it is written would show.
-        drop(std::hint::black_box(vec![Sum([f64::NAN; 4]); len]));
         let got = serial_sums(&points, &tris, &tris, len, Some(&spans));
         assert_eq!(got.len(), len);
         for (node, (g, w)) in got.iter().zip(&want).enumerate() {
             assert_eq!(g.0.map(f64::to_bits), w.0.map(f64::to_bits), "node {node}");
         }
         assert!(got[590..].iter().all(|s| s.0.map(f64::to_bits) == [0; 4]));
-        // Triangles naming nodes in their order of first use (every third
-        // corner a first touch), and the empty list.
+        // Triangles naming nodes in their order of first use, and the
+        // empty list.
         let strip: Vec<[u32; 3]> = (0..500u32)
             .map(|j| {
                 if j % 2 == 0 {
