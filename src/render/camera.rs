@@ -159,6 +159,12 @@ fn extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64
 fn block_extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64; 2]) {
     #[cfg(target_arch = "x86_64")]
     {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            if let Some(bounds) = unsafe { block_extent_avx2(points, right, up) } {
+                return bounds;
+            }
+        }
         // SAFETY: SSE2 is part of every x86-64.
         unsafe { block_extent_sse2(points, right, up) }
     }
@@ -166,6 +172,69 @@ fn block_extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2]
     {
         scalar_extent(points, right, up)
     }
+}
+
+/// [`block_extent`] four nodes per vector: the same products and sums per
+/// lane as [`dot`], and `minpd`/`maxpd` are [`below`]/[`above`] lane by
+/// lane. The lanes meet the nodes in another order than the serial fold,
+/// which only matters for equal values of different bits, zeros (the fold
+/// keeps the first zero's sign): `None` when any bound is a zero.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+fn block_extent_avx2(
+    points: &[[f64; 3]],
+    right: [f64; 3],
+    up: [f64; 3],
+) -> Option<([f64; 2], [f64; 2])> {
+    use std::arch::x86_64::*;
+    let whole = points.len() / 4 * 4;
+    let splat = |v: f64| _mm256_set1_pd(v);
+    let ([r0, r1, r2], [u0, u1, u2]) = (right.map(splat), up.map(splat));
+    let mut lo = [splat(f64::INFINITY); 2];
+    let mut hi = [splat(f64::NEG_INFINITY); 2];
+    for q in points[..whole].chunks_exact(4) {
+        let p = q.as_ptr().cast::<f64>();
+        // SAFETY: `q` is four points, twelve f64s from `p`: three vectors
+        // of pairs (nodes 0–1 and 2–3), then one vector per axis.
+        let pairs = |k: usize| unsafe {
+            _mm256_insertf128_pd::<1>(
+                _mm256_castpd128_pd256(_mm_loadu_pd(p.add(k))),
+                _mm_loadu_pd(p.add(6 + k)),
+            )
+        };
+        let (xy, zx, yz) = (pairs(0), pairs(2), pairs(4));
+        let x = _mm256_shuffle_pd::<0b1010>(xy, zx);
+        let y = _mm256_shuffle_pd::<0b0101>(xy, yz);
+        let z = _mm256_shuffle_pd::<0b1010>(zx, yz);
+        let dot = |a0: __m256d, a1: __m256d, a2: __m256d| {
+            _mm256_add_pd(
+                _mm256_add_pd(_mm256_mul_pd(x, a0), _mm256_mul_pd(y, a1)),
+                _mm256_mul_pd(z, a2),
+            )
+        };
+        for (k, v) in [dot(r0, r1, r2), dot(u0, u1, u2)].into_iter().enumerate() {
+            lo[k] = _mm256_min_pd(v, lo[k]);
+            hi[k] = _mm256_max_pd(v, hi[k]);
+        }
+    }
+    let lanes = |v: __m256d| {
+        let mut a = [0.0; 4];
+        // SAFETY: `a` is four f64s.
+        unsafe { _mm256_storeu_pd(a.as_mut_ptr(), v) };
+        a
+    };
+    let (mut l, mut h) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for k in 0..2 {
+        for (a, b) in lanes(lo[k]).into_iter().zip(lanes(hi[k])) {
+            (l[k], h[k]) = (below(a, l[k]), above(b, h[k]));
+        }
+    }
+    for p in &points[whole..] {
+        let (u, v) = (dot(*p, right), dot(*p, up));
+        l = [below(u, l[0]), below(v, l[1])];
+        h = [above(u, h[0]), above(v, h[1])];
+    }
+    l.iter().chain(&h).all(|&b| b != 0.0).then_some((l, h))
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -255,8 +324,9 @@ mod tests {
         points[5] = [f64::NAN, 1.0, 2.0];
         let right = [0.6, 0.8, 0.0];
         let up = [-0.48, 0.36, 0.8];
-        for cut in [points.len(), 40] {
-            let part = &points[..cut];
+        let cuts = [(0, points.len()), (0, 40), (1, 42), (2, 43), (3, 4099)];
+        for (from, to) in cuts {
+            let part = &points[from..to];
             let (lo, hi) = extent(part, right, up);
             let (want_lo, want_hi) = scalar_extent(part, right, up);
             assert_eq!(lo.map(f64::to_bits), want_lo.map(f64::to_bits));
@@ -267,6 +337,33 @@ mod tests {
         let (lo, hi) = extent(&zeros, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
         assert_eq!(lo.map(f64::to_bits), [(-0.0f64).to_bits(); 2]);
         assert_eq!(hi.map(f64::to_bits), [(-0.0f64).to_bits(); 2]);
+        // Zeros of either sign in every lane, the first of them in turn
+        // in each: the serial fold's signs.
+        for first in 0..5 {
+            let zeros: Vec<[f64; 3]> = (0..103)
+                .map(|i| {
+                    let z = if (i + first) % 3 == 0 { -0.0 } else { 0.0 };
+                    [z, -z, z]
+                })
+                .collect();
+            for (r, u) in [([1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), (right, up)] {
+                let (lo, hi) = extent(&zeros, r, u);
+                let (want_lo, want_hi) = scalar_extent(&zeros, r, u);
+                assert_eq!(lo.map(f64::to_bits), want_lo.map(f64::to_bits));
+                assert_eq!(hi.map(f64::to_bits), want_hi.map(f64::to_bits));
+            }
+        }
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            let lanes = unsafe { block_extent_avx2(&points[..BLOCK], right, up) };
+            let want = scalar_extent(&points[..BLOCK], right, up);
+            let bits = |(l, h): ([f64; 2], [f64; 2])| (l.map(f64::to_bits), h.map(f64::to_bits));
+            assert_eq!(lanes.map(bits), Some(bits(want)));
+            let zeros = [[0.0, -0.0, 0.0]; 9];
+            // SAFETY: as above.
+            assert_eq!(unsafe { block_extent_avx2(&zeros, right, up) }, None);
+        }
         assert_eq!(
             extent(&[], right, up),
             ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2])

@@ -235,4 +235,113 @@ mod tests {
         assert_eq!(want[k].xyz().map(f64::to_bits), plain.map(f64::to_bits));
         assert_ne!(plain, [0.0; 3]);
     }
+
+    /// A small deterministic generator (xorshift), so the meshes below are
+    /// random but the same on every run.
+    fn next(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
+    #[test]
+    fn unchecked_sums_are_the_scalar_sums_bit_for_bit_on_random_meshes() {
+        let points = scattered(600);
+        let n = points.len() as u32;
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut tris: Vec<[u32; 3]> = Vec::new();
+        // Random runs of strips (each triangle shares two corners with the
+        // last, in turning positions), fans (one corner shared by all),
+        // triangles sharing one or no corner, and degenerate ones naming a
+        // corner twice or thrice, also as the very first triangle: nodes
+        // first named in order, skipping some, and named again later.
+        tris.push([5, 5, 9]);
+        while tris.len() < 20_000 {
+            let r = next(&mut state);
+            let at = (r >> 8) as u32 % n;
+            let len = 1 + (r >> 40) as usize % 40;
+            match r % 6 {
+                0 | 1 => {
+                    // A strip: (a, b, c), (a, c, d) rotated as the torus does.
+                    let w = 1 + (r >> 20) as u32 % 7;
+                    for j in 0..len as u32 {
+                        let p = |i: u32, k: u32| (at + i * w + k) % n;
+                        tris.push([p(0, j), p(1, j), p(1, j + 1)]);
+                        tris.push([p(0, j), p(1, j + 1), p(0, j + 1)]);
+                    }
+                }
+                2 => {
+                    for j in 0..len as u32 {
+                        tris.push([at, (at + j + 1) % n, (at + j + 2) % n]);
+                    }
+                }
+                3 => {
+                    let last = *tris.last().unwrap_or(&[0, 1, 2]);
+                    tris.push([last[(r >> 30) as usize % 3], at, (at + 11) % n]);
+                }
+                4 => {
+                    let k = (next(&mut state) % u64::from(n)) as u32;
+                    let shapes = [[at, at, k], [at, k, at], [k, at, at], [at, at, at]];
+                    tris.push(shapes[(r >> 30) as usize % 4]);
+                    let last = tris[tris.len() - 1];
+                    tris.push([last[0], last[2], (at + 3) % n]);
+                }
+                _ => {
+                    for _ in 0..len {
+                        let v = next(&mut state);
+                        tris.push([0, 21, 42].map(|s| ((v >> s) % u64::from(n)) as u32));
+                    }
+                }
+            }
+        }
+        // Nodes 590.. are never named; slots past the points (a later
+        // face's) are asked for too: both stay zero.
+        for t in &mut tris {
+            *t = t.map(|m| m % 590);
+        }
+        let len = points.len() + 50;
+        let mut want = vec![Sum::default(); len];
+        sums_scalar(&points, &tris, &tris, &mut want);
+        let spans = node_spans(&tris);
+        assert!(spans.all_below(&tris, points.len()));
+        let got = serial_sums(&points, &tris, &tris, len, Some(&spans));
+        assert_eq!(got.len(), len);
+        for (node, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(g.0.map(f64::to_bits), w.0.map(f64::to_bits), "node {node}");
+        }
+        assert!(got[590..].iter().all(|s| s.0.map(f64::to_bits) == [0; 4]));
+        // Triangles naming nodes in their order of first use, and the
+        // empty list.
+        let strip: Vec<[u32; 3]> = (0..500u32)
+            .map(|j| {
+                if j % 2 == 0 {
+                    [j, j + 1, j + 2]
+                } else {
+                    [j, j + 2, j + 1]
+                }
+            })
+            .collect();
+        let spans = node_spans(&strip);
+        let mut want_strip = vec![Sum::default(); points.len()];
+        sums_scalar(&points, &strip, &strip, &mut want_strip);
+        let got_strip = serial_sums(&points, &strip, &strip, points.len(), Some(&spans));
+        for (g, w) in got_strip.iter().zip(&want_strip) {
+            assert_eq!(g.0.map(f64::to_bits), w.0.map(f64::to_bits));
+        }
+        let none: Vec<[u32; 3]> = Vec::new();
+        let spans = node_spans(&none);
+        let empty = serial_sums(&points, &none, &none, points.len() + 3, Some(&spans));
+        assert_eq!(empty, vec![Sum::default(); points.len() + 3]);
+        // The runs above did share corners and repeat them.
+        let shares_two = tris
+            .windows(2)
+            .filter(|w| w[1].iter().filter(|c| w[0].contains(c)).count() == 2);
+        assert!(shares_two.count() > 5_000);
+        let repeats = tris
+            .iter()
+            .filter(|t| t[0] == t[1] || t[1] == t[2] || t[0] == t[2]);
+        assert!(repeats.count() > 100);
+        assert!(got.iter().filter(|s| s.xyz() != [0.0; 3]).count() > 480);
+    }
 }

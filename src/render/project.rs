@@ -48,6 +48,15 @@ fn depth_range(points: &[[f64; 3]], camera: &Camera) -> (f64, f64) {
     let blocks: Vec<(f64, f64)> = points
         .par_chunks(BLOCK)
         .map(|block| {
+            #[cfg(target_arch = "x86_64")]
+            {
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    // SAFETY: the CPU has AVX2 (checked just above).
+                    if let Some(bounds) = unsafe { avx2::depth_bounds(block, camera) } {
+                        return bounds;
+                    }
+                }
+            }
             // A copy: its fields stay in registers over the loop.
             let camera = *camera;
             block
@@ -345,17 +354,58 @@ mod tests {
     #[test]
     fn depth_range_is_the_serial_fold() {
         let points = awkward_points();
-        let camera = Camera::fit(View::ISO, &points[..4000], 800, 600);
-        let serial = points
-            .iter()
-            .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
-                let z = camera.depth(*q);
-                (below(z, l), above(z, h))
-            });
-        let got = depth_range(&points, &camera);
-        assert_eq!(
-            (got.0.to_bits(), got.1.to_bits()),
-            (serial.0.to_bits(), serial.1.to_bits())
-        );
+        let fitted = Camera::fit(View::ISO, &points[..4000], 800, 600);
+        // Seen along z through the origin, a flat square has depths of
+        // either zero, in an order the lanes do not keep: the first zero
+        // the serial fold meets gives each bound's sign.
+        let flat: Vec<[f64; 3]> = (0..4003)
+            .map(|i| {
+                let t = i as f64 * 0.37;
+                [t.sin(), t.cos(), if i % 3 == 1 { -0.0 } else { 0.0 }]
+            })
+            .collect();
+        let along_z = Camera {
+            center: [0.0, 0.0, 0.0],
+            toward_eye: [0.0, 0.0, 1.0],
+            ..fitted
+        };
+        let mut zeros = 0;
+        for (camera, points) in [(&fitted, &points[..]), (&along_z, &flat[..])] {
+            for shift in 0..5 {
+                let part = &points[shift..];
+                let serial = part
+                    .iter()
+                    .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+                        let z = camera.depth(*q);
+                        (below(z, l), above(z, h))
+                    });
+                let got = depth_range(part, camera);
+                assert_eq!(
+                    (got.0.to_bits(), got.1.to_bits()),
+                    (serial.0.to_bits(), serial.1.to_bits())
+                );
+                zeros += usize::from(serial.0 == 0.0);
+            }
+        }
+        assert_eq!(zeros, 5);
+        // The lanes alone: the bounds of the awkward points (NaN, infinite
+        // and far ones in every lane), and no answer for the zeros.
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("avx2") {
+            for shift in 0..4 {
+                let part = &points[shift..];
+                let want = depth_range(part, &fitted);
+                // SAFETY: the CPU has AVX2 (checked just above).
+                let got = unsafe { avx2::depth_bounds(part, &fitted) };
+                assert_eq!(
+                    got.map(|(l, h)| (l.to_bits(), h.to_bits())),
+                    Some((want.0.to_bits(), want.1.to_bits()))
+                );
+                assert_eq!(
+                    unsafe { avx2::depth_bounds(&flat[shift..], &along_z) },
+                    None
+                );
+            }
+        }
     }
 }

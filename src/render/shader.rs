@@ -185,13 +185,74 @@ fn interpolate(
     // Sample indices are below 2^17, so `u32` to `f32` is exact, as
     // `usize` to `f32` is, in one conversion instead of six.
     let (x, y) = (sx as u32 as f32 + 0.5, sy as u32 as f32 + 0.5);
-    let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
-    let w1 = ((c[0] - a[0]) * (y - a[1]) - (c[1] - a[1]) * (x - a[0])) / -area;
-    let w2 = ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) / area;
-    let (w1, w2) = (w1.clamp(0.0, 1.0), w2.clamp(0.0, 1.0));
+    let [w1, w2] = weights(a, b, c, x, y);
     let w0 = (1.0 - w1 - w2).max(0.0);
     let l = |k: usize| light[s[k] as usize][back];
     w0 * l(0) + w1 * l(1) + w2 * l(2)
+}
+
+/// The barycentric weights of corners `b` and `c` at (`x`, `y`), each
+/// clamped to [0, 1] (a NaN stays NaN, as `f32::clamp` keeps it). With SSE2
+/// the two divisions are one two-lane division (one waits on the divider
+/// instead of two): the same operations per lane, so the same bits.
+#[inline(always)]
+fn weights(a: [f32; 2], b: [f32; 2], c: [f32; 2], x: f32, y: f32) -> [f32; 2] {
+    #[cfg(target_arch = "x86_64")]
+    {
+        // SAFETY: SSE2 is part of every x86-64.
+        unsafe { weights_sse2(a, b, c, x, y) }
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        scalar_weights(a, b, c, x, y)
+    }
+}
+
+#[cfg_attr(target_arch = "x86_64", allow(dead_code))]
+#[inline]
+fn scalar_weights(a: [f32; 2], b: [f32; 2], c: [f32; 2], x: f32, y: f32) -> [f32; 2] {
+    let area = (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    let w1 = ((c[0] - a[0]) * (y - a[1]) - (c[1] - a[1]) * (x - a[0])) / -area;
+    let w2 = ((b[0] - a[0]) * (y - a[1]) - (b[1] - a[1]) * (x - a[0])) / area;
+    [w1.clamp(0.0, 1.0), w2.clamp(0.0, 1.0)]
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "sse2")]
+#[inline]
+fn weights_sse2(a: [f32; 2], b: [f32; 2], c: [f32; 2], x: f32, y: f32) -> [f32; 2] {
+    use std::arch::x86_64::*;
+    let pair = |p: [f32; 2]| _mm_setr_ps(p[0], p[1], 0.0, 0.0);
+    // Lanes (c.x − a.x, b.x − a.x, c.y − a.y, b.y − a.y).
+    let d = _mm_sub_ps(
+        _mm_unpacklo_ps(pair(c), pair(b)),
+        _mm_unpacklo_ps(pair(a), pair(a)),
+    );
+    let dy = _mm_movehl_ps(d, d);
+    // Lane 0 is w1's numerator, lane 1 w2's, each as `scalar_weights` has it.
+    let num = _mm_sub_ps(
+        _mm_mul_ps(d, _mm_set1_ps(y - a[1])),
+        _mm_mul_ps(dy, _mm_set1_ps(x - a[0])),
+    );
+    // Lane 0 (c.x − a.x)(b.y − a.y), lane 1 (b.x − a.x)(c.y − a.y): the
+    // area is lane 1 less lane 0, the scalar products in its order.
+    const DY_SWAPPED: i32 = 0b10_11_10_11;
+    let p = _mm_mul_ps(d, _mm_shuffle_ps::<DY_SWAPPED>(d, d));
+    let area = _mm_sub_ss(_mm_shuffle_ps::<0b01_01_01_01>(p, p), p);
+    // (−area, area, area, area): the negation flips the sign bit, as `-`
+    // does (a zero area gives −0 and +0, so ±infinity as the scalar code).
+    let den = _mm_xor_ps(
+        _mm_shuffle_ps::<0>(area, area),
+        _mm_setr_ps(-0.0, 0.0, 0.0, 0.0),
+    );
+    let w = _mm_div_ps(num, den);
+    // `maxps 0, w` is `0 > w ? 0 : w` and `minps 1, v` is `1 < v ? 1 : v`:
+    // a NaN and −0 pass through both, as through `f32::clamp`.
+    let w = _mm_min_ps(_mm_set1_ps(1.0), _mm_max_ps(_mm_setzero_ps(), w));
+    [
+        _mm_cvtss_f32(w),
+        _mm_cvtss_f32(_mm_shuffle_ps::<0b01_01_01_01>(w, w)),
+    ]
 }
 
 /// `color` (lanes r, g, b, 0) times `light`, each channel rounded by adding
@@ -274,6 +335,63 @@ mod tests {
         assert_eq!(tint(lanes([200, 100, 50]), 0.5), [100, 50, 25]);
         assert_eq!(tint(lanes([255, 255, 255]), f32::NAN), [0, 0, 0]);
         assert_eq!(tint(lanes([3, 255, 128]), 2.0), [6, 255, 255]);
+    }
+
+    #[test]
+    fn two_lane_weights_are_the_scalar_weights_bit_for_bit() {
+        let mut state = 0x2545_f491_4f6c_dd1du64;
+        let mut next = || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            state
+        };
+        let mut coordinate = |scale: f32| (next() >> 40) as f32 / (1u64 << 24) as f32 * scale;
+        let mut checked = 0;
+        let mut clamped = [0usize; 2];
+        for round in 0..20_000 {
+            let scale = [1.0, 37.0, 2048.0, 1e-3][round % 4];
+            let [a, b, mut c] = [0; 3].map(|_| [coordinate(scale), coordinate(scale)]);
+            if round % 7 == 0 {
+                // Collinear corners: a zero area, each sign of it.
+                c = [2.0 * b[0] - a[0], 2.0 * b[1] - a[1]];
+            }
+            let (x, y) = (coordinate(scale), coordinate(scale));
+            let got = weights(a, b, c, x, y);
+            let want = scalar_weights(a, b, c, x, y);
+            assert_eq!(
+                got.map(f32::to_bits),
+                want.map(f32::to_bits),
+                "{a:?} {b:?} {c:?}"
+            );
+            checked += 1;
+            for k in 0..2 {
+                clamped[k] += usize::from(want[k] == 0.0 || want[k] == 1.0);
+            }
+        }
+        // Degenerate and outside samples: NaN, the infinities clamped.
+        let odd = [
+            ([0.0, 0.0], [1.0, 1.0], [2.0, 2.0], 0.5, 0.5),
+            ([0.0, 0.0], [1.0, 1.0], [2.0, 2.0], 0.5, 0.0),
+            ([0.0, 0.0], [0.0, 0.0], [0.0, 0.0], 0.0, 0.0),
+            ([f32::NAN, 0.0], [1.0, 0.0], [0.0, 1.0], 0.2, 0.2),
+            ([0.0, 0.0], [f32::INFINITY, 0.0], [0.0, 1.0], 0.2, 0.2),
+            ([-0.0, 0.0], [1.0, 0.0], [0.0, 1.0], -0.0, 0.0),
+        ];
+        for (a, b, c, x, y) in odd {
+            let want = scalar_weights(a, b, c, x, y);
+            assert_eq!(
+                weights(a, b, c, x, y).map(f32::to_bits),
+                want.map(f32::to_bits)
+            );
+        }
+        assert!(scalar_weights([0.0, 0.0], [1.0, 1.0], [2.0, 2.0], 0.5, 0.5)[0].is_nan());
+        assert_eq!(
+            weights([0.0, 0.0], [4.0, 0.0], [0.0, 4.0], 1.0, 2.0),
+            [0.25, 0.5]
+        );
+        assert_eq!(checked, 20_000);
+        assert!(clamped[0] > 1000 && clamped[1] > 1000, "{clamped:?}");
     }
 
     /// The plain shading every lookup of [`Shader`] stands for: the group

@@ -7,6 +7,7 @@
 //! the same bits.
 
 use super::{LIMIT, NodeMap};
+use crate::render::camera::{Camera, above, below};
 use crate::render::raster::Snapped;
 use std::arch::x86_64::*;
 use std::mem::MaybeUninit;
@@ -104,4 +105,62 @@ impl NodeMap {
         }
         self.block_sse2(&points[whole..], &mut snapped[whole..], &mut xy_f[whole..]);
     }
+}
+
+/// The least and greatest [`Camera::depth`] of `points` (the serial fold of
+/// `below` and `above`), four nodes per vector: the same depth bits per lane
+/// as [`NodeMap::block_avx2`] computes, and `minpd`/`maxpd` are `below` and
+/// `above` lane by lane. The lanes meet the nodes in another order than the
+/// serial fold, which only matters for equal values of different bits: a
+/// zero (the fold keeps the sign of the first zero it meets). So `None` when
+/// either bound is a zero: the caller folds serially.
+#[target_feature(enable = "avx2")]
+pub(super) fn depth_bounds(points: &[[f64; 3]], camera: &Camera) -> Option<(f64, f64)> {
+    let whole = points.len() / 4 * 4;
+    let splat = |v: f64| _mm256_set1_pd(v);
+    let [c0, c1, c2] = camera.center.map(splat);
+    let [t0, t1, t2] = camera.toward_eye.map(splat);
+    let sign = splat(-0.0);
+    let (mut lo, mut hi) = (splat(f64::INFINITY), splat(f64::NEG_INFINITY));
+    for q in points[..whole].chunks_exact(4) {
+        let p = q.as_ptr().cast::<f64>();
+        // SAFETY: `q` is four points, twelve f64s from `p`.
+        let pairs = |k: usize| unsafe {
+            _mm256_insertf128_pd::<1>(
+                _mm256_castpd128_pd256(_mm_loadu_pd(p.add(k))),
+                _mm_loadu_pd(p.add(6 + k)),
+            )
+        };
+        let (xy, zx, yz) = (pairs(0), pairs(2), pairs(4));
+        let x = _mm256_shuffle_pd::<0b1010>(xy, zx);
+        let y = _mm256_shuffle_pd::<0b0101>(xy, yz);
+        let z = _mm256_shuffle_pd::<0b1010>(zx, yz);
+        // `dot(p − centre, toward_eye)`: (d0·t0 + d1·t1) + d2·t2, negated.
+        let dot = _mm256_add_pd(
+            _mm256_add_pd(
+                _mm256_mul_pd(_mm256_sub_pd(x, c0), t0),
+                _mm256_mul_pd(_mm256_sub_pd(y, c1), t1),
+            ),
+            _mm256_mul_pd(_mm256_sub_pd(z, c2), t2),
+        );
+        let depth = _mm256_xor_pd(dot, sign);
+        // `minpd z, l` is `z < l ? z : l`: `below(z, l)`, a NaN skipped.
+        lo = _mm256_min_pd(depth, lo);
+        hi = _mm256_max_pd(depth, hi);
+    }
+    let (mut lows, mut highs) = ([0.0; 4], [0.0; 4]);
+    // SAFETY: each array is four f64s.
+    unsafe {
+        _mm256_storeu_pd(lows.as_mut_ptr(), lo);
+        _mm256_storeu_pd(highs.as_mut_ptr(), hi);
+    }
+    let (mut l, mut h) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (a, b) in lows.into_iter().zip(highs) {
+        (l, h) = (below(a, l), above(b, h));
+    }
+    for q in &points[whole..] {
+        let z = camera.depth(*q);
+        (l, h) = (below(z, l), above(z, h));
+    }
+    (l != 0.0 && h != 0.0).then_some((l, h))
 }
