@@ -11,7 +11,7 @@ mod split;
 mod tree;
 
 pub use split::Reparse;
-pub use tree::{Attribute, Element, Head};
+pub use tree::{Attribute, Attributes, Element, Head};
 use tree::{Misplaced, Origin};
 
 use crate::diag::{Code, Diagnostic};

@@ -11,9 +11,10 @@
 //! and the run goes to roxmltree as before, which also reports every error:
 //! this reader never decides that a file is wrong.
 
-use super::tree::{Attribute, Element};
+use super::tree::{Attribute, Attributes, Element};
 use crate::span::Span;
 use std::borrow::Cow;
+use std::sync::Arc;
 
 /// The elements of `text[start..end]`, a run of whole elements separated by
 /// whitespace, as roxmltree's path builds them; `None` when the run is not
@@ -34,17 +35,24 @@ pub(super) fn read_run(
         text,
         bytes: text.as_bytes().get(..end)?,
         pos: start,
+        // Every element's attributes, in document order: shared by the
+        // run's elements once it is read. Sized for a run of the split's
+        // usual length (about one per 16 bytes of markup); a longer one grows.
+        attributes: Vec::with_capacity(((end - start) / 16).min(4096) + 8),
     };
     // Finished elements: the run's, and the children of the open elements
     // after the index each was opened at (moved into it, sized exactly, when
     // it closes).
     let mut finished: Vec<Element> = Vec::with_capacity(elements);
     let mut open: Vec<(Element, usize)> = Vec::new();
-    let mut attributes = Vec::new();
     loop {
         reader.skip_whitespace();
         let Some(&byte) = reader.bytes.get(reader.pos) else {
-            return open.is_empty().then_some(finished);
+            if !open.is_empty() {
+                return None;
+            }
+            share(&mut finished, &Arc::new(reader.attributes));
+            return Some(finished);
         };
         if byte != b'<' {
             return None;
@@ -62,18 +70,31 @@ pub(super) fn read_run(
             reader.skip_whitespace();
             reader.expect(b'>')?;
             element.span = Span::new(element.span.range().start, reader.pos);
-            element.children = finished.drain(first..).collect();
+            element.children = finished.split_off(first);
             finished.push(element);
             continue;
         }
         if open.len() + 2 > max_depth {
             return None;
         }
-        let (element, closed) = reader.start_tag(&mut attributes)?;
+        let (element, closed) = reader.start_tag()?;
         if closed {
             finished.push(element);
         } else {
             open.push((element, finished.len()));
+        }
+    }
+}
+
+/// Gives every element of the trees its range of the run's attributes.
+fn share<'s>(elements: &mut [Element<'s>], attributes: &Arc<Vec<Attribute<'s>>>) {
+    let mut lists = vec![elements];
+    while let Some(list) = lists.pop() {
+        for element in list {
+            element.attributes.share(attributes);
+            if !element.children.is_empty() {
+                lists.push(&mut element.children);
+            }
         }
     }
 }
@@ -83,6 +104,8 @@ struct Reader<'s> {
     /// The text up to the run's end.
     bytes: &'s [u8],
     pos: usize,
+    /// The attributes read so far (see [`read_run`]).
+    attributes: Vec<Attribute<'s>>,
 }
 
 impl<'s> Reader<'s> {
@@ -129,12 +152,13 @@ impl<'s> Reader<'s> {
     }
 
     /// The start tag at `pos` (a `<`) as an element without children, and
-    /// whether it closed itself (`/>`). `attributes`: a reused scratch list.
-    fn start_tag(&mut self, attributes: &mut Vec<Attribute<'s>>) -> Option<(Element<'s>, bool)> {
+    /// whether it closed itself (`/>`); its attributes are pushed onto the
+    /// run's list and the element holds their range (pending until shared).
+    fn start_tag(&mut self) -> Option<(Element<'s>, bool)> {
         let tag_start = self.pos;
         self.pos += 1;
         let name = self.name()?;
-        attributes.clear();
+        let first = self.attributes.len();
         let closed = loop {
             let spaced = self.skip_whitespace() > 0;
             match self.bytes.get(self.pos)? {
@@ -154,22 +178,26 @@ impl<'s> Reader<'s> {
                     // A repeated attribute and a namespace declaration are
                     // roxmltree's to judge.
                     if attribute.name == "xmlns"
-                        || attributes.iter().any(|a| a.name == attribute.name)
+                        || (self.attributes.get(first..)?.iter())
+                            .any(|a| same_name(a.name, attribute.name))
                     {
                         return None;
                     }
-                    attributes.push(attribute);
+                    self.attributes.push(attribute);
                 }
             }
         };
         let name_start = tag_start + 1;
+        let attributes = Attributes::pending(
+            u32::try_from(first).ok()?,
+            u32::try_from(self.attributes.len() - first).ok()?,
+        );
         Some((
             Element {
                 name,
                 span: Span::new(tag_start, self.pos),
                 name_span: Span::new(name_start, name_start + name.len()),
-                // A copy sized exactly (the values are borrowed): the scratch list keeps its room.
-                attributes: attributes.to_vec(),
+                attributes,
                 children: Vec::new(),
                 text: Vec::new(),
             },
@@ -201,6 +229,13 @@ impl<'s> Reader<'s> {
             value_span: Span::new(value_start, value_start + length),
         })
     }
+}
+
+/// `a == b`, by length and first byte before the bytes: an element's
+/// attributes mostly differ there (`x`, `y`, `z`), and a `memcmp` call per
+/// pair was most of the repeated-name check.
+fn same_name(a: &str, b: &str) -> bool {
+    a.len() == b.len() && a.as_bytes().first() == b.as_bytes().first() && a == b
 }
 
 /// Bytes of a name after its first: ASCII letters, digits, `_`, `-`, `.`.
@@ -375,5 +410,100 @@ mod tests {
         // Both sides of the line are exercised.
         assert!(accepted > 500, "{accepted} {refused_by_both}");
         assert!(refused_by_both > 500, "{accepted} {refused_by_both}");
+    }
+
+    /// A random run of nested elements, each with 0–3 attributes named and
+    /// valued by its number; returns the text and how many elements it has.
+    fn nested_run(rng: &mut TestRng) -> (String, usize) {
+        let (mut text, mut open, mut count) = (String::new(), Vec::new(), 0);
+        for _ in 0..1 + rng.below(60) {
+            if !open.is_empty() && rng.below(3) == 0 {
+                let name: String = open.pop().unwrap_or_default();
+                text.push_str(&format!("</{name}>"));
+                continue;
+            }
+            let name = format!("e{count}");
+            text.push_str(&format!("<{name}"));
+            for k in 0..rng.below(4) {
+                text.push_str(&format!(" a{k}_{count}=\"{count}.{k}\""));
+            }
+            count += 1;
+            if open.len() < 6 && rng.below(2) == 0 {
+                text.push('>');
+                open.push(name);
+            } else {
+                text.push_str("/>");
+            }
+            text.push_str(["", " ", "\n  "][rng.below(3)]);
+        }
+        while let Some(name) = open.pop() {
+            text.push_str(&format!("</{name}>"));
+        }
+        (text, count)
+    }
+
+    /// The attributes of an element: every attribute of its start tag, in
+    /// order, as an independent reading of the text gives them.
+    fn start_tag_attributes(text: &str, element: &Element) -> Vec<(String, String)> {
+        let tag = &text[element.span.range().start..];
+        let tag = &tag[..tag.find('>').expect("a start tag ends")];
+        let mut pairs = Vec::new();
+        for part in tag.split_whitespace().skip(1) {
+            if let Some((name, value)) = part.trim_end_matches('/').split_once('=') {
+                pairs.push((name.to_string(), value.trim_matches('"').to_string()));
+            }
+        }
+        pairs
+    }
+
+    /// The run's attributes are one list shared by its elements: every
+    /// element, at every depth, holds exactly its start tag's attributes
+    /// (the ranges follow document order through the nesting), and the
+    /// trees are roxmltree's.
+    #[test]
+    fn every_element_holds_the_attributes_of_its_start_tag() {
+        let mut rng = TestRng::new(0x9e37_79b9_7f4a_7c15);
+        let (mut elements, mut attributes) = (0, 0);
+        for _ in 0..400 {
+            let (text, count) = nested_run(&mut rng);
+            let read = plain(&text, 16).expect("the run is plain");
+            assert_eq!(Some(&read), by_roxmltree(&text, 16).as_ref(), "{text}");
+            let mut stack: Vec<&Element> = read.iter().collect();
+            let mut seen = 0;
+            while let Some(element) = stack.pop() {
+                seen += 1;
+                let held: Vec<(String, String)> = (element.attributes.iter())
+                    .map(|a| (a.name.to_string(), a.value.to_string()))
+                    .collect();
+                assert_eq!(held, start_tag_attributes(&text, element), "{text}");
+                for a in &element.attributes {
+                    assert_eq!(&text[a.value_span.range()], a.value);
+                }
+                attributes += held.len();
+                stack.extend(&element.children);
+            }
+            assert_eq!(seen, count, "{text}");
+            elements += seen;
+        }
+        assert!(
+            elements > 4_000 && attributes > 4_000,
+            "{elements} {attributes}"
+        );
+    }
+
+    /// Attributes compare by their contents, not by the list they share.
+    #[test]
+    fn attributes_equal_by_contents_not_by_list() {
+        let text = "<a x=\"1\" y=\"2\"/><b x=\"1\" y=\"2\"/><c/>";
+        let read = plain(text, 4).expect("plain");
+        let own = by_roxmltree(text, 4).expect("well-formed");
+        assert_eq!(read[0].attributes.len(), 2);
+        assert_eq!(read[0].attributes[1].value, "2");
+        assert_ne!(read[0].attributes, read[1].attributes);
+        assert_eq!(read[0].attributes, own[0].attributes);
+        assert!(read[2].attributes.is_empty());
+        assert_eq!(read[2].attributes, Attributes::default());
+        assert_eq!(Attributes::new(Vec::new()), Attributes::default());
+        assert!(Attributes::pending(0, 2).is_empty());
     }
 }

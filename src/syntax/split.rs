@@ -120,14 +120,57 @@ impl<'s> Split<'s> {
     /// The elements of the run starting at `first` (one of
     /// [`Split::run_starts`]).
     pub fn run(&self, first: usize) -> Result<Vec<Element<'s>>, Reparse> {
+        if let Some(elements) = self.plain_run(first)? {
+            return Ok(elements);
+        }
         let mut elements = Vec::with_capacity(self.run_end(first) - first);
-        self.parse_run(first, &mut elements)?;
+        self.parse_run_whole(first, &mut elements)?;
         Ok(elements)
     }
 
-    /// Parses the run of children starting at `first`; returns the index
-    /// after its last child.
+    /// Reads the run of children starting at `first` (plain, or else by
+    /// roxmltree) into `out`; returns the index after its last child.
     fn parse_run(
+        &self,
+        first: usize,
+        out: &mut impl Extend<Element<'s>>,
+    ) -> Result<usize, Reparse> {
+        match self.plain_run(first)? {
+            Some(elements) => {
+                let next = first + elements.len();
+                out.extend(elements);
+                Ok(next)
+            }
+            None => self.parse_run_whole(first, out),
+        }
+    }
+
+    /// The elements of the run starting at `first` as [`plain::read_run`]
+    /// reads them, checked against the scan as roxmltree's are; `None` when
+    /// the run is not plain.
+    fn plain_run(&self, first: usize) -> Result<Option<Vec<Element<'s>>>, Reparse> {
+        let start = self.children.get(first).ok_or(Reparse)?.start;
+        let last = self.run_end(first) - 1;
+        let end = self.children.get(last).ok_or(Reparse)?.end;
+        let Some(elements) = plain::read_run(
+            self.text,
+            start,
+            end,
+            self.limits.max_depth,
+            last + 1 - first,
+        ) else {
+            return Ok(None);
+        };
+        let heads = self.heads.get(first..=last).ok_or(Reparse)?;
+        if heads.len() != elements.len() || !heads.iter().zip(&elements).all(|(h, e)| h.is_of(e)) {
+            return Err(Reparse);
+        }
+        Ok(Some(elements))
+    }
+
+    /// Parses the run of children starting at `first` with roxmltree, in a
+    /// wrapper; returns the index after its last child.
+    fn parse_run_whole(
         &self,
         first: usize,
         out: &mut impl Extend<Element<'s>>,
@@ -135,15 +178,6 @@ impl<'s> Split<'s> {
         let start = self.children.get(first).ok_or(Reparse)?.start;
         let last = self.run_end(first) - 1;
         let end = self.children.get(last).ok_or(Reparse)?.end;
-        if let Some(elements) = plain::read_run(
-            self.text,
-            start,
-            end,
-            self.limits.max_depth,
-            last + 1 - first,
-        ) {
-            return self.matched(first, last, elements, out);
-        }
         let piece = self.text.get(start..end).ok_or(Reparse)?;
         let mut buffer = String::with_capacity(OPEN.len() + piece.len() + CLOSE.len());
         buffer.push_str(OPEN);
@@ -174,23 +208,6 @@ impl<'s> Split<'s> {
             return Err(Reparse);
         }
         Ok(index)
-    }
-
-    /// The elements [`plain::read_run`] read of the run from `first` to
-    /// `last`, checked against the scan as roxmltree's are.
-    fn matched(
-        &self,
-        first: usize,
-        last: usize,
-        elements: Vec<Element<'s>>,
-        out: &mut impl Extend<Element<'s>>,
-    ) -> Result<usize, Reparse> {
-        let heads = self.heads.get(first..=last).ok_or(Reparse)?;
-        if heads.len() != elements.len() || !heads.iter().zip(&elements).all(|(h, e)| h.is_of(e)) {
-            return Err(Reparse);
-        }
-        out.extend(elements);
-        Ok(last + 1)
     }
 }
 

@@ -5,6 +5,7 @@
 
 use crate::span::Span;
 use std::borrow::Cow;
+use std::sync::Arc;
 
 #[derive(Debug, Clone, PartialEq)]
 pub struct Attribute<'s> {
@@ -21,10 +22,91 @@ pub struct Element<'s> {
     pub span: Span,
     /// The element's name in its start tag.
     pub name_span: Span,
-    pub attributes: Vec<Attribute<'s>>,
+    pub attributes: Attributes<'s>,
     pub children: Vec<Element<'s>>,
     /// Non-whitespace text directly inside the element, with its span.
     pub text: Vec<(String, Span)>,
+}
+
+/// An element's attributes, read as a slice: a range of one list shared by
+/// all elements of a plain run (`super::plain`), so a run of thousands of
+/// elements allocates one list instead of one per element, or a list of the
+/// element's own. Two are equal when their attributes are.
+#[derive(Clone, Default)]
+pub struct Attributes<'s> {
+    /// `None` for no attributes, and while a plain run is being read.
+    store: Option<Arc<Vec<Attribute<'s>>>>,
+    start: u32,
+    len: u32,
+}
+
+impl<'s> Attributes<'s> {
+    /// A list of the element's own.
+    pub fn new(list: Vec<Attribute<'s>>) -> Attributes<'s> {
+        match u32::try_from(list.len()) {
+            Ok(len) if len > 0 => Attributes {
+                store: Some(Arc::new(list)),
+                start: 0,
+                len,
+            },
+            _ => Attributes::default(),
+        }
+    }
+
+    /// `len` attributes from `start` of a list not made yet: empty until
+    /// [`Attributes::share`] gives it.
+    pub(super) fn pending(start: u32, len: u32) -> Attributes<'s> {
+        Attributes {
+            store: None,
+            start,
+            len,
+        }
+    }
+
+    /// Gives a pending range its list (a range of none keeps no list).
+    pub(super) fn share(&mut self, store: &Arc<Vec<Attribute<'s>>>) {
+        if self.len > 0 {
+            self.store = Some(Arc::clone(store));
+        }
+    }
+}
+
+impl<'s> std::ops::Deref for Attributes<'s> {
+    type Target = [Attribute<'s>];
+
+    fn deref(&self) -> &[Attribute<'s>] {
+        let (start, len) = (self.start as usize, self.len as usize);
+        (self.store.as_deref())
+            .and_then(|list| list.get(start..start + len))
+            .unwrap_or(&[])
+    }
+}
+
+impl<'a, 's> IntoIterator for &'a Attributes<'s> {
+    type Item = &'a Attribute<'s>;
+    type IntoIter = std::slice::Iter<'a, Attribute<'s>>;
+
+    fn into_iter(self) -> Self::IntoIter {
+        self.iter()
+    }
+}
+
+impl<'s> FromIterator<Attribute<'s>> for Attributes<'s> {
+    fn from_iter<I: IntoIterator<Item = Attribute<'s>>>(iter: I) -> Attributes<'s> {
+        Attributes::new(iter.into_iter().collect())
+    }
+}
+
+impl PartialEq for Attributes<'_> {
+    fn eq(&self, other: &Self) -> bool {
+        **self == **other
+    }
+}
+
+impl std::fmt::Debug for Attributes<'_> {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_list().entries(self.iter()).finish()
+    }
 }
 
 impl<'s> Element<'s> {
@@ -237,7 +319,7 @@ fn shell_with<'s>(
         name_span: Span::new(name_start, name_start + name.len()),
         name,
         span: at.span(range),
-        attributes,
+        attributes: Attributes::new(attributes),
         children: Vec::with_capacity(children),
         text: Vec::new(),
     })
