@@ -205,8 +205,8 @@ impl Piece {
                 // One face's sums at a time; reserved for the whole group
                 // at once (pages only count once written).
                 let mut sums = Vec::with_capacity(measured.vertices);
-                expander.each_normal(faces, &mut sums, |n| {
-                    blocks.put(&f32x3_bytes(n.map(|c| c as f32)))
+                expander.each_normal(faces, &mut sums, |run| {
+                    run.iter().try_for_each(|&n| blocks.put(&f32x3_bytes(n)))
                 })?;
                 drop(sums);
                 expander.each_triangle(faces, |t| {
@@ -947,5 +947,51 @@ mod tests {
         // order); face `b` is renumbered (in order); the poly_line's
         // positions and indices and the point set's positions by offset.
         written_by_parts_equals_in_order(&mesh, 5, 2);
+    }
+
+    /// A fragment of two faces, the first large enough to be summed in
+    /// blocks beside its triangle normals, the second turned over: the
+    /// GLB's bytes are the same on one thread and on three.
+    #[test]
+    fn a_large_expanded_group_gives_the_same_bytes_on_any_thread_count() {
+        use crate::mesh::{MeshFragment, MeshSubdomain};
+        let (nodes, triangles) = strip(60_000);
+        let (first, second) = triangles.split_at(40_000);
+        let mut scrambled = first.to_vec();
+        scrambled.reverse();
+        assert!(scrambled.len() >= super::super::face_normals::BLOCKED_MIN);
+        let mesh = Mesh {
+            dimension: 3,
+            nodes,
+            faces: vec![face("a", scrambled), face("b", second.to_vec())],
+            subdomains: vec![MeshSubdomain {
+                name: "inside".into(),
+                material: None,
+                faces: vec![(0, true), (1, false)],
+            }],
+            fragments: vec![MeshFragment {
+                name: "skin".into(),
+                subdomain: 0,
+                other: None,
+                faces: vec![0, 1],
+                edges: Vec::new(),
+            }],
+            ..Mesh::default()
+        };
+        let glb = |threads: usize| {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("a thread pool");
+            let mut out = Vec::new();
+            pool.install(|| GLB.write(&mesh, &WriteOptions::default(), &mut out))
+                .expect("written");
+            out
+        };
+        let one = glb(1);
+        // Positions, normals and indices of 60,002 + 2 vertices (the
+        // faces share two nodes) and 60,000 triangles, and the JSON.
+        assert!(one.len() > 24 * 60_004 + 12 * 60_000);
+        assert!(glb(3) == one, "three threads against one");
     }
 }

@@ -11,6 +11,7 @@
 
 mod atomic;
 mod base64;
+mod face_normals;
 mod file_ranges;
 pub mod frag;
 mod gltf;
