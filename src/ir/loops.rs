@@ -102,10 +102,10 @@ impl Loops {
     pub fn one(edges: impl ExactSizeIterator<Item = OrientedEdge>) -> Loops {
         let edges: Box<[OrientedEdge]> = edges.collect();
         // A single empty loop needs its end (see the struct's comment).
-        let ends = if edges.is_empty() {
+        let ends: Box<[u32]> = if edges.is_empty() {
             Box::new([0])
         } else {
-            Box::default()
+            Box::new([])
         };
         Loops { edges, ends }
     }
