@@ -96,6 +96,20 @@ impl Loops {
 }
 
 impl Loops {
+    /// One loop of exactly `edges`' length (every primitive face but a
+    /// two-rim cone's side): collected straight into the list, with no
+    /// builder bookkeeping (lowering makes hundreds of thousands of these).
+    pub fn one(edges: impl ExactSizeIterator<Item = OrientedEdge>) -> Loops {
+        let edges: Box<[OrientedEdge]> = edges.collect();
+        // A single empty loop needs its end (see the struct's comment).
+        let ends: Box<[u32]> = if edges.is_empty() {
+            Box::new([0])
+        } else {
+            Box::new([])
+        };
+        Loops { edges, ends }
+    }
+
     /// The loops of `loops`, `total` edges in all: the edge list is sized
     /// once and no vector is made per loop (lowering builds hundreds of
     /// thousands of faces this way).
@@ -292,6 +306,18 @@ mod tests {
             let nested = Loops::from_nested(case.iter().map(|l| l.iter().copied()), total);
             assert_eq!(nested, Loops::from(case.clone()));
             assert_eq!(nested.to_vecs(), case);
+        }
+    }
+
+    #[test]
+    fn one_loop_is_the_nested_single_loop() {
+        let mut rng = crate::test_rng::TestRng::new(0x100b);
+        for len in (0..40).chain([0, 1, 1000]) {
+            let lp: Vec<OrientedEdge> = (0..len).map(|_| oe(rng.below(1 << 20) as u32)).collect();
+            let one = Loops::one(lp.iter().copied());
+            assert_eq!(one, Loops::from_nested([lp.iter().copied()], len));
+            assert_eq!(one, Loops::from(vec![lp.clone()]));
+            assert_eq!((one.len(), one.first()), (1, Some(&lp[..])));
         }
     }
 }

@@ -393,6 +393,8 @@ fn check_relations(
         .collect();
     leaves.sort_unstable();
     leaves.dedup();
+    // The isolation grid is made only when every box is finite and in order.
+    let boxes_finite = matches!(&overlapping, Some(all) if all.solids == model.solids.len());
     let pairs = match overlapping {
         // The solids are the shapes the pairs were found for, in order.
         Some(all) if all.solids == model.solids.len() => {
@@ -418,7 +420,11 @@ fn check_relations(
     found.sort_unstable_by_key(|(k, _)| *k);
     let ok = found.is_empty();
     diags.items.extend(found.into_iter().map(|(_, d)| d));
-    ok.then_some(LeafPairs { leaves, pairs })
+    ok.then_some(LeafPairs {
+        leaves,
+        pairs,
+        boxes_finite,
+    })
 }
 
 /// The pairs among `leaves` (sorted solid ids) of the pairs of all `solids`
@@ -444,17 +450,20 @@ fn leaf_pairs(leaves: &[SolidId], all: &[(u32, u32)], solids: usize) -> Vec<(usi
 struct LeafPairs {
     leaves: Vec<SolidId>,
     pairs: Vec<(usize, usize)>,
+    /// Every solid's `bbox()` is finite (the pairs came from the isolation
+    /// grid, which is made only then): a one-leaf tree's box is its leaf's.
+    boxes_finite: bool,
 }
 
 impl LeafPairs {
     /// The pairs over `members` (in member order) when each member is a tree
     /// of exactly one leaf solid, every leaf belongs to one member, and the
-    /// member's box is its leaf's box; `None` otherwise.
+    /// member's box (the union of its leaves' boxes, [`tree_box`]) is its
+    /// leaf's box; `None` otherwise.
     fn relabelled(
         &self,
         model: &Model,
         members: &[(SubdomainId, Member)],
-        boxes: &[crate::geom::Aabb],
     ) -> Option<Vec<(usize, usize)>> {
         if members.len() != self.leaves.len() {
             return None;
@@ -462,21 +471,24 @@ impl LeafPairs {
         // Members are distinct leaves when there are as many as leaves, since
         // `leaves` is the set of all the trees' leaves.
         // Each member's leaf (its index in `leaves`), on the workers.
-        let leaf_of = |((_, member), bbox): (&(SubdomainId, Member), &crate::geom::Aabb)| {
-            let Member::Tree(Built { leaves, .. }) = member else {
+        let leaf_of = |(_, member): &(SubdomainId, Member)| {
+            let Member::Tree(built) = member else {
                 return None;
             };
-            let [leaf] = &**leaves else {
+            let [leaf] = &*built.leaves else {
                 return None;
             };
             // Equal unless a coordinate is NaN (the union with the empty box
-            // does not keep NaN): then the general pass decides.
-            if *bbox != model.solids[leaf.index()].shape.bbox() {
+            // does not keep NaN): then the general pass decides. Finite boxes
+            // need no look.
+            if !self.boxes_finite
+                && tree_box(model, built) != model.solids[leaf.index()].shape.bbox()
+            {
                 return None;
             }
             self.leaves.binary_search(leaf).ok()
         };
-        let leaf_of: Vec<usize> = (members.par_iter().zip(boxes))
+        let leaf_of: Vec<usize> = (members.par_iter())
             .with_min_len(DEFINITIONS_PER_TASK)
             .map(leaf_of)
             .collect::<Option<_>>()?;
@@ -536,13 +548,14 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
             .fold(1i128, |acc, n| acc.saturating_mul(n));
         Some((lo, hi, count))
     };
-    // Sized exactly: on large models the list has millions of entries.
-    let total: usize = (boxes.par_iter())
+    // Sized exactly: on large models the list has millions of entries. The
+    // boxes of more than 64 cells are counted too, so the pass finding them
+    // runs only when there are some (on large models, seldom).
+    let (total, big_count): (usize, usize) = (boxes.par_iter())
         .with_min_len(BOXES_PER_TASK)
         .filter_map(range)
-        .filter(|r| r.2 <= 64)
-        .map(|r| r.2 as usize)
-        .sum();
+        .map(|r| if r.2 <= 64 { (r.2 as usize, 0) } else { (0, 1) })
+        .reduce(|| (0, 0), |a, b| (a.0 + b.0, a.1 + b.1));
     // A cell is kept as a 64-bit hash of its coordinates (16 bytes an entry
     // instead of 32): cells that collide only add candidates, which the box
     // test below discards, and the pairs are sorted at the end. Filled on the
@@ -563,11 +576,15 @@ pub(super) fn candidate_pairs(boxes: &[crate::geom::Aabb], tol: f64) -> Vec<(usi
             })
         });
     cells.par_extend(placed);
-    let big: Vec<usize> = (boxes.par_iter().enumerate())
-        .with_min_len(BOXES_PER_TASK)
-        .filter(|(_, b)| range(b).is_some_and(|r| r.2 > 64))
-        .map(|(i, _)| i)
-        .collect();
+    let big: Vec<usize> = if big_count == 0 {
+        Vec::new()
+    } else {
+        (boxes.par_iter().enumerate())
+            .with_min_len(BOXES_PER_TASK)
+            .filter(|(_, b)| range(b).is_some_and(|r| r.2 > 64))
+            .map(|(i, _)| i)
+            .collect()
+    };
     // In parallel: entries equal under the order are identical, so the sorted
     // list does not depend on the threads.
     cells.par_sort_unstable();
@@ -861,22 +878,16 @@ fn check_overlaps(
     let shells = (model.subdomains.iter().enumerate())
         .filter(|(k, s)| is_shell(*k, s))
         .count();
-    // Sized once, and a member's box kept apart in `boxes` (what
-    // `candidate_pairs` reads). A solid tree's probes are made only when it is
+    // Sized once, and a member's box kept apart (what `candidate_pairs`
+    // reads). A solid tree's probes are made only when it is
     // in a candidate pair: on large models most subdomains are in none, and a
     // probe vector per subdomain was megabytes at the memory peak.
     let mut members: Vec<(SubdomainId, Member)> = Vec::with_capacity(trees.len() + shells);
-    let mut boxes: Vec<crate::geom::Aabb> = Vec::with_capacity(trees.len() + shells);
+    // The shells' boxes; the trees' are made only if the pairs cannot be
+    // relabelled from the leaves' (on files of one solid per subdomain they
+    // can, and every solid's box was made again here).
+    let mut shell_boxes: Vec<crate::geom::Aabb> = Vec::with_capacity(shells);
     members.extend(trees.iter().map(|(id, built)| (*id, Member::Tree(built))));
-    // Each tree's box on the workers (a pure function of its leaves' shapes).
-    let tree_boxes = (trees.par_iter())
-        .with_min_len(DEFINITIONS_PER_TASK)
-        .map(|(_, built)| {
-            (built.leaves.iter()).fold(crate::geom::Aabb::empty(), |acc, l| {
-                acc.union(&model.solids[l.index()].shape.bbox())
-            })
-        });
-    boxes.par_extend(tree_boxes);
     for (k, subdomain) in model.subdomains.iter().enumerate() {
         let id = SubdomainId(k as u32);
         if !is_shell(k, subdomain) {
@@ -901,7 +912,7 @@ fn check_overlaps(
         }
         let probes = interior_probes(model, id, &face_points, step);
         members.push((id, Member::Shell(Box::new((shell, probes)))));
-        boxes.push(bbox);
+        shell_boxes.push(bbox);
     }
     let inside = |member: &Member, p: &Point3| match member {
         Member::Tree(built) => built
@@ -912,9 +923,16 @@ fn check_overlaps(
     // Tree probes made so far, by member index (same points as made eagerly).
     let mut tree_probes: HashMap<usize, Vec<Point3>> = HashMap::new();
     // The same pairs as `candidate_pairs` over these boxes would give.
-    let pairs = leaf_pairs
-        .relabelled(model, &members, &boxes)
-        .unwrap_or_else(|| candidate_pairs(&boxes, model.tolerance));
+    let pairs = leaf_pairs.relabelled(model, &members).unwrap_or_else(|| {
+        // Members in order: the trees, then the shells.
+        let mut boxes: Vec<crate::geom::Aabb> = Vec::with_capacity(members.len());
+        let tree_boxes = (trees.par_iter())
+            .with_min_len(DEFINITIONS_PER_TASK)
+            .map(|(_, built)| tree_box(model, built));
+        boxes.par_extend(tree_boxes);
+        boxes.extend(shell_boxes);
+        candidate_pairs(&boxes, model.tolerance)
+    });
     drop(leaf_pairs);
     for (i, j) in pairs {
         for k in [i, j] {
@@ -952,6 +970,13 @@ fn check_overlaps(
             );
         }
     }
+}
+
+/// The box of a solid tree: the union of its leaves' boxes, in leaf order.
+fn tree_box(model: &Model, built: &Built) -> crate::geom::Aabb {
+    (built.leaves.iter()).fold(crate::geom::Aabb::empty(), |acc, l| {
+        acc.union(&model.solids[l.index()].shape.bbox())
+    })
 }
 
 /// Points just inside a subdomain, next to each of its boundary faces (edges in 2D).
@@ -1187,6 +1212,122 @@ mod tests {
         let general = classify_faces(&model, &built(Tree::Union(vec![Tree::Leaf(0)])), &samples);
         assert_eq!(fast, vec![of(0, true), of(1, false), of(3, true)]);
         assert_eq!(fast, general);
+    }
+
+    /// On files of one solid per subdomain the overlap check's pairs are the
+    /// isolation grid's, relabelled without making the trees' boxes: they
+    /// are the pairs `candidate_pairs` finds over the trees' boxes, for
+    /// members in any order, and with finite boxes the relabelling never
+    /// needs to look at a box.
+    #[test]
+    fn relabelled_pairs_are_the_pairs_of_the_trees_boxes() {
+        use crate::test_rng::TestRng;
+        let mut rng = TestRng::new(0x1abe_11ed);
+        let mut found = 0;
+        for case in 0..60 {
+            let mut model = Model::empty(Dimension::Three);
+            let n = 50 + rng.below(150);
+            let shapes: Vec<SolidShape> = (0..n)
+                .map(|_| {
+                    let mut shape = super::super::tolerance::tests::random_shape(&mut rng, false);
+                    // Crowded: about one solid in three overlaps another's box.
+                    if let SolidShape::Ball { frame } | SolidShape::Box { frame } = &mut shape {
+                        frame.origin /= 200.0;
+                    }
+                    shape
+                })
+                .collect();
+            for (k, shape) in shapes.iter().enumerate() {
+                model.solids.push(Solid {
+                    name: std::sync::Arc::new(format!("s{k}").into()),
+                    shape: shape.clone(),
+                    faces: Box::default(),
+                    boundary_edges: Box::default(),
+                    edges: Box::default(),
+                    vertices: Box::default(),
+                });
+            }
+            model.tolerance = 1e-3;
+            let refs: Vec<&SolidShape> = shapes.iter().collect();
+            let boxes = super::super::isolation::shape_boxes(&refs);
+            let overlapping = super::super::isolation::pairs(&refs, boxes, model.tolerance)
+                .overlapping
+                .expect("finite boxes");
+            // The members: one tree per solid, in a random order.
+            let mut order: Vec<usize> = (0..n).collect();
+            for k in (1..n).rev() {
+                order.swap(k, rng.below(k + 1));
+            }
+            let built: Vec<Built> = (order.iter())
+                .map(|&k| Built {
+                    tree: Tree::Leaf(0),
+                    leaves: Leaves::One(SolidId(k as u32)),
+                    span: crate::span::Span::default(),
+                })
+                .collect();
+            let members: Vec<(SubdomainId, Member)> = (built.iter().enumerate())
+                .map(|(m, b)| (SubdomainId(m as u32), Member::Tree(b)))
+                .collect();
+            let leaves: Vec<SolidId> = (0..n as u32).map(SolidId).collect();
+            let tree_boxes: Vec<crate::geom::Aabb> =
+                built.iter().map(|b| tree_box(&model, b)).collect();
+            let expected = candidate_pairs(&tree_boxes, model.tolerance);
+            for boxes_finite in [true, false] {
+                let leaf_pairs = LeafPairs {
+                    pairs: leaf_pairs(&leaves, &overlapping.pairs, n),
+                    leaves: leaves.clone(),
+                    boxes_finite,
+                };
+                let relabelled = leaf_pairs.relabelled(&model, &members);
+                assert_eq!(relabelled.as_ref(), Some(&expected), "case {case}");
+            }
+            found += expected.len();
+        }
+        assert!(found > 500, "{found} pairs");
+    }
+
+    /// The grid finds every pair of boxes within the tolerance and no other,
+    /// with and without boxes of more than 64 cells (compared with all).
+    #[test]
+    fn candidate_pairs_are_the_overlapping_pairs() {
+        use crate::geom::Aabb;
+        use crate::test_rng::TestRng;
+        let mut rng = TestRng::new(0xb0c5);
+        let mut bigs = 0;
+        for case in 0..200 {
+            let n = 1 + rng.below(120);
+            let boxes: Vec<Aabb> = (0..n)
+                .map(|_| {
+                    let at = Point3::new(
+                        rng.within(100) as f64,
+                        rng.within(100) as f64,
+                        rng.within(10) as f64,
+                    );
+                    // Mostly small; in odd cases now and then one spanning the field.
+                    let size = if case % 2 == 1 && rng.below(40) == 0 {
+                        150.0
+                    } else {
+                        1.0 + rng.below(20) as f64 / 4.0
+                    };
+                    let mut b = Aabb::empty();
+                    b.include(&at);
+                    b.include(&(at + Vec3::new(size, size, 1.0)));
+                    b
+                })
+                .collect();
+            let tol = 0.25;
+            let mut all = Vec::new();
+            for i in 0..n {
+                for j in i + 1..n {
+                    if boxes[i].overlaps(&boxes[j], tol) {
+                        all.push((i, j));
+                    }
+                }
+            }
+            assert_eq!(candidate_pairs(&boxes, tol), all, "case {case}");
+            bigs += boxes.iter().filter(|b| b.max.x - b.min.x > 100.0).count();
+        }
+        assert!(bigs > 20, "{bigs} big boxes");
     }
 
     /// `build_subdomains` collects the subdomains from the consumed

@@ -129,10 +129,7 @@ impl Brep {
         // Every primitive face but a two-rim cone's side has one loop: its
         // edges need no walk through the loop ends.
         let loops = match self.loops(f).len() {
-            1 => {
-                let edges = self.face_edges(f);
-                Loops::from_nested([edges.iter().copied().map(&orient)], edges.len())
-            }
+            1 => Loops::one(self.face_edges(f).iter().copied().map(&orient)),
             _ => {
                 let total = self.face_edges(f).len();
                 Loops::from_nested(self.loops(f).map(|l| l.iter().copied().map(&orient)), total)

@@ -35,6 +35,14 @@ pub(super) fn solid_shapes<'r>(
     shapes
 }
 
+/// Each shape's `bbox()`, in order, made on the workers.
+pub(super) fn shape_boxes(shapes: &[&SolidShape]) -> Vec<Aabb> {
+    (shapes.par_iter())
+        .with_min_len(1024)
+        .map(|shape| shape.bbox())
+        .collect()
+}
+
 /// What one candidate grid over the primitive solids gives: which solids are
 /// isolated (for the welder), and which pairs' bounding boxes overlap within
 /// the tolerance (for the crossing check, `booleans::check_relations`, which
@@ -58,6 +66,8 @@ pub(super) struct Overlapping {
 }
 
 /// Per shape: whether it is isolated, and the overlapping bounding boxes.
+/// `boxes` are the shapes' `bbox()`es ([`shape_boxes`]); their vector
+/// becomes the grid's (each box widened to its hull in place).
 /// Entities weld only when their positions are within `tol` (edges need
 /// welded ends, faces welded edges or, without edges, interior samples within
 /// `tol`), so a solid is isolated when the box of its vertex positions and
@@ -68,17 +78,19 @@ pub(super) struct Overlapping {
 /// One grid serves both questions: its boxes hold each shape's anchors and
 /// its `bbox()` with the larger margin, so every pair either question
 /// finds is among the grid's pairs, which are then tested exactly.
-pub(super) fn pairs(shapes: &[&SolidShape], tol: f64) -> SolidPairs {
-    // Each box is a pure function of its shape: made in parallel, in order.
-    let (hulls, placeable): (Vec<Aabb>, Vec<(bool, bool)>) = shapes
-        .par_iter()
+pub(super) fn pairs(shapes: &[&SolidShape], boxes: Vec<Aabb>, tol: f64) -> SolidPairs {
+    debug_assert_eq!(shapes.len(), boxes.len());
+    // Each hull is a pure function of its shape: made in parallel, in order.
+    let mut hulls = boxes;
+    let placeable: Vec<(bool, bool)> = (hulls.par_iter_mut().zip(shapes))
         .with_min_len(1024)
-        .map(|shape| {
-            let (anchors, bbox) = (anchor_box(shape), shape.bbox());
-            let placeable = (finite(&anchors), in_order(&anchors) && in_order(&bbox));
-            (anchors.union(&bbox), placeable)
+        .map(|(bbox, shape)| {
+            let anchors = anchor_box(shape);
+            let placeable = (finite(&anchors), in_order(&anchors) && in_order(bbox));
+            *bbox = anchors.union(bbox);
+            placeable
         })
-        .unzip();
+        .collect();
     let mut isolated: Vec<bool> = placeable.iter().map(|&(finite, _)| finite).collect();
     let margin = 2.0 * tol;
     if !placeable.iter().all(|&(finite, ordered)| finite && ordered) {
@@ -166,7 +178,7 @@ mod tests {
         ];
         let refs: Vec<&SolidShape> = shapes.iter().collect();
         assert_eq!(
-            pairs(&refs, tol).isolated,
+            pairs(&refs, shape_boxes(&refs), tol).isolated,
             vec![false, false, false, false, true]
         );
     }
@@ -175,7 +187,7 @@ mod tests {
     fn a_solid_with_a_non_finite_position_is_never_isolated() {
         let shapes = [unit_box(f64::NAN, 0.0, 0.0), unit_box(5.0, 0.0, 0.0)];
         let refs: Vec<&SolidShape> = shapes.iter().collect();
-        let found = pairs(&refs, 1e-6);
+        let found = pairs(&refs, shape_boxes(&refs), 1e-6);
         assert_eq!(found.isolated, vec![false, true]);
         // The grid leaves the NaN box out, so the crossing check makes its own.
         assert!(found.overlapping.is_none());
@@ -205,7 +217,7 @@ mod tests {
             unit_box(20.0, 0.0, 0.0),
         ];
         let refs: Vec<&SolidShape> = shapes.iter().collect();
-        let found = pairs(&refs, tol);
+        let found = pairs(&refs, shape_boxes(&refs), tol);
         assert_eq!(found.isolated, vec![false, false, true, true, true]);
         let overlapping = found.overlapping.map(|o| o.pairs);
         assert_eq!(overlapping, Some(vec![(0, 1), (2, 3)]));

@@ -30,13 +30,14 @@ mod reserved;
 pub mod rfunction_region;
 #[cfg(test)]
 mod subdomain_threads_tests;
+mod tolerance;
 pub mod trimmed_topology;
 mod weld;
 mod winding;
 
 use crate::diag::Diagnostics;
 use crate::doc::Document;
-use crate::geom::{Aabb, SolidShape};
+use crate::geom::SolidShape;
 use crate::ir::{
     Dimension, EntityName, Face, Model, OrientedEdge, OrientedFace, Origin, PointSet, Polyline,
     Solid, SolidId, SourceMap,
@@ -140,7 +141,13 @@ pub fn lower(
     };
     let mut model = Model::empty(dimension);
     model.parameters = resolved.parameters.clone();
-    model.tolerance = tolerance(resolved);
+    // Curves that carry edges are part of the topology, not standalone lines.
+    let edge_lines = point_calculus::edge_lines(resolved);
+    let shapes = isolation::solid_shapes(resolved, &edge_lines);
+    // Each primitive's box, made once (on the workers): the tolerance and the
+    // isolation grid both read it.
+    let boxes = isolation::shape_boxes(&shapes);
+    model.tolerance = tolerance::of(resolved, &shapes, &boxes);
     let mut source_map = SourceMap::default();
     let mut entities = Entities::default();
     let expected = expected_entities(resolved);
@@ -155,13 +162,10 @@ pub fn lower(
     map.edges.reserve(expected.edges, expected.solids);
     map.faces.reserve(expected.faces, expected.solids);
     map.solids.reserve(expected.solids, expected.solids);
-    // Curves that carry edges are part of the topology, not standalone lines.
-    let edge_lines = point_calculus::edge_lines(resolved);
-    let shapes = isolation::solid_shapes(resolved, &edge_lines);
     let isolation::SolidPairs {
         isolated,
         overlapping,
-    } = isolation::pairs(&shapes, model.tolerance);
+    } = isolation::pairs(&shapes, boxes, model.tolerance);
     let mut shared = Expected::default();
     for (shape, _) in shapes.iter().zip(&isolated).filter(|(_, i)| !**i) {
         shared.add(shape);
@@ -302,31 +306,6 @@ fn expected_entities(resolved: &Resolved) -> Expected {
         }
     }
     n
-}
-
-/// 1e-6 of the diagonal of everything the file places, at least 1e-12.
-fn tolerance(resolved: &Resolved) -> f64 {
-    let mut bbox = Aabb::empty();
-    fn visit(g: &Geometry, bbox: &mut Aabb) {
-        match g {
-            Geometry::Solid(s) => *bbox = bbox.union(&s.bbox()),
-            Geometry::Points { points, .. } | Geometry::Polyline { points, .. } => {
-                points.iter().for_each(|p| bbox.include(p))
-            }
-            Geometry::Vertex(p) => bbox.include(p),
-            Geometry::PointCurve(c) => c.samples(32).iter().for_each(|p| bbox.include(p)),
-            Geometry::Patch(patch) => patch.rows.iter().flatten().for_each(|p| bbox.include(p)),
-            Geometry::Trimmed(s) => s.samples(8).iter().for_each(|p| bbox.include(p)),
-            Geometry::Group(members) => members.iter().for_each(|m| visit(m, bbox)),
-            _ => {}
-        }
-    }
-    for o in &resolved.objects {
-        if let Some(g) = &o.geometry {
-            visit(g, &mut bbox);
-        }
-    }
-    (1e-6 * bbox.diagonal()).max(1e-12)
 }
 
 /// Queues a primitive solid for [`lower_solids`], or lowers anything else.
