@@ -275,7 +275,7 @@ fn build_tree(
         SolidTree::Intersection(ops, _) => Tree::Intersection(operands(ops, leaves, diags)?),
         SolidTree::Difference(ops, _) => Tree::Difference(operands(ops, leaves, diags)?),
         SolidTree::Solid(r) => {
-            let Some(object) = resolved.object(&r.name) else {
+            let Some(object) = resolved.object(r.name()) else {
                 let names = resolved
                     .objects
                     .iter()
@@ -289,9 +289,9 @@ fn build_tree(
                 let mut d = Diagnostic::new(
                     Code::UndefinedName,
                     r.span,
-                    format!("undefined solid '{}'", r.name),
+                    format!("undefined solid '{}'", r.name()),
                 );
-                d.help = Some(match crate::diag::did_you_mean(&r.name, names) {
+                d.help = Some(match crate::diag::did_you_mean(r.name(), names) {
                     Some(best) => format!("did you mean '{best}'?"),
                     None => {
                         "name a sphere, parallelepiped, truncated_cone, ellipsoid or torus".into()
@@ -305,7 +305,7 @@ fn build_tree(
                 Geometry::Group(members) => Some(members.len()),
                 _ => None,
             };
-            let found = (entities.solids).of(resolved, &r.name, r.index, group_members);
+            let found = (entities.solids).of(resolved, r.name(), r.index, group_members);
             let ids: &[SolidId] = &found;
             let member_geometry = match (geometry, r.index) {
                 (Geometry::Group(members), Some(k)) => members.get(k.wrapping_sub(1)),
@@ -319,7 +319,7 @@ fn build_tree(
                         r.span,
                         format!(
                             "'{}' has {} members; there is no [{k}]",
-                            r.name,
+                            r.name(),
                             members.len()
                         ),
                     )
