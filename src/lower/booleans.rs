@@ -139,7 +139,7 @@ pub(super) fn build_subdomains(
                 name: def.name.text,
                 material: def.material,
                 cells,
-                solids: Vec::new(),
+                solids: Box::default(),
                 max_area: resolved.subdomain_areas.get(def_index).copied().flatten(),
                 trimmed: trimmed_faces,
             })
@@ -249,7 +249,7 @@ pub(super) fn check_subdomains(
         }
         let subdomain = &mut model.subdomains[id.index()];
         subdomain.cells = cells;
-        subdomain.solids = built.leaves.to_vec();
+        subdomain.solids = (*built.leaves).into();
     }
     check_overlaps(model, source_map, &trees, face_samples, leaf_pairs, diags);
 }
