@@ -1192,7 +1192,10 @@ mod tests {
     /// `build_subdomains` collects the subdomains from the consumed
     /// definitions so they reuse the definitions' allocation; the standard
     /// library does that only when a subdomain fits in a definition with the
-    /// same alignment.
+    /// same alignment. Otherwise it grows a second vector beside the first:
+    /// with a 56-byte `Ref` (136-byte definitions) and `Vec` leaf solids
+    /// (144-byte subdomains), validate's peak on the 100k file rose from 166
+    /// to 195 MB.
     #[test]
     fn subdomains_fit_in_their_definitions() {
         use std::mem::{align_of, size_of};
