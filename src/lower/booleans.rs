@@ -275,7 +275,8 @@ fn build_tree(
         SolidTree::Intersection(ops, _) => Tree::Intersection(operands(ops, leaves, diags)?),
         SolidTree::Difference(ops, _) => Tree::Difference(operands(ops, leaves, diags)?),
         SolidTree::Solid(r) => {
-            let Some(object) = resolved.object(r.name()) else {
+            let last = resolved.by_name.get(&resolved.objects, r.name());
+            let Some(object) = last.and_then(|i| resolved.objects.get(i)) else {
                 let names = resolved
                     .objects
                     .iter()
@@ -305,14 +306,13 @@ fn build_tree(
                 Geometry::Group(members) => Some(members.len()),
                 _ => None,
             };
-            let found = (entities.solids).of(resolved, r.name(), r.index, group_members);
-            let ids: &[SolidId] = &found;
+            let found = (entities.solids).of(resolved, r.name(), last, r.index, group_members);
             let member_geometry = match (geometry, r.index) {
                 (Geometry::Group(members), Some(k)) => members.get(k.wrapping_sub(1)),
                 (Geometry::Group(members), None) => members.first(),
                 (g, _) => Some(g),
             };
-            if ids.is_empty() {
+            let Some(first) = found.first() else {
                 let d = match (geometry, r.index, member_geometry) {
                     (Geometry::Group(members), Some(k), None) => Diagnostic::new(
                         Code::IndexOutOfRange,
@@ -332,8 +332,8 @@ fn build_tree(
                 };
                 diags.push(d);
                 return None;
-            }
-            let planar = model.solids[ids[0].index()].shape.is_planar();
+            };
+            let planar = model.solids[first.index()].shape.is_planar();
             if planar != (model.dimension == Dimension::Two) {
                 let (what, help) = if planar {
                     (
@@ -364,11 +364,12 @@ fn build_tree(
                 );
                 return None;
             }
-            match ids {
-                [id] => Tree::Leaf(leaves.index_of(*id)),
+            match found.len() {
+                1 => Tree::Leaf(leaves.index_of(first)),
                 _ => Tree::Union(
-                    ids.iter()
-                        .map(|&id| Tree::Leaf(leaves.index_of(id)))
+                    found
+                        .iter()
+                        .map(|id| Tree::Leaf(leaves.index_of(id)))
                         .collect(),
                 ),
             }
