@@ -868,31 +868,31 @@ fn point_tag(name: &str) -> std::borrow::Cow<'static, str> {
 /// `name`, `name[3]` or `name.entity` (the entity part only when the name
 /// before the dot is non-empty).
 pub fn parse_ref(text: &str, span: Span) -> Ref {
-    let mut name = text.to_string();
-    let mut index = None;
-    let mut entity = None;
-    if let Some(dot) = name.rfind('.')
-        && dot > 0
-        && dot + 1 < name.len()
-        && !name[dot + 1..].contains(']')
-    {
-        entity = Some(name[dot + 1..].into());
-        name.truncate(dot);
+    // Most references are bare names: no dot for an entity, no `]` ending
+    // a member index.
+    if !text.bytes().any(|b| b == b'.' || b == b']') {
+        return Ref::to_name(text, span);
     }
+    let mut name_end = text.len();
+    let mut entity = None;
+    if let Some(dot) = text.rfind('.')
+        && dot > 0
+        && dot + 1 < text.len()
+        && !text[dot + 1..].contains(']')
+    {
+        entity = Some(dot + 1);
+        name_end = dot;
+    }
+    let name = &text[..name_end];
+    let mut index = None;
     if name.ends_with(']')
         && let Some(open) = name.rfind('[')
         && let Ok(i) = name[open + 1..name.len() - 1].trim().parse::<usize>()
     {
         index = Some(i);
-        name.truncate(open);
+        name_end = open;
     }
-    Ref {
-        name,
-        index,
-        entity,
-        text: text.into(),
-        span,
-    }
+    Ref::new(text, name_end, index, entity, span)
 }
 
 fn relocate(expr: &mut crate::expr::Expr, span: Span) {
@@ -917,19 +917,79 @@ mod tests {
     #[test]
     fn references_parse_members_and_entities() {
         let r = parse_ref("pts[2]", Span::default());
-        assert_eq!((r.name.as_str(), r.index, r.entity), ("pts", Some(2), None));
+        assert_eq!((r.name(), r.index, r.entity()), ("pts", Some(2), None));
         let r = parse_ref("box.xmin", Span::default());
-        assert_eq!(
-            (r.name.as_str(), r.entity.as_deref()),
-            ("box", Some("xmin"))
-        );
+        assert_eq!((r.name(), r.entity()), ("box", Some("xmin")));
         let r = parse_ref("row[3].top", Span::default());
         assert_eq!(
-            (r.name.as_str(), r.index, r.entity.as_deref()),
+            (r.name(), r.index, r.entity()),
             ("row", Some(3), Some("top"))
         );
         let r = parse_ref("point 3D", Span::default());
-        assert_eq!((r.name.as_str(), r.index), ("point 3D", None));
+        assert_eq!((r.name(), r.index), ("point 3D", None));
+        let r = parse_ref("a.b[2]", Span::default());
+        assert_eq!((r.name(), r.index, r.entity()), ("a.b", Some(2), None));
+        let r = parse_ref(".x", Span::default());
+        assert_eq!((r.name(), r.entity()), (".x", None));
+        assert_eq!(
+            parse_ref("s", Span::new(4, 5)),
+            Ref::to_name("s", Span::new(4, 5))
+        );
+    }
+
+    /// The split of a reference into owned name and entity strings that
+    /// `parse_ref` made before it kept them as ranges of the text.
+    fn split_by_copies(text: &str) -> (String, Option<usize>, Option<String>) {
+        let mut name = text.to_string();
+        let mut index = None;
+        let mut entity = None;
+        if let Some(dot) = name.rfind('.')
+            && dot > 0
+            && dot + 1 < name.len()
+            && !name[dot + 1..].contains(']')
+        {
+            entity = Some(name[dot + 1..].to_string());
+            name.truncate(dot);
+        }
+        if name.ends_with(']')
+            && let Some(open) = name.rfind('[')
+            && let Ok(i) = name[open + 1..name.len() - 1].trim().parse::<usize>()
+        {
+            index = Some(i);
+            name.truncate(open);
+        }
+        (name, index, entity)
+    }
+
+    #[test]
+    fn references_split_as_the_copying_split_did() {
+        let mut rng = TestRng::new(0x2ef5_17a3);
+        const PIECES: &[&str] = &[
+            "p", "box", "é", ".", "..", "[", "]", "[2]", "[ 3 ]", "[+4]", "[x]", "3", " ", "_",
+            ".xmin", "]x",
+        ];
+        let mut with_parts = [0; 2];
+        for _ in 0..40_000 {
+            let mut text = String::new();
+            for _ in 0..rng.below(6) {
+                text.push_str(PIECES[rng.below(PIECES.len())]);
+            }
+            let r = parse_ref(&text, Span::new(9, 9 + text.len()));
+            let (name, index, entity) = split_by_copies(&text);
+            assert_eq!(
+                (r.name(), r.index, r.entity()),
+                (name.as_str(), index, entity.as_deref()),
+                "{text:?}"
+            );
+            assert_eq!(
+                (&*r.text, r.span),
+                (text.as_str(), Span::new(9, 9 + text.len()))
+            );
+            with_parts[0] += usize::from(index.is_some());
+            with_parts[1] += usize::from(entity.is_some());
+        }
+        // Members and entities both come up often, not only plain names.
+        assert!(with_parts.iter().all(|&n| n > 2_000), "{with_parts:?}");
     }
 
     /// The number the expression parser's path makes of `text` at `span`.
@@ -1045,7 +1105,7 @@ mod tests {
         let y = center.y.as_ref().and_then(|n| n.expr()).expect("y parses");
         assert_eq!(y.kind, crate::expr::ExprKind::Number(2.0));
         assert_eq!(center.x.as_ref().map(|n| n.expr()), Some(None));
-        assert_eq!(center.point.as_ref().map(|r| r.name.as_str()), Some("p"));
+        assert_eq!(center.point.as_ref().map(|r| r.name()), Some("p"));
         assert_eq!(center.tag, "center");
     }
 

@@ -14,14 +14,60 @@ pub struct Name {
 
 /// A reference to a named object: `name`, `name[3]` (1-based member), or, in
 /// face and edge lists, `name.entity`.
+///
+/// The name and the entity are parts of the text as written, kept as byte
+/// ranges of it: one allocation per reference (there is one per solid of a
+/// subdomain, and one per point given by name).
 #[derive(Debug, Clone, PartialEq)]
 pub struct Ref {
-    pub name: String,
-    pub index: Option<usize>,
-    pub entity: Option<Box<str>>,
     /// The reference as written.
     pub text: Box<str>,
+    /// The name is `text[..name_end]`.
+    name_end: usize,
+    /// The entity is `text[entity_start..]`; 0 when there is none (an
+    /// entity never starts the text).
+    entity_start: usize,
+    pub index: Option<usize>,
     pub span: Span,
+}
+
+impl Ref {
+    /// The reference `text` whose name is `text[..name_end]`, member `index`
+    /// and entity `text[entity_start..]` (`None` or 0: no entity). Both
+    /// offsets must be character boundaries of `text`.
+    pub fn new(
+        text: &str,
+        name_end: usize,
+        index: Option<usize>,
+        entity_start: Option<usize>,
+        span: Span,
+    ) -> Ref {
+        Ref {
+            text: text.into(),
+            name_end,
+            entity_start: entity_start.unwrap_or(0),
+            index,
+            span,
+        }
+    }
+
+    /// A reference to `name` itself, without member or entity.
+    pub fn to_name(name: &str, span: Span) -> Ref {
+        Ref::new(name, name.len(), None, None, span)
+    }
+
+    /// The name referred to: the text before any `[index]` and `.entity`.
+    pub fn name(&self) -> &str {
+        self.text.get(..self.name_end).unwrap_or_default()
+    }
+
+    /// The entity after the last dot (`box.xmin`), if any.
+    pub fn entity(&self) -> Option<&str> {
+        match self.entity_start {
+            0 => None,
+            start => self.text.get(start..),
+        }
+    }
 }
 
 /// A numeric attribute: the parsed expression, or none if it did not parse

@@ -123,8 +123,10 @@ pub struct Subdomain {
     pub material: Option<String>,
     pub cells: SubdomainCells,
     /// The leaf solids of its boolean tree, when it was built from solids
-    /// (used to classify points); empty for explicit face lists.
-    pub solids: Vec<SolidId>,
+    /// (used to classify points); empty for explicit face lists. A boxed
+    /// slice (sized once) keeps a `Subdomain` no larger than the
+    /// `doc::SubdomainDef` it is built in place of (`lower/booleans.rs`).
+    pub solids: Box<[SolidId]>,
     /// 2D: the largest triangle area its mesh may have (`area=`).
     pub max_area: Option<f64>,
     /// 3D, given by faces: the trimmed surfaces (indices in

@@ -579,7 +579,7 @@ pub(super) fn unknown_entity(
     entities: &Entities,
     diags: &mut Diagnostics,
 ) {
-    if entities.failed.contains(&r.name) || entities.failed.contains(&*r.text) {
+    if entities.failed.contains(r.name()) || entities.failed.contains(&*r.text) {
         return;
     }
     let found_as = if kind != "face" && lookup_entities(&entities.faces, &r.text).is_some() {

@@ -17,6 +17,9 @@ use std::hash::BuildHasher;
 pub struct NameIndex {
     slots: Vec<u32>,
     previous: Vec<u32>,
+    /// Some name ends in `]` (such as "row[2]", which member 2 of a group
+    /// `row` also meets).
+    bracketed: bool,
 }
 
 /// The names' hash of both name tables (`names.rs` folds it to 32 bits).
@@ -36,15 +39,28 @@ impl NameIndex {
         let size = (count + count / 2 + 1).next_power_of_two();
         let mut slots = vec![0u32; size];
         let mut previous = Vec::with_capacity(count);
+        let mut bracketed = false;
         for i in 0..count {
-            let slot = probe(&slots, &name, name(i).unwrap_or_default());
+            let this = name(i).unwrap_or_default();
+            bracketed |= this.ends_with(']');
+            let slot = probe(&slots, &name, this);
             let before = slots.get(slot).copied().unwrap_or(0);
             previous.push(before);
             if let Some(s) = slots.get_mut(slot) {
                 *s = i as u32 + 1;
             }
         }
-        NameIndex { slots, previous }
+        NameIndex {
+            slots,
+            previous,
+            bracketed,
+        }
+    }
+
+    /// Whether some name ends in `]`: without one, no object is literally
+    /// named like a group's member ("row[2]").
+    pub fn has_bracketed_names(&self) -> bool {
+        self.bracketed
     }
 
     /// The index of the last object named `name` in `objects` (the list the
@@ -58,20 +74,23 @@ impl NameIndex {
         }
     }
 
-    /// Every object named `name` (a name given twice has several), in
-    /// document order.
-    pub fn all(&self, objects: &[ResolvedObject], name: &str) -> Vec<usize> {
-        let mut found = Vec::new();
-        let mut at = self.get(objects, name);
-        while let Some(i) = at {
-            found.push(i);
-            at = match self.previous.get(i).copied() {
-                None | Some(0) => None,
-                Some(s) => Some(s as usize - 1),
-            };
-        }
-        found.reverse();
-        found
+    /// Every object named `name` (a name given twice has several), from the
+    /// last to the first: a walk of the index, no list made per lookup.
+    pub fn all_from_last<'a>(
+        &'a self,
+        objects: &[ResolvedObject],
+        name: &str,
+    ) -> impl Iterator<Item = usize> + use<'a> {
+        self.from_last(self.get(objects, name))
+    }
+
+    /// `last` (an object's index, if any) and the objects of its name
+    /// before it, from the last to the first.
+    pub fn from_last(&self, last: Option<usize>) -> impl Iterator<Item = usize> + '_ {
+        std::iter::successors(last, |&i| match self.previous.get(i).copied() {
+            None | Some(0) => None,
+            Some(s) => Some(s as usize - 1),
+        })
     }
 }
 
@@ -119,9 +138,12 @@ mod tests {
     fn finds_every_object_of_a_name_in_order() {
         let objects: Vec<ResolvedObject> = ["a", "b", "a", "c", "a"].map(object).into();
         let index = NameIndex::build(&objects);
-        assert_eq!(index.all(&objects, "a"), [0, 2, 4]);
-        assert_eq!(index.all(&objects, "c"), [3]);
-        assert!(index.all(&objects, "d").is_empty());
+        let all = |name| index.all_from_last(&objects, name).collect::<Vec<_>>();
+        assert_eq!(all("a"), [4, 2, 0]);
+        assert_eq!(all("c"), [3]);
+        assert!(all("d").is_empty());
+        assert_eq!(index.from_last(Some(2)).collect::<Vec<_>>(), [2, 0]);
+        assert_eq!(index.from_last(None).count(), 0);
     }
 
     #[test]
@@ -142,8 +164,14 @@ mod tests {
         for name in names.iter().map(String::as_str).chain(["n3000", "m1", ""]) {
             let every: Vec<usize> = (0..objects.len()).filter(|&i| names[i] == name).collect();
             assert_eq!(index.get(&objects, name), every.last().copied(), "{name}");
-            assert_eq!(index.all(&objects, name), every, "{name}");
+            let from_last: Vec<usize> = index.all_from_last(&objects, name).collect();
+            assert_eq!(
+                from_last,
+                every.iter().rev().copied().collect::<Vec<_>>(),
+                "{name}"
+            );
         }
-        assert_eq!(index.all(&objects, "n0"), [0, 2, 5]);
+        let n0: Vec<usize> = index.all_from_last(&objects, "n0").collect();
+        assert_eq!(n0, [5, 2, 0]);
     }
 }

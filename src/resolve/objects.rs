@@ -168,13 +168,7 @@ impl<'a> Resolver<'a> {
     fn resolve_systems(&mut self) {
         let systems: Vec<&CoordinateSystem> = self.doc.coordinate_systems.iter().collect();
         for cs in systems {
-            let reference = crate::doc::Ref {
-                name: cs.name.text.clone(),
-                index: None,
-                entity: None,
-                text: cs.name.text.as_str().into(),
-                span: cs.name.span,
-            };
+            let reference = crate::doc::Ref::to_name(&cs.name.text, cs.name.span);
             self.frame_of(&reference);
         }
     }
@@ -369,7 +363,7 @@ impl<'a> Resolver<'a> {
 
     /// The frame of a coordinate system, through its parents (cycles reported).
     pub fn frame_of(&mut self, reference: &Ref) -> Option<Frame> {
-        let name = reference.name.as_str();
+        let name = reference.name();
         let Some(cs) = self.tables.systems.get(name).copied() else {
             let d = match self.names.kind_of(name) {
                 Some(kind) => Diagnostic::new(
@@ -559,11 +553,15 @@ impl<'a> Resolver<'a> {
                         Diagnostic::new(
                             Code::IndexOutOfRange,
                             reference.span,
-                            format!("point '{}' holds {n} points; say which one", reference.name),
+                            format!(
+                                "point '{}' holds {n} points; say which one",
+                                reference.name()
+                            ),
                         )
                         .with_help(format!(
                             "write {}[1] … {}[{n}]",
-                            reference.name, reference.name
+                            reference.name(),
+                            reference.name()
                         )),
                     );
                     None
@@ -575,7 +573,7 @@ impl<'a> Resolver<'a> {
                             reference.span,
                             format!(
                                 "point '{}' has no member {k}: it holds {n} point{}",
-                                reference.name,
+                                reference.name(),
                                 if n == 1 { "" } else { "s" }
                             ),
                         )
@@ -620,14 +618,14 @@ impl<'a> Resolver<'a> {
     /// Finds the object a reference names, checking that its element is one of
     /// `kinds` (element names as in the format; "*" accepts any object).
     pub fn lookup(&mut self, reference: &Ref, kinds: &[&str]) -> Option<usize> {
-        let Some(i) = self.names.first_object(&reference.name) else {
-            let d = match self.names.kind_of(&reference.name) {
+        let Some(i) = self.names.first_object(reference.name()) else {
+            let d = match self.names.kind_of(reference.name()) {
                 Some(kind) => Diagnostic::new(
                     Code::WrongKind,
                     reference.span,
                     format!(
                         "'{}' is {}, but {} is expected here",
-                        reference.name,
+                        reference.name(),
                         a(kind),
                         describe_kinds(kinds)
                     ),
@@ -637,7 +635,7 @@ impl<'a> Resolver<'a> {
                     let mut d = Diagnostic::new(
                         Code::UndefinedName,
                         reference.span,
-                        format!("undefined name '{}'", reference.name),
+                        format!("undefined name '{}'", reference.name()),
                     );
                     let candidates = self
                         .doc
@@ -645,13 +643,13 @@ impl<'a> Resolver<'a> {
                         .iter()
                         .filter(|o| kinds.contains(&"*") || kinds.contains(&o.kind.element()))
                         .map(|o| o.name.text.as_str());
-                    d.help = Some(match did_you_mean(&reference.name, candidates) {
+                    d.help = Some(match did_you_mean(reference.name(), candidates) {
                         Some(best) => format!("did you mean '{best}'?"),
                         None => {
                             format!(
                                 "define {} named '{}'",
                                 describe_kinds(kinds),
-                                reference.name
+                                reference.name()
                             )
                         }
                     });
@@ -670,7 +668,7 @@ impl<'a> Resolver<'a> {
                     reference.span,
                     format!(
                         "'{}' is {}, but {} is expected here",
-                        reference.name,
+                        reference.name(),
                         a(element),
                         describe_kinds(kinds)
                     ),
@@ -700,7 +698,7 @@ impl<'a> Resolver<'a> {
                             reference.span,
                             format!(
                                 "'{}' has {} members; there is no [{k}]",
-                                reference.name,
+                                reference.name(),
                                 members.len()
                             ),
                         )
@@ -730,11 +728,11 @@ impl<'a> Resolver<'a> {
                         reference.span,
                         format!(
                             "'{}' is a single {}; it has no member [{k}]",
-                            reference.name,
+                            reference.name(),
                             g.kind()
                         ),
                     )
-                    .with_help(format!("write '{}' without an index", reference.name)),
+                    .with_help(format!("write '{}' without an index", reference.name())),
                 );
                 None
             }

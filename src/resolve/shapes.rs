@@ -383,8 +383,8 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             }
             if matches!(geometry, Geometry::Group(_)) {
                 r.diags.push(
-                    Diagnostic::new(Code::WrongKind, target.span, format!("replicate '{name}' names the replicated group '{}'", target.name))
-                        .with_help(format!("replicate one member, e.g. ref=\"{}[1]\", or replicate the original object", target.name)),
+                    Diagnostic::new(Code::WrongKind, target.span, format!("replicate '{name}' names the replicated group '{}'", target.name()))
+                        .with_help(format!("replicate one member, e.g. ref=\"{}[1]\", or replicate the original object", target.name())),
                 );
                 return None;
             }
@@ -441,7 +441,7 @@ pub(super) fn resolve_kind(r: &mut Resolver, object: &Object, frame: &Frame) -> 
             for l in loops {
                 let mut edges = Vec::new();
                 for e in l {
-                    if e.entity.is_some() {
+                    if e.entity().is_some() {
                         r.diags.push(
                             Diagnostic::new(Code::WrongKind, e.span, format!("'{}' names an entity of a primitive; a face's loops take explicit <edge> names", e.text))
                                 .with_help("define the edge with <edge> and name it here"),
@@ -865,7 +865,7 @@ pub(super) fn surface_of(r: &mut Resolver, reference: &Ref) -> Option<Surface> {
 
 /// The two surfaces of an intersection line, without reporting anything.
 fn intersection_surfaces(r: &mut Resolver, reference: &Ref) -> Option<Box<[Surface; 2]>> {
-    let i = r.by_name_index(&reference.name)?;
+    let i = r.by_name_index(reference.name())?;
     match r.geometry(i)? {
         Geometry::Line(LineCarrier::Intersection { surfaces }) => Some(surfaces),
         _ => None,
@@ -945,7 +945,7 @@ fn steps_map(r: &mut Resolver, steps: &[Step], name: &str) -> Option<Frame> {
                                             c.text
                                         ),
                                     )
-                                    .with_help(format!("write {}[1]", c.name)),
+                                    .with_help(format!("write {}[1]", c.name())),
                                 );
                                 return None;
                             }
