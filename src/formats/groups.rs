@@ -4,7 +4,6 @@
 //! vertex normals that are smooth within a face and flat across its edges.
 
 use super::WriteError;
-use super::face_normals::{BLOCKED_MIN, FaceSums, Scratch, face_normals};
 use super::mesh_facts::MeshFacts;
 use crate::mesh::Mesh;
 use rayon::prelude::*;
@@ -506,42 +505,37 @@ impl<'a> Expander<'a> {
     }
 
     /// The unit normals [`Expander::expand`] would give these faces'
-    /// vertices, in its order and as `f32` (the same sums in `f64`, face by
-    /// face), handed to `run` a run at a time: only one face's sums are
-    /// held, in `sums`. A large face's sums are formed beside its triangle
-    /// normals on another thread when there is one (`face_normals`).
+    /// vertices, in its order (the same sums in `f64`, face by face): only
+    /// one face's sums are held, in `sums`.
     pub(crate) fn each_normal<E>(
         &mut self,
         faces: &[(u32, bool)],
         sums: &mut Vec<[f64; 3]>,
-        mut run: impl FnMut(&[[f32; 3]]) -> Result<(), E>,
-    ) -> Result<(), E> {
-        let threads = rayon::current_num_threads() > 1;
-        self.each_normal_with(faces, sums, |t| threads && t >= BLOCKED_MIN, &mut run)
-    }
-
-    /// [`Expander::each_normal`], a face taken in blocks when `blocked`
-    /// says so for its triangle count.
-    pub(super) fn each_normal_with<E>(
-        &mut self,
-        faces: &[(u32, bool)],
-        sums: &mut Vec<[f64; 3]>,
-        blocked: impl Fn(usize) -> bool,
-        run: &mut impl FnMut(&[[f32; 3]]) -> Result<(), E>,
+        mut normal: impl FnMut([f64; 3]) -> Result<(), E>,
     ) -> Result<(), E> {
         let mesh = self.mesh;
         self.prepare();
-        let mut scratch = Scratch::default();
         for &(face, flip) in faces {
             let stamp = self.next_stamp();
-            let triangles = &mesh.faces[face as usize].triangles;
-            let into = FaceSums {
-                slot: &mut self.slot,
-                stamp,
-                sums,
-            };
-            let blocked = blocked(triangles.len());
-            face_normals(mesh, triangles, flip, into, blocked, &mut scratch, run)?;
+            sums.clear();
+            let mut total = [0.0; 3];
+            for tri in oriented(mesh, face, flip) {
+                let n = triangle_normal(mesh, tri);
+                total = add(total, n);
+                for node in tri {
+                    let entry = &mut self.slot[node as usize];
+                    if entry.0 != stamp {
+                        *entry = (stamp, sums.len() as u32);
+                        sums.push([0.0; 3]);
+                    }
+                    let s = &mut sums[entry.1 as usize];
+                    *s = add(*s, n);
+                }
+            }
+            let fallback = unit(total).unwrap_or([0.0, 0.0, 1.0]);
+            for s in sums.iter() {
+                normal(unit(*s).unwrap_or(fallback))?;
+            }
         }
         Ok(())
     }
@@ -967,7 +961,7 @@ pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
-pub(crate) fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 

@@ -11,7 +11,6 @@
 
 mod atomic;
 mod base64;
-mod face_normals;
 mod file_ranges;
 pub mod frag;
 mod gltf;
