@@ -948,6 +948,7 @@ fn expand_faces<N>(
 }
 
 /// Twice the area times the unit normal, by the right-hand rule.
+#[inline]
 pub(crate) fn triangle_normal(mesh: &Mesh, [a, b, c]: [u32; 3]) -> [f64; 3] {
     let (p, q, r) = (
         mesh.nodes[a as usize],
@@ -957,14 +958,17 @@ pub(crate) fn triangle_normal(mesh: &Mesh, [a, b, c]: [u32; 3]) -> [f64; 3] {
     cross(sub(q, p), sub(r, p))
 }
 
+#[inline]
 pub(crate) fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
 }
 
+#[inline]
 fn add(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
+#[inline]
 pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     [
         a[1] * b[2] - a[2] * b[1],
@@ -973,11 +977,13 @@ pub(crate) fn cross(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
     ]
 }
 
+#[inline]
 pub(crate) fn norm(a: [f64; 3]) -> f64 {
     (a[0] * a[0] + a[1] * a[1] + a[2] * a[2]).sqrt()
 }
 
 /// The unit vector along `a`, `None` for a (near) zero vector.
+#[inline]
 pub(crate) fn unit(a: [f64; 3]) -> Option<[f64; 3]> {
     let n = norm(a);
     (n > 0.0 && n.is_finite()).then(|| [a[0] / n, a[1] / n, a[2] / n])
