@@ -192,20 +192,8 @@ fn block_extent_avx2(
     let ([r0, r1, r2], [u0, u1, u2]) = (right.map(splat), up.map(splat));
     let mut lo = [splat(f64::INFINITY); 2];
     let mut hi = [splat(f64::NEG_INFINITY); 2];
-    for q in points[..whole].chunks_exact(4) {
-        let p = q.as_ptr().cast::<f64>();
-        // SAFETY: `q` is four points, twelve f64s from `p`: three vectors
-        // of pairs (nodes 0–1 and 2–3), then one vector per axis.
-        let pairs = |k: usize| unsafe {
-            _mm256_insertf128_pd::<1>(
-                _mm256_castpd128_pd256(_mm_loadu_pd(p.add(k))),
-                _mm_loadu_pd(p.add(6 + k)),
-            )
-        };
-        let (xy, zx, yz) = (pairs(0), pairs(2), pairs(4));
-        let x = _mm256_shuffle_pd::<0b1010>(xy, zx);
-        let y = _mm256_shuffle_pd::<0b0101>(xy, yz);
-        let z = _mm256_shuffle_pd::<0b1010>(zx, yz);
+    for q in points[..whole].as_chunks::<4>().0 {
+        let [x, y, z] = crate::render::project::avx2::four_points_by_axis(q);
         let dot = |a0: __m256d, a1: __m256d, a2: __m256d| {
             _mm256_add_pd(
                 _mm256_add_pd(_mm256_mul_pd(x, a0), _mm256_mul_pd(y, a1)),

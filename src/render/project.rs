@@ -11,7 +11,7 @@ use super::raster::{Projected, Snapped};
 use rayon::prelude::*;
 
 #[cfg(target_arch = "x86_64")]
-mod avx2;
+pub(super) mod avx2;
 
 /// Nodes per unit of parallel work.
 const BLOCK: usize = 1 << 13;

@@ -33,24 +33,11 @@ impl NodeMap {
         let (ss, lo, range) = (splat(self.ss), splat(self.lo), splat(self.range));
         let (limit_lo, limit_hi) = (splat(-LIMIT), splat(LIMIT));
         let (sixteen, sign, one_half) = (splat(16.0), splat(-0.0), splat(0.5));
-        let four = (points[..whole].chunks_exact(4))
+        let four = (points[..whole].as_chunks::<4>().0.iter())
             .zip(snapped[..whole].chunks_exact_mut(4))
             .zip(xy_f[..whole].chunks_exact_mut(4));
         for ((q, s), f) in four {
-            // Twelve coordinates x0 y0 z0 x1 y1 z1 … as three vectors of
-            // pairs (halves: nodes 0–1 and 2–3), then one vector per axis.
-            let p = q.as_ptr().cast::<f64>();
-            // SAFETY: `q` is four points, twelve f64s from `p`.
-            let pairs = |k: usize| unsafe {
-                _mm256_insertf128_pd::<1>(
-                    _mm256_castpd128_pd256(_mm_loadu_pd(p.add(k))),
-                    _mm_loadu_pd(p.add(6 + k)),
-                )
-            };
-            let (xy, zx, yz) = (pairs(0), pairs(2), pairs(4));
-            let x = _mm256_shuffle_pd::<0b1010>(xy, zx);
-            let y = _mm256_shuffle_pd::<0b0101>(xy, yz);
-            let z = _mm256_shuffle_pd::<0b1010>(zx, yz);
+            let [x, y, z] = four_points_by_axis(q);
             let d = [
                 _mm256_sub_pd(x, c0),
                 _mm256_sub_pd(y, c1),
@@ -122,19 +109,8 @@ pub(super) fn depth_bounds(points: &[[f64; 3]], camera: &Camera) -> Option<(f64,
     let [t0, t1, t2] = camera.toward_eye.map(splat);
     let sign = splat(-0.0);
     let (mut lo, mut hi) = (splat(f64::INFINITY), splat(f64::NEG_INFINITY));
-    for q in points[..whole].chunks_exact(4) {
-        let p = q.as_ptr().cast::<f64>();
-        // SAFETY: `q` is four points, twelve f64s from `p`.
-        let pairs = |k: usize| unsafe {
-            _mm256_insertf128_pd::<1>(
-                _mm256_castpd128_pd256(_mm_loadu_pd(p.add(k))),
-                _mm_loadu_pd(p.add(6 + k)),
-            )
-        };
-        let (xy, zx, yz) = (pairs(0), pairs(2), pairs(4));
-        let x = _mm256_shuffle_pd::<0b1010>(xy, zx);
-        let y = _mm256_shuffle_pd::<0b0101>(xy, yz);
-        let z = _mm256_shuffle_pd::<0b1010>(zx, yz);
+    for q in points[..whole].as_chunks::<4>().0 {
+        let [x, y, z] = four_points_by_axis(q);
         // `dot(p − centre, toward_eye)`: (d0·t0 + d1·t1) + d2·t2, negated.
         let dot = _mm256_add_pd(
             _mm256_add_pd(
@@ -163,4 +139,28 @@ pub(super) fn depth_bounds(points: &[[f64; 3]], camera: &Camera) -> Option<(f64,
         (l, h) = (below(z, l), above(z, h));
     }
     (l != 0.0 && h != 0.0).then_some((l, h))
+}
+
+/// Four points' coordinates as one vector per axis (lane i is point i): the
+/// twelve coordinates x0 y0 z0 x1 y1 z1 … read as three vectors of pairs
+/// (halves: points 0–1 and 2–3), then shuffled. Shared by the projection,
+/// the depth range and the camera's extent, which must read alike.
+#[inline]
+#[target_feature(enable = "avx2")]
+pub(in crate::render) fn four_points_by_axis(q: &[[f64; 3]; 4]) -> [__m256d; 3] {
+    let p = q.as_ptr().cast::<f64>();
+    // SAFETY: `q` is four points, twelve contiguous f64s from `p`; each
+    // load reads two of them at `k` and `6 + k` (k ≤ 4).
+    let pairs = |k: usize| unsafe {
+        _mm256_insertf128_pd::<1>(
+            _mm256_castpd128_pd256(_mm_loadu_pd(p.add(k))),
+            _mm_loadu_pd(p.add(6 + k)),
+        )
+    };
+    let (xy, zx, yz) = (pairs(0), pairs(2), pairs(4));
+    [
+        _mm256_shuffle_pd::<0b1010>(xy, zx),
+        _mm256_shuffle_pd::<0b0101>(xy, yz),
+        _mm256_shuffle_pd::<0b1010>(zx, yz),
+    ]
 }
