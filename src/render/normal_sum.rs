@@ -236,20 +236,12 @@ mod tests {
         assert_ne!(plain, [0.0; 3]);
     }
 
-    /// A small deterministic generator (xorshift), so the meshes below are
-    /// random but the same on every run.
-    fn next(state: &mut u64) -> u64 {
-        *state ^= *state << 13;
-        *state ^= *state >> 7;
-        *state ^= *state << 17;
-        *state
-    }
-
     #[test]
     fn unchecked_sums_are_the_scalar_sums_bit_for_bit_on_random_meshes() {
         let points = scattered(600);
         let n = points.len() as u32;
-        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        // Random meshes, the same on every run.
+        let mut rng = crate::test_rng::TestRng::new(0x9e37_79b9_7f4a_7c15);
         let mut tris: Vec<[u32; 3]> = Vec::new();
         // Random runs of strips (each triangle shares two corners with the
         // last, in turning positions), fans (one corner shared by all),
@@ -258,7 +250,7 @@ mod tests {
         // first named in order, skipping some, and named again later.
         tris.push([5, 5, 9]);
         while tris.len() < 20_000 {
-            let r = next(&mut state);
+            let r = rng.next_u64();
             let at = (r >> 8) as u32 % n;
             let len = 1 + (r >> 40) as usize % 40;
             match r % 6 {
@@ -281,7 +273,7 @@ mod tests {
                     tris.push([last[(r >> 30) as usize % 3], at, (at + 11) % n]);
                 }
                 4 => {
-                    let k = (next(&mut state) % u64::from(n)) as u32;
+                    let k = (rng.next_u64() % u64::from(n)) as u32;
                     let shapes = [[at, at, k], [at, k, at], [k, at, at], [at, at, at]];
                     tris.push(shapes[(r >> 30) as usize % 4]);
                     let last = tris[tris.len() - 1];
@@ -289,7 +281,7 @@ mod tests {
                 }
                 _ => {
                     for _ in 0..len {
-                        let v = next(&mut state);
+                        let v = rng.next_u64();
                         tris.push([0, 21, 42].map(|s| ((v >> s) % u64::from(n)) as u32));
                     }
                 }

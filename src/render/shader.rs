@@ -339,14 +339,9 @@ mod tests {
 
     #[test]
     fn two_lane_weights_are_the_scalar_weights_bit_for_bit() {
-        let mut state = 0x2545_f491_4f6c_dd1du64;
-        let mut next = || {
-            state ^= state << 13;
-            state ^= state >> 7;
-            state ^= state << 17;
-            state
-        };
-        let mut coordinate = |scale: f32| (next() >> 40) as f32 / (1u64 << 24) as f32 * scale;
+        let mut rng = crate::test_rng::TestRng::new(0x2545_f491_4f6c_dd1d);
+        let mut coordinate =
+            |scale: f32| (rng.next_u64() >> 40) as f32 / (1u64 << 24) as f32 * scale;
         let mut checked = 0;
         let mut clamped = [0usize; 2];
         for round in 0..20_000 {

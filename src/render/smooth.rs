@@ -333,13 +333,11 @@ mod tests {
 
     #[test]
     fn id_ranges_are_the_least_and_greatest_id() {
-        let mut state = 0x853c_49e6_748f_ea9bu64;
+        let mut rng = crate::test_rng::TestRng::new(0x853c_49e6_748f_ea9b);
         for len in [0, 1, 7, 8, 9, 31, 32, 33, 1000, 4099] {
             let ids: Vec<u32> = (0..len)
                 .map(|_| {
-                    state ^= state << 13;
-                    state ^= state >> 7;
-                    state ^= state << 17;
+                    let state = rng.next_u64();
                     // Ids on both sides of 2^31, where a signed minimum differs.
                     (state >> 20) as u32 ^ if state & 1 == 0 { 0x8000_0000 } else { 0 }
                 })
