@@ -124,33 +124,72 @@ pub fn bin(
     // When every face shows the same pair of groups (one face, or faces of
     // one colour), which sides are seen is known once, not per triangle.
     let same_visible = scene.same_sides.map(|sides| sides.map(|g| g != HIDDEN));
+    let band_of = &band_of[..];
     (scene.tris.par_chunks(CHUNK))
         .enumerate()
         .map(|(c, chunk)| {
-            let mut ids: Vec<Vec<u32>> = vec![Vec::new(); n_bands];
-            let mut cols = vec![(u32::MAX, 0u32); n_bands];
-            for (tri, &t) in (c * CHUNK..).zip(chunk) {
-                let Some((v, back)) = facing(proj, t) else {
-                    continue;
-                };
-                let seen = match same_visible {
-                    Some(visible) => visible[back as usize],
-                    None => visible_side(scene, tri, back),
-                };
-                if !seen {
-                    continue;
-                }
-                if let Some((x0, x1, first, last)) = sample_box(&v, width, height) {
-                    let (from, to) = (band_of[first] as usize, band_of[last] as usize);
-                    for (band, reach) in ids[from..=to].iter_mut().zip(&mut cols[from..=to]) {
-                        band.push(tri as u32);
-                        *reach = (reach.0.min(x0 as u32), reach.1.max(x1 as u32));
-                    }
-                }
+            let mut bins = ChunkBins {
+                ids: vec![Vec::new(); n_bands],
+                cols: vec![(u32::MAX, 0u32); n_bands],
+            };
+            let tris = (c * CHUNK..).zip(chunk);
+            // The loop compiled once per case, so the common one (every
+            // face alike) tests a side with no lookup of the scene.
+            match same_visible {
+                Some(visible) => bin_chunk(proj, tris, width, band_of, &mut bins, |_, back| {
+                    visible[back as usize]
+                }),
+                None => bin_chunk(proj, tris, width, band_of, &mut bins, |tri, back| {
+                    visible_side(scene, tri, back)
+                }),
             }
-            ChunkBins { ids, cols }
+            bins
         })
         .collect()
+}
+
+/// Bins triangles `tris` (ids with corners) whose side `back` is `seen`
+/// into `bins`, a sample row's band being `band_of[row]`.
+#[inline(always)]
+fn bin_chunk<'a>(
+    proj: &Projected,
+    tris: impl Iterator<Item = (usize, &'a [u32; 3])>,
+    width: usize,
+    band_of: &[u32],
+    bins: &mut ChunkBins,
+    seen: impl Fn(usize, u32) -> bool,
+) {
+    for (tri, &t) in tris {
+        let Some((v, back)) = facing(proj, t) else {
+            continue;
+        };
+        if !seen(tri, back) {
+            continue;
+        }
+        let Some((x0, x1, first, last)) = sample_box(&v, width, band_of.len()) else {
+            continue;
+        };
+        let (from, to) = (band_of[first] as usize, band_of[last] as usize);
+        let reach = (x0 as u32, x1 as u32);
+        if from == to {
+            // Most triangles (a sample or two across) lie in one band.
+            bins.add(from, tri as u32, reach);
+        } else {
+            for band in from..=to {
+                bins.add(band, tri as u32, reach);
+            }
+        }
+    }
+}
+
+impl ChunkBins {
+    /// Lists triangle `tri` in band `band`, whose columns widen to `reach`.
+    #[inline(always)]
+    fn add(&mut self, band: usize, tri: u32, reach: (u32, u32)) {
+        self.ids[band].push(tri);
+        let cols = &mut self.cols[band];
+        *cols = (cols.0.min(reach.0), cols.1.max(reach.1));
+    }
 }
 
 /// Draws band `band` (sample rows `ys`, stored from `rows[0]`) from the bins.
