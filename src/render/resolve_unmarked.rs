@@ -10,7 +10,7 @@
 use super::raster::{EMPTY, Projected};
 use super::resolve::{PixelSum, Samples, background_pixel};
 use super::scene::Scene;
-use super::shader::Shader;
+use super::shader::{Queue, Shader};
 
 /// What [`unmarked_rows`] resolves: the scene, the projection, the samples
 /// (no edge mask), the background, the first pixel row and the pixel columns.
@@ -34,6 +34,10 @@ pub(super) fn unmarked_rows<const SS: usize>(
     let bg = background_pixel(background);
     let shader = Shader::new(scene, proj);
     let group_of = |id: u64| scene.side_group((id >> 1) as usize, (id & 1) as usize);
+    // One-surface pixels wait in a queue and are shaded eight at a time
+    // (their sample columns fit the queue's u32s below 2^31).
+    let queued = sample_width <= i32::MAX as usize;
+    let mut queue = Queue::new();
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;
         let sy = py * SS;
@@ -89,6 +93,12 @@ pub(super) fn unmarked_rows<const SS: usize>(
                             })
                         }),
                     };
+                if one_group && queued {
+                    if queue.push(first_id as u32, sx as u32, px as u32) {
+                        queue.flush(&shader, sy, py, row);
+                    }
+                    continue;
+                }
                 if one_group {
                     let color = shader.shade(first_id, sx, sy, px, py);
                     row[px * 4..px * 4 + 4].copy_from_slice(&[color[0], color[1], color[2], 255]);
@@ -105,6 +115,7 @@ pub(super) fn unmarked_rows<const SS: usize>(
             }
             sum.write((SS * SS) as u32, &mut row[px * 4..px * 4 + 4]);
         }
+        queue.flush(&shader, sy, py, row);
     }
 }
 

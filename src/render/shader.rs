@@ -12,6 +12,9 @@ use super::raster::Projected;
 use super::scene::{HIDDEN, Scene};
 use crate::cache_hint::prefetch_at;
 
+mod lanes;
+pub(super) use lanes::Queue;
+
 /// Pixels ahead whose triangle's corners are fetched while one is shaded.
 const AHEAD: usize = 8;
 
@@ -53,6 +56,10 @@ pub(super) struct Shader<'s, 'a> {
     /// Front and back when every face shows the same groups (`None` for a
     /// side that is looked up per triangle).
     sides: [Option<Look>; 2],
+    /// The front and back colours when eight pixels can be shaded at once
+    /// ([`lanes`]: AVX2, the sides known and neither a cap, indices that
+    /// fit AVX2's 32-bit gathers).
+    lane_colors: Option<[[f32; 4]; 2]>,
 }
 
 impl<'s, 'a> Shader<'s, 'a> {
@@ -68,6 +75,21 @@ impl<'s, 'a> Shader<'s, 'a> {
             Some(pair) => pair.map(|g| (g != HIDDEN).then(|| Look::of(scene, g))),
             None => [None; 2],
         };
+        // A side no face shows (hidden) takes the other's colour: a lane
+        // showing it falls back to `shade` (see `lanes`).
+        let lane_colors = match sides {
+            [Some(front), Some(back)] => Some([front, back]),
+            [Some(look), None] | [None, Some(look)] => Some([look; 2]),
+            [None, None] => None,
+        }
+        .filter(|[front, back]| {
+            !front.cap
+                && !back.cap
+                && k <= i32::MAX as usize / 3
+                && xy.len().max(scene.light.len()) <= i32::MAX as usize / 2
+                && avx2()
+        })
+        .map(|looks| looks.map(|look| look.color));
         Shader {
             scene,
             tris: &scene.tris[..k],
@@ -76,6 +98,7 @@ impl<'s, 'a> Shader<'s, 'a> {
             xy,
             light,
             sides,
+            lane_colors,
         }
     }
 
@@ -162,6 +185,18 @@ impl<'s, 'a> Shader<'s, 'a> {
                 prefetch_at(self.light.as_ptr().wrapping_add(slot as usize));
             }
         }
+    }
+}
+
+/// Whether the machine has AVX2 (for [`lanes`]).
+fn avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
     }
 }
 
