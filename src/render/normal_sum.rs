@@ -102,7 +102,11 @@ fn normal_avx2(points: &[[f64; 3]], t: [u32; 3]) -> std::arch::x86_64::__m256d {
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn corner_normal(a: &[f64; 3], b: &[f64; 3], c: &[f64; 3]) -> std::arch::x86_64::__m256d {
+pub(in crate::render) fn corner_normal(
+    a: &[f64; 3],
+    b: &[f64; 3],
+    c: &[f64; 3],
+) -> std::arch::x86_64::__m256d {
     use std::arch::x86_64::*;
     let (a, b, c) = (load_point(a), load_point(b), load_point(c));
     let (u, v) = (_mm256_sub_pd(b, a), _mm256_sub_pd(c, a));
@@ -143,7 +147,7 @@ unsafe fn own_sums_unchecked(points: &[[f64; 3]], tris: &[[u32; 3]], sums: &mut 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn add_avx2(sum: &mut Sum, n: std::arch::x86_64::__m256d) {
+pub(in crate::render) fn add_avx2(sum: &mut Sum, n: std::arch::x86_64::__m256d) {
     use std::arch::x86_64::*;
     // SAFETY: `sum` is four f64s aligned to 32 bytes (`Sum`).
     unsafe {

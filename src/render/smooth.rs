@@ -10,6 +10,9 @@ use super::normal_sum::{Sum, serial_sums};
 use rayon::prelude::*;
 use std::sync::atomic::{AtomicU32, Ordering};
 
+#[cfg(target_arch = "x86_64")]
+mod windowed;
+
 /// Triangles per chunk of partial sums.
 pub const CHUNK: usize = 1 << 14;
 /// Nodes per block of the final reduction.
@@ -80,6 +83,18 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
         .iter()
         .all(|&(lo, hi)| hi.saturating_sub(lo) <= LOCAL_SPAN);
     if !local {
+        #[cfg(target_arch = "x86_64")]
+        if let Some(given) = given
+            && std::arch::is_x86_feature_detected!("avx2")
+        {
+            let mut out = vec![T::default(); n];
+            // SAFETY: the CPU has AVX2 (checked just above), and every
+            // node of `tris` is a point (`given` are their spans, all below).
+            if unsafe { windowed::light_in_window(points, tris, given.spans(), &mut out, &finish) }
+            {
+                return (own_slots, out);
+            }
+        }
         let sums = serial_sums(points, tris, corner_slots, n + extra.len(), given);
         let mut out = vec![T::default(); sums.len()];
         (out.par_chunks_mut(BLOCK))
