@@ -6,16 +6,12 @@
 //! set-up keeps few values live (corners relative to the first one) and a
 //! triangle under `SMALL` snapped units across steps its three edges as
 //! fields of one integer: one add per sample and one test of three sign
-//! bits, instead of three adds and three tests. A box of at most 4 × 4
-//! samples (most of them) is tested whole first (`box_bits`): its inside
-//! samples are drawn one by one, with no branch per outside sample, and a
-//! triangle with none sets up no depth plane. Where the processor has
+//! bits, instead of three adds and three tests. Where the processor has
 //! AVX-512, `lanes` does the same eight triangles at a time.
 
 use super::raster::Snapped;
 use crate::cache_hint::prefetch_at;
 
-mod box_bits;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 
@@ -44,41 +40,22 @@ pub unsafe fn draw_chunks<'a>(
     nodes: &[Snapped],
     chunks: impl Iterator<Item = &'a [u32]>,
 ) {
+    #[cfg(target_arch = "x86_64")]
+    let lanes = lanes::available();
+    #[cfg(not(target_arch = "x86_64"))]
+    let lanes = false;
     // SAFETY: the caller's promise.
-    unsafe { draw_chunks_by(Path::best(), rows, width, ys, tris, nodes, chunks) }
+    unsafe { draw_chunks_by(lanes, rows, width, ys, tris, nodes, chunks) }
 }
 
-/// The instructions the drawing uses.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-enum Path {
-    /// Eight triangles at a time in AVX-512 lanes (`lanes`).
-    Lanes,
-    /// One after another, a small box tested a row per AVX2 vector.
-    Avx2,
-    /// One after another, with the x86-64 baseline's instructions.
-    Scalar,
-}
-
-impl Path {
-    /// The fastest path this processor has.
-    fn best() -> Path {
-        #[cfg(target_arch = "x86_64")]
-        if lanes::available() {
-            return Path::Lanes;
-        } else if std::arch::is_x86_feature_detected!("avx2") {
-            return Path::Avx2;
-        }
-        Path::Scalar
-    }
-}
-
-/// [`draw_chunks`] by `path`.
+/// [`draw_chunks`], eight triangles at a time in vector lanes when `lanes`
+/// (the processor has AVX-512), else one after another (set up, then
+/// filled: a batch of set-ups before their sample loops was slower).
 ///
 /// # Safety
-/// As [`draw_chunks`]; `path` only one the processor has (`Lanes` when
-/// [`lanes::available`], `Avx2` when it has AVX2).
+/// As [`draw_chunks`]; `lanes` only when [`lanes::available`].
 unsafe fn draw_chunks_by<'a>(
-    path: Path,
+    lanes: bool,
     rows: &mut [u64],
     width: usize,
     ys: std::ops::Range<usize>,
@@ -87,56 +64,14 @@ unsafe fn draw_chunks_by<'a>(
     chunks: impl Iterator<Item = &'a [u32]>,
 ) {
     #[cfg(target_arch = "x86_64")]
-    match path {
-        Path::Lanes => {
-            for ids in chunks {
-                // SAFETY: the caller's promise; the processor has the
-                // instructions.
-                unsafe { lanes::draw_ids(rows, width, &ys, tris, nodes, ids) };
-            }
-            return;
+    if lanes {
+        for ids in chunks {
+            // SAFETY: the caller's promise; the processor has the
+            // instructions.
+            unsafe { lanes::draw_ids(rows, width, &ys, tris, nodes, ids) };
         }
-        // SAFETY: the caller's promises.
-        Path::Avx2 => return unsafe { one_by_one_avx2(rows, width, ys, tris, nodes, chunks) },
-        Path::Scalar => {}
+        return;
     }
-    // SAFETY: the caller's promise.
-    unsafe { one_by_one::<false>(rows, width, ys, tris, nodes, chunks) }
-}
-
-/// [`one_by_one`] compiled with AVX2.
-///
-/// # Safety
-/// As [`draw_chunks`]; the processor has AVX2.
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "avx2")]
-unsafe fn one_by_one_avx2<'a>(
-    rows: &mut [u64],
-    width: usize,
-    ys: std::ops::Range<usize>,
-    tris: &[[u32; 3]],
-    nodes: &[Snapped],
-    chunks: impl Iterator<Item = &'a [u32]>,
-) {
-    // SAFETY: the caller's promises.
-    unsafe { one_by_one::<true>(rows, width, ys, tris, nodes, chunks) }
-}
-
-/// [`draw_chunks`] one triangle after another (set up, then filled: a
-/// batch of set-ups before their sample loops was slower); small boxes
-/// tested with AVX2 when `AVX2`.
-///
-/// # Safety
-/// As [`draw_chunks`]; `AVX2` only when the processor has it.
-#[inline(always)]
-unsafe fn one_by_one<'a, const AVX2: bool>(
-    rows: &mut [u64],
-    width: usize,
-    ys: std::ops::Range<usize>,
-    tris: &[[u32; 3]],
-    nodes: &[Snapped],
-    chunks: impl Iterator<Item = &'a [u32]>,
-) {
     for ids in chunks {
         for (i, &tri) in ids.iter().enumerate() {
             // Ahead: the triangle 16 places on, the corners of the one 8 on
@@ -158,7 +93,7 @@ unsafe fn one_by_one<'a, const AVX2: bool>(
             // SAFETY: the caller's promise; `set_up` places a small
             // triangle's box in the band.
             unsafe {
-                if set_up::<AVX2>(rows, width, &ys, corners, tri, &mut small) {
+                if set_up(rows, width, &ys, corners, tri, &mut small) {
                     small.fill(rows.as_mut_ptr(), width);
                 }
             }
@@ -199,15 +134,14 @@ impl Small {
 }
 
 /// Sets up triangle `tri` with corners `t` for rows `ys` of the band:
-/// a small one into `small` (true), a large one or one whose box is at
-/// most 4 × 4 samples drawn at once; false when it draws nothing or is
-/// drawn. The box is tested with AVX2 when `AVX2`.
+/// a small one into `small` (true), a large one drawn at once; false when
+/// it draws nothing or is drawn.
 ///
 /// # Safety
 /// `ys.start <= ys.end` and `rows` holds at least `ys.len() × width`
-/// samples; `AVX2` only when the processor has it.
+/// samples.
 #[inline(always)]
-unsafe fn set_up<const AVX2: bool>(
+unsafe fn set_up(
     rows: &mut [u64],
     width: usize,
     ys: &std::ops::Range<usize>,
@@ -247,16 +181,13 @@ unsafe fn set_up<const AVX2: bool>(
     if x_first > sx1 || y_first > sy1 {
         return false;
     }
-    // Only once a sample is known inside: it costs a division.
-    let plane = || {
-        Plane::new(
-            [p.z, zb, zc],
-            [ux, uy, wx, wy],
-            area,
-            [sx0 * SUB + SUB / 2 - ax, sy0 * SUB + SUB / 2 - ay],
-            [x_first - sx0, y_first - sy0],
-        )
-    };
+    let plane = Plane::new(
+        [p.z, zb, zc],
+        [ux, uy, wx, wy],
+        area,
+        [sx0 * SUB + SUB / 2 - ax, sy0 * SUB + SUB / 2 - ay],
+        [x_first - sx0, y_first - sy0],
+    );
     let id = u64::from(tri) * 2 + u64::from(back);
     let (rows_n, row_len) = (sy1 - y_first, sx1 - x_first);
     let first = (y_first as usize - y0) * width + x_first as usize;
@@ -281,42 +212,17 @@ unsafe fn set_up<const AVX2: bool>(
             .wrapping_mul(py)
             .wrapping_sub(dys.wrapping_mul(px))
             .wrapping_add(area << FIELD);
-        let outside = BIAS.wrapping_add(owned).wrapping_sub(e);
-        let (sx, sy) = (dys.wrapping_mul(SUB), dxs.wrapping_mul(-SUB));
-        if rows_n < box_bits::SIDE && row_len < box_bits::SIDE {
-            #[cfg(target_arch = "x86_64")]
-            let bits = if AVX2 {
-                // SAFETY: `AVX2` only when the processor has it.
-                unsafe { box_bits::avx2(outside, sx, sy) }
-            } else {
-                box_bits::scalar(outside, sx, sy)
-            };
-            #[cfg(not(target_arch = "x86_64"))]
-            let bits = box_bits::scalar(outside, sx, sy);
-            let inside = bits & box_bits::in_box(rows_n, row_len);
-            if inside != 0 {
-                let fill = Fill {
-                    id,
-                    plane: plane(),
-                    rows_n,
-                    row_len,
-                };
-                // SAFETY: as for the larger small boxes below.
-                unsafe { fill.bits(rows.as_mut_ptr().add(first), width, inside) };
-            }
-            return false;
-        }
         // Field by field: a record built aside and copied in is read back
         // wider than it was written, which stalls the store forwarding.
-        small.outside = outside;
-        small.sx = sx;
-        small.sy = sy;
+        small.outside = BIAS.wrapping_add(owned).wrapping_sub(e);
+        small.sx = dys.wrapping_mul(SUB);
+        small.sy = dxs.wrapping_mul(-SUB);
         // The box's samples lie in rows y_first..=sy1 ⊂ y0..y1 and columns
         // x_first..=sx1 ⊂ 0..width, so every index from `first` is below
         // (y1 - y0) × width <= rows.len().
         small.first = first;
         small.fill.id = id;
-        small.fill.plane = plane();
+        small.fill.plane = plane;
         small.fill.rows_n = rows_n;
         small.fill.row_len = row_len;
         true
@@ -329,7 +235,7 @@ unsafe fn set_up<const AVX2: bool>(
         // SAFETY: as for the small triangle's box above.
         let fill = Fill {
             id,
-            plane: plane(),
+            plane,
             rows_n,
             row_len,
         };
@@ -431,39 +337,13 @@ impl Fill {
     /// `row.add(k)` is a sample of the band.
     #[inline(always)]
     unsafe fn store(&self, row: *mut u64, k: i64, zy: f32) {
-        let value = self.value(k, zy);
+        let depth = (zy + self.plane.dzdx * (k + i64::from(self.plane.off_x)) as f32).max(0.0);
+        let value = (u64::from(depth.to_bits()) << 32) | self.id;
         // SAFETY: the caller's promise.
         let slot = unsafe { &mut *row.add(k as usize) };
         if value < *slot {
             *slot = value;
         }
-    }
-
-    /// The samples `inside` (bits `4·row + column`, see `box_bits`) of the
-    /// box from `row`, each stored where it is nearer, without a branch on
-    /// that: most are.
-    ///
-    /// # Safety
-    /// Every sample of `inside` from `row` lies in the band.
-    #[inline(always)]
-    unsafe fn bits(&self, row: *mut u64, width: usize, mut inside: u32) {
-        while inside != 0 {
-            let at = inside.trailing_zeros();
-            inside &= inside - 1;
-            let (j, k) = (at / box_bits::SIDE, at % box_bits::SIDE);
-            let zy = self.row_depth(i64::from(j));
-            // SAFETY: the caller's promise.
-            let slot = unsafe { &mut *row.add(j as usize * width + k as usize) };
-            *slot = self.value(i64::from(k), zy).min(*slot);
-        }
-    }
-
-    /// The value of the sample `k` places along a row whose depth at its
-    /// first drawn sample is `zy`.
-    #[inline(always)]
-    fn value(&self, k: i64, zy: f32) -> u64 {
-        let depth = (zy + self.plane.dzdx * (k + i64::from(self.plane.off_x)) as f32).max(0.0);
-        (u64::from(depth.to_bits()) << 32) | self.id
     }
 
     /// The depth at the first drawn sample of box row `j`.
@@ -717,13 +597,13 @@ mod tests {
         let ids: Vec<u32> = (0..41).map(|_| (rng.within(149) + 149) as u32).collect();
         let mut drawn_samples = 0;
         for len in 0..=ids.len() {
-            let draw = |path: Path| {
+            let draw = |lanes: bool| {
                 let mut picture = vec![EMPTY; w * h];
-                // SAFETY: `picture` holds the band's samples; `path` only
-                // where the processor has it.
+                // SAFETY: `picture` holds the band's samples; `lanes` only
+                // where the processor has them.
                 unsafe {
                     draw_chunks_by(
-                        path,
+                        lanes,
                         &mut picture,
                         w,
                         0..h,
@@ -734,13 +614,11 @@ mod tests {
                 };
                 picture
             };
-            let scalar = draw(Path::Scalar);
+            let scalar = draw(false);
             drawn_samples += scalar.iter().filter(|&&v| v != EMPTY).count();
-            for path in vector_paths() {
-                assert!(
-                    draw(path) == scalar,
-                    "{len} ids, {path:?}: the pictures differ"
-                );
+            #[cfg(target_arch = "x86_64")]
+            if lanes::available() {
+                assert!(draw(true) == scalar, "{len} ids: the pictures differ");
             }
         }
         assert!(drawn_samples > 4000, "{drawn_samples} samples drawn");
@@ -775,17 +653,17 @@ mod tests {
             });
         }
         let ids: Vec<u32> = (0..tris.len() as u32).collect();
-        let draw = |path: Path| {
+        let draw = |lanes: bool| {
             let mut picture = vec![EMPTY; w * h];
             for (b, rows) in picture.chunks_mut(w * band).enumerate() {
                 let ys = b * band..(b * band + band).min(h);
-                // SAFETY: `rows` holds the band's samples; `path` only
-                // where the processor has it.
-                unsafe { draw_chunks_by(path, rows, w, ys, &tris, &nodes, ids.chunks(1000)) };
+                // SAFETY: `rows` holds the band's samples; `lanes` only
+                // where the processor has them.
+                unsafe { draw_chunks_by(lanes, rows, w, ys, &tris, &nodes, ids.chunks(1000)) };
             }
             picture
         };
-        let scalar = draw(Path::Scalar);
+        let scalar = draw(false);
         let filled = scalar.iter().filter(|&&v| v != EMPTY).count();
         let zeros = scalar
             .iter()
@@ -795,90 +673,11 @@ mod tests {
             filled > 4000 && zeros > 100,
             "{filled} filled, {zeros} at depth 0"
         );
-        for path in vector_paths() {
-            let vector = draw(path);
-            let differ = (0..w * h).filter(|&i| vector[i] != scalar[i]).count();
-            assert_eq!(differ, 0, "{path:?}: samples differ");
-        }
-    }
-
-    /// The vector paths this processor has.
-    fn vector_paths() -> Vec<Path> {
-        let mut paths = Vec::new();
         #[cfg(target_arch = "x86_64")]
-        {
-            if lanes::available() {
-                paths.push(Path::Lanes);
-            }
-            if std::arch::is_x86_feature_detected!("avx2") {
-                paths.push(Path::Avx2);
-            }
+        if lanes::available() {
+            let lanes = draw(true);
+            let differ = (0..w * h).filter(|&i| lanes[i] != scalar[i]).count();
+            assert_eq!(differ, 0, "samples differ");
         }
-        paths
-    }
-
-    #[test]
-    fn small_boxes_draw_the_bits_of_the_box_loop() {
-        // Triangles of boxes 1 × 1 to 6 × 6 samples (the bit test takes
-        // those up to 4 × 4, the box loop the others), many covering no
-        // sample, some in rows and columns clipped by the band and the
-        // picture: the pictures of every path agree, and each sample drawn
-        // is inside by the plain statement of the rule.
-        let mut rng = TestRng::new(0x6c07_8965_9f1b_2c3d);
-        let (w, h, band) = (23usize, 19usize, 7usize);
-        let (mut nodes, mut tris) = (Vec::new(), Vec::new());
-        for t in 0..4000u32 {
-            let c = [rng.within(200) + 180, rng.within(170) + 150];
-            let reach = [10, 24, 40, 56][t as usize % 4];
-            for _ in 0..3 {
-                nodes.push(Snapped {
-                    x: (c[0] + rng.within(reach)) as i32,
-                    y: (c[1] + rng.within(reach)) as i32,
-                    z: rng.within(1000) as f32 / 700.0,
-                });
-            }
-            tris.push([3 * t, 3 * t + 1, 3 * t + 2]);
-        }
-        let draw = |path: Path, ids: &[u32]| {
-            let mut picture = vec![EMPTY; w * h];
-            for (b, rows) in picture.chunks_mut(w * band).enumerate() {
-                let ys = b * band..(b * band + band).min(h);
-                // SAFETY: `rows` holds the band's samples; `path` only
-                // where the processor has it.
-                unsafe { draw_chunks_by(path, rows, w, ys, &tris, &nodes, [ids].into_iter()) };
-            }
-            picture
-        };
-        let (mut alone, mut empty) = (0, 0);
-        for t in 0..tris.len() as u32 {
-            let picture = draw(Path::Scalar, &[t]);
-            let v = [0, 1, 2].map(|k| {
-                let n = nodes[3 * t as usize + k];
-                [i64::from(n.x), i64::from(n.y)]
-            });
-            let area = signed_area(v);
-            let positive = if area < 0 { [v[0], v[2], v[1]] } else { v };
-            let mut drawn = 0;
-            for (i, &value) in picture.iter().enumerate() {
-                let (px, py) = (
-                    (i % w) as i64 * SUB + SUB / 2,
-                    (i / w) as i64 * SUB + SUB / 2,
-                );
-                let expected = area != 0 && inside(positive, px, py);
-                assert_eq!(value != EMPTY, expected, "triangle {v:?}, sample {i}");
-                drawn += usize::from(expected);
-            }
-            alone += usize::from(drawn > 0);
-            empty += usize::from(drawn == 0);
-            for path in vector_paths() {
-                assert!(draw(path, &[t]) == picture, "triangle {t}, {path:?}");
-            }
-        }
-        let ids: Vec<u32> = (0..tris.len() as u32).collect();
-        let scalar = draw(Path::Scalar, &ids);
-        for path in vector_paths() {
-            assert!(draw(path, &ids) == scalar, "all triangles, {path:?}");
-        }
-        assert!(alone > 1000 && empty > 500, "{alone} drawing, {empty} not");
     }
 }

@@ -81,7 +81,7 @@ pub(super) unsafe fn draw_ids(
                 let corners = [nodes[a as usize], nodes[b as usize], nodes[c as usize]];
                 let mut unused = super::Small::default();
                 // SAFETY: the caller's promise.
-                unsafe { set_up::<false>(rows, width, ys, corners, tri, &mut unused) };
+                unsafe { set_up(rows, width, ys, corners, tri, &mut unused) };
             }
         }
         // SAFETY: the set-up placed each small triangle's box in the band.
