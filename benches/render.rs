@@ -15,6 +15,11 @@
 //!   is faster than the read on any idle machine with one core or more;
 //! - wall time, printed beside it with every pair's own ratio and the load.
 //!
+//! Then each step again in a fresh process (cold memory, as one CLI run), and
+//! each side warm in a process of its own (repeated there, so it meets only its
+//! own freed memory: in the alternated rounds one side's allocations change
+//! the other's page faults).
+//!
 //! Run: `cargo bench --bench render`. Under `cargo test --all-targets` it runs
 //! as a smoke test on small meshes.
 
@@ -107,17 +112,25 @@ fn read_glb(path: &std::path::Path) -> (Vec<[f32; 3]>, Vec<u32>) {
     (positions, indices)
 }
 
-/// `--child read GLB` or `--child render NU NV ANTIALIAS [REPEATS]`: one timed step in
-/// a fresh process, as `geomc render` meets it (no memory left warm by earlier
-/// repetitions); prints its wall and CPU seconds.
+/// `--child read GLB [REPEATS]` or `--child render NU NV ANTIALIAS [REPEATS]`: one
+/// step timed in a fresh process, as `geomc render` meets it (no memory left warm by
+/// the other side), repeated REPEATS times (default 1); prints the medians of its wall
+/// and CPU seconds. Repeated, the step runs warm in a process of its own: its
+/// allocations meet only its own freed memory, not the other side's.
 fn child(args: &[String]) {
-    let (wall, cpu) = match args {
-        [what, path] if what == "read" => {
-            let (wall, cpu, _) = timed(|| read_glb(std::path::Path::new(path)));
-            (wall, cpu)
+    let parse = |v: &String| v.parse::<u32>().expect("a count");
+    let repeats = |r: &[String]| r.first().map_or(1, parse).max(1);
+    let mut walls = Vec::new();
+    let mut cpus = Vec::new();
+    match args {
+        [what, path, r @ ..] if what == "read" && r.len() <= 1 => {
+            for _ in 0..repeats(r) {
+                let (wall, cpu, _) = timed(|| read_glb(std::path::Path::new(path)));
+                walls.push(wall);
+                cpus.push(cpu);
+            }
         }
-        [what, nu, nv, aa, repeats @ ..] if what == "render" && repeats.len() <= 1 => {
-            let parse = |v: &String| v.parse::<u32>().expect("a count");
+        [what, nu, nv, aa, r @ ..] if what == "render" && r.len() <= 1 => {
             let mesh = torus(parse(nu) as usize, parse(nv) as usize);
             let options = RenderOptions {
                 width: 1024,
@@ -125,17 +138,15 @@ fn child(args: &[String]) {
                 antialias: parse(aa),
                 ..RenderOptions::default()
             };
-            // Repeated (for profiles of warm renders): the last one's times.
-            let mut times = (0.0, 0.0);
-            for _ in 0..repeats.first().map_or(1, parse) {
+            for _ in 0..repeats(r) {
                 let (wall, cpu, _) = timed(|| render_png(&mesh, &options).expect("renders"));
-                times = (wall, cpu);
+                walls.push(wall);
+                cpus.push(cpu);
             }
-            times
         }
-        _ => panic!("--child read GLB | --child render NU NV ANTIALIAS [REPEATS]"),
+        _ => panic!("--child read GLB [REPEATS] | --child render NU NV ANTIALIAS [REPEATS]"),
     };
-    println!("{wall} {cpu}");
+    println!("{} {}", median(&walls), median(&cpus));
 }
 
 /// Runs one `--child` step of this benchmark in a fresh process: (wall, CPU) seconds.
@@ -217,6 +228,16 @@ fn main() {
         cold_read.push(in_fresh_process(&["read", &glb_arg]));
         cold_render.push(in_fresh_process(&["render", &nu_arg, &nv_arg, "2"]));
     }
+    // And each side warm, but in a process of its own (`own` repetitions
+    // each, their medians): in the alternated rounds above the two sides
+    // share one allocator, so one side's freed memory changes the other's
+    // page faults (a render that frees less leaves the read faster).
+    let own = if smoke { "1" } else { "7" };
+    let (mut own_read, mut own_render) = (Vec::new(), Vec::new());
+    for _ in 0..reps.min(5) {
+        own_read.push(in_fresh_process(&["read", &glb_arg, own]));
+        own_render.push(in_fresh_process(&["render", &nu_arg, &nv_arg, "2", own]));
+    }
     let load_after = load_average();
     let pairs = |a: &[f64], b: &[f64]| {
         (a.iter().zip(b))
@@ -275,6 +296,22 @@ fn main() {
         "  render / read, fresh processes, medians: CPU {:.2}; wall {:.2}",
         median(&cpu_of(&cold_render)) / median(&cpu_of(&cold_read)),
         median(&wall_of(&cold_render)) / median(&wall_of(&cold_read)),
+    );
+    println!("  each side warm in a process of its own ({own} repetitions, their medians):");
+    row(
+        "gltf crate: read GLB (positions + indices)",
+        &cpu_of(&own_read),
+        &wall_of(&own_read),
+    );
+    row(
+        "geomc render 1024x1024 PNG (default, 2x2 AA)",
+        &cpu_of(&own_render),
+        &wall_of(&own_render),
+    );
+    println!(
+        "  render / read, warm in own processes, medians: CPU {:.2}; wall {:.2}",
+        median(&cpu_of(&own_render)) / median(&cpu_of(&own_read)),
+        median(&wall_of(&own_render)) / median(&wall_of(&own_read)),
     );
     let cpu_ratio = median(&render_cpu) / median(&read_cpu);
     println!(
