@@ -391,7 +391,8 @@ mod tests {
                 assert_eq!(pixel, [r, g, b, 255], "{px}");
             }
         }
-        // Pixel 0 (front, sample (0.5, 0.5)): light 1 − 0.1 weights … 0.9.
-        assert_eq!(&row[..4], [180, 90, 45, 255]);
+        // Pixel 0 (front, sample centre (0.5, 0.5)): weights 0.9, 0.05, 0.05
+        // of the corners' front light 1, 0.5, 0: 0.925 of (200, 100, 50).
+        assert_eq!(&row[..4], [185, 92, 46, 255]);
     }
 }
