@@ -35,8 +35,9 @@ pub(super) fn unmarked_rows<const SS: usize>(
     let shader = Shader::new(scene, proj);
     let group_of = |id: u64| scene.side_group((id >> 1) as usize, (id & 1) as usize);
     // One-surface pixels wait in a queue and are shaded eight at a time
-    // (their sample columns fit the queue's u32s below 2^31).
-    let queued = sample_width <= i32::MAX as usize;
+    // (their sample columns fit the queue's u32s below 2^31); where the
+    // lanes cannot run, the queue would only delay `shade`.
+    let queued = shader.shades_lanes() && sample_width <= i32::MAX as usize;
     let mut queue = Queue::new();
     for (dy, row) in out.chunks_mut(width * 4).enumerate() {
         let py = py0 + dy;

@@ -102,6 +102,11 @@ impl<'s, 'a> Shader<'s, 'a> {
         }
     }
 
+    /// Whether one-surface pixels can be shaded eight at a time ([`lanes`]).
+    pub(super) fn shades_lanes(&self) -> bool {
+        self.lane_colors.is_some()
+    }
+
     /// The colour of sample (`sx`, `sy`) of pixel (`px`, `py`) showing
     /// triangle side `id` (`2 × triangle + back`). Not inlined: in the
     /// resolver's pixel loop its registers would push the pixel's samples

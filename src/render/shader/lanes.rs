@@ -4,7 +4,9 @@
 //! loads of all eight are gathered together and one division serves eight
 //! weights (AVX2): the same operations per lane as [`Shader::shade`], so
 //! the same bytes. Without AVX2, or for scenes whose sides are looked up
-//! per triangle, the queue is shaded one pixel at a time.
+//! per triangle, the resolver calls `shade` directly and queues nothing
+//! ([`Shader::shades_lanes`]); a queued batch with a lane the vectors cannot
+//! shade is shaded one pixel at a time.
 
 use super::Shader;
 
