@@ -159,6 +159,10 @@ fn bin_chunk<'a>(
     bins: &mut ChunkBins,
     seen: impl Fn(usize, u32) -> bool,
 ) {
+    // Neighbouring triangles of a mesh mostly land in the same band, so
+    // that band's list is held aside (its length and columns in registers)
+    // while the run lasts, instead of being loaded and stored per triangle.
+    let mut run = Run::default();
     for (tri, &t) in tris {
         let Some((v, back)) = facing(proj, t) else {
             continue;
@@ -173,12 +177,61 @@ fn bin_chunk<'a>(
         let reach = (x0 as u32, x1 as u32);
         if from == to {
             // Most triangles (a sample or two across) lie in one band.
-            bins.add(from, tri as u32, reach);
+            if from != run.band {
+                run.switch(bins, from);
+            }
+            run.add(tri as u32, reach);
         } else {
             for band in from..=to {
-                bins.add(band, tri as u32, reach);
+                if band == run.band {
+                    run.add(tri as u32, reach);
+                } else {
+                    bins.add(band, tri as u32, reach);
+                }
             }
         }
+    }
+    run.switch(bins, usize::MAX);
+}
+
+/// The list of the band the last triangles went to, taken out of the
+/// chunk's bins until the next band's turn.
+struct Run {
+    band: usize,
+    ids: Vec<u32>,
+    cols: (u32, u32),
+}
+
+impl Default for Run {
+    fn default() -> Self {
+        Run {
+            band: usize::MAX,
+            ids: Vec::new(),
+            cols: (u32::MAX, 0),
+        }
+    }
+}
+
+impl Run {
+    /// Puts the run's list back and takes band `band`'s (none for
+    /// `usize::MAX`).
+    #[inline(never)]
+    fn switch(&mut self, bins: &mut ChunkBins, band: usize) {
+        if let Some(ids) = bins.ids.get_mut(self.band) {
+            *ids = std::mem::take(&mut self.ids);
+            bins.cols[self.band] = self.cols;
+        }
+        self.band = band;
+        if let Some(ids) = bins.ids.get_mut(band) {
+            self.ids = std::mem::take(ids);
+            self.cols = bins.cols[band];
+        }
+    }
+
+    #[inline(always)]
+    fn add(&mut self, tri: u32, reach: (u32, u32)) {
+        self.ids.push(tri);
+        self.cols = widen(self.cols, reach);
     }
 }
 
@@ -187,9 +240,14 @@ impl ChunkBins {
     #[inline(always)]
     fn add(&mut self, band: usize, tri: u32, reach: (u32, u32)) {
         self.ids[band].push(tri);
-        let cols = &mut self.cols[band];
-        *cols = (cols.0.min(reach.0), cols.1.max(reach.1));
+        self.cols[band] = widen(self.cols[band], reach);
     }
+}
+
+/// Columns `cols` (`first..=last`) widened to `reach`.
+#[inline(always)]
+fn widen(cols: (u32, u32), reach: (u32, u32)) -> (u32, u32) {
+    (cols.0.min(reach.0), cols.1.max(reach.1))
 }
 
 /// Draws band `band` (sample rows `ys`, stored from `rows[0]`) from the bins.
