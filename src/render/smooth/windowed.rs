@@ -14,6 +14,7 @@
 //! into light at the end.
 
 use super::{CHUNK, LOCAL_SPAN};
+use crate::cache_hint::prefetch_at;
 use crate::render::normal_sum::{Sum, add_avx2, corner_normal};
 
 /// Most nodes in the ring (2 MB of sums); a mesh needing more is summed
@@ -21,6 +22,10 @@ use crate::render::normal_sum::{Sum, add_avx2, corner_normal};
 const MOST_RING: usize = 1 << 16;
 /// Most wide chunks (a torus has one: its last rows closing onto row 0).
 const MOST_WIDE: usize = 4;
+/// How many triangles ahead [`local_chunk`] asks for a corner's point: the
+/// newest corner (the largest id) of a mesh numbered with locality is a
+/// point not read before, from memory, which its triangle would wait for.
+const AHEAD: usize = 64;
 
 /// The nodes wide chunks name: a bit per node, and per word of bits the
 /// count of set bits before it, so a node's place in the store is a rank.
@@ -234,7 +239,11 @@ unsafe fn local_chunk(points: &[[f64; 3]], tris: &[[u32; 3]], ring: &mut [Sum]) 
     let mut pairs = tris.as_chunks::<2>();
     // SAFETY (all blocks below): every node is a point, and its place in
     // the ring is below `ring.len()` (`& mask`), the caller's promise.
-    for &[t, u] in pairs.0 {
+    for (i, &[t, u]) in pairs.0.iter().enumerate() {
+        if let Some(far) = tris.get(2 * i + AHEAD) {
+            let newest = far[0].max(far[1]).max(far[2]);
+            prefetch_at(points.as_ptr().wrapping_add(newest as usize));
+        }
         let (nt, nu) = unsafe { (normal(points, t), normal(points, u)) };
         if distinct(t) && distinct(u) {
             for k in t {
