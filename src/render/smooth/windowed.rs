@@ -16,6 +16,7 @@
 use super::{CHUNK, LOCAL_SPAN};
 use crate::cache_hint::prefetch_at;
 use crate::render::normal_sum::{Sum, add_avx2, corner_normal};
+use std::mem::MaybeUninit;
 
 /// Most nodes in the ring (2 MB of sums); a mesh needing more is summed
 /// over an array of all nodes.
@@ -86,8 +87,9 @@ impl SetApart {
     }
 }
 
-/// `out[k] = finish(sum of node k)` for every node, the sums in triangle
-/// order, or `false` (nothing written) when the chunks' spans leave no
+/// `out[k] = finish(sum of node k)` for every node (`finish` is given every
+/// slot of `out` once, and the set-apart nodes' slots again from a copy),
+/// the sums in triangle order, or `false` (nothing written) when the chunks' spans leave no
 /// window small enough. `spans` are the [`CHUNK`] spans of `tris`
 /// ([`super::NodeSpans`]), every node of `tris` below `points.len()`, which
 /// is `out.len()`; the CPU has AVX2.
@@ -95,12 +97,12 @@ impl SetApart {
 /// # Safety
 /// The CPU has AVX2, and every node of `tris` is below `points.len()`.
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn light_in_window<T: Copy + Default>(
+pub(super) unsafe fn light_in_window<T: Copy>(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     spans: &[(usize, usize)],
-    out: &mut [T],
-    finish: &impl Fn(&[Sum], &mut [T]),
+    out: &mut [MaybeUninit<T>],
+    finish: &impl Fn(&[Sum], &mut [MaybeUninit<T>]),
 ) -> bool {
     let n = points.len();
     assert!(out.len() == n && spans.len() == tris.len().div_ceil(CHUNK));
@@ -184,7 +186,7 @@ pub(super) unsafe fn light_in_window<T: Copy + Default>(
         }
     }
     advance(&mut ring, &mut store, done, n);
-    let mut light = vec![T::default(); store.len()];
+    let mut light = vec![MaybeUninit::uninit(); store.len()];
     finish(&store, &mut light);
     apart.each(0, n, |node, r| out[node] = light[r]);
     true
@@ -309,10 +311,19 @@ mod tests {
     fn windowed(points: &[[f64; 3]], tris: &[[u32; 3]]) -> Option<Vec<Sum>> {
         let spans = node_spans(tris);
         assert!(spans.all_below(tris, points.len()));
-        let mut out = vec![Sum([7.0; 4]); points.len()];
-        let copy = |s: &[Sum], o: &mut [Sum]| o.copy_from_slice(s);
+        let mut out = vec![MaybeUninit::new(Sum([7.0; 4])); points.len()];
+        let copy = |s: &[Sum], o: &mut [MaybeUninit<Sum>]| {
+            for (o, s) in o.iter_mut().zip(s) {
+                o.write(*s);
+            }
+        };
         // SAFETY: the CPU has AVX2 (the callers check), every node is a point.
         let done = unsafe { light_in_window(points, tris, spans.spans(), &mut out, &copy) };
+        // SAFETY: every slot was initialised above (and perhaps written again).
+        let out: Vec<Sum> = out
+            .into_iter()
+            .map(|s| unsafe { s.assume_init() })
+            .collect();
         if !done {
             assert!(out.iter().all(|s| *s == Sum([7.0; 4])), "nothing written");
         }
