@@ -14,8 +14,7 @@
 //! into light at the end.
 
 use super::{CHUNK, LOCAL_SPAN};
-use crate::cache_hint::prefetch_at;
-use crate::render::normal_sum::{Sum, add_avx2, corner_normal};
+use crate::render::normal_sum::{Sum, add_avx2, corner_normal, cross_lanes, load_point};
 use std::mem::MaybeUninit;
 
 /// Most nodes in the ring (2 MB of sums); a mesh needing more is summed
@@ -23,10 +22,6 @@ use std::mem::MaybeUninit;
 const MOST_RING: usize = 1 << 16;
 /// Most wide chunks (a torus has one: its last rows closing onto row 0).
 const MOST_WIDE: usize = 4;
-/// How many triangles ahead [`local_chunk`] asks for a corner's point: the
-/// newest corner (the largest id) of a mesh numbered with locality is a
-/// point not read before, from memory, which its triangle would wait for.
-const AHEAD: usize = 64;
 
 /// The nodes wide chunks name: a bit per node, and per word of bits the
 /// count of set bits before it, so a node's place in the store is a rank.
@@ -222,59 +217,54 @@ fn add_two(sum: &mut Sum, a: std::arch::x86_64::__m256d, b: std::arch::x86_64::_
     }
 }
 
-fn distinct(t: [u32; 3]) -> bool {
-    t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
-}
-
-/// Adds a chunk's normals into the ring, two triangles at a time: a node
-/// of both (the diagonal of a quad cut in two) gets the first normal and
-/// then the second in registers, one load and store instead of two, so the
-/// next triangle's add to it waits less. Per node the adds keep triangle
-/// order, so the bits are those of one triangle at a time.
+/// Adds a chunk's normals into the ring. Two triangles that are a quad cut
+/// along its diagonal, (a, b, c) then (a, c, d) (a grid's and a torus's
+/// order), share the points a and c and the edge c − a: four points are
+/// read instead of six, and a and c get both normals in a register (one
+/// load and store instead of two). Each normal is the same operations on
+/// the same values as one triangle at a time, and per node the adds keep
+/// triangle order, so the bits are those of one triangle at a time; other
+/// triangles are added so.
 ///
 /// # Safety
 /// The CPU has AVX2; every node of `tris` is below `points.len()`, and its
 /// place `node & (ring.len() − 1)` is in the ring (a power of two long).
 #[target_feature(enable = "avx2")]
 unsafe fn local_chunk(points: &[[f64; 3]], tris: &[[u32; 3]], ring: &mut [Sum]) {
+    use std::arch::x86_64::_mm256_sub_pd;
     let mask = ring.len() - 1;
-    let mut pairs = tris.as_chunks::<2>();
+    let (pairs, rest) = tris.as_chunks::<2>();
     // SAFETY (all blocks below): every node is a point, and its place in
-    // the ring is below `ring.len()` (`& mask`), the caller's promise.
-    for (i, &[t, u]) in pairs.0.iter().enumerate() {
-        if let Some(far) = tris.get(2 * i + AHEAD) {
-            let newest = far[0].max(far[1]).max(far[2]);
-            prefetch_at(points.as_ptr().wrapping_add(newest as usize));
-        }
-        let (nt, nu) = unsafe { (normal(points, t), normal(points, u)) };
-        if distinct(t) && distinct(u) {
-            for k in t {
-                let sum = unsafe { ring.get_unchecked_mut(k as usize & mask) };
-                if u.contains(&k) {
-                    add_two(sum, nt, nu);
-                } else {
-                    add_avx2(sum, nt);
-                }
-            }
-            for k in u {
-                if !t.contains(&k) {
-                    add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nu);
-                }
-            }
-        } else {
-            for k in t {
-                add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nt);
-            }
-            for k in u {
-                add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nu);
-            }
-        }
-    }
-    for &t in std::mem::take(&mut pairs.1) {
+    // the ring is below `ring.len()` (`& mask`), the caller's promise; each
+    // place is borrowed for one add only, so never twice at once.
+    let places = ring.as_mut_ptr();
+    let at = |k: u32| unsafe { &mut *places.add(k as usize & mask) };
+    let point = |k: u32| load_point(unsafe { points.get_unchecked(k as usize) });
+    let one = |t: [u32; 3]| {
         let nt = unsafe { normal(points, t) };
         for k in t {
-            add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nt);
+            add_avx2(at(k), nt);
         }
+    };
+    for &[t, u] in pairs {
+        // With a ≠ b and a ≠ c every node gets the first normal before the
+        // second (b = c or d = any corner included).
+        if t[0] == u[0] && t[2] == u[1] && t[0] != t[1] && t[0] != t[2] {
+            let [a, b, c] = t.map(point);
+            let ca = _mm256_sub_pd(c, a);
+            let nt = cross_lanes(_mm256_sub_pd(b, a), ca);
+            let nu = cross_lanes(ca, _mm256_sub_pd(point(u[2]), a));
+            add_two(at(t[0]), nt, nu);
+            add_avx2(at(t[1]), nt);
+            add_two(at(t[2]), nt, nu);
+            add_avx2(at(u[2]), nu);
+        } else {
+            one(t);
+            one(u);
+        }
+    }
+    for &t in rest {
+        one(t);
     }
 }
 
@@ -369,6 +359,38 @@ mod tests {
         odd.push([39_999, 0, 39_999]);
         odd.push([5, 5, 5]);
         assert_serial_bits(&points, &odd);
+    }
+
+    #[test]
+    fn quads_with_repeated_corners_keep_the_serial_bits() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let (points, tris) = torus(400, 100);
+        assert!(
+            tris.chunks(2)
+                .all(|q| q[0][0] == q[1][0] && q[0][2] == q[1][1])
+        );
+        // Quads (a, b, c), (a, c, d) with corners named twice: d = a, b or
+        // c and b = c share the points; a = b and a = c are added one
+        // triangle at a time.
+        let mut odd = tris.clone();
+        for (q, pair) in odd.chunks_exact_mut(2).enumerate() {
+            let [a, b, c] = pair[0];
+            match q % 7 {
+                0 => pair[1][2] = a,
+                1 => pair[1][2] = b,
+                2 => pair[1][2] = c,
+                3 => (pair[0][2], pair[1][1]) = (b, b),
+                4 => pair[0][1] = a,
+                5 => (pair[0][2], pair[1][1]) = (a, a),
+                _ => {}
+            }
+        }
+        assert_serial_bits(&points, &odd);
+        // Pairs across quads (an odd start) and single triangles.
+        assert_serial_bits(&points, &odd[1..]);
+        assert_serial_bits(&points, &tris[3..CHUNK + 8]);
     }
 
     #[test]
