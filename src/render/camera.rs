@@ -435,7 +435,8 @@ mod tests {
             assert_eq!(depths.toward, (least[1], most[1]));
             let most = |k: usize| (points[..BLOCK].iter()).fold(0.0, |m, p| above(p[k].abs(), m));
             assert_eq!(depths.magnitude, [most(0), most(1), most(2)]);
-            assert!(depths.magnitude[2] > 7.0 && depths.magnitude[2] < 7.001);
+            // Node 0 is (0, 0.37, −7): the greatest |z|.
+            assert_eq!(depths.magnitude[2], 7.0);
             let zeros = [[0.0, -0.0, 0.0]; 9];
             // SAFETY: as above.
             assert_eq!(
