@@ -72,11 +72,22 @@ impl Camera {
     /// Fits `points` into a `width`×`height` picture seen from `view`, leaving
     /// [`MARGIN`] free on each side of the tighter axis.
     pub fn fit(view: View, points: &[[f64; 3]], width: u32, height: u32) -> Camera {
+        Camera::fit_with_depths(view, points, width, height).0
+    }
+
+    /// [`Camera::fit`], and what its pass over the points tells of their
+    /// depths ([`DepthHint`]), so the depth range needs no pass of its own.
+    pub fn fit_with_depths(
+        view: View,
+        points: &[[f64; 3]],
+        width: u32,
+        height: u32,
+    ) -> (Camera, DepthHint<'_>) {
         let (az, el) = (view.azimuth.to_radians(), view.elevation.to_radians());
         let toward_eye = [az.sin() * el.cos(), -az.cos() * el.cos(), el.sin()];
         let right = [az.cos(), az.sin(), 0.0];
         let up = cross(toward_eye, right);
-        let (mut lo, mut hi) = extent(points, right, up);
+        let ((mut lo, mut hi), depths) = extent(points, [right, up, toward_eye]);
         if points.is_empty() {
             lo = [-1.0, -1.0];
             hi = [1.0, 1.0];
@@ -90,7 +101,7 @@ impl Camera {
             cu * right[1] + cv * up[1],
             cu * right[2] + cv * up[2],
         ];
-        Camera {
+        let camera = Camera {
             right,
             up,
             toward_eye,
@@ -98,7 +109,13 @@ impl Camera {
             center,
             width,
             height,
-        }
+        };
+        let hint = DepthHint {
+            points,
+            toward_eye,
+            blocks: depths,
+        };
+        (camera, hint)
     }
 
     /// Image x and y in pixels (continuous: pixel i covers [i, i+1)) and the
@@ -133,44 +150,91 @@ impl Camera {
 /// Nodes per unit of parallel work in [`extent`].
 const BLOCK: usize = 1 << 13;
 
+/// What [`Camera::fit`]'s pass learnt of the depths of a block of points:
+/// the least and greatest `p·toward_eye` (as computed, NaN skipped) and the
+/// greatest magnitude of each coordinate. A node's depth
+/// (`−(p − centre)·toward_eye`) differs from `centre·toward_eye − p·toward_eye`
+/// by rounding alone, which the magnitudes bound: only blocks whose
+/// `p·toward_eye` comes that close to the least or greatest can hold the
+/// nearest or farthest node.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct DepthBlock {
+    pub toward: (f64, f64),
+    pub magnitude: [f64; 3],
+}
+
+/// The [`DepthBlock`]s of the points a camera was fitted to, per [`BLOCK`]
+/// of them in order, kept with those points (borrowed: they cannot change
+/// meanwhile) and the view's direction; `None` without AVX2.
+pub struct DepthHint<'p> {
+    points: &'p [[f64; 3]],
+    toward_eye: [f64; 3],
+    blocks: Option<Vec<DepthBlock>>,
+}
+
+impl<'p> DepthHint<'p> {
+    /// Per block of `points` (the points the camera was fitted to, seen
+    /// along `toward_eye`), the block and its [`DepthBlock`]; `None` for other
+    /// points or another view, or without the blocks.
+    pub fn blocks(
+        &self,
+        points: &[[f64; 3]],
+        toward_eye: [f64; 3],
+    ) -> Option<impl Iterator<Item = (&'p [[f64; 3]], DepthBlock)>> {
+        let same = std::ptr::eq(self.points, points)
+            && self.toward_eye.map(f64::to_bits) == toward_eye.map(f64::to_bits);
+        let blocks = self.blocks.as_ref().filter(|_| same)?;
+        Some(self.points.chunks(BLOCK).zip(blocks.iter().copied()))
+    }
+}
+
 /// The least and greatest `p·right` and `p·up` over the points (infinite
-/// bounds when there are none). Blocks are folded in order and joined in
-/// block order with the same comparisons, so the bounds are the serial
-/// fold's (on ties the first value is kept either way) for any thread count.
-fn extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64; 2]) {
+/// bounds when there are none), with AVX2 also the [`DepthBlock`]s along
+/// `toward_eye` (`axes` is right, up, toward_eye). Blocks are folded in
+/// order and joined in block order with the same comparisons, so the bounds
+/// are the serial fold's (on ties the first value is kept either way) for
+/// any thread count.
+fn extent(points: &[[f64; 3]], axes: [[f64; 3]; 3]) -> (Bounds, Option<Vec<DepthBlock>>) {
     use rayon::prelude::*;
     let empty = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    let blocks: Vec<([f64; 2], [f64; 2])> = points
+    let blocks: Vec<(Bounds, Option<DepthBlock>)> = points
         .par_chunks(BLOCK)
-        .map(|block| block_extent(block, right, up))
+        .map(|block| block_extent(block, axes))
         .collect();
-    blocks.into_iter().fold(empty, |(lo, hi), (bl, bh)| {
+    let depths = blocks.iter().map(|(_, d)| *d).collect();
+    let bounds = blocks.into_iter().fold(empty, |(lo, hi), ((bl, bh), _)| {
         (
             [below(bl[0], lo[0]), below(bl[1], lo[1])],
             [above(bh[0], hi[0]), above(bh[1], hi[1])],
         )
-    })
+    });
+    (bounds, depths)
 }
+
+/// Least and greatest `p·right` and `p·up`.
+type Bounds = ([f64; 2], [f64; 2]);
 
 /// [`extent`] of one block, serially: with SSE2 the two dot products are the
 /// lanes of one vector (the same products and sums in the same order as
 /// [`dot`]), and `minpd`/`maxpd` are [`below`]/[`above`] lane by lane.
 #[inline]
-fn block_extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2], [f64; 2]) {
+fn block_extent(points: &[[f64; 3]], axes: [[f64; 3]; 3]) -> (Bounds, Option<DepthBlock>) {
+    let [right, up, _] = axes;
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2 (checked just above).
-            if let Some(bounds) = unsafe { block_extent_avx2(points, right, up) } {
-                return bounds;
-            }
+            let (bounds, depths) = unsafe { block_extent_avx2(points, axes) };
+            // SAFETY: SSE2 is part of every x86-64.
+            let bounds = bounds.unwrap_or_else(|| unsafe { block_extent_sse2(points, right, up) });
+            return (bounds, Some(depths));
         }
         // SAFETY: SSE2 is part of every x86-64.
-        unsafe { block_extent_sse2(points, right, up) }
+        (unsafe { block_extent_sse2(points, right, up) }, None)
     }
     #[cfg(not(target_arch = "x86_64"))]
     {
-        scalar_extent(points, right, up)
+        (scalar_extent(points, right, up), None)
     }
 }
 
@@ -178,31 +242,34 @@ fn block_extent(points: &[[f64; 3]], right: [f64; 3], up: [f64; 3]) -> ([f64; 2]
 /// lane as [`dot`], and `minpd`/`maxpd` are [`below`]/[`above`] lane by
 /// lane. The lanes meet the nodes in another order than the serial fold,
 /// which only matters for equal values of different bits, zeros (the fold
-/// keeps the first zero's sign): `None` when any bound is a zero.
+/// keeps the first zero's sign): `None` when any bound is a zero. The
+/// [`DepthBlock`] too, alike (its zeros' signs do not matter).
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn block_extent_avx2(
-    points: &[[f64; 3]],
-    right: [f64; 3],
-    up: [f64; 3],
-) -> Option<([f64; 2], [f64; 2])> {
+fn block_extent_avx2(points: &[[f64; 3]], axes: [[f64; 3]; 3]) -> (Option<Bounds>, DepthBlock) {
     use std::arch::x86_64::*;
     let whole = points.len() / 4 * 4;
     let splat = |v: f64| _mm256_set1_pd(v);
-    let ([r0, r1, r2], [u0, u1, u2]) = (right.map(splat), up.map(splat));
-    let mut lo = [splat(f64::INFINITY); 2];
-    let mut hi = [splat(f64::NEG_INFINITY); 2];
+    let [[r0, r1, r2], [u0, u1, u2], [t0, t1, t2]] = axes.map(|a| a.map(splat));
+    let mut lo = [splat(f64::INFINITY); 3];
+    let mut hi = [splat(f64::NEG_INFINITY); 3];
+    let mut magnitude = [splat(0.0); 3];
+    let sign = splat(-0.0);
     for q in points[..whole].as_chunks::<4>().0 {
-        let [x, y, z] = crate::render::project::avx2::four_points_by_axis(q);
+        let xyz = crate::render::project::avx2::four_points_by_axis(q);
+        let [x, y, z] = xyz;
         let dot = |a0: __m256d, a1: __m256d, a2: __m256d| {
             _mm256_add_pd(
                 _mm256_add_pd(_mm256_mul_pd(x, a0), _mm256_mul_pd(y, a1)),
                 _mm256_mul_pd(z, a2),
             )
         };
-        for (k, v) in [dot(r0, r1, r2), dot(u0, u1, u2)].into_iter().enumerate() {
+        let dots = [dot(r0, r1, r2), dot(u0, u1, u2), dot(t0, t1, t2)];
+        for (k, v) in dots.into_iter().enumerate() {
             lo[k] = _mm256_min_pd(v, lo[k]);
             hi[k] = _mm256_max_pd(v, hi[k]);
+            // `maxpd` keeps the old magnitude for a NaN coordinate.
+            magnitude[k] = _mm256_max_pd(_mm256_andnot_pd(sign, xyz[k]), magnitude[k]);
         }
     }
     let lanes = |v: __m256d| {
@@ -211,18 +278,30 @@ fn block_extent_avx2(
         unsafe { _mm256_storeu_pd(a.as_mut_ptr(), v) };
         a
     };
-    let (mut l, mut h) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for k in 0..2 {
-        for (a, b) in lanes(lo[k]).into_iter().zip(lanes(hi[k])) {
-            (l[k], h[k]) = (below(a, l[k]), above(b, h[k]));
+    let (mut l, mut h) = ([f64::INFINITY; 3], [f64::NEG_INFINITY; 3]);
+    let mut m = [0.0f64; 3];
+    for k in 0..3 {
+        for ((a, b), c) in lanes(lo[k])
+            .into_iter()
+            .zip(lanes(hi[k]))
+            .zip(lanes(magnitude[k]))
+        {
+            (l[k], h[k], m[k]) = (below(a, l[k]), above(b, h[k]), above(c, m[k]));
         }
     }
     for p in &points[whole..] {
-        let (u, v) = (dot(*p, right), dot(*p, up));
-        l = [below(u, l[0]), below(v, l[1])];
-        h = [above(u, h[0]), above(v, h[1])];
+        for k in 0..3 {
+            let v = dot(*p, axes[k]);
+            (l[k], h[k], m[k]) = (below(v, l[k]), above(v, h[k]), above(p[k].abs(), m[k]));
+        }
     }
-    l.iter().chain(&h).all(|&b| b != 0.0).then_some((l, h))
+    let depths = DepthBlock {
+        toward: (l[2], h[2]),
+        magnitude: m,
+    };
+    let bounds = ([l[0], l[1]], [h[0], h[1]]);
+    let no_zero = l[..2].iter().chain(&h[..2]).all(|&b| b != 0.0);
+    (no_zero.then_some(bounds), depths)
 }
 
 #[cfg(target_arch = "x86_64")]
@@ -312,17 +391,18 @@ mod tests {
         points[5] = [f64::NAN, 1.0, 2.0];
         let right = [0.6, 0.8, 0.0];
         let up = [-0.48, 0.36, 0.8];
+        let toward = [0.64, -0.48, 0.6];
         let cuts = [(0, points.len()), (0, 40), (1, 42), (2, 43), (3, 4099)];
         for (from, to) in cuts {
             let part = &points[from..to];
-            let (lo, hi) = extent(part, right, up);
+            let ((lo, hi), _) = extent(part, [right, up, toward]);
             let (want_lo, want_hi) = scalar_extent(part, right, up);
             assert_eq!(lo.map(f64::to_bits), want_lo.map(f64::to_bits));
             assert_eq!(hi.map(f64::to_bits), want_hi.map(f64::to_bits));
             assert!(lo[0] < hi[0] && lo[1] < hi[1]);
         }
         let zeros = [[-0.0, -0.0, -0.0], [0.0, 0.0, 0.0], [-0.0, 0.0, -0.0]];
-        let (lo, hi) = extent(&zeros, [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]);
+        let ((lo, hi), _) = extent(&zeros, [[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], toward]);
         assert_eq!(lo.map(f64::to_bits), [(-0.0f64).to_bits(); 2]);
         assert_eq!(hi.map(f64::to_bits), [(-0.0f64).to_bits(); 2]);
         // Zeros of either sign in every lane, the first of them in turn
@@ -335,7 +415,7 @@ mod tests {
                 })
                 .collect();
             for (r, u) in [([1.0, 0.0, 0.0], [0.0, 0.0, 1.0]), (right, up)] {
-                let (lo, hi) = extent(&zeros, r, u);
+                let ((lo, hi), _) = extent(&zeros, [r, u, toward]);
                 let (want_lo, want_hi) = scalar_extent(&zeros, r, u);
                 assert_eq!(lo.map(f64::to_bits), want_lo.map(f64::to_bits));
                 assert_eq!(hi.map(f64::to_bits), want_hi.map(f64::to_bits));
@@ -344,16 +424,28 @@ mod tests {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("avx2") {
             // SAFETY: the CPU has AVX2 (checked just above).
-            let lanes = unsafe { block_extent_avx2(&points[..BLOCK], right, up) };
+            let (lanes, depths) =
+                unsafe { block_extent_avx2(&points[..BLOCK], [right, up, toward]) };
             let want = scalar_extent(&points[..BLOCK], right, up);
             let bits = |(l, h): ([f64; 2], [f64; 2])| (l.map(f64::to_bits), h.map(f64::to_bits));
             assert_eq!(lanes.map(bits), Some(bits(want)));
+            // The depth block: the serial bounds of `p·toward` and of each
+            // coordinate's magnitude (the NaN node skipped).
+            let (least, most) = scalar_extent(&points[..BLOCK], right, toward);
+            assert_eq!(depths.toward, (least[1], most[1]));
+            let most = |k: usize| (points[..BLOCK].iter()).fold(0.0, |m, p| above(p[k].abs(), m));
+            assert_eq!(depths.magnitude, [most(0), most(1), most(2)]);
+            // Node 0 is (0, 0.37, −7): the greatest |z|.
+            assert_eq!(depths.magnitude[2], 7.0);
             let zeros = [[0.0, -0.0, 0.0]; 9];
             // SAFETY: as above.
-            assert_eq!(unsafe { block_extent_avx2(&zeros, right, up) }, None);
+            assert_eq!(
+                unsafe { block_extent_avx2(&zeros, [right, up, toward]) }.0,
+                None
+            );
         }
         assert_eq!(
-            extent(&[], right, up),
+            extent(&[], [right, up, toward]).0,
             ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2])
         );
     }

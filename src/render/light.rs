@@ -6,6 +6,7 @@
 
 use super::camera::dot;
 use super::normal_sum::Sum;
+use std::mem::MaybeUninit;
 
 /// Seen on the front and the back side: 0.25 ambient plus 0.75 times the
 /// cosine to the light on that side; 0.6 for a normal of no direction.
@@ -23,7 +24,10 @@ pub fn intensity(normal: [f64; 3], light: [f64; 3]) -> [f32; 2] {
 }
 
 /// `out[i] = intensity(sums[i], light)`; `out` and `sums` have one length.
-pub fn intensities(sums: &[Sum], light: [f64; 3], out: &mut [[f32; 2]]) {
+/// Every element of `out` is written (it need not be initialised before:
+/// the light of half a million nodes is not zeroed first).
+pub fn intensities(sums: &[Sum], light: [f64; 3], out: &mut [MaybeUninit<[f32; 2]>]) {
+    assert_eq!(out.len(), sums.len());
     #[cfg(target_arch = "x86_64")]
     {
         if std::arch::is_x86_feature_detected!("avx2") {
@@ -33,13 +37,13 @@ pub fn intensities(sums: &[Sum], light: [f64; 3], out: &mut [[f32; 2]]) {
         }
     }
     for (o, s) in out.iter_mut().zip(sums) {
-        *o = intensity(s.xyz(), light);
+        o.write(intensity(s.xyz(), light));
     }
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
-fn intensities_avx2(sums: &[Sum], light: [f64; 3], out: &mut [[f32; 2]]) {
+fn intensities_avx2(sums: &[Sum], light: [f64; 3], out: &mut [MaybeUninit<[f32; 2]>]) {
     use std::arch::x86_64::*;
     let mut four_out = out.chunks_exact_mut(4);
     let mut four_sums = sums.chunks_exact(4);
@@ -86,7 +90,7 @@ fn intensities_avx2(sums: &[Sum], light: [f64; 3], out: &mut [[f32; 2]]) {
         };
         let (front, back) = (side(c), side(_mm256_xor_pd(c, sign)));
         let pairs = _mm256_set_m128(_mm_unpackhi_ps(front, back), _mm_unpacklo_ps(front, back));
-        // SAFETY: `o` is four [f32; 2], 32 contiguous bytes.
+        // SAFETY: `o` is four slots of [f32; 2], 32 contiguous bytes.
         unsafe { _mm256_storeu_ps(o.as_mut_ptr().cast(), pairs) };
     }
     for (o, s) in four_out
@@ -94,7 +98,7 @@ fn intensities_avx2(sums: &[Sum], light: [f64; 3], out: &mut [[f32; 2]]) {
         .iter_mut()
         .zip(four_sums.remainder())
     {
-        *o = intensity(s.xyz(), light);
+        o.write(intensity(s.xyz(), light));
     }
 }
 
@@ -129,8 +133,15 @@ mod tests {
         // Facing the light and facing away.
         sums[12] = Sum([light[0], light[1], light[2], 0.0]);
         sums[13] = Sum([-light[0], -light[1], -light[2], 0.0]);
-        let mut got = vec![[0.0f32; 2]; sums.len()];
+        let mut got = vec![MaybeUninit::new([7.0f32; 2]); sums.len()];
         intensities(&sums, light, &mut got);
+        // SAFETY: every element was initialised above (and written again).
+        let got: Vec<[f32; 2]> = got
+            .into_iter()
+            .map(|v| unsafe { v.assume_init() })
+            .collect();
+        // Every slot was written: none keeps the 7 it had.
+        assert!(got.iter().all(|v| v[0] <= 1.0 && v[1] <= 1.0));
         for (g, s) in got.iter().zip(&sums) {
             let want = intensity(s.xyz(), light);
             assert_eq!(g.map(f32::to_bits), want.map(f32::to_bits), "{s:?}");

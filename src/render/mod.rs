@@ -258,11 +258,12 @@ fn section_warning(scene: &scene::Scene, options: &RenderOptions) -> Option<Rend
 /// Renders the shaded raster picture.
 pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, RenderError> {
     check(mesh, options)?;
-    let camera = camera_for(mesh, options);
+    let (camera, depths) =
+        Camera::fit_with_depths(options.view, &mesh.nodes, options.width, options.height);
     let scene = scene::build(mesh, options, &camera);
     let mut warnings: Vec<RenderWarning> = section_warning(&scene, options).into_iter().collect();
     let ss = options.antialias as usize;
-    let proj = project::project(&scene.points, &camera, ss);
+    let proj = project::project(&scene.points, &camera, ss, Some(&depths));
     let (sw, sh) = (options.width as usize * ss, options.height as usize * ss);
     let mut image = if options.edges == Edges::None {
         let (w, h) = (options.width as usize, options.height as usize);

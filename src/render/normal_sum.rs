@@ -109,7 +109,21 @@ pub(in crate::render) fn corner_normal(
 ) -> std::arch::x86_64::__m256d {
     use std::arch::x86_64::*;
     let (a, b, c) = (load_point(a), load_point(b), load_point(c));
-    let (u, v) = (_mm256_sub_pd(b, a), _mm256_sub_pd(c, a));
+    cross_lanes(_mm256_sub_pd(b, a), _mm256_sub_pd(c, a))
+}
+
+/// `u × v` in the x, y, z lanes of `u` and `v`: [`cross`]'s products and
+/// differences, lane by lane.
+///
+/// [`cross`]: crate::render::camera::cross
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+pub(in crate::render) fn cross_lanes(
+    u: std::arch::x86_64::__m256d,
+    v: std::arch::x86_64::__m256d,
+) -> std::arch::x86_64::__m256d {
+    use std::arch::x86_64::*;
     // u × v = (u · v.yzx − u.yzx · v).yzx: lane y of the difference is
     // u.y·v.z − u.z·v.y, the x of `cross` (the same products in the same
     // order), and so on round, with three permutations instead of four.
@@ -160,7 +174,7 @@ pub(in crate::render) fn add_avx2(sum: &mut Sum, n: std::arch::x86_64::__m256d) 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "avx2")]
 #[inline]
-fn load_point(p: &[f64; 3]) -> std::arch::x86_64::__m256d {
+pub(in crate::render) fn load_point(p: &[f64; 3]) -> std::arch::x86_64::__m256d {
     use std::arch::x86_64::*;
     // SAFETY: `p` holds three f64s: 16 bytes at its start, 8 at its third.
     unsafe {

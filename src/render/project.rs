@@ -6,7 +6,7 @@
 //! scalar scaling, clamping and snapping of [`scalar_node`], lane by lane
 //! (nothing fused), so the same bits.
 
-use super::camera::{Camera, above, below};
+use super::camera::{Camera, DepthHint, above, below};
 use super::raster::{Projected, Snapped};
 use rayon::prelude::*;
 
@@ -20,8 +20,16 @@ const LIMIT: f64 = 1e6;
 
 /// Node positions in sample space (`ss` samples per pixel along each axis),
 /// depths normalised to [0, 1].
-pub fn project(points: &[[f64; 3]], camera: &Camera, ss: usize) -> Projected {
-    let (lo, hi) = depth_range(points, camera);
+/// `hint`, what the camera's fit learnt of these points' depths, spares the
+/// depth range most of its pass.
+pub fn project(
+    points: &[[f64; 3]],
+    camera: &Camera,
+    ss: usize,
+    hint: Option<&DepthHint>,
+) -> Projected {
+    let hinted = hint.and_then(|hint| hinted_depth_range(points, camera, hint));
+    let (lo, hi) = hinted.unwrap_or_else(|| depth_range(points, camera));
     let range = if hi > lo { hi - lo } else { 1.0 };
     let map = NodeMap::new(camera, ss as f64, lo, range);
     let n = points.len();
@@ -47,31 +55,91 @@ pub fn project(points: &[[f64; 3]], camera: &Camera, ss: usize) -> Projected {
 fn depth_range(points: &[[f64; 3]], camera: &Camera) -> (f64, f64) {
     let blocks: Vec<(f64, f64)> = points
         .par_chunks(BLOCK)
-        .map(|block| {
-            #[cfg(target_arch = "x86_64")]
-            {
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    // SAFETY: the CPU has AVX2 (checked just above).
-                    if let Some(bounds) = unsafe { avx2::depth_bounds(block, camera) } {
-                        return bounds;
-                    }
-                }
-            }
-            // A copy: its fields stay in registers over the loop.
-            let camera = *camera;
-            block
-                .iter()
-                .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
-                    let z = camera.depth(*q);
-                    (below(z, l), above(z, h))
-                })
-        })
+        .map(|block| block_depth_range(block, camera))
         .collect();
     blocks
         .into_iter()
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), (bl, bh)| {
             (below(bl, l), above(bh, h))
         })
+}
+
+/// [`depth_range`] of one block, serially.
+fn block_depth_range(block: &[[f64; 3]], camera: &Camera) -> (f64, f64) {
+    #[cfg(target_arch = "x86_64")]
+    {
+        if std::arch::is_x86_feature_detected!("avx2") {
+            // SAFETY: the CPU has AVX2 (checked just above).
+            if let Some(bounds) = unsafe { avx2::depth_bounds(block, camera) } {
+                return bounds;
+            }
+        }
+    }
+    // A copy: its fields stay in registers over the loop.
+    let camera = *camera;
+    block
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(l, h), q| {
+            let z = camera.depth(*q);
+            (below(z, l), above(z, h))
+        })
+}
+
+/// Relative bound on the rounding that parts a node's computed depth from
+/// `centre·toward_eye` minus its computed `p·toward_eye`: about 2^−50 of the
+/// sum of `(|p_k| + |centre_k|)·|toward_eye_k|` (two dot products of three
+/// terms and a difference); 2^−40 leaves room for the rounding of the
+/// bound itself.
+const ROUNDING: f64 = 1.0 / (1u64 << 40) as f64;
+/// Coordinates below this keep every product and sum of a depth finite.
+const MOST_MAGNITUDE: f64 = 1e100;
+
+/// [`depth_range`] from what the camera's fit learnt ([`DepthHint`]): a
+/// node's depth is `centre·toward_eye − p·toward_eye` up to a rounding the
+/// magnitudes bound (`slack`), so the farthest node lies in a block whose
+/// least `p·toward_eye` is within twice that of the least of all, and the
+/// nearest likewise; only those blocks are folded, in block order, so the
+/// bounds are the serial fold's values. `None` (fold them all) when the hint
+/// is not for these points and this view, a magnitude is too large (or
+/// infinite, or no node is a number), or a bound is a zero: the serial fold
+/// keeps the sign of the first zero it meets, which a skipped block may hold.
+fn hinted_depth_range(
+    points: &[[f64; 3]],
+    camera: &Camera,
+    hint: &DepthHint,
+) -> Option<(f64, f64)> {
+    let blocks: Vec<_> = hint.blocks(points, camera.toward_eye)?.collect();
+    let empty = (f64::INFINITY, f64::NEG_INFINITY, [0.0f64; 3]);
+    let (least, most, magnitude) = (blocks.iter()).fold(empty, |(l, h, m), (_, d)| {
+        let m = std::array::from_fn(|k| above(d.magnitude[k], m[k]));
+        (below(d.toward.0, l), above(d.toward.1, h), m)
+    });
+    let c = camera.center;
+    let small = (0..3).all(|k| magnitude[k] < MOST_MAGNITUDE && c[k].abs() < MOST_MAGNITUDE);
+    if !(small && least.is_finite() && most.is_finite()) {
+        return None;
+    }
+    let t = camera.toward_eye;
+    let spread: f64 = (0..3)
+        .map(|k| (magnitude[k] + c[k].abs()) * t[k].abs())
+        .sum();
+    // Twice a node's rounding, and underflow's absolute part.
+    let slack = 2.0 * (spread * ROUNDING + f64::MIN_POSITIVE);
+    let (near, far) = (most - slack, least + slack);
+    let (mut lo, mut hi) = (f64::INFINITY, f64::NEG_INFINITY);
+    for (block, d) in blocks {
+        let (holds_nearest, holds_farthest) = (d.toward.1 >= near, d.toward.0 <= far);
+        if holds_nearest || holds_farthest {
+            let (bl, bh) = block_depth_range(block, camera);
+            if holds_nearest {
+                lo = below(bl, lo);
+            }
+            if holds_farthest {
+                hi = above(bh, hi);
+            }
+        }
+    }
+    (lo != 0.0 && hi != 0.0).then_some((lo, hi))
 }
 
 /// What one node's projection needs, as plain values (copied into each
@@ -271,7 +339,7 @@ mod tests {
             ),
         ] {
             let camera = Camera::fit(view, fitted, w, h);
-            let proj = project(&points, &camera, ss);
+            let proj = project(&points, &camera, ss, None);
             assert_eq!(proj.snapped.len(), points.len());
             let (lo, hi) = depth_range(&points, &camera);
             assert!(lo < hi);
@@ -407,5 +475,75 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn hinted_depth_range_is_the_serial_fold() {
+        let points = awkward_points();
+        // Three blocks and a part of one (the far points in each), and
+        // nodes of equal depth in several blocks (a copy shifted across).
+        let many: Vec<[f64; 3]> = (0..5)
+            .flat_map(|_| points[..4002].iter().copied())
+            .collect();
+        #[cfg(target_arch = "x86_64")]
+        let avx2 = std::arch::is_x86_feature_detected!("avx2");
+        #[cfg(not(target_arch = "x86_64"))]
+        let avx2 = false;
+        let key = |p: &Projected| {
+            let snapped = p.snapped.iter().map(|s| (s.x, s.y, s.z.to_bits()));
+            let xy = p.xy_f.iter().map(|v| v.map(f32::to_bits));
+            (snapped.collect::<Vec<_>>(), xy.collect::<Vec<_>>())
+        };
+        for view in [
+            View::ISO,
+            View::TOP,
+            View::FRONT,
+            View {
+                azimuth: 200.0,
+                elevation: -30.0,
+            },
+        ] {
+            let (camera, hint) = Camera::fit_with_depths(view, &many, 640, 480);
+            assert_eq!(camera, Camera::fit(view, &many, 640, 480));
+            let want = depth_range(&many, &camera);
+            let got = hinted_depth_range(&many, &camera, &hint);
+            let bits = |(l, h): (f64, f64)| (l.to_bits(), h.to_bits());
+            assert_eq!(got.map(bits), avx2.then_some(bits(want)), "{view:?}");
+            // Other points, or another view: no hint.
+            assert_eq!(hinted_depth_range(&many[1..], &camera, &hint), None);
+            assert_eq!(hinted_depth_range(&many.clone(), &camera, &hint), None);
+            let turned = Camera {
+                toward_eye: camera.up,
+                ..camera
+            };
+            assert_eq!(hinted_depth_range(&many, &turned, &hint), None);
+            let with = project(&many, &camera, 2, Some(&hint));
+            assert_eq!(key(&with), key(&project(&many, &camera, 2, None)));
+        }
+        // NaN and infinite coordinates: no hint, the fold of every block.
+        let (camera, hint) = Camera::fit_with_depths(View::ISO, &points, 640, 480);
+        assert_eq!(hinted_depth_range(&points, &camera, &hint), None);
+        let with = project(&points, &camera, 2, Some(&hint));
+        assert_eq!(key(&with), key(&project(&points, &camera, 2, None)));
+        // Seen from the front, depth is y: nodes at y = ±0 and behind make
+        // the farthest depth a zero, whose sign the serial fold's first zero
+        // gives: no hint.
+        let edge_on: Vec<[f64; 3]> = (0..20_000)
+            .map(|i| {
+                let t = i as f64 * 0.37;
+                let y = match i % 3 {
+                    0 => 0.0,
+                    1 => -0.0,
+                    _ => -t.sin().abs() - 1.0,
+                };
+                [t.sin(), y, t.cos()]
+            })
+            .collect();
+        let (camera, hint) = Camera::fit_with_depths(View::FRONT, &edge_on, 640, 480);
+        let want = depth_range(&edge_on, &camera);
+        assert_eq!(want.1, 0.0);
+        assert_eq!(hinted_depth_range(&edge_on, &camera, &hint), None);
+        let with = project(&edge_on, &camera, 2, Some(&hint));
+        assert_eq!(key(&with), key(&project(&edge_on, &camera, 2, None)));
     }
 }

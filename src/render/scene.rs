@@ -313,13 +313,16 @@ fn shade(scene: &mut Scene, shading: Shading, camera: &Camera, spans: Option<&sm
             );
         }
         Shading::Smooth => {
-            let (slots, light) = smooth::per_slot(
-                &scene.points,
-                &scene.tris,
-                &scene.tri_face,
-                spans,
-                |s, o| intensities(s, light, o),
-            );
+            // SAFETY: `intensities` writes every slot it is given.
+            let (slots, light) = unsafe {
+                smooth::per_slot(
+                    &scene.points,
+                    &scene.tris,
+                    &scene.tri_face,
+                    spans,
+                    |s, o| intensities(s, light, o),
+                )
+            };
             scene.corner_slots = match slots {
                 Some(slots) => Cow::Owned(slots),
                 None => scene.tris.clone(),

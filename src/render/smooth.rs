@@ -8,6 +8,7 @@
 use super::camera::cross;
 use super::normal_sum::{Sum, serial_sums};
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
 use std::sync::atomic::{AtomicU32, Ordering};
 
 #[cfg(target_arch = "x86_64")]
@@ -51,12 +52,16 @@ fn add_to(sum: &mut Sum, n: [f64; 3]) {
 /// `tri_face` must be non-decreasing (triangles grouped by face in face order).
 /// `spans`, when given for a one-face mesh, are [`node_spans`] of `tris`
 /// (the caller's validity check made them; they are not made twice).
-pub fn per_slot<T: Copy + Default + Send + Sync>(
+/// The values are written once, into memory not zeroed first.
+///
+/// # Safety
+/// `finish` writes every element of the slice it is given.
+pub unsafe fn per_slot<T: Copy + Send + Sync>(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     tri_face: &[u32],
     given: Option<&NodeSpans>,
-    finish: impl Fn(&[Sum], &mut [T]) + Sync,
+    finish: impl Fn(&[Sum], &mut [MaybeUninit<T>]) + Sync,
 ) -> (Option<Vec<[u32; 3]>>, Vec<T>) {
     let n = points.len();
     let (own_slots, extra) = if tri_face.first() == tri_face.last() {
@@ -87,19 +92,26 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
         if let Some(given) = given
             && std::arch::is_x86_feature_detected!("avx2")
         {
-            let mut out = vec![T::default(); n];
+            let mut out = Vec::with_capacity(n);
+            let to = &mut out.spare_capacity_mut()[..n];
             // SAFETY: the CPU has AVX2 (checked just above), and every
             // node of `tris` is a point (`given` are their spans, all below).
-            if unsafe { windowed::light_in_window(points, tris, given.spans(), &mut out, &finish) }
-            {
+            if unsafe { windowed::light_in_window(points, tris, given.spans(), to, &finish) } {
+                // SAFETY: the window gave `finish` every one of the `n`
+                // slots, and `finish` writes every slot it is given (the
+                // caller's promise).
+                unsafe { out.set_len(n) };
                 return (own_slots, out);
             }
         }
         let sums = serial_sums(points, tris, corner_slots, n + extra.len(), given);
-        let mut out = vec![T::default(); sums.len()];
-        (out.par_chunks_mut(BLOCK))
+        let mut out = Vec::with_capacity(sums.len());
+        (out.spare_capacity_mut()[..sums.len()].par_chunks_mut(BLOCK))
             .zip(sums.par_chunks(BLOCK))
             .for_each(|(o, s)| finish(s, o));
+        // SAFETY: the chunks cover all `sums.len()` slots, and `finish`
+        // writes every slot it is given (the caller's promise).
+        unsafe { out.set_len(sums.len()) };
         return (own_slots, out);
     }
     // Partial sums per chunk: an array over its node span, and the corners
@@ -125,8 +137,9 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
             (lo, part, later)
         })
         .collect();
-    let mut out = vec![T::default(); n + extra.len()];
-    let (owned, later) = out.split_at_mut(n);
+    let len = n + extra.len();
+    let mut out = Vec::with_capacity(len);
+    let (owned, later) = out.spare_capacity_mut()[..len].split_at_mut(n);
     owned.par_chunks_mut(BLOCK).enumerate().for_each_init(
         Vec::new,
         |sums: &mut Vec<Sum>, (b, block)| {
@@ -149,6 +162,9 @@ pub fn per_slot<T: Copy + Default + Send + Sync>(
         }
     }
     finish(&later_sums, later);
+    // SAFETY: the blocks cover the first `n` slots and `later` the rest,
+    // and `finish` writes every slot it is given (the caller's promise).
+    unsafe { out.set_len(len) };
     (own_slots, out)
 }
 
@@ -308,11 +324,14 @@ mod tests {
     }
 
     fn check(points: &[[f64; 3]], tris: &[[u32; 3]], tri_face: &[u32], (nx, ny): (usize, usize)) {
-        let (slots, sums) = per_slot(points, tris, tri_face, None, |s, o: &mut [[f64; 3]]| {
+        let xyz = |s: &[Sum], o: &mut [MaybeUninit<[f64; 3]>]| {
+            assert_eq!(o.len(), s.len());
             for (o, s) in o.iter_mut().zip(s) {
-                *o = s.xyz();
+                o.write(s.xyz());
             }
-        });
+        };
+        // SAFETY: `xyz` writes every slot it is given.
+        let (slots, sums) = unsafe { per_slot(points, tris, tri_face, None, xyz) };
         let one_face = tri_face.iter().all(|&f| f == 0);
         assert_eq!(slots.is_none(), one_face);
         let slots = slots.unwrap_or_else(|| tris.to_vec());

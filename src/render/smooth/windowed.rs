@@ -14,7 +14,8 @@
 //! into light at the end.
 
 use super::{CHUNK, LOCAL_SPAN};
-use crate::render::normal_sum::{Sum, add_avx2, corner_normal};
+use crate::render::normal_sum::{Sum, add_avx2, corner_normal, cross_lanes, load_point};
+use std::mem::MaybeUninit;
 
 /// Most nodes in the ring (2 MB of sums); a mesh needing more is summed
 /// over an array of all nodes.
@@ -81,8 +82,9 @@ impl SetApart {
     }
 }
 
-/// `out[k] = finish(sum of node k)` for every node, the sums in triangle
-/// order, or `false` (nothing written) when the chunks' spans leave no
+/// `out[k] = finish(sum of node k)` for every node (`finish` is given every
+/// slot of `out` once, and the set-apart nodes' slots again from a copy),
+/// the sums in triangle order, or `false` (nothing written) when the chunks' spans leave no
 /// window small enough. `spans` are the [`CHUNK`] spans of `tris`
 /// ([`super::NodeSpans`]), every node of `tris` below `points.len()`, which
 /// is `out.len()`; the CPU has AVX2.
@@ -90,12 +92,12 @@ impl SetApart {
 /// # Safety
 /// The CPU has AVX2, and every node of `tris` is below `points.len()`.
 #[target_feature(enable = "avx2")]
-pub(super) unsafe fn light_in_window<T: Copy + Default>(
+pub(super) unsafe fn light_in_window<T: Copy>(
     points: &[[f64; 3]],
     tris: &[[u32; 3]],
     spans: &[(usize, usize)],
-    out: &mut [T],
-    finish: &impl Fn(&[Sum], &mut [T]),
+    out: &mut [MaybeUninit<T>],
+    finish: &impl Fn(&[Sum], &mut [MaybeUninit<T>]),
 ) -> bool {
     let n = points.len();
     assert!(out.len() == n && spans.len() == tris.len().div_ceil(CHUNK));
@@ -179,7 +181,7 @@ pub(super) unsafe fn light_in_window<T: Copy + Default>(
         }
     }
     advance(&mut ring, &mut store, done, n);
-    let mut light = vec![T::default(); store.len()];
+    let mut light = vec![MaybeUninit::uninit(); store.len()];
     finish(&store, &mut light);
     apart.each(0, n, |node, r| out[node] = light[r]);
     true
@@ -215,55 +217,54 @@ fn add_two(sum: &mut Sum, a: std::arch::x86_64::__m256d, b: std::arch::x86_64::_
     }
 }
 
-fn distinct(t: [u32; 3]) -> bool {
-    t[0] != t[1] && t[1] != t[2] && t[0] != t[2]
-}
-
-/// Adds a chunk's normals into the ring, two triangles at a time: a node
-/// of both (the diagonal of a quad cut in two) gets the first normal and
-/// then the second in registers, one load and store instead of two, so the
-/// next triangle's add to it waits less. Per node the adds keep triangle
-/// order, so the bits are those of one triangle at a time.
+/// Adds a chunk's normals into the ring. Two triangles that are a quad cut
+/// along its diagonal, (a, b, c) then (a, c, d) (a grid's and a torus's
+/// order), share the points a and c and the edge c − a: four points are
+/// read instead of six, and a and c get both normals in a register (one
+/// load and store instead of two). Each normal is the same operations on
+/// the same values as one triangle at a time, and per node the adds keep
+/// triangle order, so the bits are those of one triangle at a time; other
+/// triangles are added so.
 ///
 /// # Safety
 /// The CPU has AVX2; every node of `tris` is below `points.len()`, and its
 /// place `node & (ring.len() − 1)` is in the ring (a power of two long).
 #[target_feature(enable = "avx2")]
 unsafe fn local_chunk(points: &[[f64; 3]], tris: &[[u32; 3]], ring: &mut [Sum]) {
+    use std::arch::x86_64::_mm256_sub_pd;
     let mask = ring.len() - 1;
-    let mut pairs = tris.as_chunks::<2>();
+    let (pairs, rest) = tris.as_chunks::<2>();
     // SAFETY (all blocks below): every node is a point, and its place in
-    // the ring is below `ring.len()` (`& mask`), the caller's promise.
-    for &[t, u] in pairs.0 {
-        let (nt, nu) = unsafe { (normal(points, t), normal(points, u)) };
-        if distinct(t) && distinct(u) {
-            for k in t {
-                let sum = unsafe { ring.get_unchecked_mut(k as usize & mask) };
-                if u.contains(&k) {
-                    add_two(sum, nt, nu);
-                } else {
-                    add_avx2(sum, nt);
-                }
-            }
-            for k in u {
-                if !t.contains(&k) {
-                    add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nu);
-                }
-            }
-        } else {
-            for k in t {
-                add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nt);
-            }
-            for k in u {
-                add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nu);
-            }
-        }
-    }
-    for &t in std::mem::take(&mut pairs.1) {
+    // the ring is below `ring.len()` (`& mask`), the caller's promise; each
+    // place is borrowed for one add only, so never twice at once.
+    let places = ring.as_mut_ptr();
+    let at = |k: u32| unsafe { &mut *places.add(k as usize & mask) };
+    let point = |k: u32| load_point(unsafe { points.get_unchecked(k as usize) });
+    let one = |t: [u32; 3]| {
         let nt = unsafe { normal(points, t) };
         for k in t {
-            add_avx2(unsafe { ring.get_unchecked_mut(k as usize & mask) }, nt);
+            add_avx2(at(k), nt);
         }
+    };
+    for &[t, u] in pairs {
+        // With a ≠ b and a ≠ c every node gets the first normal before the
+        // second (b = c or d = any corner included).
+        if t[0] == u[0] && t[2] == u[1] && t[0] != t[1] && t[0] != t[2] {
+            let [a, b, c] = t.map(point);
+            let ca = _mm256_sub_pd(c, a);
+            let nt = cross_lanes(_mm256_sub_pd(b, a), ca);
+            let nu = cross_lanes(ca, _mm256_sub_pd(point(u[2]), a));
+            add_two(at(t[0]), nt, nu);
+            add_avx2(at(t[1]), nt);
+            add_two(at(t[2]), nt, nu);
+            add_avx2(at(u[2]), nu);
+        } else {
+            one(t);
+            one(u);
+        }
+    }
+    for &t in rest {
+        one(t);
     }
 }
 
@@ -300,10 +301,19 @@ mod tests {
     fn windowed(points: &[[f64; 3]], tris: &[[u32; 3]]) -> Option<Vec<Sum>> {
         let spans = node_spans(tris);
         assert!(spans.all_below(tris, points.len()));
-        let mut out = vec![Sum([7.0; 4]); points.len()];
-        let copy = |s: &[Sum], o: &mut [Sum]| o.copy_from_slice(s);
+        let mut out = vec![MaybeUninit::new(Sum([7.0; 4])); points.len()];
+        let copy = |s: &[Sum], o: &mut [MaybeUninit<Sum>]| {
+            for (o, s) in o.iter_mut().zip(s) {
+                o.write(*s);
+            }
+        };
         // SAFETY: the CPU has AVX2 (the callers check), every node is a point.
         let done = unsafe { light_in_window(points, tris, spans.spans(), &mut out, &copy) };
+        // SAFETY: every slot was initialised above (and perhaps written again).
+        let out: Vec<Sum> = out
+            .into_iter()
+            .map(|s| unsafe { s.assume_init() })
+            .collect();
         if !done {
             assert!(out.iter().all(|s| *s == Sum([7.0; 4])), "nothing written");
         }
@@ -349,6 +359,38 @@ mod tests {
         odd.push([39_999, 0, 39_999]);
         odd.push([5, 5, 5]);
         assert_serial_bits(&points, &odd);
+    }
+
+    #[test]
+    fn quads_with_repeated_corners_keep_the_serial_bits() {
+        if !std::arch::is_x86_feature_detected!("avx2") {
+            return;
+        }
+        let (points, tris) = torus(400, 100);
+        assert!(
+            tris.chunks(2)
+                .all(|q| q[0][0] == q[1][0] && q[0][2] == q[1][1])
+        );
+        // Quads (a, b, c), (a, c, d) with corners named twice: d = a, b or
+        // c and b = c share the points; a = b and a = c are added one
+        // triangle at a time.
+        let mut odd = tris.clone();
+        for (q, pair) in odd.chunks_exact_mut(2).enumerate() {
+            let [a, b, c] = pair[0];
+            match q % 7 {
+                0 => pair[1][2] = a,
+                1 => pair[1][2] = b,
+                2 => pair[1][2] = c,
+                3 => (pair[0][2], pair[1][1]) = (b, b),
+                4 => pair[0][1] = a,
+                5 => (pair[0][2], pair[1][1]) = (a, a),
+                _ => {}
+            }
+        }
+        assert_serial_bits(&points, &odd);
+        // Pairs across quads (an odd start) and single triangles.
+        assert_serial_bits(&points, &odd[1..]);
+        assert_serial_bits(&points, &tris[3..CHUNK + 8]);
     }
 
     #[test]
