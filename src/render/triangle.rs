@@ -7,14 +7,11 @@
 //! triangle under `SMALL` snapped units across steps its three edges as
 //! fields of one integer: one add per sample and one test of three sign
 //! bits, instead of three adds and three tests. Where the processor has
-//! AVX-512, `lanes` does the same eight triangles at a time; where it has
-//! AVX2 only, `avx2` sets up eight at a time for the scalar sample loop.
+//! AVX-512, `lanes` does the same eight triangles at a time.
 
 use super::raster::Snapped;
 use crate::cache_hint::prefetch_at;
 
-#[cfg(target_arch = "x86_64")]
-mod avx2;
 #[cfg(target_arch = "x86_64")]
 mod lanes;
 
@@ -44,41 +41,21 @@ pub unsafe fn draw_chunks<'a>(
     chunks: impl Iterator<Item = &'a [u32]>,
 ) {
     #[cfg(target_arch = "x86_64")]
-    let path = if lanes::available() {
-        Path::Avx512
-    } else if avx2::available(tris.len(), nodes.len(), width) {
-        Path::Avx2
-    } else {
-        Path::Scalar
-    };
+    let lanes = lanes::available();
     #[cfg(not(target_arch = "x86_64"))]
-    let path = Path::Scalar;
-    // SAFETY: the caller's promise; the path is one the processor has.
-    unsafe { draw_chunks_by(path, rows, width, ys, tris, nodes, chunks) }
+    let lanes = false;
+    // SAFETY: the caller's promise.
+    unsafe { draw_chunks_by(lanes, rows, width, ys, tris, nodes, chunks) }
 }
 
-/// The code that draws: one triangle after another, or eight set up at a
-/// time in vector lanes (AVX-512: also filled in lanes; AVX2: filled by the
-/// scalar sample loop).
-#[derive(Clone, Copy, Debug, PartialEq)]
-enum Path {
-    Scalar,
-    #[cfg(target_arch = "x86_64")]
-    Avx512,
-    #[cfg(target_arch = "x86_64")]
-    Avx2,
-}
-
-/// [`draw_chunks`] by `path`; the scalar path draws one triangle after
-/// another (set up, then filled: a batch of set-ups before their sample
-/// loops was slower).
+/// [`draw_chunks`], eight triangles at a time in vector lanes when `lanes`
+/// (the processor has AVX-512), else one after another (set up, then
+/// filled: a batch of set-ups before their sample loops was slower).
 ///
 /// # Safety
-/// As [`draw_chunks`]; `Path::Avx512` only when [`lanes::available`],
-/// `Path::Avx2` only when [`avx2::available`] for `tris`, `nodes` and
-/// `width`.
+/// As [`draw_chunks`]; `lanes` only when [`lanes::available`].
 unsafe fn draw_chunks_by<'a>(
-    path: Path,
+    lanes: bool,
     rows: &mut [u64],
     width: usize,
     ys: std::ops::Range<usize>,
@@ -87,17 +64,11 @@ unsafe fn draw_chunks_by<'a>(
     chunks: impl Iterator<Item = &'a [u32]>,
 ) {
     #[cfg(target_arch = "x86_64")]
-    if path != Path::Scalar {
+    if lanes {
         for ids in chunks {
             // SAFETY: the caller's promise; the processor has the
             // instructions.
-            unsafe {
-                if path == Path::Avx512 {
-                    lanes::draw_ids(rows, width, &ys, tris, nodes, ids)
-                } else {
-                    avx2::draw_ids(rows, width, &ys, tris, nodes, ids)
-                }
-            };
+            unsafe { lanes::draw_ids(rows, width, &ys, tris, nodes, ids) };
         }
         return;
     }
@@ -625,15 +596,14 @@ mod tests {
         }
         let ids: Vec<u32> = (0..41).map(|_| (rng.within(149) + 149) as u32).collect();
         let mut drawn_samples = 0;
-        let paths = vector_paths(tris.len(), nodes.len(), w);
         for len in 0..=ids.len() {
-            let draw = |path: Path| {
+            let draw = |lanes: bool| {
                 let mut picture = vec![EMPTY; w * h];
                 // SAFETY: `picture` holds the band's samples; `lanes` only
                 // where the processor has them.
                 unsafe {
                     draw_chunks_by(
-                        path,
+                        lanes,
                         &mut picture,
                         w,
                         0..h,
@@ -644,13 +614,11 @@ mod tests {
                 };
                 picture
             };
-            let scalar = draw(Path::Scalar);
+            let scalar = draw(false);
             drawn_samples += scalar.iter().filter(|&&v| v != EMPTY).count();
-            for &path in &paths {
-                assert!(
-                    draw(path) == scalar,
-                    "{path:?}, {len} ids: the pictures differ"
-                );
+            #[cfg(target_arch = "x86_64")]
+            if lanes::available() {
+                assert!(draw(true) == scalar, "{len} ids: the pictures differ");
             }
         }
         assert!(drawn_samples > 4000, "{drawn_samples} samples drawn");
@@ -685,17 +653,17 @@ mod tests {
             });
         }
         let ids: Vec<u32> = (0..tris.len() as u32).collect();
-        let draw = |path: Path| {
+        let draw = |lanes: bool| {
             let mut picture = vec![EMPTY; w * h];
             for (b, rows) in picture.chunks_mut(w * band).enumerate() {
                 let ys = b * band..(b * band + band).min(h);
                 // SAFETY: `rows` holds the band's samples; `lanes` only
                 // where the processor has them.
-                unsafe { draw_chunks_by(path, rows, w, ys, &tris, &nodes, ids.chunks(1000)) };
+                unsafe { draw_chunks_by(lanes, rows, w, ys, &tris, &nodes, ids.chunks(1000)) };
             }
             picture
         };
-        let scalar = draw(Path::Scalar);
+        let scalar = draw(false);
         let filled = scalar.iter().filter(|&&v| v != EMPTY).count();
         let zeros = scalar
             .iter()
@@ -705,27 +673,11 @@ mod tests {
             filled > 4000 && zeros > 100,
             "{filled} filled, {zeros} at depth 0"
         );
-        for path in vector_paths(tris.len(), nodes.len(), w) {
-            let lanes = draw(path);
-            let differ = (0..w * h).filter(|&i| lanes[i] != scalar[i]).count();
-            assert_eq!(differ, 0, "{path:?}: samples differ");
-        }
-    }
-
-    /// The vector paths this processor has for a mesh of `tris` triangles
-    /// and `nodes` nodes drawn `width` samples wide.
-    fn vector_paths(tris: usize, nodes: usize, width: usize) -> Vec<Path> {
-        let mut paths = Vec::new();
         #[cfg(target_arch = "x86_64")]
-        {
-            if lanes::available() {
-                paths.push(Path::Avx512);
-            }
-            if avx2::available(tris, nodes, width) {
-                paths.push(Path::Avx2);
-            }
+        if lanes::available() {
+            let lanes = draw(true);
+            let differ = (0..w * h).filter(|&i| lanes[i] != scalar[i]).count();
+            assert_eq!(differ, 0, "samples differ");
         }
-        let _ = (tris, nodes, width);
-        paths
     }
 }

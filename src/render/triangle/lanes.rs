@@ -24,22 +24,21 @@ pub(super) fn available() -> bool {
 }
 
 /// Up to eight small triangles set up, one entry per triangle: what the
-/// sample loop reads (packed to the front here; `avx2` leaves each in its
-/// triangle's lane).
+/// sample loop reads.
 #[derive(Default)]
-pub(super) struct Set {
-    pub(super) outside: [i64; 8],
-    pub(super) sx: [i64; 8],
-    pub(super) sy: [i64; 8],
-    pub(super) first: [i64; 8],
-    pub(super) id: [i64; 8],
-    pub(super) z_ref: [f32; 8],
-    pub(super) dzdx: [f32; 8],
-    pub(super) dzdy: [f32; 8],
-    pub(super) off_x: [i32; 8],
-    pub(super) off_y: [i32; 8],
-    pub(super) rows_n: [i32; 8],
-    pub(super) row_len: [i32; 8],
+struct Set {
+    outside: [i64; 8],
+    sx: [i64; 8],
+    sy: [i64; 8],
+    first: [i64; 8],
+    id: [i64; 8],
+    z_ref: [f32; 8],
+    dzdx: [f32; 8],
+    dzdy: [f32; 8],
+    off_x: [i32; 8],
+    off_y: [i32; 8],
+    rows_n: [i32; 8],
+    row_len: [i32; 8],
 }
 
 /// Draws triangles `ids` into rows `ys` of the z-buffer as
