@@ -263,7 +263,10 @@ pub fn render_image(mesh: &Mesh, options: &RenderOptions) -> Result<Rendered, Re
     let scene = scene::build(mesh, options, &camera);
     let mut warnings: Vec<RenderWarning> = section_warning(&scene, options).into_iter().collect();
     let ss = options.antialias as usize;
-    let proj = project::project(&scene.points, &camera, ss, Some(&depths));
+    // Without an edge overlay, shading reads a node's position and light
+    // from one record when the nodes are the light slots.
+    let light = (options.edges == Edges::None).then(|| scene.node_light());
+    let proj = project::project(&scene.points, &camera, ss, Some(&depths), light.flatten());
     let (sw, sh) = (options.width as usize * ss, options.height as usize * ss);
     let mut image = if options.edges == Edges::None {
         let (w, h) = (options.width as usize, options.height as usize);

@@ -9,6 +9,11 @@
 use super::camera::{Camera, DepthHint, above, below};
 use super::raster::{Projected, Snapped};
 use rayon::prelude::*;
+use std::mem::MaybeUninit;
+
+mod xy_out;
+pub use xy_out::XyLight;
+use xy_out::{WithLight, XyOut};
 
 #[cfg(target_arch = "x86_64")]
 pub(super) mod avx2;
@@ -21,12 +26,16 @@ const LIMIT: f64 = 1e6;
 /// Node positions in sample space (`ss` samples per pixel along each axis),
 /// depths normalised to [0, 1].
 /// `hint`, what the camera's fit learnt of these points' depths, spares the
-/// depth range most of its pass.
+/// depth range most of its pass. `light`, one per node (the nodes' own
+/// light slots), goes with the unsnapped positions into
+/// [`Projected::xy_light`] (then `xy_f` is left empty): shading reads a
+/// corner's position and light from one record.
 pub fn project(
     points: &[[f64; 3]],
     camera: &Camera,
     ss: usize,
     hint: Option<&DepthHint>,
+    light: Option<&[[f32; 2]]>,
 ) -> Projected {
     let hinted = hint.and_then(|hint| hinted_depth_range(points, camera, hint));
     let (lo, hi) = hinted.unwrap_or_else(|| depth_range(points, camera));
@@ -34,6 +43,26 @@ pub fn project(
     let map = NodeMap::new(camera, ss as f64, lo, range);
     let n = points.len();
     let mut snapped: Vec<Snapped> = Vec::with_capacity(n);
+    if let Some(light) = light.filter(|light| light.len() == n) {
+        let mut xy_light: Vec<XyLight> = Vec::with_capacity(n);
+        (points.par_chunks(BLOCK))
+            .zip(snapped.spare_capacity_mut()[..n].par_chunks_mut(BLOCK))
+            .zip(light.par_chunks(BLOCK))
+            .zip(xy_light.spare_capacity_mut()[..n].par_chunks_mut(BLOCK))
+            .for_each(|(((from, to_snapped), light), to)| {
+                map.block(from, to_snapped, WithLight { light, to })
+            });
+        // SAFETY: as below, with `light` (`n` long) cut alike.
+        unsafe {
+            snapped.set_len(n);
+            xy_light.set_len(n);
+        }
+        return Projected {
+            snapped,
+            xy_f: Vec::new(),
+            xy_light,
+        };
+    }
     let mut xy_f: Vec<[f32; 2]> = Vec::with_capacity(n);
     (points.par_chunks(BLOCK))
         .zip(snapped.spare_capacity_mut()[..n].par_chunks_mut(BLOCK))
@@ -46,7 +75,11 @@ pub fn project(
         snapped.set_len(n);
         xy_f.set_len(n);
     }
-    Projected { snapped, xy_f }
+    Projected {
+        snapped,
+        xy_f,
+        xy_light: Vec::new(),
+    }
 }
 
 /// The least and greatest depth of the nodes ([`Camera::depth`]). Blocks
@@ -179,12 +212,7 @@ impl NodeMap {
 
     /// Projects a block of nodes into the slots of `snapped` and `xy_f`
     /// (one per node: every slot is written).
-    fn block(
-        self,
-        points: &[[f64; 3]],
-        snapped: &mut [std::mem::MaybeUninit<Snapped>],
-        xy_f: &mut [std::mem::MaybeUninit<[f32; 2]>],
-    ) {
+    fn block(self, points: &[[f64; 3]], snapped: &mut [MaybeUninit<Snapped>], xy_f: impl XyOut) {
         assert!(snapped.len() == points.len() && xy_f.len() == points.len());
         #[cfg(target_arch = "x86_64")]
         {
@@ -197,10 +225,12 @@ impl NodeMap {
             unsafe { self.block_sse2(points, snapped, xy_f) }
         }
         #[cfg(not(target_arch = "x86_64"))]
-        for ((q, s), f) in points.iter().zip(snapped).zip(xy_f) {
+        let mut xy_f = xy_f;
+        #[cfg(not(target_arch = "x86_64"))]
+        for (i, (q, s)) in points.iter().zip(snapped).enumerate() {
             let (node, xy) = scalar_node(&self.camera, self.ss, self.lo, self.range, *q);
             s.write(node);
-            f.write(xy);
+            xy_f.one(i, xy);
         }
     }
 
@@ -211,8 +241,8 @@ impl NodeMap {
     fn block_sse2(
         self,
         points: &[[f64; 3]],
-        snapped: &mut [std::mem::MaybeUninit<Snapped>],
-        xy_f: &mut [std::mem::MaybeUninit<[f32; 2]>],
+        snapped: &mut [MaybeUninit<Snapped>],
+        mut xy_f: impl XyOut,
     ) {
         use std::arch::x86_64::*;
         let pair = |v: [f64; 2]| _mm_set_pd(v[1], v[0]);
@@ -222,7 +252,7 @@ impl NodeMap {
         let (limit_lo, limit_hi) = (_mm_set1_pd(-LIMIT), _mm_set1_pd(LIMIT));
         let (sixteen, sign, one_half) = (_mm_set1_pd(16.0), _mm_set1_pd(-0.0), _mm_set1_pd(0.5));
         let (c, t) = (self.center, self.toward_eye);
-        for ((q, s), f) in points.iter().zip(snapped).zip(xy_f) {
+        for (i, (q, s)) in points.iter().zip(snapped).enumerate() {
             let d = [q[0] - c[0], q[1] - c[1], q[2] - c[2]];
             // `Camera::depth`: −(d·toward_eye), summed as `dot` sums.
             let z = -(d[0] * t[0] + d[1] * t[1] + d[2] * t[2]);
@@ -253,10 +283,13 @@ impl NodeMap {
                 y: (s_bits >> 32) as u32 as i32,
                 z,
             });
-            f.write([
-                f32::from_bits(xy_bits as u32),
-                f32::from_bits((xy_bits >> 32) as u32),
-            ]);
+            xy_f.one(
+                i,
+                [
+                    f32::from_bits(xy_bits as u32),
+                    f32::from_bits((xy_bits >> 32) as u32),
+                ],
+            );
         }
     }
 }
@@ -339,8 +372,25 @@ mod tests {
             ),
         ] {
             let camera = Camera::fit(view, fitted, w, h);
-            let proj = project(&points, &camera, ss, None);
+            let proj = project(&points, &camera, ss, None, None);
             assert_eq!(proj.snapped.len(), points.len());
+            assert!(proj.xy_light.is_empty());
+            // With the nodes' light: records of the same positions and
+            // that light, the same snapped nodes, no pairs.
+            let light = node_light(points.len());
+            let lit = project(&points, &camera, ss, None, Some(&light));
+            assert!(lit.xy_f.is_empty());
+            assert_eq!(lit.xy_light.len(), points.len());
+            for (i, r) in lit.xy_light.iter().enumerate() {
+                assert_eq!(r.xy.map(f32::to_bits), proj.xy_f[i].map(f32::to_bits));
+                assert_eq!(r.light.map(f32::to_bits), light[i].map(f32::to_bits));
+                let (a, b) = (lit.snapped[i], proj.snapped[i]);
+                assert_eq!((a.x, a.y, a.z.to_bits()), (b.x, b.y, b.z.to_bits()));
+            }
+            // Light of another length is not the nodes': pairs.
+            let other = project(&points, &camera, ss, None, Some(&light[1..]));
+            assert!(other.xy_light.is_empty());
+            assert_eq!(other.xy_f.len(), points.len());
             let (lo, hi) = depth_range(&points, &camera);
             assert!(lo < hi);
             let range = hi - lo;
@@ -359,6 +409,29 @@ mod tests {
             assert_eq!(proj.snapped[4000].x.abs(), (LIMIT * 16.0) as i32);
             assert_eq!(proj.snapped[4004].y, 0, "NaN snaps to 0");
         }
+    }
+
+    /// Distinct light per node (NaN and −0 among them: copied, not computed).
+    fn node_light(n: usize) -> Vec<[f32; 2]> {
+        (0..n)
+            .map(|i| match i % 97 {
+                5 => [f32::NAN, -0.0],
+                k => [k as f32 / 96.0, 1.0 - i as f32 / n as f32],
+            })
+            .collect()
+    }
+
+    /// Projects `points` with `light` through a block path into records.
+    fn records_by_block(
+        points: &[[f64; 3]],
+        light: &[[f32; 2]],
+        path: impl FnOnce(&[[f64; 3]], &mut [MaybeUninit<Snapped>], WithLight),
+    ) -> Vec<XyLight> {
+        let mut snapped = vec![MaybeUninit::new(Snapped::default()); points.len()];
+        let mut to = vec![MaybeUninit::new(XyLight::default()); points.len()];
+        path(points, &mut snapped, WithLight { light, to: &mut to });
+        // SAFETY: every slot was initialised above (and written again).
+        to.into_iter().map(|r| unsafe { r.assume_init() }).collect()
     }
 
     /// One of `NodeMap`'s block paths.
@@ -403,6 +476,18 @@ mod tests {
                 };
                 let (four, four_xy) = by_block(map, part, avx2);
                 let (two, two_xy) = by_block(map, part, sse2);
+                // The records' paths: the same positions, each node's light.
+                let light = node_light(part.len());
+                let four_records =
+                    records_by_block(part, &light, |p, s, f| unsafe { map.block_avx2(p, s, f) });
+                let two_records =
+                    records_by_block(part, &light, |p, s, f| unsafe { map.block_sse2(p, s, f) });
+                for (i, xy) in four_xy.iter().enumerate() {
+                    for r in [four_records[i], two_records[i]] {
+                        assert_eq!(r.xy.map(f32::to_bits), xy.map(f32::to_bits), "node {i}");
+                        assert_eq!(r.light.map(f32::to_bits), light[i].map(f32::to_bits));
+                    }
+                }
                 for (i, q) in part.iter().enumerate() {
                     let (want, want_xy) = scalar_node(&camera, ss as f64, lo, hi - lo, *q);
                     for (got, got_xy) in [(four[i], four_xy[i]), (two[i], two_xy[i])] {
@@ -517,14 +602,14 @@ mod tests {
                 ..camera
             };
             assert_eq!(hinted_depth_range(&many, &turned, &hint), None);
-            let with = project(&many, &camera, 2, Some(&hint));
-            assert_eq!(key(&with), key(&project(&many, &camera, 2, None)));
+            let with = project(&many, &camera, 2, Some(&hint), None);
+            assert_eq!(key(&with), key(&project(&many, &camera, 2, None, None)));
         }
         // NaN and infinite coordinates: no hint, the fold of every block.
         let (camera, hint) = Camera::fit_with_depths(View::ISO, &points, 640, 480);
         assert_eq!(hinted_depth_range(&points, &camera, &hint), None);
-        let with = project(&points, &camera, 2, Some(&hint));
-        assert_eq!(key(&with), key(&project(&points, &camera, 2, None)));
+        let with = project(&points, &camera, 2, Some(&hint), None);
+        assert_eq!(key(&with), key(&project(&points, &camera, 2, None, None)));
         // Seen from the front, depth is y: nodes at y = ±0 and behind make
         // the farthest depth a zero, whose sign the serial fold's first zero
         // gives: no hint.
@@ -543,7 +628,7 @@ mod tests {
         let want = depth_range(&edge_on, &camera);
         assert_eq!(want.1, 0.0);
         assert_eq!(hinted_depth_range(&edge_on, &camera, &hint), None);
-        let with = project(&edge_on, &camera, 2, Some(&hint));
-        assert_eq!(key(&with), key(&project(&edge_on, &camera, 2, None)));
+        let with = project(&edge_on, &camera, 2, Some(&hint), None);
+        assert_eq!(key(&with), key(&project(&edge_on, &camera, 2, None, None)));
     }
 }

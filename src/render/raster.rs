@@ -32,6 +32,9 @@ pub struct Projected {
     pub snapped: Vec<Snapped>,
     /// Unsnapped, for interpolation in shading.
     pub xy_f: Vec<[f32; 2]>,
+    /// Instead of `xy_f` when each node is its own light slot: unsnapped
+    /// with the node's light, one record per node (see `project`).
+    pub xy_light: Vec<super::project::XyLight>,
 }
 
 pub struct ZBuffer {
@@ -390,6 +393,7 @@ mod tests {
         let proj = Projected {
             snapped,
             xy_f: Vec::new(),
+            xy_light: Vec::new(),
         };
         let bins = bin(&scene, &proj, width, height, band_rows);
         assert_eq!(bins.len(), 3);

@@ -158,6 +158,7 @@ mod tests {
                 [0.5, 7.0 * s],
                 [8.5 * s, 6.5 * s],
             ],
+            xy_light: Vec::new(),
         };
         (scene, proj)
     }

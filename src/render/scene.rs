@@ -71,6 +71,16 @@ impl Scene<'_> {
         }
     }
 
+    /// The light per node when every node is its own light slot (smooth
+    /// shading of one face, no section): the corner slots are the
+    /// triangles themselves.
+    pub fn node_light(&self) -> Option<&[[f32; 2]]> {
+        (std::ptr::eq(self.corner_slots.as_ptr(), self.tris.as_ptr())
+            && self.corner_slots.len() == self.tris.len()
+            && self.light.len() == self.points.len())
+        .then_some(&self.light[..])
+    }
+
     /// The face triangle `tri` lies on.
     #[inline]
     pub fn face_of(&self, tri: usize) -> u32 {

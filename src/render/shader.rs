@@ -8,11 +8,14 @@
 //! each side's colour is kept as the float lanes [`tint`] multiplies. The
 //! same arithmetic in the same order as the plain lookups, so the same bytes.
 
+use super::project::XyLight;
 use super::raster::Projected;
 use super::scene::{HIDDEN, Scene};
 use crate::cache_hint::prefetch_at;
 
 mod lanes;
+#[cfg(target_arch = "x86_64")]
+mod record_lanes;
 pub(super) use lanes::Queue;
 
 /// Pixels ahead whose triangle's corners are fetched while one is shaded.
@@ -53,6 +56,10 @@ pub(super) struct Shader<'s, 'a> {
     /// length when the slots are the nodes.
     xy: &'s [[f32; 2]],
     light: &'s [[f32; 2]],
+    /// Each node's position and light in one record, when the slots are
+    /// the nodes and the projection made them (`xy` is then empty); empty
+    /// otherwise.
+    records: &'s [XyLight],
     /// Front and back when every face shows the same groups (`None` for a
     /// side that is looked up per triangle).
     sides: [Option<Look>; 2],
@@ -66,6 +73,7 @@ impl<'s, 'a> Shader<'s, 'a> {
     pub(super) fn new(scene: &'s Scene<'a>, proj: &'s Projected) -> Shader<'s, 'a> {
         let own_slots = std::ptr::eq(scene.corner_slots.as_ptr(), scene.tris.as_ptr());
         let k = scene.tris.len().min(scene.corner_slots.len());
+        let records = if own_slots { &proj.xy_light[..] } else { &[] };
         let (mut xy, mut light) = (&proj.xy_f[..], &scene.light[..]);
         if own_slots {
             let m = xy.len().min(light.len());
@@ -87,6 +95,7 @@ impl<'s, 'a> Shader<'s, 'a> {
                 && !back.cap
                 && k <= i32::MAX as usize / 3
                 && xy.len().max(scene.light.len()) <= i32::MAX as usize / 2
+                && records.len() <= i32::MAX as usize / 4
                 && avx2()
         })
         .map(|looks| looks.map(|look| look.color));
@@ -97,6 +106,7 @@ impl<'s, 'a> Shader<'s, 'a> {
             own_slots,
             xy,
             light,
+            records,
             sides,
             lane_colors,
         }
@@ -132,6 +142,9 @@ impl<'s, 'a> Shader<'s, 'a> {
     #[inline(always)]
     fn light_at(&self, tri: usize, back: usize, sx: usize, sy: usize) -> f32 {
         let t = self.tris[tri];
+        if !self.records.is_empty() {
+            return interpolate_records(self.records, t, back, sx, sy);
+        }
         if self.own_slots {
             // The light cut to the positions' length (it is that length
             // already): a corner's position check then covers its light.
@@ -184,6 +197,12 @@ impl<'s, 'a> Shader<'s, 'a> {
             let Some(&t) = self.tris.get(tri) else {
                 return;
             };
+            if !self.records.is_empty() {
+                for n in t {
+                    prefetch_at(self.records.as_ptr().wrapping_add(n as usize));
+                }
+                return;
+            }
             let s = if self.own_slots { t } else { self.slots[tri] };
             for (n, slot) in t.into_iter().zip(s) {
                 prefetch_at(self.xy.as_ptr().wrapping_add(n as usize));
@@ -229,6 +248,25 @@ fn interpolate(
     let w0 = (1.0 - w1 - w2).max(0.0);
     let l = |k: usize| light[s[k] as usize][back];
     w0 * l(0) + w1 * l(1) + w2 * l(2)
+}
+
+/// [`interpolate`] of a triangle whose corners are their own light slots,
+/// each corner's position and light read from its record: the same
+/// arithmetic in the same order, so the same bits.
+#[inline(always)]
+fn interpolate_records(records: &[XyLight], t: [u32; 3], back: usize, sx: usize, sy: usize) -> f32 {
+    if t[0] == t[1] && t[1] == t[2] {
+        return records[t[0] as usize].light[back];
+    }
+    let (a, b, c) = (
+        records[t[0] as usize],
+        records[t[1] as usize],
+        records[t[2] as usize],
+    );
+    let (x, y) = (sx as u32 as f32 + 0.5, sy as u32 as f32 + 0.5);
+    let [w1, w2] = weights(a.xy, b.xy, c.xy, x, y);
+    let w0 = (1.0 - w1 - w2).max(0.0);
+    w0 * a.light[back] + w1 * b.light[back] + w2 * c.light[back]
 }
 
 /// The barycentric weights of corners `b` and `c` at (`x`, `y`), each
@@ -487,13 +525,23 @@ mod tests {
                 cap: g == 2,
             })
             .collect();
+        // The same positions with the nodes' own light in records, as the
+        // projection makes them for one face with its nodes as slots.
+        let records = Projected {
+            snapped: Vec::new(),
+            xy_f: Vec::new(),
+            xy_light: (xy_f.iter().zip(&light))
+                .map(|(&xy, &light)| XyLight { xy, light })
+                .collect(),
+        };
         let proj = Projected {
             snapped: Vec::new(),
             xy_f,
+            xy_light: Vec::new(),
         };
         let slots_elsewhere: Vec<[u32; 3]> = tris.iter().map(|t| t.map(|k| k + n)).collect();
         let faces: Vec<u32> = (0..tris.len() as u32).map(|i| i % 2).collect();
-        let mut shaded = 0;
+        let (mut shaded, mut by_records) = (0, 0);
         // One face with its nodes as slots (the same array as the
         // triangles), one face with other slots, two faces of different
         // groups (a cap on one, a hidden side).
@@ -520,6 +568,8 @@ mod tests {
             }
             let shader = Shader::new(&scene, &proj);
             assert_eq!(shader.own_slots, shape == 0);
+            let by_record = Shader::new(&scene, &records);
+            assert_eq!(by_record.records.len(), if shape == 0 { 40 } else { 0 });
             for tri in 0..scene.tris.len() {
                 for back in 0..2u64 {
                     if scene.side_group(tri, back as usize) == HIDDEN {
@@ -535,10 +585,15 @@ mod tests {
                             "{shape} {id}"
                         );
                         shaded += 1;
+                        if shape == 0 {
+                            assert_eq!(by_record.shade(id, sx, sy, sx / 2, sy / 2), want);
+                            by_records += 1;
+                        }
                     }
                 }
             }
         }
         assert!(shaded > 400, "{shaded}");
+        assert!(by_records > 200, "{by_records}");
     }
 }

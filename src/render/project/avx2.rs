@@ -6,7 +6,7 @@
 //! fused; the depth's division and the conversions are exactly rounded), so
 //! the same bits.
 
-use super::{LIMIT, NodeMap};
+use super::{LIMIT, NodeMap, XyOut};
 use crate::render::camera::{Camera, above, below};
 use crate::render::raster::Snapped;
 use std::arch::x86_64::*;
@@ -20,7 +20,7 @@ impl NodeMap {
         self,
         points: &[[f64; 3]],
         snapped: &mut [MaybeUninit<Snapped>],
-        xy_f: &mut [MaybeUninit<[f32; 2]>],
+        mut xy_f: impl XyOut,
     ) {
         let whole = points.len() / 4 * 4;
         let splat = |v: f64| _mm256_set1_pd(v);
@@ -33,10 +33,11 @@ impl NodeMap {
         let (ss, lo, range) = (splat(self.ss), splat(self.lo), splat(self.range));
         let (limit_lo, limit_hi) = (splat(-LIMIT), splat(LIMIT));
         let (sixteen, sign, one_half) = (splat(16.0), splat(-0.0), splat(0.5));
+        assert_eq!(xy_f.len(), points.len());
         let four = (points[..whole].as_chunks::<4>().0.iter())
             .zip(snapped[..whole].chunks_exact_mut(4))
-            .zip(xy_f[..whole].chunks_exact_mut(4));
-        for ((q, s), f) in four {
+            .enumerate();
+        for (i, (q, s)) in four {
             let [x, y, z] = four_points_by_axis(q);
             let d = [
                 _mm256_sub_pd(x, c0),
@@ -69,12 +70,8 @@ impl NodeMap {
                 _mm256_cvttpd_epi32(_mm256_and_pd(rounded, ordered))
             };
             let (fx, fy) = (_mm256_cvtpd_ps(vx), _mm256_cvtpd_ps(vy));
-            // SAFETY: `f` is four `[f32; 2]` slots, eight f32s in a row.
-            unsafe {
-                let to = f.as_mut_ptr().cast::<f32>();
-                _mm_storeu_ps(to, _mm_unpacklo_ps(fx, fy));
-                _mm_storeu_ps(to.add(4), _mm_unpackhi_ps(fx, fy));
-            }
+            // SAFETY: `4i + 3 < whole`, at most `xy_f.len()` (asserted).
+            unsafe { xy_f.four(4 * i, fx, fy) };
             let (mut sx, mut sy, mut sz) = ([0i32; 4], [0i32; 4], [0f32; 4]);
             // SAFETY: each array is four 32-bit values.
             unsafe {
@@ -90,7 +87,7 @@ impl NodeMap {
                 });
             }
         }
-        self.block_sse2(&points[whole..], &mut snapped[whole..], &mut xy_f[whole..]);
+        self.block_sse2(&points[whole..], &mut snapped[whole..], xy_f.from(whole));
     }
 }
 

@@ -119,6 +119,21 @@ impl Shader<'_, '_> {
         sx: &[u32; LANES],
         sy: usize,
     ) -> Option<[[u8; 4]; LANES]> {
+        // One call of the colours below, so it is inlined.
+        let inputs = if !self.records.is_empty() {
+            self.record_inputs(ids, sx)?
+        } else {
+            self.gathered_inputs(ids, sx)?
+        };
+        Some(tinted_lanes(colors, inputs, sy))
+    }
+
+    /// What [`tinted_lanes`] needs of eight lanes, gathered from the
+    /// triangles, slots, positions and light; `None` as for
+    /// [`Shader::shade_lanes_avx2`].
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "avx2")]
+    fn gathered_inputs(&self, ids: &[u32; LANES], sx: &[u32; LANES]) -> Option<LaneInputs> {
         use std::arch::x86_64::*;
         // SAFETY: eight u32s each.
         let (ids, sx) = unsafe {
@@ -192,69 +207,113 @@ impl Shader<'_, '_> {
                 _mm256_add_epi32(_mm256_add_epi32(slot, slot), back),
             )
         };
-        let (l0, l1, l2) = (lit(s[0]), lit(s[1]), lit(s[2]));
-        let (ax, ay) = (coord(t[0], 0), coord(t[0], 1));
-        let (bx, by) = (coord(t[1], 0), coord(t[1], 1));
-        let (cx, cy) = (coord(t[2], 0), coord(t[2], 1));
-        let half = _mm256_set1_ps(0.5);
-        let x = _mm256_add_ps(_mm256_cvtepi32_ps(sx), half);
-        let y = _mm256_set1_ps(sy as u32 as f32 + 0.5);
-        // `scalar_weights`, lane by lane, in its order.
-        let (dbx, dby) = (_mm256_sub_ps(bx, ax), _mm256_sub_ps(by, ay));
-        let (dcx, dcy) = (_mm256_sub_ps(cx, ax), _mm256_sub_ps(cy, ay));
-        let (dx, dy) = (_mm256_sub_ps(x, ax), _mm256_sub_ps(y, ay));
-        let area = _mm256_sub_ps(_mm256_mul_ps(dbx, dcy), _mm256_mul_ps(dby, dcx));
-        let num1 = _mm256_sub_ps(_mm256_mul_ps(dcx, dy), _mm256_mul_ps(dcy, dx));
-        let num2 = _mm256_sub_ps(_mm256_mul_ps(dbx, dy), _mm256_mul_ps(dby, dx));
-        let sign = _mm256_set1_ps(-0.0);
-        let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
-        // `maxps 0, w` then `minps 1, v`: `f32::clamp`, NaN and −0 kept.
-        let clamp = |w: __m256| _mm256_min_ps(one, _mm256_max_ps(zero, w));
-        let w1 = clamp(_mm256_div_ps(num1, _mm256_xor_ps(area, sign)));
-        let w2 = clamp(_mm256_div_ps(num2, area));
-        // `maxps w, 0` is `w > 0 ? w : 0`, as `f32::max(w, 0.0)` compiles.
-        let w0 = _mm256_max_ps(_mm256_sub_ps(_mm256_sub_ps(one, w1), w2), zero);
-        let sum = _mm256_add_ps(
-            _mm256_add_ps(_mm256_mul_ps(w0, l0), _mm256_mul_ps(w1, l1)),
-            _mm256_mul_ps(w2, l2),
-        );
+        let corners = [
+            coord(t[0], 0),
+            coord(t[0], 1),
+            coord(t[1], 0),
+            coord(t[1], 1),
+            coord(t[2], 0),
+            coord(t[2], 1),
+        ];
         // A triangle whose slots are all one shows that slot's light.
         let one_slot = _mm256_and_si256(
             _mm256_cmpeq_epi32(s[0], s[1]),
             _mm256_cmpeq_epi32(s[1], s[2]),
         );
-        let light = _mm256_blendv_ps(sum, l0, _mm256_castsi256_ps(one_slot));
-        // `tint` per channel: the side's colour times the light plus a half,
-        // at most 255, truncated; a NaN or a negative gives 0, as `as u8`.
-        let is_back = _mm256_castsi256_ps(_mm256_cmpeq_epi32(back, one_int));
-        let channel = |k: usize| {
-            let c = _mm256_blendv_ps(
-                _mm256_set1_ps(colors[0][k]),
-                _mm256_set1_ps(colors[1][k]),
-                is_back,
-            );
-            let v = _mm256_min_ps(
-                _mm256_set1_ps(255.0),
-                _mm256_add_ps(_mm256_mul_ps(c, light), half),
-            );
-            _mm256_max_epi32(_mm256_cvttps_epi32(v), _mm256_setzero_si256())
-        };
-        let rgba = _mm256_or_si256(
-            _mm256_or_si256(channel(0), _mm256_slli_epi32::<8>(channel(1))),
-            _mm256_or_si256(
-                _mm256_slli_epi32::<16>(channel(2)),
-                _mm256_set1_epi32(255 << 24),
-            ),
-        );
-        let mut out = [[0u8; 4]; LANES];
-        // SAFETY: `out` is 32 bytes.
-        unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), rgba) };
-        Some(out)
+        Some(LaneInputs {
+            corners,
+            light: s.map(lit),
+            one_slot,
+            back,
+            sx,
+        })
     }
+}
+
+/// What the colours of eight lanes are computed from: the corners'
+/// positions (`ax, ay, bx, by, cx, cy`) and light on the lane's side,
+/// whether the triangle's slots are all one (all ones, else zero), the side
+/// (0 front, 1 back) and the sample column.
+#[cfg(target_arch = "x86_64")]
+pub(super) struct LaneInputs {
+    pub corners: [std::arch::x86_64::__m256; 6],
+    pub light: [std::arch::x86_64::__m256; 3],
+    pub one_slot: std::arch::x86_64::__m256i,
+    pub back: std::arch::x86_64::__m256i,
+    pub sx: std::arch::x86_64::__m256i,
+}
+
+/// The colours of eight lanes: side colour `colors[back]` times the light
+/// interpolated from the corners at sample (`sx + 0.5`, `sy + 0.5`), or the
+/// first corner's light where `one_slot` is set. [`Shader::shade`]'s
+/// operations per lane, so its bits.
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "avx2")]
+#[inline]
+fn tinted_lanes(colors: [[f32; 4]; 2], inputs: LaneInputs, sy: usize) -> [[u8; 4]; LANES] {
+    use std::arch::x86_64::*;
+    let LaneInputs {
+        corners: [ax, ay, bx, by, cx, cy],
+        light: [l0, l1, l2],
+        one_slot,
+        back,
+        sx,
+    } = inputs;
+    let one_int = _mm256_set1_epi32(1);
+    let half = _mm256_set1_ps(0.5);
+    let x = _mm256_add_ps(_mm256_cvtepi32_ps(sx), half);
+    let y = _mm256_set1_ps(sy as u32 as f32 + 0.5);
+    // `scalar_weights`, lane by lane, in its order.
+    let (dbx, dby) = (_mm256_sub_ps(bx, ax), _mm256_sub_ps(by, ay));
+    let (dcx, dcy) = (_mm256_sub_ps(cx, ax), _mm256_sub_ps(cy, ay));
+    let (dx, dy) = (_mm256_sub_ps(x, ax), _mm256_sub_ps(y, ay));
+    let area = _mm256_sub_ps(_mm256_mul_ps(dbx, dcy), _mm256_mul_ps(dby, dcx));
+    let num1 = _mm256_sub_ps(_mm256_mul_ps(dcx, dy), _mm256_mul_ps(dcy, dx));
+    let num2 = _mm256_sub_ps(_mm256_mul_ps(dbx, dy), _mm256_mul_ps(dby, dx));
+    let sign = _mm256_set1_ps(-0.0);
+    let (zero, one) = (_mm256_setzero_ps(), _mm256_set1_ps(1.0));
+    // `maxps 0, w` then `minps 1, v`: `f32::clamp`, NaN and −0 kept.
+    let clamp = |w: __m256| _mm256_min_ps(one, _mm256_max_ps(zero, w));
+    let w1 = clamp(_mm256_div_ps(num1, _mm256_xor_ps(area, sign)));
+    let w2 = clamp(_mm256_div_ps(num2, area));
+    // `maxps w, 0` is `w > 0 ? w : 0`, as `f32::max(w, 0.0)` compiles.
+    let w0 = _mm256_max_ps(_mm256_sub_ps(_mm256_sub_ps(one, w1), w2), zero);
+    let sum = _mm256_add_ps(
+        _mm256_add_ps(_mm256_mul_ps(w0, l0), _mm256_mul_ps(w1, l1)),
+        _mm256_mul_ps(w2, l2),
+    );
+    let light = _mm256_blendv_ps(sum, l0, _mm256_castsi256_ps(one_slot));
+    // `tint` per channel: the side's colour times the light plus a half,
+    // at most 255, truncated; a NaN or a negative gives 0, as `as u8`.
+    let is_back = _mm256_castsi256_ps(_mm256_cmpeq_epi32(back, one_int));
+    let channel = |k: usize| {
+        let c = _mm256_blendv_ps(
+            _mm256_set1_ps(colors[0][k]),
+            _mm256_set1_ps(colors[1][k]),
+            is_back,
+        );
+        let v = _mm256_min_ps(
+            _mm256_set1_ps(255.0),
+            _mm256_add_ps(_mm256_mul_ps(c, light), half),
+        );
+        _mm256_max_epi32(_mm256_cvttps_epi32(v), _mm256_setzero_si256())
+    };
+    let rgba = _mm256_or_si256(
+        _mm256_or_si256(channel(0), _mm256_slli_epi32::<8>(channel(1))),
+        _mm256_or_si256(
+            _mm256_slli_epi32::<16>(channel(2)),
+            _mm256_set1_epi32(255 << 24),
+        ),
+    );
+    let mut out = [[0u8; 4]; LANES];
+    // SAFETY: `out` is 32 bytes.
+    unsafe { _mm256_storeu_si256(out.as_mut_ptr().cast(), rgba) };
+    out
 }
 
 #[cfg(test)]
 mod tests {
+    use super::super::super::project::XyLight;
     use super::super::super::raster::Projected;
     use super::super::super::scene::{Group, HIDDEN, Scene};
     use super::*;
@@ -302,13 +361,30 @@ mod tests {
             },
         ];
         let points = vec![[0.0; 3]; n as usize];
+        // The nodes' own light with their positions, one record per node,
+        // as the projection makes them for nodes that are their own slots.
+        let records = Projected {
+            snapped: Vec::new(),
+            xy_f: Vec::new(),
+            xy_light: (xy_f.iter().zip(&light))
+                .map(|(&xy, &light)| XyLight { xy, light })
+                .collect(),
+        };
         let proj = Projected {
             snapped: Vec::new(),
             xy_f,
+            xy_light: Vec::new(),
         };
         let mut lanes_used = 0;
-        // Own slots, other slots, and a hidden back (front lanes only).
-        for (own, hidden) in [(true, false), (false, false), (true, true)] {
+        // Own slots, other slots, and a hidden back (front lanes only);
+        // own slots read from records too.
+        for (own, hidden, by_record) in [
+            (true, false, false),
+            (false, false, false),
+            (true, true, false),
+            (true, false, true),
+            (true, true, true),
+        ] {
             let scene = Scene {
                 points: Cow::Borrowed(&points),
                 tris: Cow::Borrowed(&tris),
@@ -324,7 +400,10 @@ mod tests {
                 light: light.clone(),
                 groups: groups.clone(),
             };
-            let shader = Shader::new(&scene, &proj);
+            // The reference: positions and light read from their arrays.
+            let plain = Shader::new(&scene, &proj);
+            let shader = Shader::new(&scene, if by_record { &records } else { &proj });
+            assert_eq!(shader.records.len(), if by_record { 64 } else { 0 });
             assert_eq!(shader.lane_colors.is_some(), super::super::avx2());
             lanes_used += usize::from(shader.lane_colors.is_some());
             for round in 0..4000 {
@@ -335,7 +414,8 @@ mod tests {
                 let sx: [u32; LANES] = std::array::from_fn(|_| (rng.next_u64() % 48) as u32);
                 let px = sx.map(|x| x / 2);
                 let sy = round % 36;
-                let want = shader.shade_each(&ids, &sx, &px, sy, sy / 2);
+                let want = plain.shade_each(&ids, &sx, &px, sy, sy / 2);
+                assert_eq!(shader.shade_each(&ids, &sx, &px, sy, sy / 2), want);
                 let got = shader.shade_lanes(&ids, &sx, &px, sy, sy / 2);
                 assert_eq!(got, want, "{own} {ids:?} {sx:?} {sy}");
             }
@@ -346,7 +426,7 @@ mod tests {
             }));
             assert!(caught.is_err());
         }
-        assert_eq!(lanes_used, 3 * usize::from(super::super::avx2()));
+        assert_eq!(lanes_used, 5 * usize::from(super::super::avx2()));
     }
 
     #[test]
@@ -370,6 +450,7 @@ mod tests {
         let proj = Projected {
             snapped: Vec::new(),
             xy_f: vec![[0.0, 0.0], [10.0, 0.0], [0.0, 10.0]],
+            xy_light: Vec::new(),
         };
         let shader = Shader::new(&scene, &proj);
         let mut row = vec![7u8; 12 * 4];
