@@ -222,7 +222,8 @@ impl Shader<'_, '_> {
         );
         Some(LaneInputs {
             corners,
-            light: s.map(lit),
+            // Not `array::map`: without AVX2 it would pass vectors through memory.
+            light: [lit(s[0]), lit(s[1]), lit(s[2])],
             one_slot,
             back,
             sx,

@@ -72,8 +72,10 @@ impl Shader<'_, '_> {
             )
         };
         let is_back = _mm256_castsi256_ps(mask(backs));
-        let [a, b, c] =
-            corners.map(|[x, y, front, back]| (x, y, _mm256_blendv_ps(front, back, is_back)));
+        // Each corner's light on the lane's side (no `array::map`: a library
+        // function without AVX2 would pass the vectors through memory).
+        let side = |[_, _, front, back]: [__m256; 4]| _mm256_blendv_ps(front, back, is_back);
+        let [a, b, c] = corners;
         let back = _mm256_and_si256(mask(backs), _mm256_set1_epi32(1));
         let columns = _mm256_setr_epi32(
             sx[0] as i32,
@@ -86,8 +88,8 @@ impl Shader<'_, '_> {
             sx[7] as i32,
         );
         Some(LaneInputs {
-            corners: [a.0, a.1, b.0, b.1, c.0, c.1],
-            light: [a.2, b.2, c.2],
+            corners: [a[0], a[1], b[0], b[1], c[0], c[1]],
+            light: [side(a), side(b), side(c)],
             one_slot: mask(one_node),
             back,
             sx: columns,
