@@ -15,9 +15,10 @@
 //!   the read on any idle machine with one core or more;
 //! - wall time, printed beside it with every pair's own ratio and the load.
 //!
-//! Then each step again in a fresh process (cold memory, as one CLI run), and
-//! each side warm in a process of its own (repeated there, so it meets only its
-//! own freed memory). The verdict is the CPU ratio of the last: in the
+//! Then each step again in a fresh process (cold memory, as one CLI run); the
+//! read with geomc's own reader followed by the render in one fresh process,
+//! as one `geomc render torus.glb` run meets them; and each side warm in a
+//! process of its own (repeated there, so it meets only its own freed memory). The verdict is the CPU ratio of the last: in the
 //! alternated rounds one side's allocations change the other's page faults,
 //! and a render that freed differently moved the read's median by a sixth
 //! with the render's own CPU unchanged (session 24), so that ratio could pass
@@ -31,6 +32,7 @@
 #[global_allocator]
 static ALLOCATOR: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+use geomc::formats::read::{ReadLimits, load_mesh_limited};
 use geomc::formats::{WriteOptions, write_mesh_file};
 use geomc::mesh::{Mesh, MeshFace, MeshFragment, MeshSubdomain};
 use geomc::render::{Edges, RenderOptions, render_png, render_svg};
@@ -147,13 +149,38 @@ fn child(args: &[String]) {
                 cpus.push(cpu);
             }
         }
-        _ => panic!("--child read GLB [REPEATS] | --child render NU NV ANTIALIAS [REPEATS]"),
+        [what, path] if what == "run" => return one_run(std::path::Path::new(path)),
+        _ => panic!(
+            "--child read GLB [REPEATS] | --child render NU NV ANTIALIAS [REPEATS] | --child run GLB"
+        ),
     };
     println!("{} {}", median(&walls), median(&cpus));
 }
 
+/// `--child run GLB`: what one `geomc render GLB -o out.png --size 1024x1024`
+/// does, in this fresh process: the mesh read with geomc's own reader (with
+/// its surface checks), then rendered. Prints the read's wall and CPU seconds,
+/// then the render's.
+fn one_run(path: &std::path::Path) {
+    let (read_wall, read_cpu, loaded) =
+        timed(|| load_mesh_limited(path, None, &ReadLimits::default()).expect("reads the GLB"));
+    let options = RenderOptions {
+        width: 1024,
+        height: 1024,
+        ..RenderOptions::default()
+    };
+    let (wall, cpu, _) = timed(|| render_png(&loaded.mesh, &options).expect("renders"));
+    println!("{read_wall} {read_cpu} {wall} {cpu}");
+}
+
 /// Runs one `--child` step of this benchmark in a fresh process: (wall, CPU) seconds.
 fn in_fresh_process(args: &[&str]) -> (f64, f64) {
+    let v = child_output(args);
+    (v[0], v[1])
+}
+
+/// The seconds a `--child` step printed, run in a fresh process.
+fn child_output(args: &[&str]) -> Vec<f64> {
     let exe = std::env::current_exe().expect("the benchmark's own path");
     let out = std::process::Command::new(exe)
         .arg("--child")
@@ -166,10 +193,12 @@ fn in_fresh_process(args: &[&str]) -> (f64, f64) {
         String::from_utf8_lossy(&out.stderr)
     );
     let text = String::from_utf8_lossy(&out.stdout);
-    let mut v = text
+    let v: Vec<f64> = text
         .split_whitespace()
-        .map(|v| v.parse::<f64>().expect("seconds"));
-    (v.next().expect("wall"), v.next().expect("cpu"))
+        .map(|v| v.parse::<f64>().expect("seconds"))
+        .collect();
+    assert!(v.len() >= 2, "a wall and a CPU time: {text}");
+    v
 }
 
 fn main() {
@@ -241,6 +270,11 @@ fn main() {
         own_read.push(in_fresh_process(&["read", &glb_arg, own]));
         own_render.push(in_fresh_process(&["render", &nu_arg, &nv_arg, "2", own]));
     }
+    // And as one `geomc render GLB` run meets it: geomc's own reader, then
+    // the render, in one fresh process.
+    let runs_of_cli: Vec<Vec<f64>> = (0..reps)
+        .map(|_| child_output(&["run", &glb_arg]))
+        .collect();
     let load_after = load_average();
     let pairs = |a: &[f64], b: &[f64]| {
         (a.iter().zip(b))
@@ -299,6 +333,21 @@ fn main() {
         "  render / read, fresh processes, medians: CPU {:.2}; wall {:.2}",
         median(&cpu_of(&cold_render)) / median(&cpu_of(&cold_read)),
         median(&wall_of(&cold_render)) / median(&wall_of(&cold_read)),
+    );
+    println!(
+        "  one `geomc render` run (geomc's reader with its checks, then the render; fresh processes):"
+    );
+    let column = |k: usize| runs_of_cli.iter().map(|v| v[k]).collect::<Vec<_>>();
+    row("geomc: read GLB", &column(1), &column(0));
+    row(
+        "geomc render 1024x1024 PNG (default, 2x2 AA)",
+        &column(3),
+        &column(2),
+    );
+    println!(
+        "  render / read, one geomc run, medians: CPU {:.2}; wall {:.2}",
+        median(&column(3)) / median(&column(1)),
+        median(&column(2)) / median(&column(0)),
     );
     println!("  each side warm in a process of its own ({own} repetitions, their medians):");
     row(

@@ -9,6 +9,9 @@ use super::scene::{HIDDEN, Scene};
 use super::triangle::{self, SUB};
 use rayon::prelude::*;
 
+#[cfg(target_arch = "x86_64")]
+mod bin_avx2;
+
 pub const EMPTY: u64 = u64::MAX;
 /// Sample rows per band (the unit of parallel work).
 const BAND: usize = 32;
@@ -20,7 +23,9 @@ const CHUNK: usize = 1 << 15;
 /// bytes so the rasteriser's gather of a corner touches one cache line
 /// (separate position and depth arrays of a million-node mesh cost two
 /// misses per corner).
+/// `repr(C)`: the AVX2 binning gathers x and y as one 8-byte load.
 #[derive(Debug, Clone, Copy, Default)]
+#[repr(C)]
 pub struct Snapped {
     pub x: i32,
     pub y: i32,
@@ -120,6 +125,20 @@ pub fn bin(
     height: usize,
     band_rows: usize,
 ) -> Vec<ChunkBins> {
+    bin_with(scene, proj, width, height, band_rows, true)
+}
+
+/// [`bin`], eight triangles at a time with AVX2 when `vector` and the CPU
+/// has it (the same lists either way).
+fn bin_with(
+    scene: &Scene,
+    proj: &Projected,
+    width: usize,
+    height: usize,
+    band_rows: usize,
+    vector: bool,
+) -> Vec<ChunkBins> {
+    let vector = vector && has_avx2();
     let n_bands = height.div_ceil(band_rows);
     // Each sample row's band, looked up: two divisions by a band height
     // that is not always a power of two cost a fifth of binning.
@@ -135,66 +154,125 @@ pub fn bin(
                 ids: vec![Vec::new(); n_bands],
                 cols: vec![(u32::MAX, 0u32); n_bands],
             };
-            let tris = (c * CHUNK..).zip(chunk);
+            let tris = Tris {
+                first: c * CHUNK,
+                corners: chunk,
+            };
             // The loop compiled once per case, so the common one (every
             // face alike) tests a side with no lookup of the scene.
             match same_visible {
-                Some(visible) => bin_chunk(proj, tris, width, band_of, &mut bins, |_, back| {
-                    visible[back as usize]
-                }),
-                None => bin_chunk(proj, tris, width, band_of, &mut bins, |tri, back| {
-                    visible_side(scene, tri, back)
-                }),
+                Some(visible) => bin_chunk(
+                    proj,
+                    tris,
+                    width,
+                    (band_of, band_rows),
+                    &mut bins,
+                    vector,
+                    same_visible,
+                    |_, back| visible[back as usize],
+                ),
+                None => bin_chunk(
+                    proj,
+                    tris,
+                    width,
+                    (band_of, band_rows),
+                    &mut bins,
+                    vector,
+                    None,
+                    |tri, back| visible_side(scene, tri, back),
+                ),
             }
             bins
         })
         .collect()
 }
 
-/// Bins triangles `tris` (ids with corners) whose side `back` is `seen`
-/// into `bins`, a sample row's band being `band_of[row]`.
+fn has_avx2() -> bool {
+    #[cfg(target_arch = "x86_64")]
+    {
+        std::arch::is_x86_feature_detected!("avx2")
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    {
+        false
+    }
+}
+
+/// Consecutive triangles: their corners, the first one's id `first`.
+#[derive(Clone, Copy)]
+struct Tris<'a> {
+    first: usize,
+    corners: &'a [[u32; 3]],
+}
+
+/// Bins triangles `tris` whose side `back` is `seen` into `bins`, a sample
+/// row's band being `band_of[row]` (bands of `band_rows` rows); with AVX2
+/// when `vector` (which the caller has checked the CPU has).
+/// `same_visible`, when every face shows the same sides, says which are
+/// seen (and `seen` repeats it).
 #[inline(always)]
-fn bin_chunk<'a>(
+#[allow(clippy::too_many_arguments)]
+fn bin_chunk(
     proj: &Projected,
-    tris: impl Iterator<Item = (usize, &'a [u32; 3])>,
+    tris: Tris,
     width: usize,
-    band_of: &[u32],
+    (band_of, band_rows): (&[u32], usize),
     bins: &mut ChunkBins,
+    vector: bool,
+    same_visible: Option<[bool; 2]>,
     seen: impl Fn(usize, u32) -> bool,
 ) {
     // Neighbouring triangles of a mesh mostly land in the same band, so
     // that band's list is held aside (its length and columns in registers)
     // while the run lasts, instead of being loaded and stored per triangle.
     let mut run = Run::default();
-    for (tri, &t) in tris {
-        let Some((v, back)) = facing(proj, t) else {
-            continue;
+    let mut done = 0;
+    #[cfg(target_arch = "x86_64")]
+    if vector {
+        // SAFETY: `vector` is true only when the CPU has AVX2 (`bin_with`).
+        done = unsafe {
+            bin_avx2::bin_groups(
+                proj,
+                tris,
+                width,
+                band_of,
+                bins,
+                &mut run,
+                band_rows,
+                same_visible,
+                &seen,
+            )
         };
-        if !seen(tri, back) {
-            continue;
-        }
-        let Some((x0, x1, first, last)) = sample_box(&v, width, band_of.len()) else {
-            continue;
-        };
-        let (from, to) = (band_of[first] as usize, band_of[last] as usize);
-        let reach = (x0 as u32, x1 as u32);
-        if from == to {
-            // Most triangles (a sample or two across) lie in one band.
-            if from != run.band {
-                run.switch(bins, from);
-            }
-            run.add(tri as u32, reach);
-        } else {
-            for band in from..=to {
-                if band == run.band {
-                    run.add(tri as u32, reach);
-                } else {
-                    bins.add(band, tri as u32, reach);
-                }
-            }
-        }
+    }
+    let _ = (vector, band_rows, same_visible);
+    for (tri, &t) in (tris.first + done..).zip(&tris.corners[done..]) {
+        bin_one(proj, tri, t, width, band_of, bins, &mut run, &seen);
     }
     run.switch(bins, usize::MAX);
+}
+
+/// Bins triangle `tri` (corners `t`) when its side facing the eye is `seen`.
+#[inline(always)]
+#[allow(clippy::too_many_arguments)]
+fn bin_one(
+    proj: &Projected,
+    tri: usize,
+    t: [u32; 3],
+    width: usize,
+    band_of: &[u32],
+    bins: &mut ChunkBins,
+    run: &mut Run,
+    seen: &impl Fn(usize, u32) -> bool,
+) {
+    let Some((v, back)) = facing(proj, t) else {
+        return;
+    };
+    if !seen(tri, back) {
+        return;
+    }
+    if let Some(sample_box) = sample_box(&v, width, band_of.len()) {
+        run.place(bins, band_of, tri as u32, sample_box);
+    }
 }
 
 /// The list of the band the last triangles went to, taken out of the
@@ -216,6 +294,35 @@ impl Default for Run {
 }
 
 impl Run {
+    /// Lists triangle `tri` in the bands its sample box (columns `x0..=x1`,
+    /// rows `first..=last`) reaches.
+    #[inline(always)]
+    fn place(
+        &mut self,
+        bins: &mut ChunkBins,
+        band_of: &[u32],
+        tri: u32,
+        (x0, x1, first, last): (usize, usize, usize, usize),
+    ) {
+        let (from, to) = (band_of[first] as usize, band_of[last] as usize);
+        let reach = (x0 as u32, x1 as u32);
+        if from == to {
+            // Most triangles (a sample or two across) lie in one band.
+            if from != self.band {
+                self.switch(bins, from);
+            }
+            self.add(tri, reach);
+        } else {
+            for band in from..=to {
+                if band == self.band {
+                    self.add(tri, reach);
+                } else {
+                    bins.add(band, tri, reach);
+                }
+            }
+        }
+    }
+
     /// Puts the run's list back and takes band `band`'s (none for
     /// `usize::MAX`).
     #[inline(never)]
@@ -428,6 +535,95 @@ mod tests {
             listed += got.len();
         }
         assert!(listed > 20_000, "{listed} listed");
+    }
+
+    #[test]
+    fn vector_binning_lists_what_scalar_binning_lists() {
+        // Random triangles of every kind (tiny, a band or more high, huge,
+        // off the picture, edge-on, beyond the vector lanes' ±2^30 reach,
+        // in blocks of close neighbours),
+        // two chunks and a part (so groups of eight and a tail), binned
+        // eight at a time with AVX2 and one at a time: the same lists in
+        // the same order and the same columns, for one pair of sides for
+        // every face (each side seen or hidden) and sides per face.
+        if !has_avx2() {
+            eprintln!("no AVX2: only the scalar binning runs here");
+            return;
+        }
+        let mut rng = crate::test_rng::TestRng::new(0xbb67_ae85_84ca_a73b);
+        let (width, height, band_rows) = (93usize, 130usize, 16usize);
+        let n = 2 * CHUNK + 4_467;
+        let mut snapped = Vec::with_capacity(3 * n);
+        let (mut local, mut block_centre) = (false, [0, 0]);
+        for t in 0..n {
+            // Half the blocks of 32 like a mesh's: small neighbours, so
+            // that whole groups of eight join the band of the ones before.
+            if t % 32 == 0 {
+                local = rng.below(2) == 0;
+                block_centre = [rng.below(16 * width) as i64, rng.below(16 * height) as i64];
+            }
+            let kind = if local { 8 } else { rng.below(8) };
+            let (reach, centre) = match kind {
+                8 => (24, block_centre),
+                0..=2 => (30, [800, 1000]),
+                3 => (500, [700, 900]),
+                4 => (3000, [600, 1100]),
+                5 => (1 << 28, [0, 0]),
+                // Small, but about the lanes' reach (the scalar code's).
+                6 => (1000, [1 << 30, -(1 << 30)]),
+                _ => (40, [-700, 2200]),
+            };
+            let edge_on = rng.below(16);
+            let mut corner = || Snapped {
+                x: (centre[0] + rng.within(reach)) as i32,
+                y: (centre[1] + rng.within(reach)) as i32,
+                z: 0.5,
+            };
+            let (a, b) = (corner(), corner());
+            // One in eight edge-on: its third corner repeats one or lies
+            // on the line through both.
+            let c = match edge_on {
+                0 => a,
+                1 if kind != 5 => Snapped {
+                    x: 2 * b.x - a.x,
+                    y: 2 * b.y - a.y,
+                    z: 0.5,
+                },
+                _ => corner(),
+            };
+            snapped.extend([a, b, c]);
+        }
+        let tris: Vec<[u32; 3]> = (0..n as u32)
+            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
+            .collect();
+        let proj = Projected {
+            snapped,
+            xy_f: Vec::new(),
+        };
+        let mut scene = Scene {
+            points: Vec::new().into(),
+            tris: tris.into(),
+            tri_face: (0..n as u32).map(|t| t % 3).collect(),
+            one_face: None,
+            face_sides: vec![[0, 1], [0, HIDDEN], [HIDDEN, 2]],
+            same_sides: None,
+            corner_slots: Vec::new().into(),
+            light: Vec::new(),
+            groups: Vec::new(),
+        };
+        let sides = [None, Some([0, 1]), Some([0, HIDDEN]), Some([HIDDEN, 1])];
+        for same_sides in sides {
+            scene.same_sides = same_sides;
+            let scalar = bin_with(&scene, &proj, width, height, band_rows, false);
+            let vector = bin_with(&scene, &proj, width, height, band_rows, true);
+            let listed: usize = scalar.iter().flat_map(|c| &c.ids).map(Vec::len).sum();
+            assert!(listed > 5_000, "{same_sides:?}: {listed} listed");
+            assert_eq!(scalar.len(), vector.len());
+            for (s, v) in scalar.iter().zip(&vector) {
+                assert_eq!(s.ids, v.ids, "{same_sides:?}");
+                assert_eq!(s.cols, v.cols, "{same_sides:?}");
+            }
+        }
     }
 
     #[test]
