@@ -42,6 +42,21 @@ pub struct Projected {
     pub xy_light: Vec<super::project::XyLight>,
 }
 
+#[cfg(test)]
+impl Projected {
+    /// Unsnapped positions with each node's own light in records, as the
+    /// projection makes them when the nodes are their own light slots.
+    pub fn records_of(xy_f: &[[f32; 2]], light: &[[f32; 2]]) -> Projected {
+        Projected {
+            snapped: Vec::new(),
+            xy_f: Vec::new(),
+            xy_light: (xy_f.iter().zip(light))
+                .map(|(&xy, &light)| super::project::XyLight { xy, light })
+                .collect(),
+        }
+    }
+}
+
 pub struct ZBuffer {
     pub width: usize,
     pub height: usize,
@@ -599,6 +614,7 @@ mod tests {
         let proj = Projected {
             snapped,
             xy_f: Vec::new(),
+            xy_light: Vec::new(),
         };
         let mut scene = Scene {
             points: Vec::new().into(),

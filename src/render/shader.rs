@@ -527,13 +527,7 @@ mod tests {
             .collect();
         // The same positions with the nodes' own light in records, as the
         // projection makes them for one face with its nodes as slots.
-        let records = Projected {
-            snapped: Vec::new(),
-            xy_f: Vec::new(),
-            xy_light: (xy_f.iter().zip(&light))
-                .map(|(&xy, &light)| XyLight { xy, light })
-                .collect(),
-        };
+        let records = Projected::records_of(&xy_f, &light);
         let proj = Projected {
             snapped: Vec::new(),
             xy_f,

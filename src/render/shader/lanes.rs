@@ -314,7 +314,6 @@ fn tinted_lanes(colors: [[f32; 4]; 2], inputs: LaneInputs, sy: usize) -> [[u8; 4
 
 #[cfg(test)]
 mod tests {
-    use super::super::super::project::XyLight;
     use super::super::super::raster::Projected;
     use super::super::super::scene::{Group, HIDDEN, Scene};
     use super::*;
@@ -364,13 +363,7 @@ mod tests {
         let points = vec![[0.0; 3]; n as usize];
         // The nodes' own light with their positions, one record per node,
         // as the projection makes them for nodes that are their own slots.
-        let records = Projected {
-            snapped: Vec::new(),
-            xy_f: Vec::new(),
-            xy_light: (xy_f.iter().zip(&light))
-                .map(|(&xy, &light)| XyLight { xy, light })
-                .collect(),
-        };
+        let records = Projected::records_of(&xy_f, &light);
         let proj = Projected {
             snapped: Vec::new(),
             xy_f,
